@@ -1,0 +1,56 @@
+"""The ``attitude`` command.
+
+Subcommands live in modules of this package; each module defines
+``register(subparsers)`` that adds its parsers and sets ``func`` (a
+callable taking the parsed ``argparse.Namespace`` and returning an exit
+code). Add a module name to ``_MODULES`` to add its subcommands.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from typing import Sequence
+
+from .. import __version__
+
+# Module names under attitude_c.cli, in the order their commands are listed.
+_MODULES = ("simulate", "link", "demo")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="attitude",
+        description="libattitude: strapdown attitude measurement tools "
+        "(simulation, serial link, analysis).",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in _MODULES:
+        try:
+            mod = importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"{__name__}.{name}":
+                continue  # subcommand module not present in this tree
+            raise
+        mod.register(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    func = getattr(args, "func", None)
+    if func is None:
+        parser.print_help(sys.stderr)
+        return 2
+    try:
+        return int(func(args) or 0)
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

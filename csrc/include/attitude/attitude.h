@@ -1,0 +1,10 @@
+/*
+ * libattitude umbrella header: include this to get the whole public API.
+ * Each module adds exactly one line here.
+ */
+#ifndef ATTITUDE_ATTITUDE_H
+#define ATTITUDE_ATTITUDE_H
+
+#include "attitude/common.h"
+
+#endif /* ATTITUDE_ATTITUDE_H */

@@ -1,0 +1,49 @@
+/*
+ * libattitude — common definitions shared by every module.
+ *
+ * Build-time scalar type: the library is compiled either in double
+ * (default) or in float (define ATT_REAL_F32). `att_real` is that type.
+ *
+ * Status codes: every function that can fail returns an `att_status`;
+ * ATT_OK (0) is success, negative values are errors. No function ever
+ * reports failure through a NaN.
+ *
+ * Headers in this directory are also fed (after the C preprocessor with
+ * ATT_CDEF defined) to CFFI's cdef(), so they must keep to plain
+ * declarations outside `#ifndef ATT_CDEF` blocks: no inline functions,
+ * no macros that carry meaning to Python (use enums for constants).
+ */
+#ifndef ATTITUDE_COMMON_H
+#define ATTITUDE_COMMON_H
+
+#ifndef ATT_CDEF
+#include <stddef.h>
+#include <stdint.h>
+#endif
+
+#if defined(ATT_REAL_F32)
+typedef float att_real;
+#else
+typedef double att_real;
+#endif
+
+/* Status codes. Ranges: generic -1..-19, integrator -20..-39,
+ * TLC2543 -40..-59, link -60..-79, fixed point -80..-99. */
+typedef enum {
+    ATT_OK = 0,
+    ATT_E_NULL = -1,       /* a required pointer argument is NULL */
+    ATT_E_ARG = -2,        /* an argument is out of its documented domain */
+    ATT_E_NONFINITE = -3,  /* NaN or Inf in an input */
+    ATT_E_RANGE = -4,      /* value outside the representable range */
+    ATT_E_STATE = -5,      /* call not valid in the current state */
+    ATT_E_TIMEOUT = -6,    /* a bounded wait expired */
+    ATT_E_BUFFER = -7      /* caller buffer too small */
+} att_status;
+
+/* Short English description of a status code (static storage). */
+const char *att_status_str(int status);
+
+/* Size of att_real in bytes in this build (4 = float, 8 = double). */
+int att_real_size(void);
+
+#endif /* ATTITUDE_COMMON_H */

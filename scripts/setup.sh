@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Install everything the project needs on a fresh Debian machine:
+# the cross toolchains and simulators (apt, needs root or sudo) and the
+# Python package with its test dependencies (editable, so the CFFI
+# extensions are built from this tree).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+APT_PACKAGES=(
+  gcc clang libclang-rt-14-dev make cmake pkg-config  # host builds, sanitizers, fuzzing
+  gcc-arm-none-eabi libnewlib-arm-none-eabi           # ARMv4T bare metal (semihosting)
+  gcc-arm-linux-gnueabi                               # ARMv4T embedded Linux (armel)
+  gcc-arm-linux-gnueabihf gcc-aarch64-linux-gnu       # other Linux targets
+  qemu-user                                           # qemu-arm -cpu ti925t, qemu-aarch64
+  sdcc sdcc-ucsim                                     # AT89S51 firmware and the s51 simulator
+  socat                                               # pseudo-terminal pairs for UART tests
+)
+
+missing=()
+for p in "${APT_PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  echo "setup: installing Debian packages: ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+PY=${PYTHON:-python3}
+echo "setup: installing attitude_c (editable) with test dependencies"
+$PY -m pip install -q --upgrade pip >/dev/null 2>&1 || true
+$PY -m pip install -q -e ".[test]"

@@ -1,0 +1,57 @@
+"""Shared pytest fixtures and helpers.
+
+Toolchain rule: a test that needs a toolchain calls ``require_target(name)``
+(or ``require_tools``). Locally a missing tool skips the test with a
+message saying what to install; in CI (``CI`` set in the environment) it
+fails, because CI installs every toolchain (see scripts/setup.sh).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from toolchain import targets as _targets  # noqa: E402
+
+IN_CI = bool(os.environ.get("CI"))
+
+
+def _missing(msg: str) -> None:
+    if IN_CI:
+        pytest.fail(f"{msg} (CI must install it: see scripts/setup.sh)")
+    pytest.skip(msg)
+
+
+def require_tools(*tools: str, apt: str) -> None:
+    """Skip (locally) or fail (CI) unless every tool is on PATH."""
+    missing = [t for t in tools if shutil.which(t) is None]
+    if missing:
+        _missing(f"needs {', '.join(missing)}: apt-get install {apt}")
+
+
+def require_target(name: str) -> _targets.Target:
+    """Load toolchain target ``name``; skip/fail with an install hint if absent."""
+    t = _targets.load(name)
+    missing = t.missing_tools()
+    if missing:
+        _missing(f"target {name} needs {', '.join(missing)}: {t.install_hint()}")
+    return t
+
+
+@pytest.fixture(scope="session")
+def root() -> Path:
+    return ROOT
+
+
+@pytest.fixture(scope="session")
+def build_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A per-session scratch build directory (never inside the source tree)."""
+    return tmp_path_factory.mktemp("build")

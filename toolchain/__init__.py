@@ -1,0 +1,1 @@
+"""Build support shared by tasks.py and the tests: target definitions and compilers."""

@@ -1,0 +1,154 @@
+"""Target definitions (toolchain/<name>.toml) and small build/run helpers.
+
+One TOML file per target holds the compiler, flags, archiver, emulator and
+the Debian packages that provide them; nothing toolchain-specific lives in
+code. ``tasks.py`` and the tests both use this module.
+
+    t = load("armv4t-bare")
+    exe = t.build_program(["csrc/tests/test_quat.c"], "build/armv4t-bare/test_quat")
+    out = t.run([exe])
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Iterable, Sequence
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib  # type: ignore[no-redef]
+
+ROOT = Path(__file__).resolve().parents[1]
+TOOLCHAIN_DIR = ROOT / "toolchain"
+CSRC = ROOT / "csrc"
+INCLUDE = CSRC / "include"
+BUILD = ROOT / "build"
+
+#: Library sources that make up libattitude (portable C99).
+LIB_SOURCES_DIR = CSRC / "src"
+
+
+class ToolchainMissing(RuntimeError):
+    """A tool of the target is not installed; the message says what to install."""
+
+
+@dataclass
+class Target:
+    name: str
+    kind: str  # "gcc" (gcc/clang-like driver) or "sdcc"
+    os: str
+    cc: str
+    ar: str
+    cflags: list[str]
+    ldflags: list[str] = field(default_factory=list)
+    libs: list[str] = field(default_factory=list)
+    run_cmd: list[str] = field(default_factory=list)
+    apt: list[str] = field(default_factory=list)
+    objdump: str | None = None
+
+    # -- availability -----------------------------------------------------
+    def tools(self) -> list[str]:
+        tools = [self.cc, self.ar]
+        if self.run_cmd:
+            tools.append(self.run_cmd[0])
+        return tools
+
+    def missing_tools(self) -> list[str]:
+        return [t for t in self.tools() if shutil.which(t) is None]
+
+    def install_hint(self) -> str:
+        return "apt-get install " + " ".join(self.apt)
+
+    def require(self) -> None:
+        missing = self.missing_tools()
+        if missing:
+            raise ToolchainMissing(
+                f"target {self.name}: {', '.join(missing)} not found; {self.install_hint()}"
+            )
+
+    # -- building ---------------------------------------------------------
+    def build_dir(self) -> Path:
+        return BUILD / self.name
+
+    def compile_cmd(self, src: Path | str, obj: Path | str, defines: Sequence[str] = (),
+                    extra_cflags: Sequence[str] = (), include_dirs: Sequence[Path | str] = ()) -> list[str]:
+        incs = [f"-I{d}" for d in (INCLUDE, *include_dirs)]
+        defs = [f"-D{d}" for d in defines]
+        if self.kind == "sdcc":
+            return [self.cc, *self.cflags, *incs, *defs, *extra_cflags, "-c", str(src), "-o", str(obj)]
+        return [self.cc, *self.cflags, *incs, *defs, *extra_cflags, "-c", str(src), "-o", str(obj)]
+
+    def build_program(self, sources: Iterable[Path | str], out: Path | str, *,
+                      defines: Sequence[str] = (), extra_cflags: Sequence[str] = (),
+                      include_dirs: Sequence[Path | str] = (), with_lib: bool = True,
+                      lib_sources: Sequence[Path | str] | None = None) -> Path:
+        """Compile ``sources`` (plus the library sources if ``with_lib``) into one program.
+
+        gcc-kind targets compile and link in one driver call; the output is
+        an executable. sdcc targets compile each file to a .rel and link an
+        Intel-hex image ``out`` (suffix .ihx); the main file must come first.
+        """
+        self.require()
+        out = Path(out)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        srcs = [Path(s) for s in sources]
+        if with_lib:
+            libsrc = [Path(s) for s in (lib_sources if lib_sources is not None
+                                        else sorted(LIB_SOURCES_DIR.glob("*.c")))]
+            srcs += [s for s in libsrc if s not in srcs]
+        incs = [f"-I{d}" for d in (INCLUDE, *include_dirs)]
+        defs = [f"-D{d}" for d in defines]
+        if self.kind == "sdcc":
+            objdir = out.parent / (out.stem + ".objs")
+            objdir.mkdir(parents=True, exist_ok=True)
+            rels = []
+            for s in srcs:
+                rel = objdir / (s.stem + ".rel")
+                _run([self.cc, *self.cflags, *incs, *defs, *extra_cflags, "-c", str(s), "-o", str(rel)])
+                rels.append(str(rel))
+            ihx = out.with_suffix(".ihx")
+            _run([self.cc, *self.cflags, *self.ldflags, *extra_cflags, *rels, "-o", str(ihx)])
+            return ihx
+        cmd = [self.cc, *self.cflags, *incs, *defs, *extra_cflags, *map(str, srcs),
+               "-o", str(out), *self.ldflags, *self.libs]
+        _run(cmd)
+        return out
+
+    def run(self, argv: Sequence[str | Path], *, input: bytes | None = None,
+            timeout: float = 600, check: bool = True, extra_run_args: Sequence[str] = ()) -> subprocess.CompletedProcess:
+        """Run a program built for this target (through its emulator if any)."""
+        cmd = [*self.run_cmd, *extra_run_args, *map(str, argv)]
+        proc = subprocess.run(cmd, input=input, capture_output=True, timeout=timeout)
+        if check and proc.returncode != 0:
+            raise subprocess.CalledProcessError(proc.returncode, cmd, proc.stdout, proc.stderr)
+        return proc
+
+
+def _run(cmd: list[str]) -> None:
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise subprocess.CalledProcessError(proc.returncode, cmd, proc.stdout, proc.stderr)
+
+
+def names() -> list[str]:
+    return sorted(p.stem for p in TOOLCHAIN_DIR.glob("*.toml"))
+
+
+def load(name: str) -> Target:
+    path = TOOLCHAIN_DIR / f"{name}.toml"
+    if not path.exists():
+        raise ValueError(f"unknown target {name!r}; known targets: {', '.join(names())}")
+    d = tomllib.loads(path.read_text())
+    cc = os.environ.get(f"ATT_CC_{name.upper().replace('-', '_')}", d["cc"])
+    return Target(
+        name=d["name"], kind=d["kind"], os=d["os"], cc=cc, ar=d["ar"],
+        cflags=list(d.get("cflags", [])), ldflags=list(d.get("ldflags", [])),
+        libs=list(d.get("libs", [])), run_cmd=list(d.get("run", [])),
+        apt=list(d.get("apt", [])), objdump=d.get("objdump"),
+    )

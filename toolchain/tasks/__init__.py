@@ -1,0 +1,1 @@
+"""invoke task modules, one per area (see tasks.py)."""

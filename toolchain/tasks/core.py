@@ -1,0 +1,131 @@
+"""Core tasks: build, test, lint, clean, bench."""
+
+from __future__ import annotations
+
+import datetime
+import importlib
+import platform
+import re
+import shutil
+import sys
+from pathlib import Path
+
+from invoke import task
+
+ROOT = Path(__file__).resolve().parents[2]
+BENCH_DOC = ROOT / "docs" / "benchmarks.md"
+
+
+@task(help={"force": "rebuild the CFFI extensions even if up to date"})
+def build(c, force=False):
+    """Build the Python package and its CFFI extensions in place (editable install)."""
+    with c.cd(str(ROOT)):
+        c.run(f"{sys.executable} -m pip install -q --no-build-isolation -e .{' --force-reinstall --no-deps' if force else ''}")
+
+
+@task(help={
+    "k": "only tests matching this pytest -k expression",
+    "jobs": "parallel pytest workers (pytest-xdist); 0 = serial",
+    "extra": "extra arguments passed to pytest verbatim",
+})
+def test(c, k="", jobs=2, extra=""):
+    """Run the test suite (pytest; C, ARMv4T and 8051 targets included)."""
+    args = [sys.executable, "-m", "pytest", "tests"]
+    if jobs:
+        args += ["-n", str(jobs)]
+    if k:
+        args += ["-k", repr(k)]
+    if extra:
+        args.append(extra)
+    with c.cd(str(ROOT)):
+        c.run(" ".join(args), pty=False)
+
+
+@task
+def lint(c):
+    """Static checks: ruff and mypy on Python, strict warnings on every C compiler."""
+    with c.cd(str(ROOT)):
+        c.run(f"{sys.executable} -m ruff check attitude_c tests toolchain tasks.py bench", warn=False)
+        c.run(f"{sys.executable} -m mypy attitude_c", warn=False)
+        srcs = " ".join(str(p.relative_to(ROOT)) for p in sorted((ROOT / "csrc" / "src").glob("*.c")))
+        strict = "-std=c99 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -Icsrc/include"
+        for cc in ("gcc", "clang"):
+            if shutil.which(cc):
+                for d in ("", "-DATT_REAL_F32"):
+                    c.run(f"{cc} {strict} {d} {srcs}")
+
+
+@task
+def clean(c):
+    """Remove build outputs (build/, compiled extensions, caches)."""
+    for p in [ROOT / "build", ROOT / "dist", ROOT / ".pytest_cache", ROOT / ".hypothesis"]:
+        shutil.rmtree(p, ignore_errors=True)
+    for pat in ("attitude_c/_att_*.so", "attitude_c/_att_*.c", "attitude_c/_att_*.o", "*.egg-info"):
+        for p in ROOT.glob(pat):
+            if p.is_dir():
+                shutil.rmtree(p, ignore_errors=True)
+            else:
+                p.unlink()
+
+
+# -- benchmarks ------------------------------------------------------------
+# Each module bench/<name>.py defines TITLE and run(quick: bool) -> str (a
+# Markdown section body). `invoke bench` runs them all (or --only NAME) and
+# rewrites that module's section of docs/benchmarks.md, keeping the others.
+BENCH_ORDER = ("host", "armv4t", "fixed", "tlc2543", "firmware", "link", "peers")
+
+
+def _bench_modules() -> list[str]:
+    present = {p.stem for p in (ROOT / "bench").glob("*.py") if not p.stem.startswith("_")}
+    return [m for m in BENCH_ORDER if m in present] + sorted(present - set(BENCH_ORDER))
+
+
+def _machine() -> str:
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import os
+
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()} {platform.release()}"
+
+
+def write_bench_section(name: str, title: str, body: str, command: str) -> None:
+    BENCH_DOC.parent.mkdir(exist_ok=True)
+    text = BENCH_DOC.read_text() if BENCH_DOC.exists() else (
+        "# Benchmarks\n\nLatest figures of every benchmark of the project. "
+        "Regenerate all with `invoke bench` (one section: `invoke bench --only NAME`).\n"
+        "Each section says the machine, the date and the command that produced it.\n")
+    start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    section = (f"{start}\n## {title}\n\n*Machine:* {_machine()}  \n*Date:* {stamp}  \n"
+               f"*Command:* `{command}`\n\n{body.strip()}\n{end}")
+    pat = re.compile(re.escape(start) + r".*?" + re.escape(end), re.S)
+    if pat.search(text):
+        text = pat.sub(lambda _m: section, text)
+    else:
+        text = text.rstrip() + "\n\n" + section + "\n"
+    # keep sections in BENCH_ORDER
+    BENCH_DOC.write_text(text if text.endswith("\n") else text + "\n")
+
+
+@task(help={
+    "only": "run only this benchmark module (bench/NAME.py); default all",
+    "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
+})
+def bench(c, only="", quick=False):
+    """Run every benchmark and write the figures into docs/benchmarks.md."""
+    sys.path.insert(0, str(ROOT))
+    mods = [only] if only else _bench_modules()
+    for name in mods:
+        mod = importlib.import_module(f"bench.{name}")
+        print(f"== bench {name}: {mod.TITLE}", flush=True)
+        body = mod.run(quick=quick)
+        cmd = "invoke bench" + (f" --only {name}" if only else "") + (" --quick" if quick else "")
+        write_bench_section(name, mod.TITLE, body, cmd)
+        print(body)
+    print(f"wrote {BENCH_DOC.relative_to(ROOT)}")
