@@ -94,32 +94,42 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, {platform.system()} {platform.release()}"
 
 
+BENCH_PARTS = ROOT / "docs" / "bench"
+
+
 def write_bench_section(name: str, title: str, body: str, command: str) -> None:
-    BENCH_DOC.parent.mkdir(exist_ok=True)
-    text = BENCH_DOC.read_text() if BENCH_DOC.exists() else (
-        "# Benchmarks\n\nLatest figures of every benchmark of the project. "
-        "Regenerate all with `invoke bench` (one section: `invoke bench --only NAME`).\n"
-        "Each section says the machine, the date and the command that produced it.\n")
-    start, end = f"<!-- bench:{name} -->", f"<!-- /bench:{name} -->"
+    """Write docs/bench/NAME.md (one benchmark's latest figures) and reassemble the table."""
+    BENCH_PARTS.mkdir(parents=True, exist_ok=True)
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    section = (f"{start}\n## {title}\n\n*Machine:* {_machine()}  \n*Date:* {stamp}  \n"
-               f"*Command:* `{command}`\n\n{body.strip()}\n{end}")
-    pat = re.compile(re.escape(start) + r".*?" + re.escape(end), re.S)
-    if pat.search(text):
-        text = pat.sub(lambda _m: section, text)
-    else:
-        text = text.rstrip() + "\n\n" + section + "\n"
-    # keep sections in BENCH_ORDER
-    BENCH_DOC.write_text(text if text.endswith("\n") else text + "\n")
+    (BENCH_PARTS / f"{name}.md").write_text(
+        f"## {title}\n\n*Machine:* {_machine()}  \n*Date:* {stamp}  \n"
+        f"*Command:* `{command}`\n\n{body.strip()}\n")
+    assemble_bench_doc()
+
+
+def assemble_bench_doc() -> None:
+    """docs/benchmarks.md = header + every docs/bench/*.md in BENCH_ORDER."""
+    present = {p.stem: p for p in BENCH_PARTS.glob("*.md")}
+    order = [n for n in BENCH_ORDER if n in present] + sorted(set(present) - set(BENCH_ORDER))
+    parts = [present[n].read_text().strip() for n in order]
+    BENCH_DOC.write_text(
+        "# Benchmarks\n\n"
+        "Latest figures of every benchmark of the project, one section per benchmark module "
+        "(`bench/NAME.py`). Regenerate all of them with `invoke bench`, one with "
+        "`invoke bench --only NAME`; each section gives the machine, the date and the command.\n\n"
+        + "\n\n".join(parts) + "\n")
 
 
 @task(help={
-    "only": "run only this benchmark module (bench/NAME.py); default all",
+    "only": "run only this benchmark module (bench/NAME.py); 'assemble' just rebuilds the table",
     "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
 })
 def bench(c, only="", quick=False):
     """Run every benchmark and write the figures into docs/benchmarks.md."""
     sys.path.insert(0, str(ROOT))
+    if only == "assemble":  # just rebuild docs/benchmarks.md from docs/bench/*.md
+        assemble_bench_doc()
+        return
     mods = [only] if only else _bench_modules()
     for name in mods:
         mod = importlib.import_module(f"bench.{name}")
