@@ -6,5 +6,6 @@
 #define ATTITUDE_ATTITUDE_H
 
 #include "attitude/common.h"
+#include "attitude/fixed.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

@@ -1,0 +1,36 @@
+/*
+ * Private declarations shared by the fixed-point sources (csrc/src/fixed*.c).
+ */
+#ifndef ATT_FIXED_INTERNAL_H
+#define ATT_FIXED_INTERNAL_H
+
+#include "attitude/fixed.h"
+
+/* Method coefficients in Q2.30 (k = NUM/DEN of attitude/integrator.h,
+ * rounded to nearest). */
+#define ATT_FX_K_RV2 715827883L     /* 2/3 */
+#define ATT_FX_K_RV3_13 442918502L  /* 33/80 */
+#define ATT_FX_K_RV3_23 765041050L  /* 57/80 (= k12) */
+#define ATT_FX_K_RV3C_13 483183821L /* 9/20 */
+#define ATT_FX_K_RV3C_23 724775731L /* 27/40 (= k12) */
+#define ATT_FX_K_RV3R_12 1491308L   /* 1/720 */
+#define ATT_FX_K_RV3R_13 (-46230551L) /* -31/720 */
+#define ATT_FX_K_RV3R_23 180448279L /* 121/720 */
+#define ATT_FX_K_RV3R_START 89478485L /* 1/12 */
+
+/* 1 if every one of the n values satisfies |x| ≤ ATT_FX_DTHETA_MAX. */
+int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n);
+
+/* Φ = Δθ1 + Δθ2 + Δθ3 + (k13 Δθ1) × Δθ3 + (k23 Δθ2) × (Δθ3 − Δθ1)
+ * (three-sample form with k12 = k23), inputs checked by the caller. */
+void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3]);
+
+/* c = cos(φ/2), s = sin(φ/2)/(φ/2) (Q2.30) for Φ with |Φ|² ≤ 9.6. */
+void att_fx_cs_(const att_q30 phi[3], int32_t *c, int32_t *s);
+
+/* Q ← Q ⊗ q(Φ) with the folded renormalization; Φ checked by the caller
+ * (|Φ|² ≤ 9.6). Returns ATT_FX_E_RANGE (q untouched) if |Q|² − 1 is
+ * outside ±2^-20, i.e. q was not a unit quaternion of this module. */
+att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3]);
+
+#endif /* ATT_FIXED_INTERNAL_H */
