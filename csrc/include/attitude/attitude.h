@@ -6,5 +6,7 @@
 #define ATTITUDE_ATTITUDE_H
 
 #include "attitude/common.h"
+#include "attitude/quat.h"
+#include "attitude/integrator.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
