@@ -37,7 +37,7 @@ __all__ = [
 
 # The integrator API (attitude_c.core) is re-exported here. Importing it does
 # not load the C extension (attitude_c._lib loads it on first use).
-from . import core as _core  # noqa: E402
-from .core import *  # noqa: E402,F401,F403
+from . import core as _core
+from .core import *
 
 __all__ += list(_core.__all__)
