@@ -8,5 +8,6 @@
 #include "attitude/common.h"
 #include "attitude/quat.h"
 #include "attitude/integrator.h"
+#include "attitude/link.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
