@@ -117,6 +117,16 @@ FX_STATIC void fxh_mac(fxh_acc *a, int32_t x, int32_t y)
     fxh_add(a, hi, lo);
 }
 
+/* a += 2 * x * y */
+FX_STATIC void fxh_mac2(fxh_acc *a, int32_t x, int32_t y)
+{
+    uint32_t hi, lo;
+    fxh_prod(x, y, &hi, &lo);
+    hi = (hi << 1) | (lo >> 31);
+    lo <<= 1;
+    fxh_add(a, hi, lo);
+}
+
 /* a -= x * y */
 FX_STATIC void fxh_msc(fxh_acc *a, int32_t x, int32_t y)
 {
@@ -235,6 +245,11 @@ FX_STATIC void fxw_uprod(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
     *lo = (uint32_t)p;
 }
 
+FX_STATIC void fxw_mac2(fxw_acc *a, int32_t x, int32_t y)
+{
+    a->v += (uint64_t)((int64_t)x * (int64_t)y) << 1;
+}
+
 FX_STATIC void fxw_msc(fxw_acc *a, int32_t x, int32_t y)
 {
     a->v -= (uint64_t)((int64_t)x * (int64_t)y);
@@ -293,6 +308,7 @@ typedef fxh_acc fx_acc;
 #define fx_zero fxh_zero
 #define fx_uprod fxh_uprod
 #define fx_mac fxh_mac
+#define fx_mac2 fxh_mac2
 #define fx_msc fxh_msc
 #define fx_add_shl fxh_add_shl
 #define fx_round fxh_round
@@ -303,6 +319,7 @@ typedef fxw_acc fx_acc;
 #define fx_zero fxw_zero
 #define fx_uprod fxw_uprod
 #define fx_mac fxw_mac
+#define fx_mac2 fxw_mac2
 #define fx_msc fxw_msc
 #define fx_add_shl fxw_add_shl
 #define fx_round fxw_round

@@ -79,9 +79,11 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3
  *  4. c ← c − c·e/2, s ← s − s·e/2 (Q2.30 × Q2.50 → shift 51), so that
  *     |Q ⊗ q| = 1 to first order: no separate normalization pass and no
  *     second rounding of Q.
- *  5. q = [c, s·Φ/2] (Q2.30 × Q2.30 → shift 31).
- *  6. Q ⊗ q: per component a 4-term exact Q4.60 sum (|terms| ≤ 1.0·2^60),
- *     rounded once to Q2.30.
+ *  5. q = [c (Q2.30), h = s·Φ/2 (Q2.30 × Q2.30 → Q1.31, shift 30, dithered
+ *     rounding, see below)].
+ *  6. Q ⊗ q in Q3.61: Q·h terms (Q2.30 × Q1.31) and 2·Q·c (Q2.30 × Q2.30,
+ *     doubled); per component the exact sum is bounded by |Q||q| ≈ 2^61,
+ *     rounded once to Q2.30 (shift 31).
  */
 void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
@@ -115,7 +117,8 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3])
 {
     fx_acc acc;
-    int32_t c, s, e, h[4];
+    int32_t c, s, e, h[4]; /* h[0] unused: the scalar part c stays Q2.30 */
+    uint8_t n;
 
     att_fx_cs_(phi, &c, &s);
     fx_zero(&acc);
@@ -130,37 +133,49 @@ att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3])
     c -= fx_mul(c, e, 51);
     s -= fx_mul(s, e, 51);
 
-    h[0] = c;
-    h[1] = fx_mul(s, phi[0], 31);
-    h[2] = fx_mul(s, phi[1], 31);
-    h[3] = fx_mul(s, phi[2], 31);
+    /* vector part h = s·Φ/2 in Q1.31 (|h| ≤ sin(1.55) < 1), i.e. Q2.30 ×
+     * Q2.30 → shift 30, rounded with dither: h = floor((s·Φ + D)/2^30),
+     * D ∈ [0, 2^30) a hash of the low bits of Q (Knuth's multiplicative
+     * hash). Plain rounding of h is biased for smooth motion: h differs
+     * from the integer Φ by the tiny, slowly varying (s − 1)·Φ/2 term, so
+     * its rounding error repeats step after step and the attitude drifts
+     * linearly. With D uniform the rounding is unbiased (E[h] = s·Φ/2
+     * exactly) and the error is white; deterministic, the same on every
+     * target. */
+    for (n = 0; n < 3; ++n) {
+        uint32_t dk = (uint32_t)((uint32_t)q[n + 1] * (uint32_t)2654435761ul) >> 2;
+        fx_zero(&acc);
+        fx_mac(&acc, s, phi[n]);
+        fx_add_shl(&acc, (int32_t)dk - (int32_t)0x20000000L, 0);
+        h[n + 1] = fx_round(&acc, 30);
+    }
 
     {
         int32_t r0, r1, r2, r3;
         fx_zero(&acc);
-        fx_mac(&acc, q[0], h[0]);
+        fx_mac2(&acc, q[0], c);
         fx_msc(&acc, q[1], h[1]);
         fx_msc(&acc, q[2], h[2]);
         fx_msc(&acc, q[3], h[3]);
-        r0 = fx_round(&acc, 30);
+        r0 = fx_round(&acc, 31);
         fx_zero(&acc);
         fx_mac(&acc, q[0], h[1]);
-        fx_mac(&acc, q[1], h[0]);
+        fx_mac2(&acc, q[1], c);
         fx_mac(&acc, q[2], h[3]);
         fx_msc(&acc, q[3], h[2]);
-        r1 = fx_round(&acc, 30);
+        r1 = fx_round(&acc, 31);
         fx_zero(&acc);
         fx_mac(&acc, q[0], h[2]);
         fx_msc(&acc, q[1], h[3]);
-        fx_mac(&acc, q[2], h[0]);
+        fx_mac2(&acc, q[2], c);
         fx_mac(&acc, q[3], h[1]);
-        r2 = fx_round(&acc, 30);
+        r2 = fx_round(&acc, 31);
         fx_zero(&acc);
         fx_mac(&acc, q[0], h[3]);
         fx_mac(&acc, q[1], h[2]);
         fx_msc(&acc, q[2], h[1]);
-        fx_mac(&acc, q[3], h[0]);
-        r3 = fx_round(&acc, 30);
+        fx_mac2(&acc, q[3], c);
+        r3 = fx_round(&acc, 31);
         q[0] = r0;
         q[1] = r1;
         q[2] = r2;
