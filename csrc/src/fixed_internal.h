@@ -18,12 +18,21 @@
 #define ATT_FX_K_RV3R_23 180448279L /* 121/720 */
 #define ATT_FX_K_RV3R_START 89478485L /* 1/12 */
 
+/* |x| > ATT_FX_DTHETA_MAX, one add and one unsigned compare */
+#define FX_DBAD(x) ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > \
+                    2u * (uint32_t)ATT_FX_DTHETA_MAX)
+
 /* 1 if every one of the n values satisfies |x| ≤ ATT_FX_DTHETA_MAX. */
 int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n);
 
 /* Φ = Δθ1 + Δθ2 + Δθ3 + (k13 Δθ1) × Δθ3 + (k23 Δθ2) × (Δθ3 − Δθ1)
  * (three-sample form with k12 = k23), inputs checked by the caller. */
 void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3]);
+
+/* rv3-reuse with two previous increments: Φ = d3 + (k12 d1) × d2 +
+ * (k13 d1 + k23 d2) × d3, inputs checked by the caller. */
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3],
+                       att_q30 phi[3]);
 
 /* c = cos(φ/2), s = sin(φ/2)/(φ/2) (Q2.30) for Φ with |Φ|² ≤ 9.6. */
 void att_fx_cs_(const att_q30 phi[3], int32_t *c, int32_t *s);

@@ -70,6 +70,21 @@ FX_STATIC void fxh_zero(fxh_acc *a)
     a->hi = 0;
 }
 
+/* a = u (a non-negative 32-bit value) */
+FX_STATIC void fxh_init_u(fxh_acc *a, uint32_t u)
+{
+    a->lo = u;
+    a->hi = 0;
+}
+
+/* a = x·2^31 + 2^30 (start of a sum rounded by floor(a / 2^31)) */
+FX_STATIC void fxh_init_shl31(fxh_acc *a, int32_t x)
+{
+    uint32_t ux = (uint32_t)x;
+    a->lo = (ux << 31) | 0x40000000ul;
+    a->hi = (ux >> 1) | (ux & 0x80000000ul);
+}
+
 /* (hi:lo) = ux * uy, unsigned 32 × 32 → 64 bits, from four 16 × 16 → 32-bit
  * partial products (MUL-friendly on the 8051: no 64-bit type). */
 FX_STATIC void fxh_uprod(uint32_t ux, uint32_t uy, uint32_t *hi, uint32_t *lo)
@@ -180,6 +195,12 @@ FX_STATIC int32_t fxh_round(const fxh_acc *a, uint8_t sh)
     return fx_u2s((lo >> sh) | (hi << (32u - sh)));
 }
 
+/* floor(a / 2^sh), 1 ≤ sh ≤ 31, low 32 bits */
+FX_STATIC int32_t fxh_floor(const fxh_acc *a, uint8_t sh)
+{
+    return fx_u2s((a->lo >> sh) | (a->hi << (32u - sh)));
+}
+
 /* Unsigned extraction of a non-negative sum < 2^64, 0 < sh ≤ 63; the
  * caller guarantees the result < 2^32. */
 FX_STATIC uint32_t fxh_round_u(const fxh_acc *a, uint8_t sh)
@@ -190,6 +211,13 @@ FX_STATIC uint32_t fxh_round_u(const fxh_acc *a, uint8_t sh)
         return (lo >> sh) | (hi << (32u - sh));
     }
     return hi >> (sh - 32u);
+}
+
+/* 1 if the accumulated value v satisfies −2^b ≤ v < 2^b (33 ≤ b ≤ 62):
+ * the high word of v + 2^b is below 2^(b−31). */
+FX_STATIC int fxh_small(const fxh_acc *a, uint8_t b)
+{
+    return (uint32_t)(a->hi + (1ul << (b - 32u))) < (1ul << (b - 31u));
 }
 
 /* Round-to-nearest extraction with range check, 0 ≤ sh ≤ 62: returns 0
@@ -232,6 +260,18 @@ typedef struct {
 } fxw_acc;
 
 FX_STATIC void fxw_zero(fxw_acc *a) { a->v = 0; }
+
+FX_STATIC void fxw_init_u(fxw_acc *a, uint32_t u) { a->v = u; }
+
+FX_STATIC void fxw_init_shl31(fxw_acc *a, int32_t x)
+{
+    a->v = ((uint64_t)(int64_t)x << 31) | 0x40000000u;
+}
+
+FX_STATIC int32_t fxw_floor(const fxw_acc *a, uint8_t sh)
+{
+    return fx_u2s((uint32_t)(a->v >> sh));
+}
 
 FX_STATIC void fxw_mac(fxw_acc *a, int32_t x, int32_t y)
 {
@@ -277,6 +317,11 @@ FX_STATIC uint32_t fxw_round_u(const fxw_acc *a, uint8_t sh)
     return (uint32_t)((a->v + ((uint64_t)1 << (sh - 1u))) >> sh);
 }
 
+FX_STATIC int fxw_small(const fxw_acc *a, uint8_t b)
+{
+    return (uint32_t)((uint32_t)(a->v >> 32) + (1ul << (b - 32u))) < (1ul << (b - 31u));
+}
+
 FX_STATIC int fxw_round_sat(const fxw_acc *a, uint8_t sh, int32_t *out)
 {
     uint64_t v = a->v;
@@ -306,6 +351,9 @@ FX_STATIC int fxw_round_sat(const fxw_acc *a, uint8_t sh, int32_t *out)
 #if defined(FX_USE_HALVES)
 typedef fxh_acc fx_acc;
 #define fx_zero fxh_zero
+#define fx_init_u fxh_init_u
+#define fx_init_shl31 fxh_init_shl31
+#define fx_floor fxh_floor
 #define fx_uprod fxh_uprod
 #define fx_mac fxh_mac
 #define fx_mac2 fxh_mac2
@@ -314,9 +362,13 @@ typedef fxh_acc fx_acc;
 #define fx_round fxh_round
 #define fx_round_u fxh_round_u
 #define fx_round_sat fxh_round_sat
+#define fx_small fxh_small
 #else
 typedef fxw_acc fx_acc;
 #define fx_zero fxw_zero
+#define fx_init_u fxw_init_u
+#define fx_init_shl31 fxw_init_shl31
+#define fx_floor fxw_floor
 #define fx_uprod fxw_uprod
 #define fx_mac fxw_mac
 #define fx_mac2 fxw_mac2
@@ -325,6 +377,7 @@ typedef fxw_acc fx_acc;
 #define fx_round fxw_round
 #define fx_round_u fxw_round_u
 #define fx_round_sat fxw_round_sat
+#define fx_small fxw_small
 #endif
 
 /* round(x · y / 2^sh), the caller guarantees the result fits (0 ≤ sh ≤ 62) */

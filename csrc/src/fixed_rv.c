@@ -30,7 +30,7 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
 {
     uint8_t i;
     for (i = 0; i < n; ++i) {
-        if (d[i] > (att_q30)ATT_FX_DTHETA_MAX || d[i] < -(att_q30)ATT_FX_DTHETA_MAX) {
+        if (FX_DBAD(d[i])) {
             return 0;
         }
     }
@@ -39,51 +39,61 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
 
 /*
  * Three-sample rotation vector with k12 = k23 (rv3, rv3-coning):
- *   Φ = Δθ1 + Δθ2 + Δθ3 + a × Δθ3 + b × (Δθ3 − Δθ1),  a = k13 Δθ1, b = k23 Δθ2
- * Inputs Q2.30 with |Δθ| ≤ 0.4 (a, b rounded to Q2.30, |a|,|b| ≤ 0.29;
- * |Δθ3 − Δθ1| ≤ 0.8 exact). Per component: the sum (×2^30) and the four
- * cross-product terms are accumulated exactly in Q4.60 and rounded once
- * to Q2.30; |Φ_i| ≤ 1.2 + 0.83·0.4·... ≤ 1.79 < 2, no saturation needed.
+ *   Φ = Δθ1 + Δθ2 + Δθ3 + a × Δθ3 + b × w,  a = k13 Δθ1, b = k23 Δθ2, w = Δθ3 − Δθ1
+ * Inputs Q2.30 with |Δθ| ≤ 0.4: a, b rounded to Q2.30 (|a|, |b| ≤ 0.29),
+ * w exact (|w| ≤ 0.8). Per component the four cross-product terms are
+ * accumulated exactly in Q4.60 and rounded once to Q2.30 (shift 30), then
+ * the exact integer sum is added (= one rounding of the exact total); |Φ_i| ≤ 3·0.4 + 2·0.29·0.4 + 2·0.29·0.8 = 1.9 < 2,
+ * so no saturation is needed. Subtracted products use a negated operand
+ * (one multiply-accumulate each).
  */
 void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3])
 {
-    int32_t a[3], b[3], w[3];
-    uint8_t i;
+    int32_t a0, a1, a2, b0, b1, b2, w0, w1, w2, e0, e1, e2;
     fx_acc acc;
-    for (i = 0; i < 3; ++i) {
-        a[i] = fx_mul(k13, d[i], 30);
-        b[i] = fx_mul(k23, d[3 + i], 30);
-        w[i] = d[6 + i] - d[i];
-    }
-    for (i = 0; i < 3; ++i) {
-        uint8_t j = (uint8_t)((i + 1u) % 3u), k = (uint8_t)((i + 2u) % 3u);
-        fx_zero(&acc);
-        fx_add_shl(&acc, d[i] + d[3 + i] + d[6 + i], 30);
-        fx_mac(&acc, a[j], d[6 + k]);
-        fx_msc(&acc, a[k], d[6 + j]);
-        fx_mac(&acc, b[j], w[k]);
-        fx_msc(&acc, b[k], w[j]);
-        phi[i] = fx_round(&acc, 30);
-    }
+    a0 = fx_mul(k13, d[0], 30);
+    a1 = fx_mul(k13, d[1], 30);
+    a2 = fx_mul(k13, d[2], 30);
+    b0 = fx_mul(k23, d[3], 30);
+    b1 = fx_mul(k23, d[4], 30);
+    b2 = fx_mul(k23, d[5], 30);
+    e0 = d[6];
+    e1 = d[7];
+    e2 = d[8];
+    w0 = e0 - d[0];
+    w1 = e1 - d[1];
+    w2 = e2 - d[2];
+
+    /* round(S·2^30 + X) / 2^30 = S + round(X / 2^30) for an integer sum S */
+    fx_zero(&acc);
+    fx_mac(&acc, a1, e2);
+    fx_mac(&acc, -a2, e1);
+    fx_mac(&acc, b1, w2);
+    fx_mac(&acc, -b2, w1);
+    phi[0] = d[0] + d[3] + e0 + fx_round(&acc, 30);
+
+    fx_zero(&acc);
+    fx_mac(&acc, a2, e0);
+    fx_mac(&acc, -a0, e2);
+    fx_mac(&acc, b2, w0);
+    fx_mac(&acc, -b0, w2);
+    phi[1] = d[1] + d[4] + e1 + fx_round(&acc, 30);
+
+    fx_zero(&acc);
+    fx_mac(&acc, a0, e1);
+    fx_mac(&acc, -a1, e0);
+    fx_mac(&acc, b0, w1);
+    fx_mac(&acc, -b1, w0);
+    phi[2] = d[2] + d[5] + e2 + fx_round(&acc, 30);
 }
 
 /*
- * Q ← Q ⊗ q(Φ), renormalization folded into q:
- * (steps 1-2 in att_fx_cs_)
+ * c = cos(φ/2), s = sin(φ/2)/(φ/2) (both Q2.30) for |Φ|² ≤ 9.6:
  *  1. v = |Φ|²/8: exact Q4.60 sum of squares (< 9.6·2^60 < 2^64, unsigned),
  *     rounded to Q2.30 (shift 33); v ≤ 1.2.
- *  2. c = cos(φ/2), s = sin(φ/2)/(φ/2) by Horner in v, Q2.30, one rounding
- *     per step (|partial sums| ≤ 1), degree from fx_deg_vmax.
- *  3. e = |Q|² − 1: exact Q4.60 sum minus 2^60, rounded to Q2.50 (shift 10);
- *     |e| must be ≤ 2^-20 (else ATT_FX_E_RANGE, Q untouched).
- *  4. c ← c − c·e/2, s ← s − s·e/2 (Q2.30 × Q2.50 → shift 51), so that
- *     |Q ⊗ q| = 1 to first order: no separate normalization pass and no
- *     second rounding of Q.
- *  5. q = [c (Q2.30), h = s·Φ/2 (Q2.30 × Q2.30 → Q1.31, shift 30, dithered
- *     rounding, see below)].
- *  6. Q ⊗ q in Q3.61: Q·h terms (Q2.30 × Q1.31) and 2·Q·c (Q2.30 × Q2.30,
- *     doubled); per component the exact sum is bounded by |Q||q| ≈ 2^61,
- *     rounded once to Q2.30 (shift 31).
+ *  2. Horner in v, Q2.30, one rounding per step (|partial sums| ≤ 1),
+ *     degree from fx_deg_vmax (degree 1, v ≤ 2.6e-5 i.e. φ ≤ 0.0145 rad,
+ *     is the common case and has a short path: c = 1 − v exactly).
  */
 void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
@@ -97,8 +107,13 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
     fx_mac(&acc, phi[2], phi[2]);
     v = (int32_t)fx_round_u(&acc, 33);
 
+    if (v <= fx_deg_vmax[0]) {
+        *cp = (int32_t)ATT_FX_Q30_ONE - v;
+        *sp = (int32_t)ATT_FX_Q30_ONE - fx_mul(v, fx_sin_k[1], 30);
+        return;
+    }
     deg = 7;
-    for (n = 0; n < 6; ++n) {
+    for (n = 1; n < 6; ++n) {
         if (v <= fx_deg_vmax[n]) {
             deg = (int8_t)(n + 1);
             break;
@@ -114,80 +129,95 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
     *sp = s;
 }
 
+/*
+ * Q ← Q ⊗ q(Φ), renormalization folded into q:
+ *  1-2. c, s from att_fx_cs_.
+ *  3. e = |Q|² − 1: exact Q4.60 sum minus 2^60; |e| < 2^-20 is required
+ *     (else ATT_FX_E_RANGE, Q untouched: Q was not a unit quaternion of
+ *     this module); e/2 rounded to Q2.30 (shift 31).
+ *  4. c ← c − e/2, so that |Q ⊗ q|² = (1 + e)(c² − c·e + |h|²) = 1 + O(e·(1 − c))
+ *     + rounding: the norm error is removed at every update, without a
+ *     separate normalization pass and without a second rounding of Q.
+ *  5. h = s·Φ/2 in Q1.31 (|h| ≤ sin(1.55) < 1): Q2.30 × Q2.30 → shift 30,
+ *     dithered rounding h = floor((s·Φ + D)/2^30) with D ∈ [0, 2^30) a
+ *     hash of the low bits of Q (Knuth's multiplicative hash). Plain
+ *     rounding of h is biased for smooth motion: h differs from the
+ *     integer Φ by the tiny, slowly varying (s − 1)·Φ/2, so its rounding
+ *     error repeats update after update and the attitude drifts linearly.
+ *     With D uniform, E[h] = s·Φ/2 exactly and the error is white.
+ *     Deterministic: the same bits on every target.
+ *  6. Q ⊗ [c, h] in Q3.61: Q·h terms (Q2.30 × Q1.31) and Q·c twice
+ *     (Q2.30 × Q2.30 = Q60, doubled); the exact sum of each component is
+ *     bounded by |Q||q| ≈ 2^61 and rounded once to Q2.30 (shift 31).
+ */
 att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3])
 {
     fx_acc acc;
-    int32_t c, s, e, h[4]; /* h[0] unused: the scalar part c stays Q2.30 */
-    uint8_t n;
+    int32_t c, c2, s, e, h1, h2, h3, q0, q1, q2, q3;
 
     att_fx_cs_(phi, &c, &s);
+    q0 = q[0];
+    q1 = q[1];
+    q2 = q[2];
+    q3 = q[3];
+
     fx_zero(&acc);
-    fx_mac(&acc, q[0], q[0]);
-    fx_mac(&acc, q[1], q[1]);
-    fx_mac(&acc, q[2], q[2]);
-    fx_mac(&acc, q[3], q[3]);
+    fx_mac(&acc, q0, q0);
+    fx_mac(&acc, q1, q1);
+    fx_mac(&acc, q2, q2);
+    fx_mac(&acc, q3, q3);
     fx_add_shl(&acc, -(int32_t)ATT_FX_Q30_ONE, 30);
-    if (fx_round_sat(&acc, 10, &e) != 0 || e > (1L << 30) || e < -(1L << 30)) {
+    if (!fx_small(&acc, 40)) {
         return (att_status)ATT_FX_E_RANGE;
     }
-    c -= fx_mul(c, e, 51);
-    s -= fx_mul(s, e, 51);
+    e = fx_round(&acc, 31);
+    c -= e;
 
-    /* vector part h = s·Φ/2 in Q1.31 (|h| ≤ sin(1.55) < 1), i.e. Q2.30 ×
-     * Q2.30 → shift 30, rounded with dither: h = floor((s·Φ + D)/2^30),
-     * D ∈ [0, 2^30) a hash of the low bits of Q (Knuth's multiplicative
-     * hash). Plain rounding of h is biased for smooth motion: h differs
-     * from the integer Φ by the tiny, slowly varying (s − 1)·Φ/2 term, so
-     * its rounding error repeats step after step and the attitude drifts
-     * linearly. With D uniform the rounding is unbiased (E[h] = s·Φ/2
-     * exactly) and the error is white; deterministic, the same on every
-     * target. */
-    for (n = 0; n < 3; ++n) {
-        uint32_t dk = (uint32_t)((uint32_t)q[n + 1] * (uint32_t)2654435761ul) >> 2;
-        fx_zero(&acc);
-        fx_mac(&acc, s, phi[n]);
-        fx_add_shl(&acc, (int32_t)dk - (int32_t)0x20000000L, 0);
-        h[n + 1] = fx_round(&acc, 30);
-    }
+#define FX_H(hk, qk, pk)                                                          \
+    fx_init_u(&acc, (uint32_t)((uint32_t)(qk) * (uint32_t)2654435761ul) >> 2);    \
+    fx_mac(&acc, s, pk);                                                          \
+    hk = fx_floor(&acc, 30)
+    FX_H(h1, q1, phi[0]);
+    FX_H(h2, q2, phi[1]);
+    FX_H(h3, q3, phi[2]);
+#undef FX_H
 
-    {
-        int32_t r0, r1, r2, r3;
-        fx_zero(&acc);
-        fx_mac2(&acc, q[0], c);
-        fx_msc(&acc, q[1], h[1]);
-        fx_msc(&acc, q[2], h[2]);
-        fx_msc(&acc, q[3], h[3]);
-        r0 = fx_round(&acc, 31);
-        fx_zero(&acc);
-        fx_mac(&acc, q[0], h[1]);
-        fx_mac2(&acc, q[1], c);
-        fx_mac(&acc, q[2], h[3]);
-        fx_msc(&acc, q[3], h[2]);
-        r1 = fx_round(&acc, 31);
-        fx_zero(&acc);
-        fx_mac(&acc, q[0], h[2]);
-        fx_msc(&acc, q[1], h[3]);
-        fx_mac2(&acc, q[2], c);
-        fx_mac(&acc, q[3], h[1]);
-        r2 = fx_round(&acc, 31);
-        fx_zero(&acc);
-        fx_mac(&acc, q[0], h[3]);
-        fx_mac(&acc, q[1], h[2]);
-        fx_msc(&acc, q[2], h[1]);
-        fx_mac2(&acc, q[3], c);
-        r3 = fx_round(&acc, 31);
-        q[0] = r0;
-        q[1] = r1;
-        q[2] = r2;
-        q[3] = r3;
-    }
+    /* 2·Q_i·c = Q_i·2^31 + Q_i·c2 with c2 = 2c − 2^31 (fits int32: 0 ≤ c < 2^31);
+     * the accumulator starts at Q_i·2^31 + 2^30 (the rounding half). */
+    c2 = fx_u2s((uint32_t)c * 2u - 0x80000000ul);
+    fx_init_shl31(&acc, q0);
+    fx_mac(&acc, q0, c2);
+    fx_mac(&acc, q1, -h1);
+    fx_mac(&acc, q2, -h2);
+    fx_mac(&acc, q3, -h3);
+    q[0] = fx_floor(&acc, 31);
+
+    fx_init_shl31(&acc, q1);
+    fx_mac(&acc, q0, h1);
+    fx_mac(&acc, q1, c2);
+    fx_mac(&acc, q2, h3);
+    fx_mac(&acc, q3, -h2);
+    q[1] = fx_floor(&acc, 31);
+
+    fx_init_shl31(&acc, q2);
+    fx_mac(&acc, q0, h2);
+    fx_mac(&acc, q1, -h3);
+    fx_mac(&acc, q2, c2);
+    fx_mac(&acc, q3, h1);
+    q[2] = fx_floor(&acc, 31);
+
+    fx_init_shl31(&acc, q3);
+    fx_mac(&acc, q0, h3);
+    fx_mac(&acc, q1, h2);
+    fx_mac(&acc, q2, -h1);
+    fx_mac(&acc, q3, c2);
+    q[3] = fx_floor(&acc, 31);
     return ATT_OK;
 }
 
 att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
 {
     fx_acc acc;
-    uint32_t n2;
     if (q == 0 || phi == 0) {
         return ATT_E_NULL;
     }
@@ -197,8 +227,7 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
     fx_mac(&acc, phi[0], phi[0]);
     fx_mac(&acc, phi[1], phi[1]);
     fx_mac(&acc, phi[2], phi[2]);
-    n2 = fx_round_u(&acc, 36);
-    if (n2 > 161061274ul) { /* 9.6 · 2^24 */
+    if (fx_round_u(&acc, 36) > 161061274ul) { /* 9.6 · 2^24 */
         return (att_status)ATT_FX_E_RANGE;
     }
     return att_fx_apply_(q, phi);
@@ -210,7 +239,8 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
     if (q == 0 || d == 0) {
         return ATT_E_NULL;
     }
-    if (!att_fx_dtheta_ok_(d, 9)) {
+    if (FX_DBAD(d[0]) || FX_DBAD(d[1]) || FX_DBAD(d[2]) || FX_DBAD(d[3]) || FX_DBAD(d[4])
+        || FX_DBAD(d[5]) || FX_DBAD(d[6]) || FX_DBAD(d[7]) || FX_DBAD(d[8])) {
         return (att_status)ATT_FX_E_RANGE;
     }
     att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, phi);

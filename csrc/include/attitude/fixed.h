@@ -82,13 +82,16 @@ enum {
     ATT_FX_UPDATED = 1     /* a new attitude was written */
 };
 
-/* Caller-owned integrator state (36 bytes + 2 on the 8051). */
+/* Caller-owned integrator state (55 bytes on the 8051). Treat as opaque. */
 typedef struct {
     att_q30 q[4];          /* attitude quaternion, Q2.30, |q| = 1 within ±4 LSB */
-    att_q30 buf[2][3];     /* rv2/rv3: increments of the unfinished update; rv3-reuse: the
-                              two previous increments (buf[1] newest); Q2.30 rad */
+    att_q30 buf[9];        /* 3 increments (3 values each): rv2/rv3: those of the unfinished
+                              update, oldest first (the last one is scratch); rv3-reuse:
+                              the two previous increments, increment `old` the older;
+                              Q2.30 rad */
     uint8_t method;        /* att_fx_method */
     uint8_t nbuf;          /* valid entries of buf */
+    uint8_t old;           /* rv3-reuse: index of the older increment (0 or 1) */
 } att_fx_integ;
 
 /* ADC-code → increment converter (per axis), set up by att_fx_adc_init. */
