@@ -225,14 +225,11 @@ FX_STATIC int fxh_small(const fxh_acc *a, uint8_t b)
 FX_STATIC int fxh_round_sat(const fxh_acc *a, uint8_t sh, int32_t *out)
 {
     uint32_t hi = a->hi, lo = a->lo;
-    uint32_t sign = (hi & 0x80000000ul) ? 0xFFFFFFFFul : 0u;
-    uint32_t rhi, rlo;
+    uint32_t neg = hi & 0x80000000ul;
+    uint32_t sign, rhi, rlo;
     fxh_add_half(&hi, &lo, sh);
-    /* adding the half may overflow a value next to +2^63: detect it */
-    if (sign == 0u && (hi & 0x80000000ul)) {
-        return -1;
-    }
-    sign = (hi & 0x80000000ul) ? 0xFFFFFFFFul : 0u;
+    /* t = v + half is exact as unsigned when v ≥ 0 and as signed when v < 0 */
+    sign = (neg && (hi & 0x80000000ul)) ? 0xFFFFFFFFul : 0u;
     if (sh == 0u) {
         rlo = lo;
         rhi = hi;
@@ -325,15 +322,13 @@ FX_STATIC int fxw_small(const fxw_acc *a, uint8_t b)
 FX_STATIC int fxw_round_sat(const fxw_acc *a, uint8_t sh, int32_t *out)
 {
     uint64_t v = a->v;
-    uint64_t sign = (v >> 63) ? ~(uint64_t)0 : 0u;
-    uint64_t r;
+    uint64_t neg = v >> 63;
+    uint64_t sign, r;
     if (sh != 0u) {
         v += (uint64_t)1 << (sh - 1u);
-        if (sign == 0u && (v >> 63)) {
-            return -1;
-        }
     }
-    sign = (v >> 63) ? ~(uint64_t)0 : 0u;
+    /* t = v + half is exact as unsigned when v ≥ 0 and as signed when v < 0 */
+    sign = (neg && (v >> 63)) ? ~(uint64_t)0 : 0u;
     r = v >> sh;
     if (sh != 0u) {
         r |= sign << (64u - sh);

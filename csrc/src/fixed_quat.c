@@ -305,6 +305,9 @@ static uint32_t fx_cordic(int32_t x, int32_t y, int32_t *mag)
     if (mag != 0) {
         *mag = fx_mul(xs, 652032874L, (uint8_t)(30 + sh)); /* 1/K in Q2.30 */
     }
+    if (y == 0) { /* on the x axis: exact, and atan2(0, x < 0) = +π, not −π */
+        z = (x < 0) ? 0x80000000ul : 0u;
+    }
     return z;
 }
 
