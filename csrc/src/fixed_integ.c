@@ -16,7 +16,7 @@
  * rounded once (shift 30), the integer d3 added. |Φ_i| ≤ 0.4 + 0.02 < 2.
  */
 void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3],
-                       att_q30 phi[3])
+                       uint32_t t, att_q30 phi[3])
 {
     int32_t p0, p1, p2, u0, u1, u2;
     fx_acc acc;
@@ -32,24 +32,24 @@ void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d
     FX_U(u1, 1);
     FX_U(u2, 2);
 #undef FX_U
-    fx_zero(&acc);
+    fx_init_u(&acc, FX_DITHER30(t, 1u));
     fx_mac(&acc, p1, d2[2]);
     fx_mac(&acc, -p2, d2[1]);
     fx_mac(&acc, u1, d3[2]);
     fx_mac(&acc, -u2, d3[1]);
-    phi[0] = d3[0] + fx_round(&acc, 30);
-    fx_zero(&acc);
+    phi[0] = d3[0] + fx_floor(&acc, 30);
+    fx_init_u(&acc, FX_DITHER30(t, 11u));
     fx_mac(&acc, p2, d2[0]);
     fx_mac(&acc, -p0, d2[2]);
     fx_mac(&acc, u2, d3[0]);
     fx_mac(&acc, -u0, d3[2]);
-    phi[1] = d3[1] + fx_round(&acc, 30);
-    fx_zero(&acc);
+    phi[1] = d3[1] + fx_floor(&acc, 30);
+    fx_init_u(&acc, FX_DITHER30(t, 22u));
     fx_mac(&acc, p0, d2[1]);
     fx_mac(&acc, -p1, d2[0]);
     fx_mac(&acc, u0, d3[1]);
     fx_mac(&acc, -u1, d3[0]);
-    phi[2] = d3[2] + fx_round(&acc, 30);
+    phi[2] = d3[2] + fx_floor(&acc, 30);
 }
 
 /*
@@ -60,25 +60,25 @@ void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d
  * sum added. |Φ_i| ≤ 0.8 + 2/3·2·0.16 < 1.1.
  */
 static void fx_phi2(const att_q30 a[3], const att_q30 b[3], int32_t k, uint8_t with_a,
-                    att_q30 phi[3])
+                    uint32_t t, att_q30 phi[3])
 {
-    int32_t t0, t1, t2;
+    int32_t k0, k1, k2;
     fx_acc acc;
-    t0 = fx_mul(k, a[0], 30);
-    t1 = fx_mul(k, a[1], 30);
-    t2 = fx_mul(k, a[2], 30);
-    fx_zero(&acc);
-    fx_mac(&acc, t1, b[2]);
-    fx_mac(&acc, -t2, b[1]);
-    phi[0] = b[0] + (with_a ? a[0] : 0) + fx_round(&acc, 30);
-    fx_zero(&acc);
-    fx_mac(&acc, t2, b[0]);
-    fx_mac(&acc, -t0, b[2]);
-    phi[1] = b[1] + (with_a ? a[1] : 0) + fx_round(&acc, 30);
-    fx_zero(&acc);
-    fx_mac(&acc, t0, b[1]);
-    fx_mac(&acc, -t1, b[0]);
-    phi[2] = b[2] + (with_a ? a[2] : 0) + fx_round(&acc, 30);
+    k0 = fx_mul(k, a[0], 30);
+    k1 = fx_mul(k, a[1], 30);
+    k2 = fx_mul(k, a[2], 30);
+    fx_init_u(&acc, FX_DITHER30(t, 1u));
+    fx_mac(&acc, k1, b[2]);
+    fx_mac(&acc, -k2, b[1]);
+    phi[0] = b[0] + (with_a ? a[0] : 0) + fx_floor(&acc, 30);
+    fx_init_u(&acc, FX_DITHER30(t, 11u));
+    fx_mac(&acc, k2, b[0]);
+    fx_mac(&acc, -k0, b[2]);
+    phi[1] = b[1] + (with_a ? a[1] : 0) + fx_floor(&acc, 30);
+    fx_init_u(&acc, FX_DITHER30(t, 22u));
+    fx_mac(&acc, k0, b[1]);
+    fx_mac(&acc, -k1, b[0]);
+    phi[2] = b[2] + (with_a ? a[2] : 0) + fx_floor(&acc, 30);
 }
 
 att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30 phi[3])
@@ -99,13 +99,13 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
     }
     switch (method) {
     case ATT_FX_RV3:
-        att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, phi);
+        att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, 0, phi);
         break;
     case ATT_FX_RV3_CONING:
-        att_fx_phi_rv3_(d, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, phi);
+        att_fx_phi_rv3_(d, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, 0, phi);
         break;
     case ATT_FX_RV2:
-        fx_phi2(d, d + 3, ATT_FX_K_RV2, 1, phi);
+        fx_phi2(d, d + 3, ATT_FX_K_RV2, 1, 0, phi);
         break;
     default: /* rv1, rv3-reuse */
         if (n == 1u) {
@@ -113,9 +113,9 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
             phi[1] = d[1];
             phi[2] = d[2];
         } else if (n == 2u) {
-            fx_phi2(d, d + 3, ATT_FX_K_RV3R_START, 0, phi);
+            fx_phi2(d, d + 3, ATT_FX_K_RV3R_START, 0, 0, phi);
         } else {
-            att_fx_phi_reuse_(d, d + 3, d + 6, phi);
+            att_fx_phi_reuse_(d, d + 3, d + 6, 0, phi);
         }
         break;
     }
@@ -171,9 +171,11 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
     att_q30 phi[3];
     att_status st;
     uint8_t m;
+    uint32_t t;
     if (s == 0 || dtheta == 0) {
         return ATT_E_NULL;
     }
+    t = fx_dither_seed(s->q);
     if (FX_DBAD(dtheta[0]) || FX_DBAD(dtheta[1]) || FX_DBAD(dtheta[2])) {
         return (att_status)ATT_FX_E_RANGE;
     }
@@ -185,15 +187,15 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
             return ATT_FX_PENDING;
         }
         if (m == ATT_FX_RV3) {
-            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, phi);
+            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
         } else {
-            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, phi);
+            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
         }
     } else if (m == ATT_FX_RV3_REUSE) {
         if (s->nbuf == 2u) {
-            att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta, phi);
+            att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta, t, phi);
         } else if (s->nbuf == 1u) {
-            fx_phi2(s->buf, dtheta, ATT_FX_K_RV3R_START, 0, phi);
+            fx_phi2(s->buf, dtheta, ATT_FX_K_RV3R_START, 0, t, phi);
         } else {
             fx_copy3(phi, dtheta);
         }
@@ -203,13 +205,13 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
             s->nbuf = 1;
             return ATT_FX_PENDING;
         }
-        fx_phi2(s->buf, dtheta, ATT_FX_K_RV2, 1, phi);
+        fx_phi2(s->buf, dtheta, ATT_FX_K_RV2, 1, t, phi);
     } else if (m == ATT_FX_RV1) {
         fx_copy3(phi, dtheta);
     } else {
         return (att_status)ATT_FX_E_METHOD;
     }
-    st = att_fx_apply_(s->q, phi);
+    st = att_fx_apply_(s->q, phi, t);
     if (st != ATT_OK) {
         return st;
     }
@@ -277,17 +279,20 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
         if (s->nbuf == 0u && i + 3u <= n
             && (s->method == ATT_FX_RV3 || s->method == ATT_FX_RV3_CONING)) {
             att_q30 phi[3];
+            uint32_t t = fx_dither_seed(s->q);
             if (s->method == ATT_FX_RV3) {
-                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, phi);
+                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
             } else {
-                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, phi);
+                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
             }
-            r = att_fx_apply_(s->q, phi);
+            r = att_fx_apply_(s->q, phi, t);
             i += 3u;
         } else if (s->method == ATT_FX_RV3_REUSE && i >= 2u) {
             att_q30 phi[3];
-            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i, phi);
-            r = att_fx_apply_(s->q, phi);
+            uint32_t t = fx_dither_seed(s->q);
+            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i, t,
+                              phi);
+            r = att_fx_apply_(s->q, phi, t);
             if (r == ATT_OK && i + 1u == n) { /* leave the history in the state */
                 fx_copy3(s->buf, dtheta + 3u * (i - 1u));
                 fx_copy3(s->buf + 3, dtheta + 3u * i);

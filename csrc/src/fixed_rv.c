@@ -26,6 +26,17 @@ static const int32_t fx_deg_vmax[6] = {
     28378L, 2349547L, 24989211L, 113507487L, 331839229L, 747556367L
 };
 
+uint32_t att_fx_dither_seed_(const att_q30 q[4])
+{
+    uint32_t x = (uint32_t)q[0] ^ (uint32_t)q[1] ^ (uint32_t)q[2] ^ (uint32_t)q[3];
+    x ^= x >> 16;
+    x *= 0x85EBCA6Bul;
+    x ^= x >> 13;
+    x *= 0xC2B2AE35ul;
+    x ^= x >> 16;
+    return (x != 0u) ? x : 1u; /* 0 would mean "no dither" */
+}
+
 int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
 {
     uint8_t i;
@@ -47,7 +58,7 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
  * so no saturation is needed. Subtracted products use a negated operand
  * (one multiply-accumulate each).
  */
-void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3])
+void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
 {
     int32_t a0, a1, a2, b0, b1, b2, w0, w1, w2, e0, e1, e2;
     fx_acc acc;
@@ -64,27 +75,28 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, att_q30 phi[3
     w1 = e1 - d[1];
     w2 = e2 - d[2];
 
-    /* round(S·2^30 + X) / 2^30 = S + round(X / 2^30) for an integer sum S */
-    fx_zero(&acc);
+    /* round(S·2^30 + X) / 2^30 = S + round(X / 2^30) for an integer sum S
+     * (dithered: floor((X + D) / 2^30), see FX_DITHER30) */
+    fx_init_u(&acc, FX_DITHER30(t, 1u));
     fx_mac(&acc, a1, e2);
     fx_mac(&acc, -a2, e1);
     fx_mac(&acc, b1, w2);
     fx_mac(&acc, -b2, w1);
-    phi[0] = d[0] + d[3] + e0 + fx_round(&acc, 30);
+    phi[0] = d[0] + d[3] + e0 + fx_floor(&acc, 30);
 
-    fx_zero(&acc);
+    fx_init_u(&acc, FX_DITHER30(t, 11u));
     fx_mac(&acc, a2, e0);
     fx_mac(&acc, -a0, e2);
     fx_mac(&acc, b2, w0);
     fx_mac(&acc, -b0, w2);
-    phi[1] = d[1] + d[4] + e1 + fx_round(&acc, 30);
+    phi[1] = d[1] + d[4] + e1 + fx_floor(&acc, 30);
 
-    fx_zero(&acc);
+    fx_init_u(&acc, FX_DITHER30(t, 22u));
     fx_mac(&acc, a0, e1);
     fx_mac(&acc, -a1, e0);
     fx_mac(&acc, b0, w1);
     fx_mac(&acc, -b1, w0);
-    phi[2] = d[2] + d[5] + e2 + fx_round(&acc, 30);
+    phi[2] = d[2] + d[5] + e2 + fx_floor(&acc, 30);
 }
 
 /*
@@ -150,7 +162,7 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
  *     (Q2.30 × Q2.30 = Q60, doubled); the exact sum of each component is
  *     bounded by |Q||q| ≈ 2^61 and rounded once to Q2.30 (shift 31).
  */
-att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3])
+att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 {
     fx_acc acc;
     int32_t c, c2, s, e, h1, h2, h3, q0, q1, q2, q3;
@@ -173,13 +185,13 @@ att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3])
     e = fx_round(&acc, 31);
     c -= e;
 
-#define FX_H(hk, qk, pk)                                                          \
-    fx_init_u(&acc, (uint32_t)((uint32_t)(qk) * (uint32_t)2654435761ul) >> 2);    \
+#define FX_H(hk, ROT, pk)                                                         \
+    fx_init_u(&acc, FX_DITHER30(t, ROT));                                         \
     fx_mac(&acc, s, pk);                                                          \
     hk = fx_floor(&acc, 30)
-    FX_H(h1, q1, phi[0]);
-    FX_H(h2, q2, phi[1]);
-    FX_H(h3, q3, phi[2]);
+    FX_H(h1, 6u, phi[0]);
+    FX_H(h2, 17u, phi[1]);
+    FX_H(h3, 27u, phi[2]);
 #undef FX_H
 
     /* 2·Q_i·c = Q_i·2^31 + Q_i·c2 with c2 = 2c − 2^31 (fits int32: 0 ≤ c < 2^31);
@@ -230,12 +242,16 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
     if (fx_round_u(&acc, 36) > 161061274ul) { /* 9.6 · 2^24 */
         return (att_status)ATT_FX_E_RANGE;
     }
-    return att_fx_apply_(q, phi);
+    {
+        uint32_t t = fx_dither_seed(q);
+        return att_fx_apply_(q, phi, t);
+    }
 }
 
 att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
 {
     att_q30 phi[3];
+    uint32_t t;
     if (q == 0 || d == 0) {
         return ATT_E_NULL;
     }
@@ -243,6 +259,7 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
         || FX_DBAD(d[5]) || FX_DBAD(d[6]) || FX_DBAD(d[7]) || FX_DBAD(d[8])) {
         return (att_status)ATT_FX_E_RANGE;
     }
-    att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, phi);
-    return att_fx_apply_(q, phi);
+    t = fx_dither_seed(q);
+    att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
+    return att_fx_apply_(q, phi, t);
 }
