@@ -6,5 +6,6 @@
 #define ATTITUDE_ATTITUDE_H
 
 #include "attitude/common.h"
+#include "attitude/tlc2543.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
