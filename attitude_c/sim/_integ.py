@@ -48,8 +48,8 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: "Callable[[float], np
     first increment starts. Returns ``(quats (M, 4), last (M,), offset)``:
     output j is the attitude at ``(last[j] + offset)`` periods, ``last[j]``
     the index of the newest increment it used (offset 1: the end of that
-    increment). ``rk4`` takes the mean rates Δθ/h as rate samples at the
-    interval midpoints (rows t, t+h/2, t+h of a 2h step), so it starts half
+    increment). ``rk4`` takes the mean rates Δθ/h, corrected to the rates at
+    the interval midpoints (second-difference term), as rate samples (rows t, t+h/2, t+h of a 2h step), so it starts half
     a period in and its outputs fall at midpoints (offset 0.5).
     """
     import attitude_c
@@ -62,7 +62,15 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: "Callable[[float], np
     if method == "rk4":
         if n < 3:
             return empty
-        q = attitude_c.integrate_rates(dtheta / h, h / 2, method="rk4", q0=q0_at(0.5),
+        # mean rate over an interval = midpoint rate + h²ω''/24 + O(h⁴): remove
+        # the second-order term with the second difference of the means
+        m = dtheta / h
+        w = m.copy()
+        if n >= 3:
+            w[1:-1] -= (m[2:] - 2 * m[1:-1] + m[:-2]) / 24
+            w[0] -= (m[2] - 2 * m[1] + m[0]) / 24
+            w[-1] -= (m[-1] - 2 * m[-2] + m[-3]) / 24
+        q = attitude_c.integrate_rates(w, h, method="rk4", q0=q0_at(0.5),
                                        precision=precision)
         q = np.asarray(q, dtype=float)
         last = 2 * np.arange(1, len(q) + 1)
