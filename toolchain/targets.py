@@ -51,6 +51,29 @@ class Target:
     run_cmd: list[str] = field(default_factory=list)
     apt: list[str] = field(default_factory=list)
     objdump: str | None = None
+    #: Glob patterns (relative to the repository root) of the library sources
+    #: built for this target; default: the whole portable library.
+    lib_source_globs: list[str] = field(default_factory=lambda: ["csrc/src/*.c"])
+    #: What `invoke cross-build` produces besides the static library.
+    shared: bool = False          # libattitude.so (Linux targets)
+    app: bool = False             # the attitude-rx program (needs POSIX threads and termios)
+    app_libs: list[str] = field(default_factory=list)
+    pic_flags: list[str] = field(default_factory=lambda: ["-fPIC"])
+    #: Post-build checks by name (e.g. "armv4t": toolchain/armv4t_check.py).
+    checks: list[str] = field(default_factory=list)
+
+    def library_sources(self) -> list[Path]:
+        """The library sources this target builds (sorted, de-duplicated)."""
+        out: set[Path] = set()
+        for pat in self.lib_source_globs:
+            out.update(ROOT.glob(pat))
+        return sorted(out)
+
+    def tool(self, name: str) -> str:
+        """A binutils tool of this toolchain (``readelf``, ``size``...) next to ``ar``."""
+        if self.ar.endswith("-ar"):
+            return self.ar[: -len("ar")] + name
+        return name
 
     # -- availability -----------------------------------------------------
     def tools(self) -> list[str]:
@@ -151,4 +174,8 @@ def load(name: str) -> Target:
         cflags=list(d.get("cflags", [])), ldflags=list(d.get("ldflags", [])),
         libs=list(d.get("libs", [])), run_cmd=list(d.get("run", [])),
         apt=list(d.get("apt", [])), objdump=d.get("objdump"),
+        lib_source_globs=list(d.get("lib_sources", ["csrc/src/*.c"])),
+        shared=bool(d.get("shared", False)), app=bool(d.get("app", False)),
+        app_libs=list(d.get("app_libs", [])), pic_flags=list(d.get("pic_flags", ["-fPIC"])),
+        checks=list(d.get("checks", [])),
     )

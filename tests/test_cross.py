@@ -1,0 +1,226 @@
+"""Cross builds: invoke cross-build, the ARMv4T instruction check, the plain
+Makefile, the CMake toolchain file and the qemu instruction counter."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from conftest import ROOT, require_target, require_tools
+from toolchain import armv4t_check
+from toolchain.tasks.cross import cross_build_target
+
+# A small user program: what a mini2440 application does with the library.
+EXAMPLE_C = r"""
+#include <stdio.h>
+#include "attitude/attitude.h"
+int main(void)
+{
+    printf("att_real=%d ok=%s\n", att_real_size(), att_status_str(ATT_OK));
+    return 0;
+}
+"""
+
+SNIPPET_C = r"""
+unsigned lead(unsigned a) { return (unsigned)__builtin_clz(a); }
+"""
+
+
+def _cc(t, src: Path, obj: Path, *flags: str) -> Path:
+    subprocess.run([t.cc, "-O2", "-marm", "-mfloat-abi=soft", *flags, "-c", str(src), "-o", str(obj)],
+                   check=True, capture_output=True)
+    return obj
+
+
+# -- the ARMv4T check -------------------------------------------------------
+
+def test_armv4t_check_rejects_armv5te_object(tmp_path: Path) -> None:
+    """An object built for ARMv5TE (clz) is caught; the v4T build of the same code is clean."""
+    t = require_target("armv4t")
+    src = tmp_path / "snippet.c"
+    src.write_text(SNIPPET_C)
+    bad = _cc(t, src, tmp_path / "v5te.o", "-march=armv5te")
+    vs = armv4t_check.check_objects([bad], objdump=t.objdump)
+    mnems = {v.insn.split()[0] for v in vs}
+    assert "clz" in mnems, vs
+    assert any("v5TE" in v.reason for v in vs if v.insn.startswith("Tag_CPU_arch")), vs
+    good = _cc(t, src, tmp_path / "v4t.o", "-march=armv4t", "-mtune=arm920t")
+    assert armv4t_check.check_objects([good], objdump=t.objdump) == []
+
+
+def test_armv4t_check_rejects_interworking_and_vfp(tmp_path: Path) -> None:
+    """Returns that load pc (no interworking on v4T), blx and VFP code are caught."""
+    t = require_target("armv4t")
+    asm = tmp_path / "bad.s"
+    asm.write_text(
+        ".arm\n.text\n.global f\nf:\n push {r4, lr}\n pop {r4, pc}\n"
+        ".global g\ng:\n mov pc, lr\n.global h\nh:\n ldr pc, [sp], #4\n"
+        ".global j\nj:\n ldr pc, [pc, r0, lsl #2]\n bx lr\n")
+    obj = tmp_path / "bad.o"
+    subprocess.run([t.cc, "-march=armv4t", "-c", str(asm), "-o", str(obj)], check=True,
+                   capture_output=True)
+    vs = armv4t_check.check_objects([obj], objdump=t.objdump)
+    funcs = sorted(v.function for v in vs)
+    assert funcs == ["f", "g", "h"], vs  # j's jump table stays in ARM state: accepted
+    vfp = tmp_path / "vfp.c"
+    vfp.write_text("double mac(double a, double b, double c) { return a * b + c; }\n"
+                   "int (*fp)(void); int call(void) { return fp() + 1; }\n")
+    obj2 = _cc(t, vfp, tmp_path / "vfp.o", "-march=armv5te", "-mfpu=vfp", "-mfloat-abi=softfp")
+    reasons = " ".join(v.reason for v in armv4t_check.check_objects([obj2], objdump=t.objdump))
+    assert "FPU" in reasons and "BLX" in reasons
+
+
+def test_armv4t_check_cli_exit_status(tmp_path: Path) -> None:
+    t = require_target("armv4t")
+    src = tmp_path / "snippet.c"
+    src.write_text(SNIPPET_C)
+    bad = _cc(t, src, tmp_path / "v5te.o", "-march=armv5te")
+    assert armv4t_check.main(["--objdump", t.objdump, str(bad)]) == 1
+    good = _cc(t, src, tmp_path / "v4t.o", "-march=armv4t")
+    assert armv4t_check.main(["--objdump", t.objdump, str(good)]) == 0
+
+
+# -- invoke cross-build -----------------------------------------------------
+
+def _example_against(t, out: Path, tmp_path: Path) -> Path:
+    """Compile the example with the flags pkg-config gives for build/NAME/attitude.pc."""
+    require_tools("pkg-config", apt="pkg-config")
+    env = dict(os.environ, PKG_CONFIG_PATH=str(out), PKG_CONFIG_LIBDIR=str(out))
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "--static", "attitude"], env=env,
+                           check=True, capture_output=True, text=True).stdout.split()
+    src = tmp_path / "example.c"
+    src.write_text(EXAMPLE_C)
+    exe = tmp_path / "example"
+    rpath = [] if "-static" in t.ldflags else [f"-Wl,-rpath,{out}"]  # dynamic: find our .so
+    subprocess.run([t.cc, *t.cflags, str(src), "-o", str(exe), *flags, *t.ldflags, *rpath],
+                   check=True, capture_output=True)
+    return exe
+
+
+@pytest.mark.qemu
+def test_cross_build_armv4t(tmp_path: Path) -> None:
+    """invoke cross-build --target armv4t: every product, ARMv4T-clean, usable through pkg-config."""
+    t = require_target("armv4t")
+    out = tmp_path / "armv4t"
+    products = cross_build_target("armv4t", out=out)
+    for name in ("libattitude.a", "libattitude.so", "attitude.pc", "include/attitude/attitude.h"):
+        assert (out / name).exists(), name
+    assert "armv4t_check" in products  # the build ran the check (and would have failed on a violation)
+    if any((ROOT / "csrc" / "app").glob("*.c")):
+        assert (out / "attitude-rx").exists()
+    exe = _example_against(t, out, tmp_path)
+    assert armv4t_check.check_objects([out / "libattitude.a"], objdump=t.objdump) == []
+    res = t.run([exe], timeout=60)
+    assert res.stdout.decode().strip() == "att_real=8 ok=ok"
+
+
+@pytest.mark.parametrize("name", ["host", "armv4t-bare", "armv7hf", "aarch64", "mcs51"])
+def test_cross_build_other_targets(name: str, tmp_path: Path) -> None:
+    t = require_target(name)
+    out = tmp_path / name
+    products = cross_build_target(name, out=out)
+    assert products["static"].stat().st_size > 0
+    assert (products["pc"]).read_text().startswith("prefix=${pcfiledir}")
+    if t.os == "linux":
+        assert (out / "libattitude.so").exists()
+    if name == "host":
+        exe = _example_against(t, out, tmp_path)
+        assert subprocess.run([exe], capture_output=True, text=True, check=True).stdout.strip() \
+            == "att_real=8 ok=ok"
+
+
+def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
+    """The float build's attitude.pc passes -DATT_REAL_F32 (att_real is part of the ABI)."""
+    t = require_target("host")
+    out = tmp_path / "f32"
+    cross_build_target("host", precision="f32", out=out)
+    assert "-DATT_REAL_F32" in (out / "attitude.pc").read_text()
+    exe = _example_against(t, out, tmp_path)
+    assert subprocess.run([exe], capture_output=True, text=True, check=True).stdout.strip() \
+        == "att_real=4 ok=ok"
+
+
+# -- plain Makefile and CMake -----------------------------------------------
+
+def _clean_copy(tmp_path: Path) -> Path:
+    """The tracked sources only (what a fresh clone has), so no stale build output is reused."""
+    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "Makefile", "CMakeLists.txt",
+                            "cmake", "csrc", "pyproject.toml"], cwd=ROOT, check=True,
+                           capture_output=True, text=True).stdout.split()
+    dst = tmp_path / "src"
+    for f in files:
+        (dst / f).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / f, dst / f)
+    return dst
+
+
+@pytest.mark.qemu
+def test_makefile_cross_compile_install_and_link(tmp_path: Path) -> None:
+    """make CROSS_COMPILE=arm-linux-gnueabi- from a clean tree; make install; an example links."""
+    t = require_target("armv4t")
+    require_tools("make", "pkg-config", apt="make pkg-config")
+    src = _clean_copy(tmp_path)
+    arch = "-march=armv4t -mtune=arm920t -marm -mfloat-abi=soft"
+    subprocess.run(["make", "-j2", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}"],
+                   cwd=src, check=True, capture_output=True)
+    root = tmp_path / "rootfs"
+    subprocess.run(["make", "install", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}",
+                    "PREFIX=/usr", f"DESTDIR={root}"], cwd=src, check=True, capture_output=True)
+    lib = root / "usr" / "lib"
+    for name in ("libattitude.a", "libattitude.so", "libattitude.so.0", "pkgconfig/attitude.pc"):
+        assert (lib / name).exists(), name
+    assert (root / "usr" / "include" / "attitude" / "attitude.h").exists()
+    assert "prefix=/usr" in (lib / "pkgconfig" / "attitude.pc").read_text()
+    assert armv4t_check.check_objects([lib / "libattitude.a"], objdump=t.objdump) == []
+    if any((ROOT / "csrc" / "app").glob("*.c")):
+        assert (root / "usr" / "bin" / "attitude-rx").exists()
+    env = dict(os.environ, PKG_CONFIG_PATH="", PKG_CONFIG_LIBDIR=str(lib / "pkgconfig"),
+               PKG_CONFIG_SYSROOT_DIR=str(root))
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "--static", "attitude"], env=env,
+                           check=True, capture_output=True, text=True).stdout.split()
+    ex = tmp_path / "example.c"
+    ex.write_text(EXAMPLE_C)
+    exe = tmp_path / "example"
+    subprocess.run(["arm-linux-gnueabi-gcc", *arch.split(), str(ex), "-o", str(exe), "-static", *flags],
+                   check=True, capture_output=True)
+    assert t.run([exe], timeout=60).stdout.decode().strip() == "att_real=8 ok=ok"
+
+
+def test_cmake_armv4t_toolchain(tmp_path: Path) -> None:
+    """CMake with cmake/armv4t-toolchain.cmake builds an ARMv4T-clean libattitude.a."""
+    t = require_target("armv4t")
+    require_tools("cmake", "make", apt="cmake make")
+    bdir = tmp_path / "cmake"
+    subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir),
+                    f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'armv4t-toolchain.cmake'}"],
+                   check=True, capture_output=True)
+    subprocess.run(["cmake", "--build", str(bdir), "-j2"], check=True, capture_output=True)
+    assert armv4t_check.check_objects([bdir / "libattitude.a"], objdump=t.objdump) == []
+    assert (bdir / "libattitude.so").exists()
+
+
+# -- qemu instruction counter ----------------------------------------------
+
+@pytest.mark.qemu
+def test_qemu_count_exact_loop(tmp_path: Path) -> None:
+    """count_instructions is exact: a 2-instruction loop run k times costs 2k more."""
+    from toolchain.qemu_count import count_instructions, per_iteration
+
+    t = require_target("armv4t-bare")
+    src = tmp_path / "loop.c"
+    src.write_text(
+        "#include <stdlib.h>\n"
+        "int main(int argc, char **argv) {\n"
+        "  unsigned n = argc > 1 ? (unsigned)atoi(argv[1]) : 0;\n"
+        "  if (n) __asm__ volatile(\"1: subs %0, %0, #1\\n bne 1b\" : \"+r\"(n) :: \"cc\");\n"
+        "  return 0;\n}\n")
+    exe = t.build_program([src], tmp_path / "loop", with_lib=False)
+    # same-length arguments so that atoi() costs the same in both runs
+    a = count_instructions(exe, ["0001"])
+    b = count_instructions(exe, ["1001"])
+    assert b - a == 2000  # exactly subs + bne per extra iteration
+    assert per_iteration(exe, lambda k: [f"{k:04d}"], 1, 501) == 2.0

@@ -1,0 +1,172 @@
+"""Cross builds: `invoke cross-build --target NAME` (settings in toolchain/NAME.toml).
+
+Produces in ``build/NAME/``:
+
+* ``libattitude.a`` (``libattitude.lib`` for SDCC targets) from the target's
+  library sources (all of ``csrc/src`` except on mcs51, which builds only
+  the 8051 parts);
+* ``libattitude.so`` (+ ``.so.0`` and the versioned file) on Linux targets;
+* ``attitude-rx`` (statically linked) on Linux targets;
+* ``include/attitude/*.h`` and ``attitude.pc`` (relocatable: paths relative
+  to the .pc file, so ``PKG_CONFIG_PATH=build/NAME pkg-config --cflags
+  --libs attitude`` works wherever the tree is);
+* on ``armv4t``/``armv4t-bare``: the ARMv4T instruction check of every
+  object (toolchain/armv4t_check.py); the build fails on a violation.
+
+The build is done from Python (not by calling make) so that every
+target, including SDCC, uses exactly the flags of its TOML file.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Sequence
+
+from invoke import task
+
+from toolchain import targets as T
+
+ROOT = T.ROOT
+APP_DIR = ROOT / "csrc" / "app"
+SOVERSION = "0"
+
+
+def version() -> str:
+    m = re.search(r'^version\s*=\s*"([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.M)
+    return m.group(1) if m else "0.0.0"
+
+
+def _run(cmd: Sequence[str], verbose: bool) -> None:
+    if verbose:
+        print(" ".join(map(str, cmd)), flush=True)
+    proc = subprocess.run(list(map(str, cmd)), capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise BuildError(f"command failed ({proc.returncode}): {' '.join(map(str, cmd))}\n"
+                         f"{proc.stdout}{proc.stderr}")
+
+
+class BuildError(RuntimeError):
+    pass
+
+
+def _compile_all(t: T.Target, srcs: Sequence[Path], objdir: Path, extra: Sequence[str],
+                 defines: Sequence[str], verbose: bool) -> list[Path]:
+    objdir.mkdir(parents=True, exist_ok=True)
+    objs = []
+    suffix = ".rel" if t.kind == "sdcc" else ".o"
+    for s in srcs:
+        o = objdir / (s.stem + suffix)
+        _run(t.compile_cmd(s, o, defines=defines, extra_cflags=extra,
+                           include_dirs=[APP_DIR] if s.parent == APP_DIR else []), verbose)
+        objs.append(o)
+    return objs
+
+
+def pc_text(t: T.Target, defines: Sequence[str], libs: Sequence[str]) -> str:
+    cflags = " ".join(f"-D{d}" for d in defines)
+    return (
+        "prefix=${pcfiledir}\n"
+        "libdir=${prefix}\n"
+        "includedir=${prefix}/include\n\n"
+        "Name: attitude\n"
+        f"Description: libattitude strapdown attitude library ({t.name} build)\n"
+        f"Version: {version()}\n"
+        f"Cflags: -I${{includedir}}{(' ' + cflags) if cflags else ''}\n"
+        "Libs: -L${libdir} -lattitude\n"
+        f"Libs.private: {' '.join(libs)}\n"
+    )
+
+
+def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = None,
+                       verbose: bool = False) -> dict[str, Path]:
+    """Build target ``name`` into ``out`` (default build/NAME); returns the products."""
+    t = T.load(name)
+    t.require()
+    if precision not in ("f64", "f32"):
+        raise ValueError(f"precision must be 'f64' or 'f32', not {precision!r}")
+    # SDCC has no double (it would silently be float): always the float build.
+    defines = ["ATT_REAL_F32"] if precision == "f32" or t.kind == "sdcc" else []
+    out = Path(out) if out else t.build_dir()
+    if out.exists():
+        shutil.rmtree(out)
+    out.mkdir(parents=True)
+    srcs = t.library_sources()
+    if not srcs:
+        raise BuildError(f"target {name}: no library sources match {t.lib_source_globs}")
+    products: dict[str, Path] = {}
+
+    objs = _compile_all(t, srcs, out / "obj", [], defines, verbose)
+    if t.kind == "sdcc":
+        lib = out / "libattitude.lib"
+        _run([t.ar, "rcs", lib, *objs], verbose)
+    else:
+        lib = out / "libattitude.a"
+        _run([t.ar, "rcs", lib, *objs], verbose)
+    products["static"] = lib
+
+    if t.shared and t.kind == "gcc":
+        pobjs = _compile_all(t, srcs, out / "obj-pic", t.pic_flags, defines, verbose)
+        real = out / f"libattitude.so.{version()}"
+        ldflags = [f for f in t.ldflags if f != "-static"]
+        _run([t.cc, *t.cflags, "-shared", f"-Wl,-soname,libattitude.so.{SOVERSION}",
+              *pobjs, "-o", real, *ldflags, *t.libs], verbose)
+        for link in (f"libattitude.so.{SOVERSION}", "libattitude.so"):
+            (out / link).symlink_to(real.name)
+        products["shared"] = out / "libattitude.so"
+
+    app_objs: list[Path] = []
+    if t.app:
+        app_srcs = sorted(APP_DIR.glob("*.c"))
+        if app_srcs:
+            app_objs = _compile_all(t, app_srcs, out / "obj-app", [], defines, verbose)
+            exe = out / "attitude-rx"
+            _run([t.cc, *t.cflags, *app_objs, lib, "-o", exe, *t.ldflags, *t.app_libs, *t.libs],
+                 verbose)
+            products["app"] = exe
+
+    inc = out / "include" / "attitude"
+    inc.mkdir(parents=True)
+    for h in sorted((T.INCLUDE / "attitude").glob("*.h")):
+        shutil.copy2(h, inc / h.name)
+    products["include"] = inc
+    pc = out / "attitude.pc"
+    pc.write_text(pc_text(t, defines, t.libs))
+    products["pc"] = pc
+
+    if "armv4t" in t.checks:
+        from toolchain.armv4t_check import check_objects
+
+        vs = check_objects([lib, *app_objs], objdump=t.objdump or t.tool("objdump"))
+        if vs:
+            raise BuildError(f"target {name}: {len(vs)} instruction(s) the ARM920T cannot execute:\n"
+                             + "\n".join(map(str, vs)))
+        products["armv4t_check"] = lib
+    return products
+
+
+@task(help={
+    "target": "target name (toolchain/NAME.toml): armv4t, armv4t-bare, armv7hf, aarch64, host, mcs51",
+    "precision": "f64 (att_real = double, default) or f32 (float)",
+    "out": "output directory (default build/TARGET)",
+    "verbose": "print every command",
+})
+def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
+    """Build libattitude (+ .so, attitude-rx, headers, attitude.pc) for a target into build/TARGET."""
+    try:
+        products = cross_build_target(target, precision=precision, out=Path(out) if out else None,
+                                      verbose=verbose)
+    except (T.ToolchainMissing, BuildError, ValueError) as exc:
+        raise SystemExit(f"cross-build: {exc}")
+    for kind, p in products.items():
+        rel = os.path.relpath(p, ROOT)
+        if kind == "armv4t_check":
+            print(f"  ARMv4T check: every object is ARMv4T clean")
+        else:
+            print(f"  {kind:8s} {rel}")
+
+
+TOP_LEVEL = (cross_build,)
