@@ -163,6 +163,8 @@ class Board:
     delay_comp: bool = True
 
     def check(self, bits: int) -> None:
+        if not (isinstance(bits, int) and 1 <= bits <= 16):
+            raise InvalidArgument(f"ADC bits must be 1..16 (16-bit link words), got {bits!r}")
         if not 1 <= self.oversample <= (1 << (16 - bits)):
             raise InvalidArgument(
                 f"oversample must be 1..{1 << (16 - bits)} so that the sum of {bits}-bit codes "
