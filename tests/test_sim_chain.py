@@ -3,7 +3,6 @@ link errors, bad input."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 import numpy as np

@@ -28,7 +28,7 @@ import numpy as np
 from . import _integ
 from .chain import Acquired, SimConfig, acquire, simulate
 
-__all__ = ["STAGES", "BudgetResult", "run_budget", "format_budget", "plot_budget"]
+__all__ = ["STAGES", "BudgetResult", "format_budget", "plot_budget", "run_budget"]
 
 STAGES = ("algorithm", "+ quantization", "+ gyro noise/bias", "+ link errors", "+ float32",
           "+ fixed-point")

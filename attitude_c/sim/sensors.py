@@ -21,13 +21,13 @@ from ..errors import InvalidArgument
 from .trajectory import Trajectory
 
 __all__ = [
-    "GyroModel",
     "GYRO_PRESETS",
-    "gyro_preset",
-    "Conditioning",
     "AdcModel",
     "Board",
     "Calibration",
+    "Conditioning",
+    "GyroModel",
+    "gyro_preset",
     "quantize_ideal",
 ]
 
@@ -57,7 +57,7 @@ class GyroModel:
     scale_error: float = 0.0
 
     def without(self, *, noise: bool = False, bias: bool = False, bandwidth: bool = False,
-                scale: bool = False) -> "GyroModel":
+                scale: bool = False) -> GyroModel:
         """A copy with the named error sources switched off."""
         kw: dict[str, Any] = {}
         if noise:
