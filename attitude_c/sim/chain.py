@@ -112,7 +112,8 @@ class SimConfig:
             "conditioning": {"vref_v": self.conditioning.vref, "span": self.conditioning.span,
                              "gain": self.conditioning.gain(self.gyro)},
             "adc": {"bits": self.adc.bits, "vref_v": self.adc.vref, "backend": self.adc.backend},
-            "board": {"oversample": self.board.oversample, "delay_comp": self.board.delay_comp},
+            "board": {"oversample": self.board.oversample, "delay_comp": self.board.delay_comp,
+                      "sample_at": self.board.sample_at},
             "calibration_s": self.calibration_s,
             "link": self.link,
             "ber": self.ber,
@@ -165,7 +166,8 @@ def _acquire(cfg: SimConfig, gyro: GyroModel, t0: float, n: int, rngs: dict[str,
     m = cfg.board.oversample
     dt = h / m
     delay = gyro.tau if cfg.board.delay_comp else 0.0
-    ti = t0 + (np.arange(n * m) + 0.5) * dt + delay
+    frac = 0.5 if cfg.board.sample_at == "mid" else 0.0
+    ti = t0 + (np.arange(n * m) + frac) * dt + delay
     if static:
         rate = np.zeros((n * m, 3))
     else:

@@ -161,8 +161,11 @@ class Board:
 
     oversample: int = 16
     delay_comp: bool = True
+    sample_at: str = "mid"  # "mid": sub-interval midpoints; "start": their starts
 
     def check(self, bits: int) -> None:
+        if self.sample_at not in ("mid", "start"):
+            raise InvalidArgument(f"sample_at must be 'mid' or 'start', got {self.sample_at!r}")
         if not (isinstance(bits, int) and 1 <= bits <= 16):
             raise InvalidArgument(f"ADC bits must be 1..16 (16-bit link words), got {bits!r}")
         if not 1 <= self.oversample <= (1 << (16 - bits)):
