@@ -130,19 +130,19 @@ def run(quick: bool = False) -> str:
     fus = imufusion_rate(n_loop)
     rv3 = rates["rv3", "f64"]
     out = [
-        f"Samples per call: {n:,} increments (~1 rad/s at 1 kHz); best of {repeat}. "
+        (f"Samples per call: {n:,} increments (~1 rad/s at 1 kHz); best of {repeat}. "
         "Updates/s count attitude outputs (rv2: one per 2 increments, rv3 and rv3-coning: one per 3, "
         "rk4: one per 2 rate rows). The C figures time one raw `att_integ_batch` / "
         "`att_integ_rk4_batch` call through CFFI (input checks are in the call: NaN/Inf abort it); "
-        "`attitude_c.integrate` adds the Python-side validation (one `isfinite` pass and a copy).",
+        "`attitude_c.integrate` adds the Python-side validation (one `isfinite` pass and a copy)."),
         "",
-        "| method | C f64 updates/s | gyro samples/s | C f32 updates/s | NumPy reference updates/s "
-        "| C f64 / NumPy | Python loop (`Integrator.update` per sample) |",
+        ("| method | C f64 updates/s | gyro samples/s | C f32 updates/s | NumPy reference updates/s "
+        "| C f64 / NumPy | Python loop (`Integrator.update` per sample) |"),
         "|---|---|---|---|---|---|---|",
         *rows,
         "",
-        f"imufusion (x-io Fusion, `Ahrs.update_no_magnetometer` per sample, Python loop): "
-        f"{_fmt(fus)} updates/s.",
+        (f"imufusion (x-io Fusion, `Ahrs.update_no_magnetometer` per sample, Python loop): "
+        f"{_fmt(fus)} updates/s."),
         "",
         f"Targets of issue 2 for rv3 f64: ≥ 10 M updates/s → **{_fmt(rv3)}** "
         f"({'met' if rv3 >= 10e6 else 'NOT met'}); ≥ 20× the NumPy reference → "
