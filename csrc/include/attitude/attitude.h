@@ -6,5 +6,8 @@
 #define ATTITUDE_ATTITUDE_H
 
 #include "attitude/common.h"
+#include "attitude/quat.h"
+#include "attitude/integrator.h"
+#include "attitude/link.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
