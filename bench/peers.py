@@ -13,6 +13,7 @@ error against the exact truth over the run.
 from __future__ import annotations
 
 import importlib.metadata as md
+import math
 import time
 from typing import Any, Callable
 
@@ -116,25 +117,25 @@ def run(quick: bool = False) -> str:
     except ImportError:
         rows.append(("ahrs", "not installed (pip install attitude-c[bench])", float("nan"), None))
 
-    ref = next((r[2] for r in rows if r[0].startswith("imufusion") and r[2] == r[2]), None)
+    ref = next((r[2] for r in rows if r[0].startswith("imufusion") and not math.isnan(r[2])), None)
     lines = [
-        f"Paper trajectory at 100 Hz (h = {h} s): our batch call on {n_ours:,} increments, "
-        f"per-sample loops and peers on {n_peer:,} samples ({n_peer * h:.0f} s). "
-        "Max error: largest attitude-angle error against the exact truth over the first "
-        f"{n_peer * h:.0f} s (our increment methods get exact increments, the peers the mean "
-        "rate of each interval). Source: `bench/peers.py`.",
+        (f"Paper trajectory at 100 Hz (h = {h} s): our batch call on {n_ours:,} increments, "
+         f"per-sample loops and peers on {n_peer:,} samples ({n_peer * h:.0f} s). "
+         "Max error: largest attitude-angle error against the exact truth over the first "
+         f"{n_peer * h:.0f} s (our increment methods get exact increments, the peers the mean "
+         "rate of each interval). Source: `bench/peers.py`."),
         "",
         "| implementation | how called | samples/s | vs imufusion | max error (rad) |",
         "|---|---|---:|---:|---:|",
     ]
     for name, how, rate, err in rows:
-        sp = f"{rate / ref:.1f}×" if ref and rate == rate else "—"
-        r = f"{rate:,.0f}" if rate == rate else "—"
+        sp = f"{rate / ref:.1f}×" if ref and not math.isnan(rate) else "—"
+        r = f"{rate:,.0f}" if not math.isnan(rate) else "—"
         e = f"{err:.2e}" if err is not None else "—"
         lines.append(f"| {name} | {how} | {r} | {sp} | {e} |")
-    lines += ["", "imufusion with gain 0 is a first-order (Euler) quaternion update q += ½ q ⊗ ω h, "
-              "hence its larger error; ahrs AngularRate applies the exponential of the rate held "
-              "constant over the interval (like our rv1)."]
+    lines += ["", ("imufusion with gain 0 is a first-order (Euler) quaternion update "
+                   "q += ½ q ⊗ ω h, hence its larger error; ahrs AngularRate applies the "
+                   "exponential of the rate held constant over the interval (like our rv1).")]
     return "\n".join(lines)
 
 
