@@ -7,5 +7,6 @@
 #define ATTITUDE_CFFI_BINDINGS_H
 
 #include "attitude/attitude.h"
+#include "link_sim.h"
 
 #endif
