@@ -255,8 +255,10 @@ def _read(port: Any, wait_s: float) -> bytes:
         port.timeout = wait_s
         n = port.in_waiting if hasattr(port, "in_waiting") else 0
         return port.read(max(1, n))
-    except serial.SerialException as exc:
+    except (serial.SerialException, OSError) as exc:
         raise LinkError(f"port {getattr(port, 'name', port)!r} failed: {exc}") from exc
+    except (TypeError, AttributeError) as exc:  # pyserial after close() from another thread
+        raise LinkError(f"port {getattr(port, 'name', port)!r} was closed") from exc
 
 
 def _write(port: Any, data: bytes) -> None:
