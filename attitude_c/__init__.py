@@ -35,12 +35,9 @@ __all__ = [
     "__version__",
 ]
 
-# The integrator API (attitude_c.core) is re-exported here.
-try:
-    from .core import *  # noqa: F401,F403
-    from .core import __all__ as _core_all
+# The integrator API (attitude_c.core) is re-exported here. Importing it does
+# not load the C extension (attitude_c._lib loads it on first use).
+from . import core as _core
+from .core import *
 
-    __all__ += list(_core_all)
-except ImportError as _exc:  # pragma: no cover - only while core is absent
-    if "attitude_c.core" not in str(_exc) and "No module named" not in str(_exc):
-        raise
+__all__ += list(_core.__all__)

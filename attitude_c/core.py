@@ -1,0 +1,482 @@
+"""The public Python API of the libattitude core (C library through CFFI).
+
+Rotation math (vectorized over leading axes) and the rotation-vector
+attitude integrator of docs/integrator.md, in two builds of the same C
+source: ``precision="f64"`` (double) and ``precision="f32"`` (float).
+``integrate(..., precision="fixed")`` dispatches to
+:mod:`attitude_c.fixedpoint` (the Q-format port).
+
+Conventions (docs/conventions.md): quaternions ``[λ, p1, p2, p3]`` scalar
+first, rotating body vectors into the ENU navigation frame; attitude
+matrices ``C = C_b^n`` (…, 3, 3); Euler angles ``[yaw ψ, pitch θ, roll γ]``
+of the z-x-y sequence, radians. Every function returns float64 arrays
+(the f32 build's results converted exactly).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._lib import ffi_lib
+from .errors import AttitudeError, InvalidArgument, InvalidType, NonFiniteError, RangeError
+
+__all__ = [
+    "INCREMENT_METHODS",
+    "METHODS",
+    "PRECISIONS",
+    "Integrator",
+    "dcm_to_euler",
+    "dcm_to_quat",
+    "euler_to_dcm",
+    "euler_to_quat",
+    "heading",
+    "integrate",
+    "integrate_rates",
+    "quat_conj",
+    "quat_multiply",
+    "quat_normalize",
+    "quat_to_dcm",
+    "quat_to_euler",
+    "quat_to_rotvec",
+    "rotvec_to_quat",
+]
+
+#: Integration methods, in the order of the C enum ``att_method``.
+METHODS: tuple[str, ...] = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+#: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
+INCREMENT_METHODS: tuple[str, ...] = METHODS[:5]
+#: Increments consumed per attitude update, per method.
+FRAME: dict[str, int] = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1}
+#: Numeric precisions: the two float builds and the fixed-point port.
+PRECISIONS: tuple[str, ...] = ("f64", "f32", "fixed")
+
+_DTYPES = {"f64": np.float64, "f32": np.float32}
+
+# Integrator-specific C status codes (csrc/include/attitude/integrator.h).
+_INTEG_STATUS = {
+    -20: (InvalidArgument, "unknown method, or a call not valid for this method"),
+    -21: (RangeError, "increment too large: the attitude update is not finite"),
+}
+
+FloatArray = NDArray[np.float64]
+
+
+# --------------------------------------------------------------------------
+# argument checking (one place for every public function)
+# --------------------------------------------------------------------------
+
+def _check_precision(precision: Any, allow_fixed: bool = False) -> str:
+    """Validate ``precision``; the single place where it is checked."""
+    if not isinstance(precision, str):
+        raise InvalidType(f"precision must be a str, got {type(precision).__name__}")
+    allowed = PRECISIONS if allow_fixed else PRECISIONS[:2]
+    if precision not in allowed:
+        raise InvalidArgument(f"precision must be one of {allowed!r}, got {precision!r}")
+    return precision
+
+
+def _check_method(method: Any, allowed: tuple[str, ...] = METHODS) -> str:
+    if not isinstance(method, str):
+        raise InvalidType(f"method must be a str, got {type(method).__name__}")
+    if method not in allowed:
+        raise InvalidArgument(f"method must be one of {allowed!r}, got {method!r}")
+    return method
+
+
+def _as_real(x: ArrayLike, name: str) -> NDArray[Any]:
+    """Array of a real numeric dtype (bool, complex, object, str rejected)."""
+    try:
+        a = np.asarray(x)
+    except Exception as exc:  # ragged lists and the like
+        raise InvalidArgument(f"{name} cannot be converted to an array: {exc}") from exc
+    if a.dtype.kind not in "iuf":
+        raise InvalidType(
+            f"{name} must hold real numbers (integer or float dtype), got dtype {a.dtype}")
+    return a
+
+
+def _first_bad(flat_ok: Any) -> int:
+    """Index of the first False in a boolean array."""
+    return int(np.argmin(np.asarray(flat_ok, dtype=bool)))
+
+
+def _records(x: ArrayLike, name: str, tail: tuple[int, ...], what: str,
+             allow_empty: bool = True) -> NDArray[np.float64]:
+    """Check shape (..., *tail) and finiteness; return float64 (n, prod(tail))."""
+    a = _as_real(x, name)
+    nt = len(tail)
+    if a.ndim < nt or a.shape[a.ndim - nt:] != tail:
+        want = "(..., " + ", ".join(str(t) for t in tail) + ")"
+        raise InvalidArgument(f"{name} must have shape {want} ({what}), got {a.shape}")
+    lead = a.shape[: a.ndim - nt]
+    a = np.asarray(a, dtype=np.float64).reshape(-1, int(np.prod(tail)))
+    if a.shape[0] == 0 and not allow_empty:
+        raise InvalidArgument(f"{name} is empty: at least one {what} is needed")
+    ok = np.isfinite(a).all(axis=1)
+    if not ok.all():
+        i = _first_bad(ok)
+        where = np.unravel_index(i, lead) if len(lead) > 1 else i
+        raise NonFiniteError(f"{name}: sample {where} holds NaN or Inf", index=i)
+    return a
+
+
+def _to_c(a: NDArray[np.float64], precision: str, name: str) -> NDArray[Any]:
+    dt = _DTYPES[precision]
+    if dt is np.float32:
+        with np.errstate(over="ignore"):
+            b = np.ascontiguousarray(a, dtype=np.float32)
+        ok = np.isfinite(b).all(axis=1) if b.ndim == 2 else np.isfinite(b)
+        if not np.all(ok):
+            i = _first_bad(np.atleast_1d(np.asarray(ok, dtype=bool)))
+            raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')")
+        return b
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _ptr(ffi: Any, a: NDArray[Any]) -> Any:
+    return ffi.cast("att_real *", ffi.from_buffer(a))
+
+
+def _raise(status: int, what: str, index: int | None = None) -> None:
+    if status >= 0:
+        return
+    cls, text = _INTEG_STATUS.get(status, (None, None))
+    if cls is None:
+        from .errors import raise_for_status
+
+        try:
+            raise_for_status(status, what)
+        except NonFiniteError as exc:
+            raise NonFiniteError(f"{exc} at sample {index}", index=index) from None
+        except AttitudeError as exc:
+            if index is not None:
+                raise type(exc)(f"{exc} at sample {index}") from None
+            raise
+        return
+    where = f" at sample {index}" if index is not None else ""
+    raise cls(f"{what}: {text}{where} (status {status})")
+
+
+# --------------------------------------------------------------------------
+# rotation math
+# --------------------------------------------------------------------------
+
+def _convert(cname: str, x: ArrayLike, name: str, tail_in: tuple[int, ...],
+             tail_out: tuple[int, ...], what: str, precision: str) -> FloatArray:
+    precision = _check_precision(precision)
+    a0 = _as_real(x, name)
+    recs = _records(a0, name, tail_in, what)
+    lead = a0.shape[: a0.ndim - len(tail_in)]
+    ffi, lib = ffi_lib(precision)
+    a = _to_c(recs, precision, name)
+    n = a.shape[0]
+    out = np.empty((n, int(np.prod(tail_out)) if tail_out else 1), dtype=_DTYPES[precision])
+    if n:
+        err = ffi.new("size_t *")
+        st = getattr(lib, cname)(_ptr(ffi, a), _ptr(ffi, out), n, err)
+        if st != 0:
+            i = int(err[0])
+            where = np.unravel_index(i, lead) if len(lead) > 1 else i
+            if st == lib.ATT_E_ARG:
+                raise InvalidArgument(f"{name}: sample {where} is a zero quaternion")
+            _raise(st, name, i)
+    return out.astype(np.float64).reshape(lead + tail_out)
+
+
+def quat_to_dcm(q: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Attitude matrix ``C_b^n`` (…, 3, 3) of quaternions (…, 4) (eq. 1 of q/|q|)."""
+    return _convert("att_quat_to_dcm_n", q, "q", (4,), (3, 3), "quaternion", precision)
+
+
+def dcm_to_quat(C: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Unit quaternion (…, 4), λ ≥ 0, of attitude matrices (…, 3, 3)."""
+    return _convert("att_dcm_to_quat_n", C, "C", (3, 3), (4,), "3×3 matrix", precision)
+
+
+def dcm_to_euler(C: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Euler angles ``[ψ, θ, γ]`` (…, 3) of attitude matrices (gimbal-lock rule in docs)."""
+    return _convert("att_dcm_to_euler_n", C, "C", (3, 3), (3,), "3×3 matrix", precision)
+
+
+def euler_to_dcm(e: ArrayLike, precision: str = "f64") -> FloatArray:
+    """``C = R_z(ψ) R_x(θ) R_y(γ)`` (…, 3, 3) of Euler angles ``[ψ, θ, γ]`` (…, 3)."""
+    return _convert("att_euler_to_dcm_n", e, "e", (3,), (3, 3), "[yaw, pitch, roll]", precision)
+
+
+def quat_to_euler(q: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Euler angles ``[ψ, θ, γ]`` (…, 3) of quaternions (…, 4)."""
+    return _convert("att_quat_to_euler_n", q, "q", (4,), (3,), "quaternion", precision)
+
+
+def euler_to_quat(e: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Quaternion ``q_z(ψ) ⊗ q_x(θ) ⊗ q_y(γ)`` (…, 4), λ ≥ 0."""
+    return _convert("att_euler_to_quat_n", e, "e", (3,), (4,), "[yaw, pitch, roll]", precision)
+
+
+def heading(x: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Heading from north, positive toward east, in [0, 2π) (rad).
+
+    ``x`` is quaternions (…, 4) or attitude matrices (…, 3, 3) (told apart
+    by the shape: last axis 4 → quaternions)."""
+    a = _as_real(x, "x")
+    if a.ndim >= 1 and a.shape[-1] == 4:
+        return _convert("att_quat_heading_n", a, "x", (4,), (), "quaternion", precision)
+    if a.ndim >= 2 and a.shape[-2:] == (3, 3):
+        return _convert("att_dcm_heading_n", a, "x", (3, 3), (), "3×3 matrix", precision)
+    raise InvalidArgument(
+        f"x must be quaternions (..., 4) or attitude matrices (..., 3, 3), got shape {a.shape}")
+
+
+def quat_multiply(a: ArrayLike, b: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Hamilton product ``a ⊗ b`` (…, 4) (broadcast over leading axes)."""
+    precision = _check_precision(precision)
+    aa, bb = np.broadcast_arrays(_as_real(a, "a"), _as_real(b, "b"))
+    ra = _records(aa, "a", (4,), "quaternion")
+    rb = _records(bb, "b", (4,), "quaternion")
+    lead = aa.shape[:-1]
+    ffi, lib = ffi_lib(precision)
+    ca, cb = _to_c(ra, precision, "a"), _to_c(rb, precision, "b")
+    out = np.empty_like(ca)
+    if ca.shape[0]:
+        err = ffi.new("size_t *")
+        _raise(lib.att_quat_mul_n(_ptr(ffi, ca), _ptr(ffi, cb), _ptr(ffi, out), ca.shape[0], err),
+               "a, b")
+    return out.astype(np.float64).reshape(lead + (4,))
+
+
+def quat_conj(q: ArrayLike) -> FloatArray:
+    """Conjugate ``[λ, −p1, −p2, −p3]`` (…, 4)."""
+    a = _as_real(q, "q")
+    _records(a, "q", (4,), "quaternion")
+    return np.asarray(a, dtype=np.float64) * np.array([1.0, -1.0, -1.0, -1.0])
+
+
+def quat_normalize(q: ArrayLike, precision: str = "f64") -> FloatArray:
+    """``q / |q|`` (…, 4); a zero quaternion is an error."""
+    return _convert("att_quat_normalize_n", q, "q", (4,), (4,), "quaternion", precision)
+
+
+def rotvec_to_quat(phi: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Rotation-vector quaternion ``q(Φ)`` of eq. (3) (…, 4) for Φ (…, 3) in rad."""
+    return _convert("att_rotvec_to_quat_n", phi, "phi", (3,), (4,), "rotation vector", precision)
+
+
+def quat_to_rotvec(q: ArrayLike, precision: str = "f64") -> FloatArray:
+    """Shortest rotation vector (…, 3), |Φ| ≤ π, of quaternions (…, 4)."""
+    return _convert("att_quat_to_rotvec_n", q, "q", (4,), (3,), "quaternion", precision)
+
+
+# --------------------------------------------------------------------------
+# the integrator
+# --------------------------------------------------------------------------
+
+def _check_q0(q0: ArrayLike | None) -> NDArray[np.float64] | None:
+    if q0 is None:
+        return None
+    a = _as_real(q0, "q0")
+    if a.shape != (4,):
+        raise InvalidArgument(f"q0 must be one quaternion of shape (4,), got {a.shape}")
+    a = a.astype(np.float64)
+    if not np.isfinite(a).all():
+        raise NonFiniteError("q0 holds NaN or Inf", index=0)
+    if not np.any(a):
+        raise InvalidArgument("q0 is the zero quaternion (it has no attitude)")
+    return a
+
+
+class Integrator:
+    """Streaming attitude integrator (one C ``att_integ`` state).
+
+    ``Integrator(method="rv3", q0=None, precision="f64")``. Feed angle
+    increments (increment methods) or rate samples (``rk4``, with ``dt``)
+    to :meth:`update`; it returns the attitude after every update completed
+    by these samples, as an (M, 4) float64 array (M may be 0: rv2/rv3 buffer
+    increments until their frame is full, rk4 rows until a step ends).
+    """
+
+    def __init__(self, method: str = "rv3", q0: ArrayLike | None = None,
+                 precision: str = "f64") -> None:
+        self.method: str = _check_method(method)
+        self.precision: str = _check_precision(precision)
+        self._ffi, self._lib = ffi_lib(self.precision)
+        self._dtype = _DTYPES[self.precision]
+        self._state = self._ffi.new("att_integ *")
+        self._pending_dt: NDArray[np.float64] = np.empty(0)
+        self.reset(q0)
+
+    def reset(self, q0: ArrayLike | None = None) -> None:
+        """Back to attitude ``q0`` (None = identity), buffered samples dropped."""
+        q = _check_q0(q0)
+        qp = self._ffi.NULL
+        if q is not None:
+            qc = _to_c(q.reshape(1, 4), self.precision, "q0")
+            qp = _ptr(self._ffi, qc)
+        st = self._lib.att_integ_init(self._state, METHODS.index(self.method), qp)
+        if st == self._lib.ATT_E_ARG:
+            raise InvalidArgument("q0 is the zero quaternion (it has no attitude)")
+        _raise(st, "q0")
+        self._pending_dt = np.empty(0)
+
+    @property
+    def q(self) -> FloatArray:
+        """Current attitude quaternion (4,) float64."""
+        return np.array([float(self._state.q[i]) for i in range(4)])
+
+    @property
+    def pending(self) -> int:
+        """Samples buffered in the state (rv2/rv3 frame, rv3-reuse history, rk4 rows)."""
+        return int(self._state.nbuf)
+
+    @property
+    def updates(self) -> int:
+        """Attitude updates since construction or reset (C counter, wraps)."""
+        return int(self._state.updates)
+
+    def outputs(self, n: int) -> int:
+        """How many updates ``n`` more samples would complete."""
+        return int(self._lib.att_integ_outputs(self._state, int(n)))
+
+    def update(self, x: ArrayLike, dt: ArrayLike | None = None) -> FloatArray:
+        """Feed increments Δθ (rad, (3,) or (N, 3)) — or, for ``rk4``, body
+        rates ω (rad/s) with ``dt`` — and return the (M, 4) attitudes of the
+        updates they complete. On error (NaN/Inf, …) nothing is consumed.
+
+        For rk4, ``dt`` is the sampling interval of the rows (s): a scalar or
+        one value per row (dt[i] = time from row i to row i+1). Rows
+        alternate step start/end and midpoint; the step of an update is
+        h = dt[start] + dt[midpoint].
+        """
+        a = _records(x, "omega" if self.method == "rk4" else "dtheta", (3,),
+                     "3-vector per sample")
+        if self.method == "rk4":
+            return self._update_rates(a, dt)
+        if dt is not None:
+            raise InvalidArgument(f"dt is only used with method 'rk4', not {self.method!r}")
+        c = _to_c(a, self.precision, "dtheta")
+        n = c.shape[0]
+        m = self.outputs(n)
+        out = np.empty((max(m, 1), 4), dtype=self._dtype)
+        if n:
+            ffi = self._ffi
+            nout = ffi.new("size_t *")
+            err = ffi.new("size_t *")
+            st = self._lib.att_integ_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, out), nout, err)
+            _raise(st, "dtheta", int(err[0]))
+            m = int(nout[0])
+        return out[:m].astype(np.float64)
+
+    def _update_rates(self, a: NDArray[np.float64], dt: ArrayLike | None) -> FloatArray:
+        n = a.shape[0]
+        if dt is None:
+            raise InvalidArgument("dt is required with method 'rk4' (sampling interval, s)")
+        d = _as_real(dt, "dt").astype(np.float64)
+        if d.ndim == 0:
+            d = np.full(n, float(d))
+        elif d.shape != (n,):
+            raise InvalidArgument(
+                f"dt must be a scalar or one value per row, shape ({n},), got {d.shape}")
+        if not np.isfinite(d).all():
+            raise NonFiniteError(f"dt: sample {_first_bad(np.isfinite(d))} holds NaN or Inf",
+                                 index=_first_bad(np.isfinite(d)))
+        if n and not (d > 0).all():
+            raise InvalidArgument(f"dt must be > 0: dt[{_first_bad(d > 0)}] = "
+                                  f"{d[_first_bad(d > 0)]!r}")
+        m = self.outputs(n)
+        alld = np.concatenate([self._pending_dt, d])
+        h = alld[0: 2 * m: 2] + alld[1: 2 * m: 2] if m else np.ones(1)
+        c = _to_c(a, self.precision, "omega")
+        hc = _to_c(h.reshape(-1, 1), self.precision, "dt").reshape(-1)
+        out = np.empty((max(m, 1), 4), dtype=self._dtype)
+        if n:
+            ffi = self._ffi
+            nout = ffi.new("size_t *")
+            err = ffi.new("size_t *")
+            st = self._lib.att_integ_rk4_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, hc),
+                                               hc.shape[0], _ptr(ffi, out), nout, err)
+            _raise(st, "omega", int(err[0]))
+            m = int(nout[0])
+            nb = self.pending
+            self._pending_dt = alld[len(alld) - nb:] if nb else np.empty(0)
+        return out[:m].astype(np.float64)
+
+    def __repr__(self) -> str:
+        return (f"Integrator(method={self.method!r}, precision={self.precision!r}, "
+                f"q={self.q.tolist()!r}, pending={self.pending})")
+
+
+def _fixedpoint() -> Any:
+    try:
+        from . import fixedpoint  # type: ignore[attr-defined]
+    except ImportError as exc:
+        raise InvalidArgument(
+            "precision='fixed' needs attitude_c.fixedpoint (the Q-format integrator), "
+            f"which is not available here: {exc}") from exc
+    return fixedpoint
+
+
+def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = None,
+              precision: str = "f64") -> FloatArray:
+    """Integrate body angle increments Δθ (N, 3) (rad) from attitude q0.
+
+    Returns the quaternion after each attitude update, (M, 4) float64:
+    M = N for rv1 and rv3-reuse, N // 2 for rv2, N // 3 for rv3 and
+    rv3-coning (a trailing partial frame is ignored; use Integrator to
+    stream). ``precision`` is "f64", "f32" or "fixed".
+    """
+    precision = _check_precision(precision, allow_fixed=True)
+    method = _check_method(method, INCREMENT_METHODS + ("rk4",))
+    if method == "rk4":
+        raise InvalidArgument("method 'rk4' integrates rates: use integrate_rates(omega, dt)")
+    a = _records(dtheta, "dtheta", (3,), "angle increment", allow_empty=False)
+    if _as_real(dtheta, "dtheta").ndim != 2:
+        raise InvalidArgument(f"dtheta must have shape (N, 3), got {np.shape(dtheta)}")
+    if a.shape[0] < FRAME[method]:
+        raise InvalidArgument(f"method {method!r} needs at least {FRAME[method]} increments "
+                              f"per update, got {a.shape[0]}")
+    q = _check_q0(q0)
+    if precision == "fixed":
+        out = _fixedpoint().integrate(a, method, q)
+        return np.asarray(out, dtype=np.float64)
+    return Integrator(method, q, precision).update(a)
+
+
+def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: str = "rk4",
+                    q0: ArrayLike | None = None, precision: str = "f64") -> FloatArray:
+    """Integrate body rates ω (N, 3) (rad/s) sampled every ``dt`` s.
+
+    ``dt``: scalar or one value per row (dt[i] = time from row i to row i+1).
+    ``rk4``: rows are at t, t+h/2, t+h, t+3h/2, … (each step end is the
+    next step's start), h = dt[2k] + dt[2k+1]; returns (N − 1) // 2
+    attitudes. Increment methods: Δθ_i = ω_i · dt_i (ω_i the mean rate of
+    interval i), then as :func:`integrate`.
+    """
+    precision = _check_precision(precision, allow_fixed=True)
+    method = _check_method(method)
+    a = _records(omega, "omega", (3,), "rate sample", allow_empty=False)
+    if _as_real(omega, "omega").ndim != 2:
+        raise InvalidArgument(f"omega must have shape (N, 3), got {np.shape(omega)}")
+    q = _check_q0(q0)
+    if method != "rk4":
+        d = _as_real(dt, "dt").astype(np.float64)
+        if d.ndim == 0:
+            d = np.full(a.shape[0], float(d))
+        elif d.shape != (a.shape[0],):
+            raise InvalidArgument(
+                f"dt must be a scalar or one value per row, shape ({a.shape[0]},), got {d.shape}")
+        if not np.isfinite(d).all():
+            raise NonFiniteError("dt holds NaN or Inf", index=_first_bad(np.isfinite(d)))
+        if not (d > 0).all():
+            raise InvalidArgument("dt must be > 0")
+        return integrate(a * d[:, None], method, q, precision)
+    if a.shape[0] < 3:
+        raise InvalidArgument(f"method 'rk4' needs at least 3 rate rows (t, t+h/2, t+h), "
+                              f"got {a.shape[0]}")
+    if precision == "fixed":
+        fx = _fixedpoint()
+        if not hasattr(fx, "integrate_rates"):
+            raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
+        return np.asarray(fx.integrate_rates(a, dt, method, q), dtype=np.float64)
+    return Integrator("rk4", q, precision).update(a, dt)

@@ -1,0 +1,42 @@
+"""Full-system simulation of the paper's attitude measurement system.
+
+trajectory → gyros → analog conditioning → TLC2543 ADC (C driver + device
+model) → acquisition-board increment formation → serial link (C sender and
+receiver, optional channel errors) → integrator (any method, f64/f32/fixed)
+→ attitude → errors against the truth. See docs/simulation.md.
+"""
+
+from __future__ import annotations
+
+from .budget import STAGES, BudgetResult, format_budget, plot_budget, run_budget
+from .chain import PAPER_MAXIMA, Acquired, SimConfig, SimResult, acquire, simulate
+from .report import format_table, plot_attitude, plot_errors, write_run
+from .sensors import (
+    GYRO_PRESETS,
+    AdcModel,
+    Board,
+    Calibration,
+    Conditioning,
+    GyroModel,
+    gyro_preset,
+)
+from .trajectory import (
+    TRAJECTORIES,
+    ConingTrajectory,
+    ConstantRateTrajectory,
+    CsvTrajectory,
+    PaperTrajectory,
+    StaticTrajectory,
+    Trajectory,
+    euler_rates_to_body,
+    make_trajectory,
+)
+
+__all__ = [
+    "STAGES", "BudgetResult", "format_budget", "plot_budget", "run_budget",
+    "PAPER_MAXIMA", "Acquired", "SimConfig", "SimResult", "acquire", "simulate",
+    "format_table", "plot_attitude", "plot_errors", "write_run",
+    "GYRO_PRESETS", "AdcModel", "Board", "Calibration", "Conditioning", "GyroModel", "gyro_preset",
+    "TRAJECTORIES", "ConingTrajectory", "ConstantRateTrajectory", "CsvTrajectory", "PaperTrajectory",
+    "StaticTrajectory", "Trajectory", "euler_rates_to_body", "make_trajectory",
+]

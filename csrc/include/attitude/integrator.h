@@ -1,0 +1,125 @@
+/*
+ * libattitude — the rotation-vector attitude integrator (prefix att_integ_).
+ *
+ * Q(k+1) = Q(k) ⊗ q(Φ) (paper eq. 4) with the rotation vector Φ of one
+ * update interval built from body-frame angle increments Δθ (rad) by one
+ * of the methods below (all of the form
+ *     Φ = ΣΔθi + k12 Δθ1×Δθ2 + k13 Δθ1×Δθ3 + k23 Δθ2×Δθ3,
+ * Δθ1 the oldest increment), or by fourth-order Runge–Kutta on the
+ * quaternion kinematic equation Q' = ½ Q ⊗ [0, ω] from body rates ω.
+ *
+ * The increment is applied as Q ← Q + Q ⊗ [cos(φ/2) − 1, sin(φ/2)/φ · Φ]
+ * with cos(φ/2) − 1 computed without cancellation, and Q is renormalized
+ * every ATT_INTEG_RENORM_PERIOD updates (first-order, no sqrt/division).
+ * See docs/integrator.md for the formulas, their sources and derivations.
+ *
+ * The state is caller-owned; no malloc, no global state, no I/O.
+ * Batch and streaming calls share the same state and semantics: a batch
+ * call is exactly a sequence of single updates.
+ */
+#ifndef ATTITUDE_INTEGRATOR_H
+#define ATTITUDE_INTEGRATOR_H
+
+#include "attitude/common.h"
+
+/* Integration methods. */
+typedef enum {
+    ATT_METHOD_RV1 = 0,        /* Φ = Δθ; one update per increment */
+    ATT_METHOD_RV2 = 1,        /* two-sample: one update per 2 increments */
+    ATT_METHOD_RV3 = 2,        /* paper eq. (5), 33/80 and 57/80: one update per 3 increments */
+    ATT_METHOD_RV3_CONING = 3, /* 9/20 and 27/40 (Ignagni): one update per 3 increments */
+    ATT_METHOD_RV3_REUSE = 4,  /* one update per increment, correction from the newest
+                                  increment and the two before it (sec. 1.2 done right) */
+    ATT_METHOD_RK4 = 5,        /* RK4 from rates at t, t+h/2, t+h (att_integ_update_rate) */
+    ATT_METHOD_COUNT = 6
+} att_method;
+
+/* Method coefficients as exact fractions k = NUM / DEN (for fixed-point
+ * ports). rv2: Φ = Δθ1 + Δθ2 + k Δθ1×Δθ2. Three-sample forms: k12, k13,
+ * k23 of the general form above. rv3-reuse (newest increment Δθ3, the two
+ * previous Δθ1, Δθ2): Φ = Δθ3 + k12 Δθ1×Δθ2 + k13 Δθ1×Δθ3 + k23 Δθ2×Δθ3;
+ * its second update (one previous increment) uses Φ = Δθ2 + (1/12) Δθ1×Δθ2
+ * and its first update Φ = Δθ1. */
+enum {
+    ATT_RV2_K_NUM = 2, ATT_RV2_DEN = 3,
+    ATT_RV3_K12_NUM = 57, ATT_RV3_K13_NUM = 33, ATT_RV3_K23_NUM = 57, ATT_RV3_DEN = 80,
+    ATT_RV3C_K12_NUM = 27, ATT_RV3C_K13_NUM = 18, ATT_RV3C_K23_NUM = 27, ATT_RV3C_DEN = 40,
+    ATT_RV3R_K12_NUM = 1, ATT_RV3R_K13_NUM = -31, ATT_RV3R_K23_NUM = 121, ATT_RV3R_DEN = 720,
+    ATT_RV3R_START_K_NUM = 1, ATT_RV3R_START_DEN = 12
+};
+
+/* Renormalization period (updates) and update() results. */
+enum {
+    ATT_INTEG_RENORM_PERIOD = 16,
+    ATT_INTEG_PENDING = 0,  /* increment buffered, no new attitude yet */
+    ATT_INTEG_UPDATED = 1   /* a new attitude was written to q_out */
+};
+
+/* Integrator status codes (range -20..-39). */
+enum {
+    ATT_E_INTEG_METHOD = -20,   /* unknown method, or a call not valid for this method */
+    ATT_E_INTEG_DIVERGED = -21  /* finite input but a non-finite result (increment too large) */
+};
+
+/* Caller-owned state. Treat as opaque; read the attitude with
+ * att_integ_attitude(). */
+typedef struct {
+    att_real q[4];        /* current attitude Q (unit, renormalized periodically) */
+    att_real buf[2][3];   /* rv2/rv3: increments of the unfinished update; rv3-reuse:
+                             the two previous increments (buf[1] newest); rk4: the
+                             rate at the start of the step (buf[0]) and the midpoint
+                             rate (buf[1]) */
+    att_real k[3];        /* k12, k13, k23 of the method (or k of rv2 in k[0]) */
+    int method;           /* att_method */
+    int nbuf;             /* number of valid entries of buf */
+    unsigned int since_norm; /* updates since the last renormalization */
+    unsigned long updates;   /* attitude updates since init/reset (wraps) */
+} att_integ;
+
+/* Initialize for `method` with attitude q0 (NULL = identity; normalized
+ * here; ATT_E_ARG if zero, ATT_E_NONFINITE if NaN/Inf). */
+att_status att_integ_init(att_integ *s, att_method method, const att_real q0[4]);
+
+/* Back to attitude q0 (NULL = identity), buffers cleared, method kept. */
+att_status att_integ_reset(att_integ *s, const att_real q0[4]);
+
+/* Current attitude (unit quaternion, λ sign not forced). */
+att_status att_integ_attitude(const att_integ *s, att_real q[4]);
+
+/* Number of attitude updates that n more increments (or rate samples for
+ * rk4) would produce from the current state. */
+size_t att_integ_outputs(const att_integ *s, size_t n);
+
+/* Feed one increment (increment methods). Returns ATT_INTEG_UPDATED and
+ * writes the new attitude to q_out (may be NULL) when an update completes,
+ * ATT_INTEG_PENDING when the increment was only buffered, or a negative
+ * status (state unchanged): ATT_E_NONFINITE, ATT_E_INTEG_DIVERGED,
+ * ATT_E_INTEG_METHOD (rk4 state). */
+int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4]);
+
+/* Feed one rate sample (rk4 only). The first sample after init/reset is
+ * the rate at the start; then samples alternate midpoint (t+h/2) and end
+ * (t+h, which is also the start of the next step). An update completes on
+ * each end sample, with step h (s, > 0) given with that end sample (the h
+ * given with the midpoint sample is ignored). */
+int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att_real q_out[4]);
+
+/* n increments (n×3 values) in one call, exactly as n att_integ_update()
+ * calls. q_out receives the attitude after each completed update (4
+ * values each; room for att_integ_outputs(s, n) records), *n_out their
+ * number. On error the state is left as it was at entry, *err_index is
+ * the index of the offending increment (the first non-finite one, or the
+ * last one of the diverged update) and *n_out is 0. n_out and err_index
+ * may be NULL. */
+att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out,
+                           size_t *n_out, size_t *err_index);
+
+/* n rate samples (n×3 values, rk4 only), exactly as n
+ * att_integ_update_rate() calls; h holds n_h step sizes: n_h == 1 uses
+ * h[0] for every update, otherwise h[j] is the step of the j-th update
+ * completed in this call (n_h must be ≥ att_integ_outputs(s, n)). Errors
+ * as att_integ_batch (ATT_E_ARG: bad h or n_h, err_index = the update). */
+att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h,
+                               size_t n_h, att_real *q_out, size_t *n_out, size_t *err_index);
+
+#endif /* ATTITUDE_INTEGRATOR_H */

@@ -1,0 +1,154 @@
+"""API contract of attitude_c.core: shapes, dtypes, errors, streaming semantics."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import attitude_c as ac
+from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+
+RNG = np.random.default_rng(7)
+D = RNG.normal(scale=0.01, size=(30, 3))
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+@pytest.mark.parametrize("method,per", [("rv1", 1), ("rv2", 2), ("rv3", 3), ("rv3-coning", 3),
+                                        ("rv3-reuse", 1)])
+def test_output_counts_and_leftovers(method: str, per: int, precision: str) -> None:
+    q = ac.integrate(D[:29], method, precision=precision)
+    assert q.shape == (29 // per, 4) and q.dtype == np.float64
+    # unit quaternions: renormalized every 16 updates, error between ~ 16 ulp of the build
+    tol = 2e-6 if precision == "f32" else 1e-14
+    np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=tol)
+    # streaming in odd chunks gives the same attitudes (leftovers stay buffered)
+    it = ac.Integrator(method, precision=precision)
+    parts = [it.update(D[a:b]) for a, b in ((0, 1), (1, 8), (8, 9), (9, 29))]
+    np.testing.assert_array_equal(np.concatenate(parts), q)
+    assert it.pending == (29 % per if method != "rv3-reuse" else 2)
+    one = ac.Integrator(method, precision=precision)
+    singles = [one.update(d) for d in D[:29]]
+    np.testing.assert_array_equal(np.concatenate(singles), q)
+
+
+def test_q0_and_reset() -> None:
+    q0 = np.array([2.0, 0.0, 0.0, 2.0])  # normalized by the integrator
+    q = ac.integrate(np.zeros((3, 3)), "rv1", q0=q0)
+    np.testing.assert_allclose(q, np.tile(q0 / np.linalg.norm(q0), (3, 1)), atol=1e-15)
+    it = ac.Integrator("rv3", q0=q0)
+    it.update(D[:4])
+    assert it.pending == 1 and it.updates == 1
+    it.reset()
+    assert it.pending == 0 and it.updates == 0
+    np.testing.assert_array_equal(it.q, [1.0, 0.0, 0.0, 0.0])
+
+
+def test_bad_inputs_name_the_problem() -> None:
+    bad = D.copy()
+    bad[17, 1] = np.nan
+    with pytest.raises(NonFiniteError, match="sample 17") as ei:
+        ac.integrate(bad, "rv3")
+    assert ei.value.index == 17
+    bad[17, 1] = np.inf
+    with pytest.raises(ValueError):
+        ac.integrate(bad, "rv1", precision="f32")
+    with pytest.raises(InvalidArgument, match="method"):
+        ac.integrate(D, "rv5")
+    with pytest.raises(InvalidArgument, match="integrate_rates"):
+        ac.integrate(D, "rk4")
+    with pytest.raises(InvalidType, match="method"):
+        ac.integrate(D, 3)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match="precision"):
+        ac.integrate(D, "rv3", precision="f16")
+    with pytest.raises(InvalidArgument, match=r"shape \(\.\.\., 3\)"):
+        ac.integrate(np.zeros((5, 4)))
+    with pytest.raises(InvalidArgument, match=r"\(N, 3\)"):
+        ac.integrate(np.zeros((2, 5, 3)))
+    with pytest.raises(InvalidArgument, match="empty"):
+        ac.integrate(np.zeros((0, 3)))
+    with pytest.raises(InvalidArgument, match="at least 3"):
+        ac.integrate(np.zeros((2, 3)), "rv3")
+    with pytest.raises(InvalidType, match="dtheta"):
+        ac.integrate(np.zeros((3, 3), dtype=complex))
+    with pytest.raises(InvalidType, match="dtheta"):
+        ac.integrate([["a", "b", "c"]] * 3)
+    with pytest.raises(InvalidArgument, match="zero quaternion"):
+        ac.integrate(D, q0=[0, 0, 0, 0])
+    with pytest.raises(NonFiniteError, match="q0"):
+        ac.integrate(D, q0=[1, 0, np.nan, 0])
+    with pytest.raises(RangeError, match="float32"):
+        ac.integrate(np.full((3, 3), 1e39), "rv1", precision="f32")
+    with pytest.raises(RangeError, match="too large"):
+        ac.integrate(np.full((3, 3), 1e200), "rv1")
+
+
+def test_failed_update_consumes_nothing() -> None:
+    it = ac.Integrator("rv3")
+    it.update(D[:2])
+    q_before, pending = it.q, it.pending
+    bad = D[2:10].copy()
+    bad[5] = np.nan
+    with pytest.raises(NonFiniteError):
+        it.update(bad)
+    assert it.pending == pending
+    np.testing.assert_array_equal(it.q, q_before)
+    np.testing.assert_array_equal(
+        np.concatenate([ac.Integrator("rv3").update(D[:2]), it.update(D[2:10])]),
+        ac.integrate(D[:10], "rv3"))
+
+
+def test_rates_interfaces() -> None:
+    w = np.array([0.2, -0.1, 0.4])
+    om = np.tile(w, (21, 1))
+    q = ac.integrate_rates(om, 0.005)  # rk4: rows at h/2 spacing, h = 0.01
+    assert q.shape == (10, 4)
+    # one dt per row gives the same as the scalar
+    np.testing.assert_array_equal(ac.integrate_rates(om, np.full(21, 0.005)), q)
+    # streaming rk4 with per-row dt in odd chunks
+    it = ac.Integrator("rk4")
+    parts = [it.update(om[a:b], dt=np.full(b - a, 0.005)) for a, b in ((0, 2), (2, 7), (7, 21))]
+    np.testing.assert_array_equal(np.concatenate(parts), q)
+    # increment methods through rates: dtheta = omega * dt
+    np.testing.assert_array_equal(ac.integrate_rates(om, 0.01, method="rv3"),
+                                  ac.integrate(om * 0.01, "rv3"))
+    with pytest.raises(InvalidArgument, match="dt is required"):
+        ac.Integrator("rk4").update(om)
+    with pytest.raises(InvalidArgument, match="dt must be > 0"):
+        ac.integrate_rates(om, -0.01)
+    with pytest.raises(InvalidArgument, match="one value per row"):
+        ac.integrate_rates(om, np.ones(3))
+    with pytest.raises(InvalidArgument, match="at least 3"):
+        ac.integrate_rates(om[:2], 0.01)
+    with pytest.raises(NonFiniteError, match="dt"):
+        ac.integrate_rates(om, np.full(21, np.nan))
+
+
+def test_fixed_precision_dispatch(monkeypatch: pytest.MonkeyPatch) -> None:
+    import sys
+    import types
+
+    calls = []
+    fake = types.ModuleType("attitude_c.fixedpoint")
+
+    def integrate(dtheta: np.ndarray, method: str, q0: object) -> np.ndarray:
+        calls.append((dtheta.shape, method, q0))
+        return np.zeros((1, 4))
+
+    fake.integrate = integrate  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "attitude_c.fixedpoint", fake)
+    monkeypatch.setattr(ac, "fixedpoint", fake, raising=False)
+    out = ac.integrate(D[:3], "rv3", precision="fixed")
+    assert out.shape == (1, 4) and calls == [((3, 3), "rv3", None)]
+    with pytest.raises(InvalidArgument, match="rk4"):
+        ac.integrate_rates(np.zeros((3, 3)), 0.01, precision="fixed")
+    with pytest.raises(InvalidArgument, match="precision"):
+        ac.Integrator("rv3", precision="fixed")
+
+
+def test_methods_constant() -> None:
+    assert ac.METHODS == ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+    from attitude_c._lib import ffi_lib
+
+    _, lib = ffi_lib("f64")
+    assert [getattr(lib, f"ATT_METHOD_{m.upper().replace('-', '_')}") for m in ac.METHODS] \
+        == list(range(6))
