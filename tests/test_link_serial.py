@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 import os
+import select
 import subprocess
 import sys
 import threading
@@ -159,7 +160,9 @@ def test_cli_rx_tx_processes_over_pty():
                                "--impl", "python", "--gap-timeout-ms", str(GAP_MS), "--duration", "30"],
                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
         try:
-            time.sleep(0.5)  # let rx open its tty
+            # wait (bounded) until rx has its tty open
+            ready = select.select([rx.stderr], [], [], 30)[0]
+            assert ready and b"listening" in rx.stderr.readline()
             tx = subprocess.run([sys.executable, "-m", "attitude_c", "link-tx", "--port", p0,
                                  "--syn-timeout-ms", "1000", "--answer-timeout-ms", "1000"],
                                 input="\n".join(lines) + "\n", capture_output=True, text=True,

@@ -94,8 +94,9 @@ def _stop_on_signals() -> threading.Event:
     def handler(signum: int, frame: Any) -> None:
         ev.set()
 
-    signal.signal(signal.SIGINT, handler)
-    signal.signal(signal.SIGTERM, handler)
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
     return ev
 
 
@@ -111,6 +112,9 @@ def cmd_rx(args: argparse.Namespace) -> int:
 
     def show(b: bytes) -> None:
         print(_hex_block(b), flush=True)
+
+    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl})",
+          file=sys.stderr, flush=True)
 
     try:
         rep = run_receiver(port, impl=args.impl, block_size=args.block_size,

@@ -171,6 +171,9 @@ class LinkRun:
             "blocks": n,
             "accepted_by_B": len(self.accepted),
             "delivered_unique": unique,
+            # blocks of which no intact copy reached B (delivered_unique + lost == blocks);
+            # not gave_up + lost_to_reboot: B may hold a block whose 0x00 answers were all lost
+            "lost": n - unique,
             "undetected_errors": int(np.count_nonzero(~correct)),
             "duplicates": int(np.count_nonzero(dup)),
             "acked": int(np.count_nonzero(self.outcome == OUTCOME_ACKED)),

@@ -124,6 +124,31 @@ class _Bridge:
             th.join(timeout=2.0)
 
 
+def _paths_claimed_by_others() -> set[str]:
+    """/dev/pts paths named on the command line of other processes. A stray
+    program that reopens ``--port /dev/pts/N`` by path (e.g. a leaked
+    receiver in a retry loop) would read bytes off a new pty that reuses
+    that number, so PtyPair does not hand such ptys out."""
+    out: set[str] = set()
+    me = os.getpid()
+    try:
+        pids = [int(p) for p in os.listdir("/proc") if p.isdigit()]
+    except OSError:
+        return out
+    for pid in pids:
+        if pid == me:
+            continue
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                args = f.read().split(b"\0")
+        except OSError:
+            continue
+        for a in args:
+            if a.startswith(b"/dev/pts/"):
+                out.add(a.decode(errors="replace"))
+    return out
+
+
 class PtyPair(_Bridge):
     """Two raw pseudo-terminals joined by a bridge: open ``.paths[0]`` for one
     end and ``.paths[1]`` for the other (``with PtyPair() as (p0, p1): ...``)."""
@@ -133,12 +158,21 @@ class PtyPair(_Bridge):
         self._fds: list[int] = []
         masters = []
         self.paths: list[str] = []
-        for _ in range(2):
+        claimed = _paths_claimed_by_others()
+        for _ in range(64):
+            if len(masters) == 2:
+                break
             m, s = os.openpty()
+            self._fds += [m, s]  # a skipped pty stays open until close(): not handed out again
+            path = os.ttyname(s)
+            if path in claimed:
+                continue
             tty.setraw(s)  # cfmakeraw on the tty side
-            self._fds += [m, s]
             masters.append(m)
-            self.paths.append(os.ttyname(s))
+            self.paths.append(path)
+        if len(masters) != 2:
+            self.close()
+            raise LinkError("PtyPair: could not get two pseudo-terminals nobody else claims")
         self._masters = masters
 
         def reader(fd: int) -> Callable[[], bytes]:
