@@ -13,7 +13,7 @@ pytest.importorskip("attitude_c.link", reason="the link module has not landed in
 
 
 def _cfg(**kw) -> SimConfig:
-    base = dict(duration=60.0, adc=AdcModel(backend="ideal"), seed=5)
+    base = {"duration": 60.0, "adc": AdcModel(backend="ideal"), "seed": 5}
     base.update(kw)
     return SimConfig(**base)
 

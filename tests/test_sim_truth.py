@@ -73,7 +73,7 @@ def _rk4_attitude(tr, t_end: float, h: float) -> np.ndarray:
         return 0.5 * quat_mul(q, np.concatenate([[0.0], tr.omega(t)]))
 
     t = tr.t_start
-    for _ in range(int(round((t_end - tr.t_start) / h))):
+    for _ in range(round((t_end - tr.t_start) / h)):
         k1 = f(q, t)
         k2 = f(q + h / 2 * k1, t + h / 2)
         k3 = f(q + h / 2 * k2, t + h / 2)

@@ -130,6 +130,9 @@ def register(subparsers: Any) -> None:
                    help="gyro model preset (docs/simulation.md gives the figures and sources)")
     g.add_argument("--oversample", type=_int_range("--oversample", 1, 16), default=16, metavar="N",
                    help="ADC conversions per axis summed by the board per period")
+    g.add_argument("--sample-at", default="mid", choices=("mid", "start"),
+                   help="where in each sub-interval the board converts: mid (midpoint rule) or "
+                   "start (one rate sample at the start: the naive design)")
     g.add_argument("--calibration", type=_nonneg("--calibration"), default=60.0, metavar="S",
                    help="static zero-rate calibration before the run (s)")
     g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ideal"),
@@ -213,7 +216,7 @@ def build_config(args: argparse.Namespace) -> Any:
     return SimConfig(trajectory=traj, duration=args.duration, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
-                     board=Board(oversample=args.oversample), calibration_s=args.calibration,
+                     board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,
                      link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed,
                      firmware=None if args.firmware == "none" else args.firmware)
 

@@ -40,7 +40,7 @@ def precision_available(precision: str) -> bool:
     return True
 
 
-def run_integrator(dtheta: np.ndarray, method: str, q0_at: "Callable[[float], np.ndarray]",
+def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.ndarray],
                    precision: str, h: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Integrate increments (n, 3) of period h.
 
@@ -64,12 +64,12 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: "Callable[[float], np
             return empty
         # mean rate over an interval = midpoint rate + h²ω''/24 + O(h⁴): remove
         # the second-order term with the second difference of the means
-        m = dtheta / h
-        w = m.copy()
+        mean = dtheta / h
+        w = mean.copy()
         if n >= 3:
-            w[1:-1] -= (m[2:] - 2 * m[1:-1] + m[:-2]) / 24
-            w[0] -= (m[2] - 2 * m[1] + m[0]) / 24
-            w[-1] -= (m[-1] - 2 * m[-2] + m[-3]) / 24
+            w[1:-1] -= (mean[2:] - 2 * mean[1:-1] + mean[:-2]) / 24
+            w[0] -= (mean[2] - 2 * mean[1] + mean[0]) / 24
+            w[-1] -= (mean[-1] - 2 * mean[-2] + mean[-3]) / 24
         q = attitude_c.integrate_rates(w, h, method="rk4", q0=q0_at(0.5),
                                        precision=precision)
         q = np.asarray(q, dtype=float)

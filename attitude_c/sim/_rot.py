@@ -11,14 +11,14 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
-    "quat_mul",
-    "quat_conj",
-    "quat_normalize",
     "euler_to_quat",
-    "quat_to_euler",
-    "rotvec_to_quat",
-    "quat_to_rotvec",
     "quat_angle_between",
+    "quat_conj",
+    "quat_mul",
+    "quat_normalize",
+    "quat_to_euler",
+    "quat_to_rotvec",
+    "rotvec_to_quat",
     "wrap_angle",
 ]
 

@@ -28,7 +28,7 @@ import numpy as np
 from . import _integ
 from .chain import Acquired, SimConfig, acquire, simulate
 
-__all__ = ["STAGES", "BudgetResult", "run_budget", "format_budget", "plot_budget"]
+__all__ = ["STAGES", "BudgetResult", "format_budget", "plot_budget", "run_budget"]
 
 STAGES = ("algorithm", "+ quantization", "+ gyro noise/bias", "+ link errors", "+ float32",
           "+ fixed-point")
@@ -76,6 +76,12 @@ def run_budget(base: SimConfig, methods: tuple[str, ...] = _integ.METHODS, ber: 
     """Run every stage for every method on the scenario of ``base``."""
     stages = _stage_configs(base, ber)
     skipped: dict[str, str] = {}
+    try:
+        from .. import link as _link  # noqa: F401
+    except ImportError:
+        skipped["+ link errors"] = "attitude_c.link is not built: later stages use no link"
+        stages = [(n, replace(c, link="none", ber=0.0) if c.link == "c" else c)
+                  for n, c in stages if n != "+ link errors"]
     if not _integ.precision_available("fixed"):
         skipped["+ fixed-point"] = "precision='fixed' is not available in the installed core"
         stages = [s for s in stages if s[0] != "+ fixed-point"]

@@ -31,7 +31,7 @@ from .sensors import (
 )
 from .trajectory import PaperTrajectory, Trajectory
 
-__all__ = ["SimConfig", "SimResult", "Acquired", "acquire", "simulate", "PAPER_MAXIMA", "SENSOR_MODES"]
+__all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "acquire", "simulate"]
 
 # The paper's reported error extremes at a 0.08 s period (sec. 4, Fig. 8), rad.
 PAPER_MAXIMA = {"heading": (-0.05, 0.12), "pitch": (-0.10, 0.15)}
@@ -112,7 +112,8 @@ class SimConfig:
             "conditioning": {"vref_v": self.conditioning.vref, "span": self.conditioning.span,
                              "gain": self.conditioning.gain(self.gyro)},
             "adc": {"bits": self.adc.bits, "vref_v": self.adc.vref, "backend": self.adc.backend},
-            "board": {"oversample": self.board.oversample, "delay_comp": self.board.delay_comp},
+            "board": {"oversample": self.board.oversample, "delay_comp": self.board.delay_comp,
+                      "sample_at": self.board.sample_at},
             "calibration_s": self.calibration_s,
             "link": self.link,
             "ber": self.ber,
@@ -165,7 +166,8 @@ def _acquire(cfg: SimConfig, gyro: GyroModel, t0: float, n: int, rngs: dict[str,
     m = cfg.board.oversample
     dt = h / m
     delay = gyro.tau if cfg.board.delay_comp else 0.0
-    ti = t0 + (np.arange(n * m) + 0.5) * dt + delay
+    frac = 0.5 if cfg.board.sample_at == "mid" else 0.0
+    ti = t0 + (np.arange(n * m) + frac) * dt + delay
     if static:
         rate = np.zeros((n * m, 3))
     else:
@@ -191,7 +193,7 @@ def _calibrate(cfg: SimConfig, gyro: GyroModel, rngs: dict[str, np.random.Genera
     g = cfg.conditioning.gain(gyro)
     # codes per rad/s through gyro scale, conditioning gain and ADC
     codes_per_rad_s = gyro.scale_v_per_dps / DEG * g * full / cfg.adc.vref
-    n_cal = int(round(cfg.calibration_s / cfg.period))
+    n_cal = round(cfg.calibration_s / cfg.period)
     if n_cal > 0:
         words = _acquire(cfg, gyro, cfg.trajectory.t_start - cfg.calibration_s, n_cal, rngs,
                          True, bias, progress, "calibration")
@@ -221,7 +223,7 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
         raise InvalidArgument("--firmware s51 is not available in this build: the firmware "
                               "issue has not landed")
     h = cfg.period
-    n = int(math.floor(cfg.duration / h + 1e-9))
+    n = math.floor(cfg.duration / h + 1e-9)
     t0 = cfg.trajectory.t_start
     rngs = _spawn(cfg.seed)
     backends: dict[str, Any] = {}
@@ -283,7 +285,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     summary: dict[str, Any] = {
         "attitude_c_version": __version__,
         "parameters": cfg.params(),
-        "updates": int(len(t_out)),
+        "updates": len(t_out),
         "samples": int(n),
         "errors_rad": {
             "heading": _stats(-err[:, 0]),

@@ -12,7 +12,7 @@ import numpy as np
 
 from .chain import PAPER_MAXIMA, SimResult
 
-__all__ = ["write_run", "format_table", "plot_errors", "plot_attitude", "to_jsonable"]
+__all__ = ["format_table", "plot_attitude", "plot_errors", "to_jsonable", "write_run"]
 
 
 def to_jsonable(x: Any) -> Any:
@@ -45,7 +45,7 @@ def _title(res: SimResult) -> str:
             f"h = {c.period:g} s")
 
 
-def plot_errors(res: SimResult, path: Path, dpi: int = 100) -> None:
+def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
     """Heading, pitch and roll error curves, one panel each (paper Fig. 8 style)."""
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 7.0), sharex=True)
@@ -70,7 +70,7 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 100) -> None:
     plt.close(fig)
 
 
-def plot_attitude(res: SimResult, path: Path, dpi: int = 100) -> None:
+def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     """The attitude itself: truth and computed yaw, pitch, roll (degrees)."""
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
@@ -108,9 +108,9 @@ def format_table(summary: dict[str, Any]) -> str:
     e = summary["errors_rad"]
     p = summary["parameters"]
     lines = [
-        f"attitude simulate: {p['trajectory']['trajectory']} trajectory, method {p['method']}, "
-        f"precision {p['precision']}, sensors {p['sensors']} ({p['gyro']['name']}), "
-        f"period {p['period_s']:g} s, {p['duration_s']:g} s, seed {p['seed']}",
+        (f"attitude simulate: {p['trajectory']['trajectory']} trajectory, method {p['method']}, "
+         f"precision {p['precision']}, sensors {p['sensors']} ({p['gyro']['name']}), "
+         f"period {p['period_s']:g} s, {p['duration_s']:g} s, seed {p['seed']}"),
         "",
         f"{'error (rad)':<16}{'max':>12}{'min':>12}{'RMS':>12}{'paper max':>12}{'× better':>10}",
     ]
@@ -124,10 +124,10 @@ def format_table(summary: dict[str, Any]) -> str:
         lines.append(f"{key:<16}{s['max']:>12.3e}{s['min']:>12.3e}{s['rms']:>12.3e}{pm_s}{b_s}")
     lk = summary.get("link", {})
     if lk.get("link") == "c":
-        lines += ["", f"link ({lk.get('backend')}, BER {lk.get('ber', 0):g}): sent {lk.get('sent')}, "
-                      f"delivered {lk.get('delivered')} (ok {lk.get('delivered_ok')}, duplicated "
-                      f"{lk.get('duplicated')}, corrupted undetected {lk.get('corrupted_undetected')}), "
-                      f"lost {lk.get('lost')}"]
+        lines += ["", (f"link ({lk.get('backend')}, BER {lk.get('ber', 0):g}): sent {lk.get('sent')}, "
+                       f"delivered {lk.get('delivered')} (ok {lk.get('delivered_ok')}, duplicated "
+                       f"{lk.get('duplicated')}, corrupted undetected "
+                       f"{lk.get('corrupted_undetected')}), lost {lk.get('lost')}")]
     lines.append(f"updates {summary['updates']}, elapsed {summary.get('elapsed_s', 0):.2f} s")
     return "\n".join(lines)
 

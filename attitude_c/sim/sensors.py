@@ -21,13 +21,13 @@ from ..errors import InvalidArgument
 from .trajectory import Trajectory
 
 __all__ = [
-    "GyroModel",
     "GYRO_PRESETS",
-    "gyro_preset",
-    "Conditioning",
     "AdcModel",
     "Board",
     "Calibration",
+    "Conditioning",
+    "GyroModel",
+    "gyro_preset",
     "quantize_ideal",
 ]
 
@@ -57,7 +57,7 @@ class GyroModel:
     scale_error: float = 0.0
 
     def without(self, *, noise: bool = False, bias: bool = False, bandwidth: bool = False,
-                scale: bool = False) -> "GyroModel":
+                scale: bool = False) -> GyroModel:
         """A copy with the named error sources switched off."""
         kw: dict[str, Any] = {}
         if noise:
@@ -161,8 +161,13 @@ class Board:
 
     oversample: int = 16
     delay_comp: bool = True
+    sample_at: str = "mid"  # "mid": sub-interval midpoints; "start": their starts
 
     def check(self, bits: int) -> None:
+        if self.sample_at not in ("mid", "start"):
+            raise InvalidArgument(f"sample_at must be 'mid' or 'start', got {self.sample_at!r}")
+        if not (isinstance(bits, int) and 1 <= bits <= 16):
+            raise InvalidArgument(f"ADC bits must be 1..16 (16-bit link words), got {bits!r}")
         if not 1 <= self.oversample <= (1 << (16 - bits)):
             raise InvalidArgument(
                 f"oversample must be 1..{1 << (16 - bits)} so that the sum of {bits}-bit codes "

@@ -29,15 +29,15 @@ from ..errors import InvalidArgument, NonFiniteError
 from ._rot import euler_to_quat, quat_conj, quat_mul, quat_to_euler, quat_to_rotvec, rotvec_to_quat
 
 __all__ = [
-    "Trajectory",
-    "PaperTrajectory",
+    "TRAJECTORIES",
     "ConingTrajectory",
-    "StaticTrajectory",
     "ConstantRateTrajectory",
     "CsvTrajectory",
+    "PaperTrajectory",
+    "StaticTrajectory",
+    "Trajectory",
     "euler_rates_to_body",
     "make_trajectory",
-    "TRAJECTORIES",
 ]
 
 # Gauss–Legendre nodes used to integrate smooth rates over one interval: 8
@@ -371,7 +371,7 @@ class CsvTrajectory(Trajectory):
         return np.diff(self._cumulative(tt), axis=0)
 
     def params(self) -> dict[str, Any]:
-        return {"trajectory": self.name, "path": self.path, "rows": int(len(self.t)),
+        return {"trajectory": self.name, "path": self.path, "rows": len(self.t),
                 "t_start": self.t_start, "t_end": self.t_end}
 
 
