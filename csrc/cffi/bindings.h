@@ -8,5 +8,6 @@
 
 #include "attitude/attitude.h"
 #include "link_sim.h"
+#include "tlc2543_model.h"
 
 #endif
