@@ -95,7 +95,8 @@ def _run_c_link(blocks: list[bytes], ber: float, seed: int, attempts: int
         "delivered_ok": int(np.count_nonzero(correct & ~dup)),
         "duplicated": int(np.count_nonzero(dup)),
         "corrupted_undetected": int(np.count_nonzero(~correct)),
-        "lost": int(s["gave_up"]) + int(s["lost_to_reboot"]),
+        # never accepted intact (A may give up on a block B did accept: 0x00 lost)
+        "lost": len(blocks) - len(np.unique(idx[correct])),
         "gave_up": int(s["gave_up"]),
         "link_time_s": float(s["duration_s"]),
         "sender": s["sender"],
