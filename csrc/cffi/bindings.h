@@ -7,5 +7,6 @@
 #define ATTITUDE_CFFI_BINDINGS_H
 
 #include "attitude/attitude.h"
+#include "tlc2543_model.h"
 
 #endif
