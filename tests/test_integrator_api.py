@@ -152,3 +152,14 @@ def test_methods_constant() -> None:
     _, lib = ffi_lib("f64")
     assert [getattr(lib, f"ATT_METHOD_{m.upper().replace('-', '_')}") for m in ac.METHODS] \
         == list(range(6))
+
+
+def test_demo_command(capsys: pytest.CaptureFixture[str]) -> None:
+    from attitude_c.cli import main
+
+    assert main(["demo", "--seconds", "1"]) == 0
+    out = capsys.readouterr().out
+    for m in ac.INCREMENT_METHODS:
+        assert m in out
+    assert main(["demo", "--beta", "-1"]) == 2
+    assert "must be > 0" in capsys.readouterr().err
