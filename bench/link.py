@@ -59,14 +59,14 @@ def run(quick: bool) -> str:
 
     th = _theory()
     lines = [
-        "One exchange = `0xAA`, `0xBB`, N = 6 data bytes, checksum, answer = "
-        f"{th['byte_times']} byte times of 10 bits = {th['exchange_ms']:.3f} ms at 9600 baud.",
+        ("One exchange = `0xAA`, `0xBB`, N = 6 data bytes, checksum, answer = "
+        f"{th['byte_times']} byte times of 10 bits = {th['exchange_ms']:.3f} ms at 9600 baud."),
         "",
         "| Quantity | Value |",
         "|---|---|",
         f"| Theoretical maximum | {th['max_blocks_per_s']:.1f} blocks/s ({th['max_blocks_per_s'] * N:.0f} payload B/s) |",
-        f"| Payload share of line time | {th['payload_share_bytes']:.0%} of the bytes, "
-        f"{th['payload_share_bits']:.0%} of the bit times (start/stop bits excluded) |",
+        (f"| Payload share of line time | {th['payload_share_bytes']:.0%} of the bytes, "
+        f"{th['payload_share_bits']:.0%} of the bit times (start/stop bits excluded) |"),
     ]
     # simulated line time (paced, zero processing latency)
     blocks = np.random.default_rng(1).integers(0, 256, (2000, N), dtype=np.uint8)
@@ -81,10 +81,10 @@ def run(quick: bool) -> str:
         lines.append(f"| Real ptys paced at 9600 baud, {a} A -> {b} B ({ok}/{n_real} blocks) | "
                      f"{rate:.1f} blocks/s ({rate / th['max_blocks_per_s']:.0%} of maximum; the rest is "
                      f"host scheduling latency per turn-around) |")
-    lines += ["", "Weaknesses by design (simulated, C ends, default timeouts, 5 attempts; "
-              "BER applies to every data bit both ways):", "",
-              "| BER | blocks | undetected corrupted / 10^5 | duplicates / 10^5 | gave up / 10^5 | "
-              "retries / block | blocks/s |", "|---|---|---|---|---|---|---|"]
+    lines += ["", ("Weaknesses by design (simulated, C ends, default timeouts, 5 attempts; "
+              "BER applies to every data bit both ways):"), "",
+              ("| BER | blocks | undetected corrupted / 10^5 | duplicates / 10^5 | gave up / 10^5 | "
+              "retries / block | blocks/s |"), "|---|---|---|---|---|---|---|"]
     for ber, n in ((1e-4, 200_000 if quick else 10_000_000), (1e-3, 100_000 if quick else 2_000_000)):
         b = np.random.default_rng(7).integers(0, 256, (n, N), dtype=np.uint8)
         r = simulate_link(b, channel=ChannelConfig(ber=ber, seed=11))
@@ -93,9 +93,9 @@ def run(quick: bool) -> str:
         lines.append(f"| {ber:g} | {n:,} | {s['undetected_errors'] * per:.2f} ({s['undetected_errors']}) | "
                      f"{s['duplicates'] * per:.1f} ({s['duplicates']}) | {s['gave_up'] * per:.2f} | "
                      f"{s['sender']['retries'] / n:.4f} | {s['blocks_per_s']:.1f} |")
-    lines += ["", "Estimate for comparison: a frame (6 data + checksum) is 56 bits; about 6.1 % of the "
+    lines += ["", ("Estimate for comparison: a frame (6 data + checksum) is 56 bits; about 6.1 % of the "
               "2-bit error patterns leave the 8-bit sum unchanged (same bit position in two bytes with "
               "opposite effect, or any two bit-7 flips), so undetected ~ 1540 p^2 x 0.061 per frame: "
               "0.09 / 10^5 at 1e-4 and 9 / 10^5 at 1e-3 (+ retransmissions, + 3-bit patterns). "
-              "Duplicates ~ P(the 8-bit 0x00 answer is hit) = 8p: 80 / 10^5 at 1e-4, 800 / 10^5 at 1e-3."]
+              "Duplicates ~ P(the 8-bit 0x00 answer is hit) = 8p: 80 / 10^5 at 1e-4, 800 / 10^5 at 1e-3.")]
     return "\n".join(lines)
