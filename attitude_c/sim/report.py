@@ -45,7 +45,7 @@ def _title(res: SimResult) -> str:
             f"h = {c.period:g} s")
 
 
-def plot_errors(res: SimResult, path: Path, dpi: int = 100) -> None:
+def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
     """Heading, pitch and roll error curves, one panel each (paper Fig. 8 style)."""
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 7.0), sharex=True)
@@ -70,7 +70,7 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 100) -> None:
     plt.close(fig)
 
 
-def plot_attitude(res: SimResult, path: Path, dpi: int = 100) -> None:
+def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     """The attitude itself: truth and computed yaw, pitch, roll (degrees)."""
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
