@@ -57,6 +57,7 @@ class BudgetResult:
     link: dict[str, Any]
     params: dict[str, Any]
     skipped: dict[str, str]
+    dominant_no_link: dict[str, str]
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -66,7 +67,8 @@ class BudgetResult:
                             for i, s in enumerate(self.stages)},
             "contribution_rad": {s: dict(zip(self.methods, self.contribution[i].tolist()))
                                  for i, s in enumerate(self.stages)},
-            "dominant_source": self.dominant, "link": self.link, "parameters": self.params,
+            "dominant_source": self.dominant, "dominant_source_without_link": self.dominant_no_link,
+            "link": self.link, "parameters": self.params,
             "skipped": self.skipped,
         }
 
@@ -134,13 +136,17 @@ def run_budget(base: SimConfig, methods: tuple[str, ...] = _integ.METHODS, ber: 
                 r0 = rms[names.index(_BASE[name]), j]
                 dd = e["rms"] ** 2 - r0**2
                 contrib[i, j] = float(np.sign(dd) * np.sqrt(abs(dd)))
-    dominant = {}
+    dominant: dict[str, str] = {}
+    dominant_no_link: dict[str, str] = {}
     for j, m in enumerate(methods):
         col = np.where(np.isnan(contrib[:, j]), -np.inf, contrib[:, j])
         dominant[m] = names[int(np.argmax(col))]
+        col_nl = np.where([n == "+ link errors" for n in names], -np.inf, col)
+        dominant_no_link[m] = names[int(np.argmax(col_nl))]
     params = base.params()
     params["budget_ber"] = ber
-    return BudgetResult(list(methods), names, rms, mx, contrib, dominant, link, params, skipped)
+    return BudgetResult(list(methods), names, rms, mx, contrib, dominant, link, params, skipped,
+                        dominant_no_link)
 
 
 def format_budget(b: BudgetResult, markdown: bool = False) -> str:
@@ -155,6 +161,8 @@ def format_budget(b: BudgetResult, markdown: bool = False) -> str:
     head = ["stage"] + b.methods
     rows = [[s] + [cell(i, j) for j in range(len(b.methods))] for i, s in enumerate(b.stages)]
     rows.append(["dominant source"] + [b.dominant[m] for m in b.methods])
+    if "+ link errors" in b.stages:
+        rows.append(["dominant without link"] + [b.dominant_no_link[m] for m in b.methods])
     if markdown:
         out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         out += ["| " + " | ".join(r) + " |" for r in rows]
@@ -174,34 +182,42 @@ def format_budget(b: BudgetResult, markdown: bool = False) -> str:
 
 
 def plot_budget(b: BudgetResult, path: Any, dpi: int = 100) -> None:
-    """Grouped bars: RMS attitude error after each stage, per method (log scale)."""
+    """Grouped bars: each source's contribution (rad, log scale), per method.
+    Hatched bars: switching the source on lowered the RMS error."""
     import matplotlib
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(8.0, 4.2))
+    fig, ax = plt.subplots(figsize=(8.0, 4.4))
     n_s = len(b.stages)
     width = 0.8 / n_s
     x = np.arange(len(b.methods))
-    greys = plt.get_cmap("viridis")(np.linspace(0.05, 0.95, n_s))
+    colors = plt.get_cmap("viridis")(np.linspace(0.05, 0.95, n_s))
+    negative = []
     for i, s in enumerate(b.stages):
-        ax.bar(x + (i - (n_s - 1) / 2) * width, np.maximum(b.rms[i], 1e-12), width, label=s,
-               color=greys[i], edgecolor="black", linewidth=0.4)
+        c = b.contribution[i]
+        h = np.where(np.isnan(c), 0.0, np.maximum(np.abs(c), 1e-12))
+        bars = ax.bar(x + (i - (n_s - 1) / 2) * width, h, width,
+                      label=s if i == 0 else f"{s} (vs {_BASE[s]})" if s in _DIRECT else s,
+                      color=colors[i], edgecolor="black", linewidth=0.4)
+        negative += [bar for bar, v in zip(bars, c) if v < 0]
     ax.set_yscale("log")
+    ax.set_ylim(bottom=1e-9)
     ax.set_xticks(x)
     ax.set_xticklabels(b.methods)
-    ax.set_ylabel("RMS attitude error / rad")
+    ax.set_ylabel("contribution to RMS attitude error / rad")
     p = b.params
     ax.set_title(f"Error budget — {p['trajectory']['trajectory']} trajectory, h = {p['period_s']:g} s, "
-                 f"{p['duration_s']:g} s, gyro {p['gyro']['name']}, BER {p['budget_ber']:g}", fontsize=9)
+                 f"{p['duration_s']:g} s, gyro {p['gyro']['name']}, link BER {p['budget_ber']:g}",
+                 fontsize=9)
     ax.axhline(0.12, color="red", linestyle="--", linewidth=0.8)
     ax.text(len(b.methods) - 0.5, 0.12, "paper's max heading error", color="red", fontsize=7,
             ha="right", va="bottom")
     ax.grid(True, axis="y", linestyle=":", linewidth=0.6)
     ax.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.1))
+    for bar in negative:  # after the legend, so that its swatches stay plain
+        bar.set_hatch("///")
     fig.tight_layout()
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
-
-
