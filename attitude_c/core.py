@@ -15,6 +15,7 @@ of the z-x-y sequence, radians. Every function returns float64 arrays
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -304,6 +305,8 @@ class Integrator:
         self._ffi, self._lib = ffi_lib(self.precision)
         self._dtype = _DTYPES[self.precision]
         self._state = self._ffi.new("att_integ *")
+        self._one_in = self._ffi.new("att_real[3]")
+        self._one_out = self._ffi.new("att_real[4]")
         self._pending_dt: NDArray[np.float64] = np.empty(0)
         self.reset(q0)
 
@@ -349,6 +352,9 @@ class Integrator:
         alternate step start/end and midpoint; the step of an update is
         h = dt[start] + dt[midpoint].
         """
+        if (self.method != "rk4" and dt is None and isinstance(x, np.ndarray)
+                and x.shape == (3,) and x.dtype.kind == "f"):
+            return self._update_one(x)
         a = _records(x, "omega" if self.method == "rk4" else "dtheta", (3,),
                      "3-vector per sample")
         if self.method == "rk4":
@@ -367,6 +373,23 @@ class Integrator:
             _raise(st, "dtheta", int(err[0]))
             m = int(nout[0])
         return out[:m].astype(np.float64)
+
+    def _update_one(self, x: NDArray[Any]) -> FloatArray:
+        """Fast path for one float increment (3,): no array conversions; the C
+        call itself rejects NaN/Inf (state untouched) and we name the sample."""
+        buf = self._one_in
+        buf[0], buf[1], buf[2] = float(x[0]), float(x[1]), float(x[2])
+        if self._dtype is np.float32 and not all(map(math.isfinite, (buf[0], buf[1], buf[2]))) \
+                and all(map(math.isfinite, (float(x[0]), float(x[1]), float(x[2])))):
+            raise RangeError("dtheta: sample 0 overflows float32 (precision='f32')")
+        r = self._lib.att_integ_update(self._state, buf, self._one_out)
+        if r == 1:
+            o = self._one_out
+            return np.array([[o[0], o[1], o[2], o[3]]])
+        if r == 0:
+            return np.empty((0, 4))
+        _raise(r, "dtheta", 0)
+        raise AssertionError("unreachable")  # pragma: no cover
 
     def _update_rates(self, a: NDArray[np.float64], dt: ArrayLike | None) -> FloatArray:
         n = a.shape[0]

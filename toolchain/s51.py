@@ -62,6 +62,14 @@ class S51Error(RuntimeError):
     """The simulated program did not finish through ``s51_exit`` (or s51 failed)."""
 
 
+class S51BuildError(S51Error):
+    """SDCC rejected a source (any warning is an error); ``stderr`` holds its messages."""
+
+    def __init__(self, message: str, stderr: str) -> None:
+        super().__init__(message)
+        self.stderr = stderr
+
+
 class S51Timeout(S51Error, TimeoutError):
     """s51 did not exit within the wall-clock timeout (program never stopped)."""
 
@@ -100,8 +108,8 @@ def build(sources: Sequence[Path | str], out: Path | str, *,
     """Compile ``sources`` (main file first) + ``lib_sources`` with SDCC into an .ihx.
 
     Flags are those of toolchain/mcs51.toml (``--Werror``: any warning fails the
-    build with :class:`subprocess.CalledProcessError`, whose ``stderr`` holds
-    SDCC's messages). ``with_sif`` links the s51_sif helpers and puts
+    build with :class:`S51BuildError`, whose message and ``stderr`` hold SDCC's
+    messages). ``with_sif`` links the s51_sif helpers and puts
     toolchain/ on the include path. Returns the path of the .ihx image.
     """
     t = target()
@@ -109,8 +117,12 @@ def build(sources: Sequence[Path | str], out: Path | str, *,
     if with_sif:
         srcs.append(SIF_SOURCE)
     incs = [*include_dirs, HERE] if with_sif else list(include_dirs)
-    return t.build_program(srcs, out, defines=defines, extra_cflags=extra_cflags,
-                           include_dirs=incs, with_lib=False)
+    try:
+        return t.build_program(srcs, out, defines=defines, extra_cflags=extra_cflags,
+                               include_dirs=incs, with_lib=False)
+    except subprocess.CalledProcessError as exc:
+        err = (exc.stderr or "") + (exc.stdout or "")
+        raise S51BuildError(f"SDCC failed: {' '.join(map(str, exc.cmd))}\n{err}", err) from None
 
 
 def run(ihx: Path | str, *, timeout: float = 30.0, uart_input: bytes = b"",

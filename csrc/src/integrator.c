@@ -308,11 +308,16 @@ int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att
         q[i] = s->q[i];
     }
     att__quat_add_mul(q, d);
-    sn = s->since_norm;
-    if (++sn >= (unsigned int)ATT_INTEG_RENORM_PERIOD) {
-        att__quat_renorm1(q);
-        sn = 0;
+    /* unlike q(Φ), the RK4 step is not norm-preserving (its norm error
+     * grows with the rate's variation over the step): renormalize every
+     * update, exactly (sqrt) since that error is not always tiny */
+    {
+        att_real n = att_sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+        for (i = 0; i < 4; i++) {
+            q[i] /= n;
+        }
     }
+    sn = 0;
     r = commit(s, q, sn, q_out);
     if (r < 0) {
         return r;

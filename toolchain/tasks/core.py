@@ -131,11 +131,28 @@ def bench(c, only="", quick=False):
         assemble_bench_doc()
         return
     mods = [only] if only else _bench_modules()
+    failed: list[str] = []
     for name in mods:
-        mod = importlib.import_module(f"bench.{name}")
-        print(f"== bench {name}: {mod.TITLE}", flush=True)
-        body = mod.run(quick=quick)
+        # one broken or unavailable benchmark must not lose the others' figures:
+        # report it, keep its previous docs/bench/NAME.md, go on, fail at the end
+        try:
+            mod = importlib.import_module(f"bench.{name}")
+            print(f"== bench {name}: {mod.TITLE}", flush=True)
+            body = mod.run(quick=quick)
+        except Exception as exc:  # noqa: BLE001 - any failure of one module
+            import traceback
+
+            traceback.print_exc()
+            print(f"== bench {name}: FAILED ({type(exc).__name__}: {exc})", flush=True)
+            failed.append(name)
+            continue
         cmd = "invoke bench" + (f" --only {name}" if only else "") + (" --quick" if quick else "")
         write_bench_section(name, mod.TITLE, body, cmd)
         print(body)
+    assemble_bench_doc()
     print(f"wrote {BENCH_DOC.relative_to(ROOT)}")
+    if failed:
+        from invoke.exceptions import Exit
+
+        raise Exit(f"benchmark(s) failed: {', '.join(failed)} (their previous sections were kept)",
+                   code=1)

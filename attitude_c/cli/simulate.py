@@ -1,0 +1,273 @@
+"""``attitude simulate``: the paper's whole system end to end in simulation."""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+
+
+def _positive(kind: str) -> Callable[[str], float]:
+    def conv(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}: expected a number, got {text!r}") from None
+        if not math.isfinite(v) or v <= 0:
+            raise argparse.ArgumentTypeError(f"{kind}: must be a finite number > 0, got {text!r}")
+        return v
+    return conv
+
+
+def _nonneg(kind: str) -> Callable[[str], float]:
+    def conv(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}: expected a number, got {text!r}") from None
+        if not math.isfinite(v) or v < 0:
+            raise argparse.ArgumentTypeError(f"{kind}: must be a finite number >= 0, got {text!r}")
+        return v
+    return conv
+
+
+def _ber(text: str) -> float:
+    v = _nonneg("BER")(text)
+    if v >= 0.5:
+        raise argparse.ArgumentTypeError(f"BER: must be below 0.5, got {text!r}")
+    return v
+
+
+def _int_range(kind: str, lo: int, hi: int) -> Callable[[str], int]:
+    def conv(text: str) -> int:
+        try:
+            v = int(text, 0)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}: expected an integer, got {text!r}") from None
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"{kind}: must be in {lo}..{hi}, got {v}")
+        return v
+    return conv
+
+
+def _triple(kind: str) -> Callable[[str], tuple[float, float, float]]:
+    def conv(text: str) -> tuple[float, float, float]:
+        parts = [p for p in text.replace(" ", "").split(",") if p != ""]
+        if len(parts) == 1:
+            parts = parts * 3
+        if len(parts) != 3:
+            raise argparse.ArgumentTypeError(f"{kind}: give one value or three comma-separated "
+                                             f"values, got {text!r}")
+        try:
+            vals = tuple(float(p) for p in parts)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}: not a number in {text!r}") from None
+        if not all(math.isfinite(v) for v in vals):
+            raise argparse.ArgumentTypeError(f"{kind}: values must be finite, got {text!r}")
+        return vals  # type: ignore[return-value]
+    return conv
+
+
+def _methods(text: str) -> tuple[str, ...]:
+    ms = tuple(m.strip() for m in text.split(",") if m.strip())
+    bad = [m for m in ms if m not in _METHODS]
+    if bad or not ms:
+        raise argparse.ArgumentTypeError(f"unknown method(s) {bad or text!r}; choose from "
+                                         f"{', '.join(_METHODS)}")
+    return ms
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser(
+        "simulate",
+        help="run the paper's system end to end in simulation (errors, plots, budget)",
+        description="Simulate the whole attitude measurement system of the paper: a known "
+        "trajectory, gyros, the TLC2543 ADC (C driver + device model), the acquisition board, "
+        "the serial link (C sender/receiver, optional bit errors) and the integrator; compare "
+        "the computed attitude with the truth. Writes errors.png (paper Fig. 8 style), "
+        "attitude.png, timeseries.csv and summary.json into the output directory and prints a "
+        "table. With --budget, switches the error sources on one at a time for every method.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    g = p.add_argument_group("scenario")
+    g.add_argument("--trajectory", default="paper",
+                   choices=("paper", "coning", "static", "constant-rate", "csv"),
+                   help="reference motion (csv needs --trajectory-file)")
+    g.add_argument("--trajectory-file", metavar="CSV", default=None,
+                   help="CSV with columns time,yaw,pitch,roll (rad; *_deg for degrees) or "
+                   "time,q0,q1,q2,q3")
+    g.add_argument("--duration", type=_positive("--duration"), default=60.0, metavar="S",
+                   help="simulated time (s)")
+    g.add_argument("--period", type=_positive("--period"), default=0.08, metavar="S",
+                   help="gyro sample period: one angle increment per period (s); the paper: 0.08")
+    g.add_argument("--amplitude", type=_triple("--amplitude"), default=(30.0, 20.0, 25.0),
+                   metavar="Y,P,R", help="paper trajectory: sinusoid amplitudes (deg)")
+    g.add_argument("--frequency", type=_triple("--frequency"), default=(0.20, 0.25, 0.30),
+                   metavar="Y,P,R", help="paper trajectory: frequencies (Hz)")
+    g.add_argument("--phase", type=_triple("--phase"), default=(0.0, 30.0, 60.0),
+                   metavar="Y,P,R", help="paper trajectory: phases (deg)")
+    g.add_argument("--cone-angle", type=_nonneg("--cone-angle"), default=20.0, metavar="DEG",
+                   help="coning trajectory: half-angle (deg)")
+    g.add_argument("--cone-frequency", type=_nonneg("--cone-frequency"), default=0.5, metavar="HZ",
+                   help="coning trajectory: coning frequency (Hz)")
+    g.add_argument("--rate", type=_triple("--rate"), default=(10.0, -5.0, 20.0), metavar="X,Y,Z",
+                   help="constant-rate trajectory: body rate (deg/s)")
+    g = p.add_argument_group("system")
+    g.add_argument("--method", default="rv3", choices=_METHODS, help="integrator method")
+    g.add_argument("--precision", default="f64", choices=("f64", "f32", "fixed"),
+                   help="integrator arithmetic")
+    g.add_argument("--sensors", default="full", choices=("ideal", "quantized", "full"),
+                   help="ideal: exact increments; quantized: perfect gyro through ADC and board; "
+                   "full: plus gyro noise, bias, filter, saturation")
+    g.add_argument("--gyro", default="cg-l53", choices=("cg-l53", "adxrs150", "ideal"),
+                   help="gyro model preset (docs/simulation.md gives the figures and sources)")
+    g.add_argument("--oversample", type=_int_range("--oversample", 1, 16), default=16, metavar="N",
+                   help="ADC conversions per axis summed by the board per period")
+    g.add_argument("--sample-at", default="mid", choices=("mid", "start"),
+                   help="where in each sub-interval the board converts: mid (midpoint rule) or "
+                   "start (one rate sample at the start: the naive design)")
+    g.add_argument("--calibration", type=_nonneg("--calibration"), default=60.0, metavar="S",
+                   help="static zero-rate calibration before the run (s)")
+    g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ideal"),
+                   help="tlc2543: C driver against the device model; ideal: vectorized quantizer; "
+                   "auto: tlc2543 when built")
+    g.add_argument("--link", default="c", choices=("c", "none"),
+                   help="c: every sample through the C link sender and receiver; none: direct")
+    g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
+    g.add_argument("--attempts", type=_int_range("--attempts", 1, 255), default=5,
+                   help="link sender attempts per block before giving up")
+    g.add_argument("--firmware", choices=("none", "s51"), default="none",
+                   help="run the acquisition side as the real 8051 firmware in s51")
+    g = p.add_argument_group("run")
+    g.add_argument("--seed", type=_int_range("--seed", 0, 2**63 - 1), default=0,
+                   help="random seed (noise, bias, channel errors)")
+    g.add_argument("--out", metavar="DIR", default=None,
+                   help="output directory (default results/<run>/)")
+    g.add_argument("--budget", action="store_true",
+                   help="error budget: sources on one at a time, for every method")
+    g.add_argument("--methods", type=_methods, default=_METHODS, metavar="M1,M2",
+                   help="methods of the budget")
+    g.add_argument("--budget-ber", type=_ber, default=1e-3, metavar="BER",
+                   help="BER of the budget's link stage")
+    g.add_argument("--no-plots", action="store_true", help="skip the PNG files")
+    g.add_argument("--no-progress", action="store_true", help="no progress bar")
+    g.add_argument("--json", action="store_true", help="print the JSON summary instead of the table")
+    p.set_defaults(func=run)
+
+
+class _Progress:
+    """tqdm bar per stage, shown only for stages with enough work."""
+
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled
+        self.bars: dict[str, Any] = {}
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if not self.enabled or total < 2000 and stage != "budget":
+            return
+        bar = self.bars.get(stage)
+        if bar is None:
+            from tqdm import tqdm
+
+            bar = tqdm(total=total, desc=stage, unit="it", leave=False, file=sys.stderr,
+                       dynamic_ncols=True, mininterval=0.3)
+            self.bars[stage] = bar
+        bar.update(done - bar.n)
+        if done >= total:
+            bar.close()
+
+    def close(self) -> None:
+        for b in self.bars.values():
+            b.close()
+
+
+def build_config(args: argparse.Namespace) -> Any:
+    from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
+
+    if args.trajectory == "csv":
+        if not args.trajectory_file:
+            raise ValueError("--trajectory csv needs --trajectory-file CSV")
+        traj = make_trajectory("csv", path=args.trajectory_file)
+    elif args.trajectory_file:
+        raise ValueError("--trajectory-file is only used with --trajectory csv")
+    elif args.trajectory == "paper":
+        traj = make_trajectory("paper", amplitude=[math.radians(v) for v in args.amplitude],
+                               frequency=list(args.frequency),
+                               phase=[math.radians(v) for v in args.phase])
+    elif args.trajectory == "coning":
+        traj = make_trajectory("coning", half_angle=math.radians(args.cone_angle),
+                               frequency=args.cone_frequency)
+    elif args.trajectory == "constant-rate":
+        traj = make_trajectory("constant-rate", rate=[math.radians(v) for v in args.rate])
+    else:
+        traj = make_trajectory("static")
+    adc = args.adc
+    if adc == "auto":
+        from ..sim._tlc import available
+
+        adc = "tlc2543" if available() else "ideal"
+    return SimConfig(trajectory=traj, duration=args.duration, period=args.period,
+                     method=args.method, precision=args.precision, sensors=args.sensors,
+                     gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
+                     board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,
+                     link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed,
+                     firmware=None if args.firmware == "none" else args.firmware)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..errors import AttitudeError
+
+    try:
+        return _run(args)
+    except (AttitudeError, ValueError, TypeError, ImportError) as exc:
+        print(f"attitude simulate: error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _run(args: argparse.Namespace) -> int:
+    from ..sim import format_budget, format_table, plot_budget, run_budget, simulate, write_run
+    from ..sim.report import to_jsonable
+
+    cfg = build_config(args)
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    name = f"{stamp}-{'budget' if args.budget else cfg.method}-{cfg.trajectory.name}-s{cfg.seed}"
+    out = Path(args.out) if args.out else Path("results") / name
+    prog = _Progress(enabled=not args.no_progress)
+    t0 = time.perf_counter()
+    try:
+        if args.budget:
+            b = run_budget(cfg, methods=args.methods, ber=args.budget_ber, progress=prog)
+            out.mkdir(parents=True, exist_ok=True)
+            d = b.to_dict()
+            d["elapsed_s"] = time.perf_counter() - t0
+            (out / "budget.json").write_text(json.dumps(to_jsonable(d), indent=2) + "\n")
+            (out / "budget.md").write_text(format_budget(b, markdown=True) + "\n")
+            if not args.no_plots:
+                plot_budget(b, out / "budget.png")
+            prog.close()
+            if args.json:
+                print(json.dumps(to_jsonable(d), indent=2))
+            else:
+                print("error budget: RMS attitude-angle error (rad) after each stage "
+                      "(contribution of the stage's source)")
+                print(format_budget(b))
+                print(f"wrote {out}/ (budget.json, budget.md{', budget.png' if not args.no_plots else ''})"
+                      f" in {time.perf_counter() - t0:.1f} s")
+            return 0
+        res = simulate(cfg, progress=prog)
+        files = write_run(res, out, plots=not args.no_plots)
+    finally:
+        prog.close()
+    if args.json:
+        print(json.dumps(to_jsonable(res.summary), indent=2))
+    else:
+        print(format_table(res.summary))
+        print(f"wrote {out}/ ({', '.join(p.name for p in files.values())})")
+    return 0

@@ -1,0 +1,104 @@
+/*
+ * attitude-rx — receiver app of the Linux computer (paper sec. 3.3–3.4,
+ * Fig. 6): link receiver thread + attitude thread joined by a bounded
+ * sample queue. Private header of csrc/app (not part of libattitude).
+ */
+#ifndef ATTITUDE_RX_H
+#define ATTITUDE_RX_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <pthread.h>
+
+#include "attitude/attitude.h"
+
+/* Exit codes (the BSD sysexits values, so shell scripts can tell them apart). */
+enum {
+    RX_EXIT_OK = 0,
+    RX_EXIT_USAGE = 64,   /* bad command line */
+    RX_EXIT_NOPORT = 66,  /* port does not exist */
+    RX_EXIT_INTERNAL = 70,
+    RX_EXIT_IOERR = 74,   /* port cannot be configured (not a tty...) */
+    RX_EXIT_NOPERM = 77,  /* no permission to open the port */
+    RX_EXIT_CONFIG = 78   /* bad config file or value */
+};
+
+enum {
+    RX_QUEUE_MAX = 4096,  /* largest --queue */
+    RX_PATH_MAX = 256,
+    RX_MSG_MAX = 256
+};
+
+typedef enum { RX_FORMAT_CSV = 0, RX_FORMAT_JSONL = 1 } rx_format;
+
+/* Everything the command line / config file sets. */
+typedef struct {
+    char port[RX_PATH_MAX];
+    long baud;                /* bits per second */
+    double period;            /* s, gyro sample period */
+    double zero[3];           /* ADC code at zero rate, per channel */
+    double scale[3];          /* rad/s per code, per channel */
+    int axis_src[3];          /* body axis i = sign[i] * channel axis_src[i] */
+    int axis_sign[3];
+    att_method method;
+    rx_format format;
+    unsigned block_size;      /* link block N: a multiple of 6 (3 x 16-bit codes per sample) */
+    unsigned queue_size;      /* samples the queue holds (1..RX_QUEUE_MAX) */
+    unsigned gap_ms;          /* link receiver gap timeout, ms */
+    unsigned long count;      /* stop after this many output lines (0 = run until signalled) */
+    double consumer_delay;    /* s the attitude thread sleeps per sample (diagnostics/tests) */
+    double reopen_delay;      /* s between attempts to reopen a port that went away */
+    int header;               /* print the CSV header line */
+} rx_config;
+
+/* Defaults: 9600 baud, 0.01 s, zero 2048, scale = 90 deg/s per 2048 codes,
+ * axes x,y,z, rv3, CSV, N = 6, queue 256, gap 20 ms. */
+void rx_config_defaults(rx_config *c);
+
+/* Parse argv (and the --config file it names, whose values the command
+ * line overrides). Returns 0, or an RX_EXIT_* code with a message in msg.
+ * Sets *help when --help was given. */
+int rx_config_parse(rx_config *c, int argc, char **argv, int *help, char *msg, size_t msglen);
+
+/* Apply one "name value" setting (long option name without "--"). */
+int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, size_t msglen);
+
+/* Read a config file of "name = value" lines ('#' comments). */
+int rx_config_file(rx_config *c, const char *path, char *msg, size_t msglen);
+
+const char *rx_method_name(att_method m);
+
+void rx_usage(const char *prog, void *stream);
+
+/* ---- bounded sample queue (one producer, one consumer) ---- */
+typedef struct {
+    uint16_t code[3];   /* raw ADC codes X, Y, Z as received */
+    uint32_t seq;       /* sample number since start (0-based) */
+} rx_sample;
+
+typedef struct {
+    pthread_mutex_t lock;
+    pthread_cond_t nonempty;
+    rx_sample buf[RX_QUEUE_MAX];
+    unsigned cap, head, count;
+    unsigned long pushed, popped, overflows;
+    unsigned high_water;
+    int closed;
+} rx_queue;
+
+int rx_queue_init(rx_queue *q, unsigned cap);
+void rx_queue_destroy(rx_queue *q);
+/* Non-blocking: 0 = queued, 1 = full (sample dropped, overflow counted). */
+int rx_queue_push(rx_queue *q, const rx_sample *s);
+/* Blocking until a sample or the queue is closed and empty: 0 = got one, 1 = closed. */
+int rx_queue_pop(rx_queue *q, rx_sample *s);
+void rx_queue_close(rx_queue *q);
+
+/* ---- serial port ---- */
+/* Open and configure `path` raw 8N1 at `baud`. Returns the fd, or -1 with
+ * errno set and a message in msg. */
+int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
+/* 1 if baud is one the termios layer knows. */
+int rx_serial_baud_ok(long baud);
+
+#endif /* ATTITUDE_RX_H */

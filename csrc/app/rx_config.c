@@ -1,0 +1,391 @@
+/* attitude-rx: command line and config file. */
+#define _POSIX_C_SOURCE 200809L
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rx.h"
+
+static const struct {
+    const char *name;
+    att_method method;
+} methods[] = {
+    {"rv1", ATT_METHOD_RV1}, {"rv2", ATT_METHOD_RV2}, {"rv3", ATT_METHOD_RV3},
+    {"rv3-coning", ATT_METHOD_RV3_CONING}, {"rv3-reuse", ATT_METHOD_RV3_REUSE},
+    {"rk4", ATT_METHOD_RK4},
+};
+
+const char *rx_method_name(att_method m)
+{
+    size_t i;
+    for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
+        if (methods[i].method == m)
+            return methods[i].name;
+    return "?";
+}
+
+void rx_config_defaults(rx_config *c)
+{
+    int i;
+    memset(c, 0, sizeof *c);
+    c->baud = 9600;
+    c->period = 0.01;
+    for (i = 0; i < 3; i++) {
+        c->zero[i] = 2048.0;
+        /* 90 deg/s full scale over half of a 12-bit range (CG-L53 + TLC2543) */
+        c->scale[i] = (90.0 * 3.14159265358979323846 / 180.0) / 2048.0;
+        c->axis_src[i] = i;
+        c->axis_sign[i] = 1;
+    }
+    c->method = ATT_METHOD_RV3;
+    c->format = RX_FORMAT_CSV;
+    c->block_size = 6;
+    c->queue_size = 256;
+    c->gap_ms = 20;
+    c->reopen_delay = 1.0;
+    c->header = 1;
+}
+
+static int fail(char *msg, size_t len, int code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, len, fmt, ap);
+    va_end(ap);
+    return code;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    double v;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end != '\0' || errno != 0 || !isfinite(v))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+static int parse_ulong(const char *s, unsigned long *out)
+{
+    char *end;
+    unsigned long v;
+    if (*s == '-' || *s == '\0')
+        return -1;
+    errno = 0;
+    v = strtoul(s, &end, 10);
+    if (*end != '\0' || errno != 0)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* "a" or "a,b,c" -> three doubles */
+static int parse_triple(const char *s, double out[3])
+{
+    char tmp[128];
+    char *p, *tok, *save = NULL;
+    int n = 0;
+    double v[3];
+    if (strlen(s) >= sizeof tmp)
+        return -1;
+    strcpy(tmp, s);
+    for (p = tmp; (tok = strtok_r(p, ",", &save)) != NULL; p = NULL) {
+        if (n == 3 || parse_double(tok, &v[n]) != 0)
+            return -1;
+        n++;
+    }
+    if (n == 1) {
+        out[0] = out[1] = out[2] = v[0];
+        return 0;
+    }
+    if (n != 3)
+        return -1;
+    out[0] = v[0];
+    out[1] = v[1];
+    out[2] = v[2];
+    return 0;
+}
+
+/* "x,y,z", "+y,-x,z", "1,0,2" ... : body axis i = sign * channel */
+static int parse_axes(const char *s, int src[3], int sign[3])
+{
+    char tmp[64];
+    char *p, *tok, *save = NULL;
+    int n = 0, seen = 0;
+    int a_src[3], a_sign[3];
+    if (strlen(s) >= sizeof tmp)
+        return -1;
+    strcpy(tmp, s);
+    for (p = tmp; (tok = strtok_r(p, ",", &save)) != NULL; p = NULL) {
+        int sg = 1, ch;
+        if (n == 3)
+            return -1;
+        while (isspace((unsigned char)*tok))
+            tok++;
+        if (*tok == '+' || *tok == '-') {
+            sg = *tok == '-' ? -1 : 1;
+            tok++;
+        }
+        if (tok[0] == '\0' || tok[1] != '\0')
+            return -1;
+        switch (tolower((unsigned char)tok[0])) {
+        case 'x': case '0': ch = 0; break;
+        case 'y': case '1': ch = 1; break;
+        case 'z': case '2': ch = 2; break;
+        default: return -1;
+        }
+        if (seen & (1 << ch))
+            return -1; /* each channel once */
+        seen |= 1 << ch;
+        a_src[n] = ch;
+        a_sign[n] = sg;
+        n++;
+    }
+    if (n != 3)
+        return -1;
+    memcpy(src, a_src, sizeof a_src);
+    memcpy(sign, a_sign, sizeof a_sign);
+    return 0;
+}
+
+int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, size_t len)
+{
+    unsigned long u;
+    double d;
+    size_t i;
+    if (value == NULL)
+        return fail(msg, len, RX_EXIT_USAGE, "option --%s needs a value", name);
+    if (strcmp(name, "port") == 0) {
+        if (strlen(value) >= sizeof c->port || value[0] == '\0')
+            return fail(msg, len, RX_EXIT_CONFIG, "port: bad path '%s'", value);
+        strcpy(c->port, value);
+    } else if (strcmp(name, "baud") == 0) {
+        if (parse_ulong(value, &u) != 0 || !rx_serial_baud_ok((long)u))
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "baud: '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 230400)",
+                        value);
+        c->baud = (long)u;
+    } else if (strcmp(name, "period") == 0) {
+        if (parse_double(value, &d) != 0 || !(d > 0.0) || d > 10.0)
+            return fail(msg, len, RX_EXIT_CONFIG, "period: '%s' must be a sample period in seconds, 0 < T <= 10", value);
+        c->period = d;
+    } else if (strcmp(name, "gyro-zero") == 0) {
+        double v[3];
+        if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > 65535
+            || v[1] > 65535 || v[2] > 65535)
+            return fail(msg, len, RX_EXIT_CONFIG, "gyro-zero: '%s' must be CODE or CODE,CODE,CODE (0..65535)", value);
+        memcpy(c->zero, v, sizeof v);
+    } else if (strcmp(name, "gyro-scale") == 0) {
+        double v[3];
+        if (parse_triple(value, v) != 0 || v[0] == 0 || v[1] == 0 || v[2] == 0)
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "gyro-scale: '%s' must be RAD_PER_S_PER_CODE or three of them, non-zero", value);
+        memcpy(c->scale, v, sizeof v);
+    } else if (strcmp(name, "axes") == 0) {
+        if (parse_axes(value, c->axis_src, c->axis_sign) != 0)
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "axes: '%s' must name each channel once with an optional sign, e.g. x,y,z or -y,+x,z", value);
+    } else if (strcmp(name, "method") == 0) {
+        for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
+            if (strcmp(value, methods[i].name) == 0)
+                break;
+        if (i == sizeof methods / sizeof methods[0])
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "method: unknown '%s' (rv1, rv2, rv3, rv3-coning, rv3-reuse, rk4)", value);
+        c->method = methods[i].method;
+    } else if (strcmp(name, "format") == 0) {
+        if (strcmp(value, "csv") == 0)
+            c->format = RX_FORMAT_CSV;
+        else if (strcmp(value, "jsonl") == 0)
+            c->format = RX_FORMAT_JSONL;
+        else
+            return fail(msg, len, RX_EXIT_CONFIG, "format: '%s' must be csv or jsonl", value);
+    } else if (strcmp(name, "block-size") == 0) {
+        if (parse_ulong(value, &u) != 0 || u == 0 || u % 6 != 0 || u > ATT_LINK_BLOCK_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "block-size: '%s' must be a multiple of 6 (3 x 16-bit codes per sample) up to 60", value);
+        c->block_size = (unsigned)u;
+    } else if (strcmp(name, "queue") == 0) {
+        if (parse_ulong(value, &u) != 0 || u == 0 || u > RX_QUEUE_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG, "queue: '%s' must be 1..%d samples", value, RX_QUEUE_MAX);
+        c->queue_size = (unsigned)u;
+    } else if (strcmp(name, "gap-ms") == 0) {
+        if (parse_ulong(value, &u) != 0 || u == 0 || u > ATT_LINK_TIMEOUT_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG, "gap-ms: '%s' must be 1..%d ms", value, ATT_LINK_TIMEOUT_MAX);
+        c->gap_ms = (unsigned)u;
+    } else if (strcmp(name, "count") == 0) {
+        if (parse_ulong(value, &u) != 0)
+            return fail(msg, len, RX_EXIT_CONFIG, "count: '%s' must be a number of output lines", value);
+        c->count = u;
+    } else if (strcmp(name, "consumer-delay") == 0) {
+        if (parse_double(value, &d) != 0 || d < 0 || d > 10)
+            return fail(msg, len, RX_EXIT_CONFIG, "consumer-delay: '%s' must be 0..10 s", value);
+        c->consumer_delay = d;
+    } else if (strcmp(name, "reopen-delay") == 0) {
+        if (parse_double(value, &d) != 0 || d < 0.01 || d > 60)
+            return fail(msg, len, RX_EXIT_CONFIG, "reopen-delay: '%s' must be 0.01..60 s", value);
+        c->reopen_delay = d;
+    } else if (strcmp(name, "header") == 0) {
+        if (strcmp(value, "yes") == 0 || strcmp(value, "1") == 0)
+            c->header = 1;
+        else if (strcmp(value, "no") == 0 || strcmp(value, "0") == 0)
+            c->header = 0;
+        else
+            return fail(msg, len, RX_EXIT_CONFIG, "header: '%s' must be yes or no", value);
+    } else {
+        return fail(msg, len, RX_EXIT_CONFIG, "unknown setting '%s'", name);
+    }
+    return 0;
+}
+
+static char *trim(char *s)
+{
+    char *e;
+    while (isspace((unsigned char)*s))
+        s++;
+    e = s + strlen(s);
+    while (e > s && isspace((unsigned char)e[-1]))
+        *--e = '\0';
+    return s;
+}
+
+int rx_config_file(rx_config *c, const char *path, char *msg, size_t len)
+{
+    char line[512];
+    unsigned lineno = 0;
+    FILE *f = fopen(path, "r");
+    if (f == NULL)
+        return fail(msg, len, RX_EXIT_CONFIG, "config file %s: %s", path, strerror(errno));
+    while (fgets(line, sizeof line, f) != NULL) {
+        char *hash, *eq, *name, *value;
+        int rc;
+        lineno++;
+        if (strchr(line, '\n') == NULL && !feof(f)) {
+            fclose(f);
+            return fail(msg, len, RX_EXIT_CONFIG, "%s:%u: line too long", path, lineno);
+        }
+        if ((hash = strchr(line, '#')) != NULL)
+            *hash = '\0';
+        name = trim(line);
+        if (*name == '\0')
+            continue;
+        eq = strchr(name, '=');
+        if (eq == NULL) {
+            fclose(f);
+            return fail(msg, len, RX_EXIT_CONFIG, "%s:%u: expected 'name = value'", path, lineno);
+        }
+        *eq = '\0';
+        value = trim(eq + 1);
+        name = trim(name);
+        if (strcmp(name, "config") == 0) {
+            fclose(f);
+            return fail(msg, len, RX_EXIT_CONFIG, "%s:%u: config files do not nest", path, lineno);
+        }
+        rc = rx_config_set(c, name, value, msg, len);
+        if (rc != 0) {
+            char inner[RX_MSG_MAX];
+            snprintf(inner, sizeof inner, "%s", msg);
+            fclose(f);
+            return fail(msg, len, RX_EXIT_CONFIG, "%s:%u: %s", path, lineno, inner);
+        }
+    }
+    fclose(f);
+    return 0;
+}
+
+/* Split "--name=value" / "--name value"; returns the index of the next argument. */
+static int next_opt(int argc, char **argv, int i, char *name, size_t nlen, const char **value)
+{
+    const char *a = argv[i] + 2;
+    const char *eq = strchr(a, '=');
+    if (eq != NULL) {
+        size_t n = (size_t)(eq - a);
+        if (n >= nlen)
+            n = nlen - 1;
+        memcpy(name, a, n);
+        name[n] = '\0';
+        *value = eq + 1;
+        return i + 1;
+    }
+    snprintf(name, nlen, "%s", a);
+    if (strcmp(name, "help") == 0 || strcmp(name, "no-header") == 0) {
+        *value = "";
+        return i + 1;
+    }
+    *value = (i + 1 < argc) ? argv[i + 1] : NULL;
+    return i + 2;
+}
+
+int rx_config_parse(rx_config *c, int argc, char **argv, int *help, char *msg, size_t len)
+{
+    int i, rc;
+    char name[64];
+    const char *value;
+    *help = 0;
+    /* pass 1: --help and --config (the file first, so the command line wins) */
+    for (i = 1; i < argc;) {
+        if (strncmp(argv[i], "--", 2) != 0)
+            return fail(msg, len, RX_EXIT_USAGE, "unexpected argument '%s' (options start with --)", argv[i]);
+        i = next_opt(argc, argv, i, name, sizeof name, &value);
+        if (strcmp(name, "help") == 0) {
+            *help = 1;
+            return 0;
+        }
+        if (strcmp(name, "config") == 0) {
+            if (value == NULL)
+                return fail(msg, len, RX_EXIT_USAGE, "option --config needs a value");
+            rc = rx_config_file(c, value, msg, len);
+            if (rc != 0)
+                return rc;
+        }
+    }
+    /* pass 2: everything else */
+    for (i = 1; i < argc;) {
+        i = next_opt(argc, argv, i, name, sizeof name, &value);
+        if (strcmp(name, "config") == 0)
+            continue;
+        if (strcmp(name, "no-header") == 0) {
+            c->header = 0;
+            continue;
+        }
+        rc = rx_config_set(c, name, value, msg, len);
+        if (rc != 0)
+            return rc == RX_EXIT_CONFIG && strncmp(msg, "unknown setting", 15) == 0
+                ? fail(msg, len, RX_EXIT_USAGE, "unknown option --%s (see --help)", name) : rc;
+    }
+    if (c->port[0] == '\0')
+        return fail(msg, len, RX_EXIT_USAGE, "no serial port: give --port PATH (or port = PATH in --config FILE)");
+    return 0;
+}
+
+void rx_usage(const char *prog, void *stream)
+{
+    fprintf((FILE *)stream,
+            "usage: %s --port PATH [options]\n"
+            "Receive gyro samples over the serial link (AA/BB handshake, checksum, 00/FF answer),\n"
+            "integrate the attitude in a second thread, print one line per attitude update.\n\n"
+            "  --port PATH              serial device (required)\n"
+            "  --baud N                 line rate, default 9600 (8N1 raw)\n"
+            "  --period SECONDS         gyro sample period, default 0.01\n"
+            "  --gyro-zero CODE[,C,C]   ADC code at zero rate, default 2048\n"
+            "  --gyro-scale K[,K,K]     rad/s per code, default 7.6699e-4 (90 deg/s per 2048 codes)\n"
+            "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
+            "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rk4, default rv3\n"
+            "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
+            "  --block-size N           link block bytes (multiple of 6), default 6\n"
+            "  --queue N                samples the inter-thread queue holds, default 256\n"
+            "  --gap-ms MS              link gap timeout inside a block, default 20\n"
+            "  --count N                stop after N output lines (default: until SIGINT/SIGTERM)\n"
+            "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
+            "  --consumer-delay SECONDS make the attitude thread sleep per sample (diagnostics)\n"
+            "  --config FILE            'name = value' lines with the names above; the command line wins\n"
+            "Exit codes: 0 ok, 64 usage, 66 no such port, 74 port not usable, 77 permission denied,\n"
+            "78 bad configuration.\n",
+            prog);
+}

@@ -1,0 +1,242 @@
+/*
+ * Test-vector runner: reads vectors written by toolchain/vectors.py (inputs
+ * from the NumPy reference's generator), runs the library on them and
+ * prints the results for pytest to compare with the reference. Plain C99
+ * + stdio, no malloc: it runs on the host, on the bare ARMv4T core under
+ * `qemu-arm -cpu ti925t` (newlib semihosting opens the file) and on
+ * ARM Linux under qemu-arm.
+ *
+ * Input (whitespace-separated tokens, '#' starts a comment line):
+ *   case ID FUNC N [PARAMS...]   then N records of FUNC's input arity
+ * FUNC and PARAMS:
+ *   quat_mul (8 -> 4), quat_conj (4 -> 4), quat_normalize (4 -> 4),
+ *   rotvec_to_quat (3 -> 4), quat_to_rotvec (4 -> 3), quat_to_dcm (4 -> 9),
+ *   dcm_to_quat (9 -> 4), dcm_to_euler (9 -> 3), euler_to_dcm (3 -> 9),
+ *   quat_to_euler (4 -> 3), euler_to_quat (3 -> 4), quat_heading (4 -> 1),
+ *   dcm_heading (9 -> 1)                 -- the array (_n) forms, PARAMS none;
+ *   integ METHOD q0 q1 q2 q3             -- N increments (3) -> a quaternion per update;
+ *   rk4 H q0 q1 q2 q3                    -- N rates (3), step H -> a quaternion per update;
+ *   link_checksum                        -- N bytes (one record of N values) -> 1.
+ * Output per case:
+ *   = ID STATUS ERR_INDEX NOUT           (ERR_INDEX -1 when none)
+ *   NOUT lines of output values
+ * and a last line "vectors: C cases, S bytes of att_real".
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "attitude/attitude.h"
+
+enum { MAX_REC = 2048, MAX_VALS = MAX_REC * 9, MAX_OUT = MAX_REC * 9 };
+
+static att_real in_buf[MAX_VALS];
+static att_real in_buf2[MAX_VALS];
+static att_real out_buf[MAX_OUT];
+static FILE *in;
+
+#if defined(ATT_REAL_F32)
+#define DIGITS 9
+#else
+#define DIGITS 17
+#endif
+
+static int token(char *tok, size_t n)
+{
+    int c;
+    size_t k = 0;
+    for (;;) { /* skip blanks and comment lines */
+        c = fgetc(in);
+        if (c == EOF)
+            return -1;
+        if (c == '#') {
+            while (c != '\n' && c != EOF)
+                c = fgetc(in);
+            continue;
+        }
+        if (c != ' ' && c != '\t' && c != '\n' && c != '\r')
+            break;
+    }
+    while (c != EOF && c != ' ' && c != '\t' && c != '\n' && c != '\r') {
+        if (k + 1 < n)
+            tok[k++] = (char)c;
+        c = fgetc(in);
+    }
+    tok[k] = '\0';
+    return 0;
+}
+
+static int number(double *v)
+{
+    char tok[64], *end;
+    if (token(tok, sizeof tok) != 0)
+        return -1;
+    *v = strtod(tok, &end);
+    return *end == '\0' ? 0 : -1;
+}
+
+static int read_values(att_real *dst, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++) {
+        double v;
+        if (number(&v) != 0)
+            return -1;
+        dst[i] = (att_real)v;
+    }
+    return 0;
+}
+
+static void print_records(const att_real *v, size_t nrec, size_t arity)
+{
+    size_t r, j;
+    for (r = 0; r < nrec; r++) {
+        for (j = 0; j < arity; j++)
+            printf(j ? " %.*g" : "%.*g", DIGITS, (double)v[r * arity + j]);
+        putchar('\n');
+    }
+}
+
+typedef att_status (*map_fn)(const att_real *, att_real *, size_t, size_t *);
+
+static const struct {
+    const char *name;
+    size_t in, out;
+    map_fn fn;
+} maps[] = {
+    {"quat_normalize", 4, 4, att_quat_normalize_n},
+    {"rotvec_to_quat", 3, 4, att_rotvec_to_quat_n},
+    {"quat_to_rotvec", 4, 3, att_quat_to_rotvec_n},
+    {"quat_to_dcm", 4, 9, att_quat_to_dcm_n},
+    {"dcm_to_quat", 9, 4, att_dcm_to_quat_n},
+    {"dcm_to_euler", 9, 3, att_dcm_to_euler_n},
+    {"euler_to_dcm", 3, 9, att_euler_to_dcm_n},
+    {"quat_to_euler", 4, 3, att_quat_to_euler_n},
+    {"euler_to_quat", 3, 4, att_euler_to_quat_n},
+    {"quat_heading", 4, 1, att_quat_heading_n},
+    {"dcm_heading", 9, 1, att_dcm_heading_n},
+};
+
+static const struct {
+    const char *name;
+    att_method m;
+} methods[] = {
+    {"rv1", ATT_METHOD_RV1}, {"rv2", ATT_METHOD_RV2}, {"rv3", ATT_METHOD_RV3},
+    {"rv3-coning", ATT_METHOD_RV3_CONING}, {"rv3-reuse", ATT_METHOD_RV3_REUSE},
+};
+
+static void result(const char *id, int status, long err, size_t nout)
+{
+    printf("= %s %d %ld %lu\n", id, status, err, (unsigned long)nout);
+}
+
+static int run_case(const char *id, const char *fn, size_t n)
+{
+    size_t i, err = 0;
+    att_status st;
+    if (n > MAX_REC)
+        return -1;
+    for (i = 0; i < sizeof maps / sizeof maps[0]; i++) {
+        if (strcmp(fn, maps[i].name) != 0)
+            continue;
+        if (read_values(in_buf, n * maps[i].in) != 0)
+            return -1;
+        st = maps[i].fn(in_buf, out_buf, n, &err);
+        if (st == ATT_OK)
+            err = n;
+        result(id, st, st == ATT_OK ? -1L : (long)err, err);
+        print_records(out_buf, err, maps[i].out);
+        return 0;
+    }
+    if (strcmp(fn, "quat_mul") == 0) {
+        for (i = 0; i < n; i++)
+            if (read_values(in_buf + 4 * i, 4) != 0 || read_values(in_buf2 + 4 * i, 4) != 0)
+                return -1;
+        st = att_quat_mul_n(in_buf, in_buf2, out_buf, n, &err);
+        if (st == ATT_OK)
+            err = n;
+        result(id, st, st == ATT_OK ? -1L : (long)err, err);
+        print_records(out_buf, err, 4);
+        return 0;
+    }
+    if (strcmp(fn, "quat_conj") == 0) {
+        if (read_values(in_buf, 4 * n) != 0)
+            return -1;
+        for (i = 0; i < n; i++)
+            att_quat_conj(in_buf + 4 * i, out_buf + 4 * i);
+        result(id, ATT_OK, -1L, n);
+        print_records(out_buf, n, 4);
+        return 0;
+    }
+    if (strcmp(fn, "link_checksum") == 0) {
+        uint8_t bytes[256];
+        if (n > sizeof bytes || read_values(in_buf, n) != 0)
+            return -1;
+        for (i = 0; i < n; i++)
+            bytes[i] = (uint8_t)in_buf[i];
+        out_buf[0] = (att_real)att_link_checksum(bytes, (uint8_t)n);
+        result(id, ATT_OK, -1L, 1);
+        print_records(out_buf, 1, 1);
+        return 0;
+    }
+    if (strcmp(fn, "integ") == 0 || strcmp(fn, "rk4") == 0) {
+        char mname[32];
+        att_real q0[4], h = 0;
+        att_integ s;
+        size_t nout = 0;
+        int rk4 = strcmp(fn, "rk4") == 0;
+        att_method m = ATT_METHOD_RK4;
+        if (rk4) {
+            if (read_values(&h, 1) != 0)
+                return -1;
+        } else {
+            if (token(mname, sizeof mname) != 0)
+                return -1;
+            for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
+                if (strcmp(mname, methods[i].name) == 0)
+                    break;
+            if (i == sizeof methods / sizeof methods[0])
+                return -1;
+            m = methods[i].m;
+        }
+        if (read_values(q0, 4) != 0 || read_values(in_buf, 3 * n) != 0)
+            return -1;
+        st = att_integ_init(&s, m, q0);
+        if (st == ATT_OK) {
+            if (att_integ_outputs(&s, n) > MAX_OUT / 4)
+                return -1;
+            st = rk4 ? att_integ_rk4_batch(&s, in_buf, n, &h, 1, out_buf, &nout, &err)
+                     : att_integ_batch(&s, in_buf, n, out_buf, &nout, &err);
+        }
+        result(id, st, st == ATT_OK ? -1L : (long)err, nout);
+        print_records(out_buf, nout, 4);
+        return 0;
+    }
+    return -1;
+}
+
+int main(int argc, char **argv)
+{
+    char tok[64], id[64], fn[64];
+    unsigned long cases = 0;
+    in = argc > 1 ? fopen(argv[1], "r") : stdin;
+    if (in == NULL) {
+        printf("vectors: cannot open %s\n", argv[1]);
+        return 2;
+    }
+    while (token(tok, sizeof tok) == 0) {
+        double n;
+        if (strcmp(tok, "case") != 0 || token(id, sizeof id) != 0 || token(fn, sizeof fn) != 0
+            || number(&n) != 0 || n < 0) {
+            printf("vectors: malformed input near '%s' after %lu cases\n", tok, cases);
+            return 2;
+        }
+        if (run_case(id, fn, (size_t)n) != 0) {
+            printf("vectors: bad case %s (%s, %lu records)\n", id, fn, (unsigned long)n);
+            return 2;
+        }
+        cases++;
+    }
+    printf("vectors: %lu cases, %d bytes of att_real\n", cases, att_real_size());
+    return 0;
+}

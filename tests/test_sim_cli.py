@@ -1,0 +1,124 @@
+"""`attitude simulate`: default run, --help, bad arguments, outputs, budget."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from attitude_c.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
+    return env
+
+
+def test_help_lists_the_options() -> None:
+    r = subprocess.run([sys.executable, "-m", "attitude_c", "simulate", "--help"],
+                       capture_output=True, text=True, env=_env(), cwd=ROOT, timeout=60,
+                       check=False)
+    assert r.returncode == 0, r.stderr
+    for opt in ("--seed", "--budget", "--method", "--precision", "--ber", "--out", "--trajectory"):
+        assert opt in r.stdout
+
+
+def test_default_run_writes_every_output(tmp_path, capsys) -> None:
+    """The bare command (defaults: the paper's 60 s scenario) with --out."""
+    out = tmp_path / "run"
+    assert main(["simulate", "--out", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "heading" in text and "pitch" in text and "paper max" in text
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["parameters"]["method"] == "rv3"
+    assert summary["parameters"]["period_s"] == 0.08
+    assert summary["parameters"]["duration_s"] == 60.0
+    for k in ("heading", "pitch", "roll"):
+        assert set(summary["errors_rad"][k]) >= {"max", "min", "rms"}
+    assert summary["link"]["sent"] == 750
+    with open(out / "timeseries.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == summary["updates"] == 250
+    assert float(rows[-1]["t_s"]) == pytest.approx(60.0)
+    import matplotlib.image as mpimg
+
+    for png in ("errors.png", "attitude.png"):
+        img = mpimg.imread(out / png)
+        assert img.ndim == 3 and img.shape[0] > 300 and img.shape[1] > 500
+        assert np.std(img) > 0.01  # not blank
+
+
+def test_seed_reproducible(tmp_path) -> None:
+    args = ["simulate", "--duration", "8", "--no-plots", "--no-progress", "--adc", "ideal"]
+    for name, seed in (("a", "3"), ("b", "3"), ("c", "4")):
+        assert main(args + ["--seed", seed, "--out", str(tmp_path / name)]) == 0
+    s = {n: json.loads((tmp_path / n / "summary.json").read_text())["errors_rad"] for n in "abc"}
+    assert s["a"] == s["b"]
+    assert s["a"] != s["c"]
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--period", "-1"], "--period"),
+    (["--period", "abc"], "--period"),
+    (["--method", "rv9"], "--method"),
+    (["--ber", "0.9"], "BER"),
+    (["--oversample", "40"], "--oversample"),
+    (["--amplitude", "1,2"], "--amplitude"),
+    (["--seed", "x"], "--seed"),
+])
+def test_bad_arguments_are_usage_errors(argv, needle, capsys) -> None:
+    with pytest.raises(SystemExit) as ei:
+        main(["simulate", *argv])
+    assert ei.value.code == 2
+    assert needle in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["--trajectory", "csv"], "--trajectory-file"),
+    (["--trajectory", "csv", "--trajectory-file", "/nonexistent/t.csv"], "cannot read"),
+    (["--amplitude", "30,95,10"], "pitch"),
+    (["--link", "none", "--ber", "1e-3"], "ber"),
+])
+def test_bad_values_give_clear_errors(argv, needle, tmp_path, capsys) -> None:
+    rc = main(["simulate", "--no-progress", "--out", str(tmp_path / "x"), *argv])
+    assert rc == 2
+    err = capsys.readouterr().err
+    assert err.startswith("attitude simulate: error:") and needle in err
+
+
+def test_csv_trajectory_run(tmp_path) -> None:
+    t = np.arange(0, 10.0001, 0.02)
+    e = np.column_stack([20 * np.sin(t), 10 * np.sin(0.7 * t), 15 * np.cos(0.5 * t)])
+    p = tmp_path / "traj.csv"
+    np.savetxt(p, np.column_stack([t, e]), delimiter=",", header="time,yaw_deg,pitch_deg,roll_deg",
+               comments="", fmt="%.12g")
+    out = tmp_path / "o"
+    assert main(["simulate", "--trajectory", "csv", "--trajectory-file", str(p), "--duration", "9",
+                 "--sensors", "ideal", "--no-plots", "--no-progress", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["parameters"]["trajectory"]["trajectory"] == "csv"
+    assert s["errors_rad"]["attitude_angle"]["max_abs"] < 1e-3
+
+
+def test_budget_cli(tmp_path, capsys) -> None:
+    out = tmp_path / "b"
+    assert main(["simulate", "--budget", "--duration", "9", "--methods", "rv1,rv3",
+                 "--budget-ber", "0", "--no-progress", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "dominant source" in text
+    b = json.loads((out / "budget.json").read_text())
+    assert b["methods"] == ["rv1", "rv3"]
+    assert b["dominant_source"]["rv1"] == "algorithm"
+    assert (out / "budget.md").read_text().startswith("| stage |")
+    import matplotlib.image as mpimg
+
+    assert mpimg.imread(out / "budget.png").shape[0] > 200

@@ -1,0 +1,311 @@
+"""Test vectors for the C runner (csrc/vectors/run_vectors.c), from the NumPy reference.
+
+``generate(seed)`` builds every case: inputs (seeded random plus the
+special cases: identity, 180° rotations, tiny and large rotation vectors,
+θ = ±90°, non-finite inputs) and the expected outputs of
+``attitude_c.reference`` (float64). ``write(cases, path)`` writes the
+runner's input file; ``parse(text)`` reads the runner's output;
+``compare(cases, results, precision)`` returns the mismatches.
+
+The same file runs on every target (host, ARMv4T bare metal under
+``qemu-arm -cpu ti925t``, ARM Linux under ``qemu-arm``); pytest compares
+each target's output with the reference (tests/test_vectors.py).
+
+Inputs are rounded to float32 so that the float build of the library
+sees exactly the values the reference used (its errors are then its own
+arithmetic only, which the float tolerances below are derived from).
+
+Command line (to run the vectors on a real board)::
+
+    python -m toolchain.vectors --out vectors.txt
+    ./run_vectors vectors.txt > results.txt
+    python -m toolchain.vectors --check results.txt [--precision f32]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+RUNNER_SRC = ROOT / "csrc" / "vectors" / "run_vectors.c"
+
+#: float32 unit roundoff (2^-24): the size of one rounding in the float build.
+EPS32 = 2.0 ** -24
+#: float64 unit roundoff (2^-53).
+EPS64 = 2.0 ** -53
+
+INCREMENT_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse")
+
+
+@dataclass
+class Case:
+    id: str
+    func: str
+    inputs: np.ndarray              # (N, arity) float64, float32-representable
+    params: list[str] = field(default_factory=list)
+    expected: np.ndarray | None = None  # (M, out_arity) float64
+    status_ok: bool = True          # False: the C call must fail
+    err_index: int = -1             # expected failing record (when not status_ok)
+    kind: str = "plain"             # comparison: plain | quat (up to sign) | angle (mod 2π) | euler
+    ops: int = 20                   # float roundings behind one output (tolerance scale)
+    scale: float = 1.0              # magnitude of the outputs
+
+
+def _ref() -> Any:
+    from attitude_c import reference
+
+    return reference
+
+
+def _f32(x: np.ndarray) -> np.ndarray:
+    return np.asarray(x, dtype=np.float32).astype(np.float64)
+
+
+def _unit_quats(rng: np.random.Generator, n: int) -> np.ndarray:
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return _f32(q)
+
+
+def _special_quats() -> np.ndarray:
+    s = math.sqrt(0.5)
+    return _f32(np.array([
+        [1, 0, 0, 0],          # identity
+        [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1],   # 180° about x, y, z
+        [0, s, s, 0],          # 180° about a diagonal
+        [s, s, 0, 0],          # +90° about x: pitch = +90° (gimbal lock)
+        [s, -s, 0, 0],         # pitch = -90°
+        [s, 0, 0, s],          # 90° yaw
+        [1, 1e-7, -1e-7, 1e-7],  # tiny rotation
+    ], dtype=np.float64))
+
+
+def _euler_random(rng: np.random.Generator, n: int, pitch_margin: float) -> np.ndarray:
+    """[ψ, θ, γ] away from the ±180° wrap of ψ, γ and from gimbal lock by pitch_margin."""
+    e = np.column_stack([
+        rng.uniform(-3.1, 3.1, n),
+        rng.uniform(-math.pi / 2 + pitch_margin, math.pi / 2 - pitch_margin, n),
+        rng.uniform(-3.1, 3.1, n),
+    ])
+    return _f32(e)
+
+
+def generate(seed: int = 20100601, n: int = 64) -> list[Case]:
+    """Every vector case, with the reference's expected outputs."""
+    ref = _ref()
+    rng = np.random.default_rng(seed)
+    cases: list[Case] = []
+
+    def add(func: str, inputs: np.ndarray, expected: Any, **kw: Any) -> None:
+        cases.append(Case(f"{func}.{len(cases)}", func, np.asarray(inputs, dtype=np.float64),
+                          expected=None if expected is None else
+                          np.asarray(expected, dtype=np.float64).reshape(len(inputs), -1), **kw))
+
+    q = np.vstack([_special_quats(), _unit_quats(rng, n)])
+    q_scaled = _f32(q * rng.uniform(0.5, 2.0, size=(len(q), 1)))  # not unit
+    a, b = _unit_quats(rng, n), _unit_quats(rng, n)
+    add("quat_mul", np.hstack([a, b]), ref.quat_multiply(a, b), ops=8)
+    add("quat_conj", q, ref.quat_conj(q), ops=1)
+    add("quat_normalize", q_scaled, ref.quat_normalize(q_scaled), ops=12)
+    phi = np.vstack([
+        np.zeros((1, 3)),
+        _f32(rng.normal(size=(n, 3)) * 1e-6),   # tiny: series branch
+        _f32(rng.normal(size=(n, 3)) * 0.05),   # near the series/trig switch (φ = 0.2)
+        _f32(rng.normal(size=(n, 3)) * 1.5),    # large
+        _f32(np.array([[math.pi, 0, 0], [0, 0, -3.1]])),
+    ])
+    add("rotvec_to_quat", phi, ref.rotvec_to_quat(phi), kind="quat", ops=20)
+    # quat -> rotvec: away from 180° (the sign flip there is a discontinuity)
+    qr = q[np.abs(q[:, 0]) > 0.05]
+    add("quat_to_rotvec", qr, ref.quat_to_rotvec(qr), ops=40, scale=math.pi)
+    add("quat_to_dcm", q_scaled, ref.quat_to_dcm(q_scaled).reshape(-1, 9), ops=20)
+    C = ref.quat_to_dcm(q).reshape(-1, 9)
+    Cf = _f32(C)
+    add("dcm_to_quat", Cf, ref.dcm_to_quat(Cf.reshape(-1, 3, 3)), kind="quat", ops=40)
+    e = _euler_random(rng, n, pitch_margin=0.05)
+    Ce = _f32(ref.euler_to_dcm(e).reshape(-1, 9))
+    add("dcm_to_euler", Ce, ref.dcm_to_euler(Ce.reshape(-1, 3, 3)), kind="euler", ops=40,
+        scale=math.pi)
+    add("euler_to_dcm", e, ref.euler_to_dcm(e).reshape(-1, 9), ops=30)
+    qe = _f32(ref.euler_to_quat(e))
+    add("quat_to_euler", qe, ref.quat_to_euler(qe), kind="euler", ops=40, scale=math.pi)
+    add("euler_to_quat", e, ref.euler_to_quat(e), kind="quat", ops=30)
+    add("quat_heading", qe, np.asarray(ref.heading(qe)).reshape(-1, 1), kind="angle", ops=40,
+        scale=2 * math.pi)
+    add("dcm_heading", Ce, np.asarray(ref.heading(Ce.reshape(-1, 3, 3))).reshape(-1, 1),
+        kind="angle", ops=40, scale=2 * math.pi)
+    # gimbal lock: exact θ = ±90° gives a defined answer (f64 only compares these exactly)
+    add("quat_to_euler", q[5:7], ref.quat_to_euler(q[5:7]), kind="euler", ops=40, scale=math.pi)
+
+    # bad input: NaN / Inf in the 3rd record, zero quaternion
+    bad = q[:5].copy()
+    bad[2, 1] = np.nan
+    add("quat_to_dcm", bad, None, status_ok=False, err_index=2)
+    bad2 = phi[:5].copy()
+    bad2[3, 0] = np.inf
+    add("rotvec_to_quat", bad2, None, status_ok=False, err_index=3)
+    zero = np.vstack([q[:1], np.zeros((1, 4))])
+    add("quat_normalize", zero, None, status_ok=False, err_index=1)
+
+    # integrator: every method, random ~1 rad/s motion at 100 Hz, plus a constant rate
+    for m in INCREMENT_METHODS:
+        k = 150
+        w = 1.0 + 0.5 * np.sin(np.arange(k)[:, None] * 0.05 + np.array([0.0, 1.0, 2.0]))
+        dth = _f32(w * 0.01 * np.array([1.0, -0.7, 0.4]))
+        q0 = _unit_quats(rng, 1)[0]
+        out = ref.integrate(dth, method=m, q0=q0)
+        cases.append(Case(f"integ.{m}.{len(cases)}", "integ", dth, params=[m, *(repr(float(v)) for v in q0)],
+                          expected=np.asarray(out, dtype=np.float64), kind="quat", ops=12 * len(out)))
+    dth = _f32(np.tile([[0.002, -0.001, 0.003]], (30, 1)))
+    dth[17, 2] = np.nan
+    cases.append(Case(f"integ.nan.{len(cases)}", "integ", dth, params=["rv3", "1", "0", "0", "0"],
+                      status_ok=False, err_index=17))
+    # rk4 from rates: first sample = start, then alternating midpoint / end
+    k = 121
+    t = np.arange(k) * 0.005
+    omega = _f32(np.column_stack([np.sin(2 * t), 0.5 * np.cos(3 * t), 0.3 + 0 * t]))
+    h = 0.01  # step of the C call = 2 sample spacings (start, midpoint, end)
+    out = ref.integrate_rates(omega, h / 2, method="rk4")
+    cases.append(Case(f"rk4.{len(cases)}", "rk4", omega, params=[repr(h), "1", "0", "0", "0"],
+                      expected=np.asarray(out, dtype=np.float64), kind="quat", ops=40 * len(out)))
+    # link checksum
+    blk = rng.integers(0, 256, size=(1, 64)).astype(np.float64)
+    cases.append(Case(f"link_checksum.{len(cases)}", "link_checksum", blk.reshape(-1, 1).T,
+                      expected=np.array([[float(int(blk.sum()) % 256)]]), ops=0))
+    return cases
+
+
+def write(cases: Sequence[Case], path: str | Path) -> Path:
+    """Write the runner's input file."""
+    path = Path(path)
+    lines = ["# libattitude test vectors (toolchain/vectors.py); inputs only, expected values stay in Python"]
+    for c in cases:
+        n = len(c.inputs) if c.func != "link_checksum" else c.inputs.shape[1]
+        lines.append(f"case {c.id} {c.func} {n} {' '.join(c.params)}".rstrip())
+        for row in c.inputs:
+            lines.append(" ".join(repr(float(v)) if np.isfinite(v) else ("nan" if np.isnan(v) else
+                                  ("inf" if v > 0 else "-inf")) for v in row))
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@dataclass
+class Result:
+    status: int
+    err_index: int
+    values: np.ndarray
+
+
+def parse(text: str) -> tuple[dict[str, Result], str]:
+    """Runner output -> ({case id: Result}, summary line)."""
+    res: dict[str, Result] = {}
+    lines = text.strip().splitlines()
+    i = 0
+    summary = ""
+    while i < len(lines):
+        ln = lines[i]
+        if ln.startswith("= "):
+            _, cid, st, err, nout = ln.split()
+            rows = [list(map(float, lines[i + 1 + j].split())) for j in range(int(nout))]
+            res[cid] = Result(int(st), int(err), np.array(rows, dtype=np.float64))
+            i += 1 + int(nout)
+        else:
+            if ln.startswith("vectors:"):
+                summary = ln
+            i += 1
+    return res, summary
+
+
+def tolerance(case: Case, precision: str) -> float:
+    """Absolute tolerance for one output of ``case``.
+
+    f64: the reference and the C code use different formulas, each good to
+    a few ulps per rounding; ``ops`` roundings of size ≤ 2^-53 relative,
+    times the output magnitude, times 4 for the two implementations and
+    the condition of the function. This is ~1e-12 or below for the
+    single-call functions (the integrator issue's differential bound).
+    f32: the C code rounds each of its ``ops`` operations to float32
+    (2^-24 relative, worst case linear accumulation), the reference is
+    exact in comparison; inputs are float32-representable so they add no
+    error. Outputs are printed with 9 significant digits (round-trip for
+    float32), which is covered by the same bound.
+    """
+    eps = EPS64 if precision == "f64" else EPS32
+    return 4.0 * max(case.ops, 1) * eps * case.scale
+
+
+def _wrap(d: np.ndarray) -> np.ndarray:
+    return (d + math.pi) % (2 * math.pi) - math.pi
+
+
+def compare(cases: Sequence[Case], results: dict[str, Result], precision: str) -> list[str]:
+    """Mismatches between the runner's results and the reference (empty = all good)."""
+    bad: list[str] = []
+    for c in cases:
+        r = results.get(c.id)
+        if r is None:
+            bad.append(f"{c.id}: no result")
+            continue
+        if not c.status_ok:
+            if r.status >= 0 or r.err_index != c.err_index:
+                bad.append(f"{c.id}: expected an error at record {c.err_index}, got status {r.status} "
+                           f"at {r.err_index}")
+            continue
+        if r.status != 0:
+            bad.append(f"{c.id}: status {r.status} at record {r.err_index}")
+            continue
+        assert c.expected is not None
+        exp = c.expected
+        if r.values.shape != exp.shape:
+            bad.append(f"{c.id}: shape {r.values.shape} != expected {exp.shape}")
+            continue
+        if c.kind == "quat":  # q and -q are the same rotation
+            sign = np.where(np.sum(r.values * exp, axis=1, keepdims=True) < 0, -1.0, 1.0)
+            d = np.abs(r.values * sign - exp)
+        elif c.kind in ("angle", "euler"):
+            d = np.abs(_wrap(r.values - exp))
+        else:
+            d = np.abs(r.values - exp)
+        tol = tolerance(c, precision)
+        if c.kind == "euler" and precision == "f32":
+            # near gimbal lock yaw and roll are ill-conditioned: an error δ in
+            # the matrix moves them by δ / cos θ (θ kept ≤ 90° - 0.05 rad here)
+            tol *= 1.0 / math.sin(0.05)
+        worst = float(np.max(d)) if d.size else 0.0
+        if not worst <= tol:
+            idx = np.unravel_index(int(np.argmax(d)), d.shape)
+            bad.append(f"{c.id}: |C - reference| = {worst:.3g} > {tol:.3g} at {idx}: "
+                       f"{r.values[idx[0]]} vs {exp[idx[0]]}")
+    return bad
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m toolchain.vectors", description=__doc__.splitlines()[0])
+    ap.add_argument("--out", help="write the runner's input file here")
+    ap.add_argument("--check", help="compare a runner output file with the reference")
+    ap.add_argument("--precision", choices=["f64", "f32"], default="f64")
+    ap.add_argument("--seed", type=int, default=20100601)
+    a = ap.parse_args(argv)
+    cases = generate(a.seed)
+    if a.out:
+        write(cases, a.out)
+        print(f"wrote {len(cases)} cases to {a.out}")
+    if a.check:
+        res, summary = parse(Path(a.check).read_text())
+        bad = compare(cases, res, a.precision)
+        for b in bad:
+            print(b)
+        print(f"{len(cases) - len(bad)} of {len(cases)} cases match the reference ({summary})")
+        return 1 if bad else 0
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
