@@ -281,7 +281,7 @@ __sfr16 __at(0xEBEA) bench_t_sum;       /* checksum handed out */
 __sfr16 __at(0xEDEC) bench_sent;        /* tx.stats.blocks_sent seen last */
 __sfr16 __at(0xEFEE) bench_t_loop;      /* start of this loop iteration */
 __sfr16 __at(0xD8D7) bench_t_scan;
-__sbit __at(0xC7) bench_busy;           /* this iteration did link work */
+__sfr __at(0xBE) bench_busy;           /* this iteration did link work */
 __sfr32 __at(0xF4F3F2F1) bench_busy_sum;
 __sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
 __sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
@@ -483,10 +483,8 @@ void main(void)
     (void)att_link_sender_init(&tx, &link_cfg);
 #if defined(FW_SIM_MODEL)
     fw_sim_model_init();
-    (void)tlc2543_init(&adc, fw_sim_adc_hal(), 0);
-#else
-    (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
 #endif
+    (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push(); /* the queue is empty: BOOT report first */
     put_report_head((uint8_t)FW_REPORT_BOOT);
     put_word((uint16_t)(((uint16_t)FW_VERSION << 8) | (uint8_t)(FW_PERIOD_TICKS >> 8)));
@@ -554,12 +552,18 @@ void main(void)
             if (sampling) {
                 next_sample += (uint16_t)FW_PERIOD_TICKS;
                 if (sample_slot()) {
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_step();
+#endif
 #if defined(FW_BENCH)
                     bench_scan_begin();
 #endif
                     st = tlc2543_scan(&adc, xyz, 3, (uint16_t __data *)wp, TLC2543_POWER_DOWN);
 #if defined(FW_BENCH)
                     bench_scan_end();
+#endif
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_check();
 #endif
                     sample_store(st);
                 }
@@ -568,6 +572,9 @@ void main(void)
                 seq++; /* until sampling starts, seq counts the self-test attempts */
                 if (q_push()) {
                     st = tlc2543_self_test_codes(&adc, (uint16_t __data *)wp);
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_check();
+#endif
                     if (self_test_done(st)) {
                         sampling = 1;
                         seq = 0;

@@ -221,7 +221,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}"]
         sources.append(FW_DIR / "sim" / "sim_io.c")
     if kind == "sim":
-        defines += ["FW_SIM_MODEL", "TLC2543_HAL_CUSTOM", *_gyro_defines(gyros)]
+        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
         for f in faults:
             if f not in fault_defs:
                 raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)}")
