@@ -569,8 +569,8 @@ void main(void)
                 }
                 seq++;
             } else {
-                seq++; /* until sampling starts, seq counts the self-test attempts */
-                if (q_push()) {
+                if (q_push()) { /* the report slot, also where the codes land */
+                    seq++; /* until sampling starts, seq counts the self-test attempts */
                     st = tlc2543_self_test_codes(&adc, (uint16_t __data *)wp);
 #if defined(FW_SIM_MODEL)
                     fw_sim_model_check();

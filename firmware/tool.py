@@ -192,7 +192,8 @@ def parse_mem(mem: Path) -> tuple[int, int, int]:
 
 def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
           sim_blocks: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
-          extra_defines: Iterable[str] = (), name: str | None = None) -> Image:
+          extra_defines: Iterable[str] = (), name: str | None = None,
+          code_size: int = FLASH_SIZE) -> Image:
     """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
 
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
@@ -230,7 +231,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         sources.insert(1, FW_DIR / "sim" / "tlc_model.c")
     if kind == "bench":
         defines += ["FW_BENCH"]
-    link_flags = flags
+    link_flags = [f for f in flags if f not in ("--code-size", "4096")] + ["--code-size", str(code_size)]
     if kind != "production":
         # The simulation images carry the device model / counters and the
         # simulator-interface output: they may exceed 4 KB (s51's code
@@ -248,12 +249,12 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if proc.returncode != 0:
         msg = proc.stdout + proc.stderr
         if "Insufficient" in msg or "Could not get" in msg:
-            raise FirmwareTooBig(f"{name} does not fit the AT89S51 (4 KB flash, 128 B RAM):\n{msg}")
+            raise FirmwareTooBig(f"{name} does not fit the AT89S51 ({code_size} B flash, 128 B RAM):\n{msg}")
         raise FirmwareError(f"link failed for {name}:\n{msg}")
     flash, stack_start, stack_free = parse_mem(mem)
     img = Image(ihx=ihx, kind=kind, config=config, flash=flash, ram_static=stack_start,
                 stack_start=stack_start, stack_free=stack_free)
-    if (kind == "production" and flash > FLASH_SIZE) or stack_start + stack_free > IRAM_SIZE or stack_free <= 0:
+    if (kind == "production" and flash > code_size) or stack_start + stack_free > IRAM_SIZE or stack_free <= 0:
         raise FirmwareTooBig(img.size_report())
     return img
 

@@ -55,7 +55,10 @@ __sfr16 __at(0xAEAD) fwm_vz;
     ((fwm_nclk < 8u ? (fwm_in = (unsigned char)((fwm_in << 1) | fwm_din_pin)) : 0), \
      fwm_nclk++, fwm_t = fwm_msb, fwm_word <<= 1)
 #if defined(FW_SIM_DOUT_STUCK)
-#define TLC2543_PIN_DOUT (FWM_DOUT_READ, (FW_SIM_DOUT_STUCK))
+/* fault: DATA OUT tied to the level in this cell (set by fw_sim_model_init;
+ * a cell rather than a constant, so the compiler keeps the driver's code) */
+__sfr __at(0xBF) fwm_stuck_dout;
+#define TLC2543_PIN_DOUT (FWM_DOUT_READ, (fwm_stuck_dout != 0u))
 #else
 #define TLC2543_PIN_DOUT (FWM_DOUT_READ, fwm_t)
 #endif
@@ -63,12 +66,8 @@ __sfr16 __at(0xAEAD) fwm_vz;
 /* End of an I/O cycle (first EOC read with CS high, tlc_model.c): checks
  * it, converts; returns the EOC level (1 if no conversion: power-down). */
 unsigned char fwm_end_cycle(void);
-#if defined(FW_SIM_EOC_STUCK)
-#define TLC2543_PIN_EOC (((fwm_cs_pin && fwm_nclk != 0u) ? fwm_end_cycle() : 0), 0)
-#else
 #define TLC2543_PIN_EOC                                                        \
     ((fwm_cs_pin && fwm_nclk != 0u) ? fwm_end_cycle()                          \
                                      : (fwm_eoc_wait != 0u ? (fwm_eoc_wait--, 0) : 1))
-#endif
 
 #endif /* FW_TLC_HAL_SIM_H */

@@ -89,6 +89,9 @@ void fw_sim_model_init(void)
     m_k = 0;
     m_bound = 0;
     m_conversions = 0;
+#if defined(FW_SIM_DOUT_STUCK)
+    fwm_stuck_dout = FW_SIM_DOUT_STUCK;
+#endif
 }
 
 /* Gyro c's input now, as a 12-bit code << 4. */
@@ -143,7 +146,11 @@ unsigned char fwm_end_cycle(void)
     } else {
         fwm_word = 0u; /* Vref-, grounded inputs */
     }
+#if defined(FW_SIM_EOC_STUCK)
+    fwm_eoc_wait = 255u; /* fault: EOC stays low past the driver's bound */
+#else
     fwm_eoc_wait = FW_SIM_CONV_POLLS - 1; /* this read is the first low one */
+#endif
     return 0u;
 }
 
