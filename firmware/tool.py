@@ -161,8 +161,10 @@ class Image:
     stack_free: int     #: bytes from stack_start to the end of RAM (0x7F)
 
     def size_report(self) -> str:
-        return (f"{self.ihx.name}: flash {self.flash} / {FLASH_SIZE} bytes "
-                f"({FLASH_SIZE - self.flash} free), RAM {self.ram_static} / {IRAM_SIZE} bytes static, "
+        flash = (f"flash {self.flash} / {FLASH_SIZE} bytes ({FLASH_SIZE - self.flash} free)"
+                 if self.kind == "production" else
+                 f"code {self.flash} bytes ({self.kind} image: model/counters, not for the chip)")
+        return (f"{self.ihx.name}: {flash}, RAM {self.ram_static} / {IRAM_SIZE} bytes static, "
                 f"stack 0x{self.stack_start:02X}..0x7F = {self.stack_free} bytes free")
 
 
