@@ -137,7 +137,7 @@ def run(quick: bool = False) -> str:
         "`attitude_c.integrate` adds the Python-side validation (one `isfinite` pass and a copy)."),
         "",
         ("| method | C f64 updates/s | gyro samples/s | C f32 updates/s | NumPy reference updates/s "
-        "| C f64 / NumPy | Python loop (`Integrator.update` per sample) |"),
+        "| C f64 / NumPy | Python loop, one `Integrator.update` call per sample, updates/s |"),
         "|---|---|---|---|---|---|---|",
         *rows,
         "",

@@ -130,4 +130,8 @@ def send_words(words: np.ndarray, *, ber: float, rng: np.random.Generator, attem
         out["backend"] = "direct (attitude_c.link not built)"
     out["delivered"] = len(delivered)
     out.update(counts)
+    if "link_time_s" in out and len(blocks):
+        # the simulated line carries the blocks back to back: the fraction of
+        # the run's real time the 9600-baud exchanges need (must stay below 1)
+        out["line_busy_fraction"] = out["link_time_s"] / (len(blocks) * period)
     return blocks_to_words(delivered), idx, out

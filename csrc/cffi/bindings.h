@@ -7,5 +7,7 @@
 #define ATTITUDE_CFFI_BINDINGS_H
 
 #include "attitude/attitude.h"
+#include "link_sim.h"
+#include "tlc2543_model.h"
 
 #endif

@@ -186,13 +186,33 @@ att_status att_dcm_to_quat(const att_real C[9], att_real q[4])
         r[3] = t[3];
         break;
     }
+    /* r is column `best` of M = K + I, with K Bar-Itzhack's symmetric 4×4
+     * matrix of C; for an orthogonal C, M = 4 q qᵀ and r = 4 q_best q.
+     * For a not-quite-orthogonal C (rounded, integrated) M's eigenvalues
+     * are 4 + O(δ) and three O(δ): one more product M r (a power-iteration
+     * step) moves r to the optimal quaternion (the eigenvector of the
+     * largest eigenvalue, Bar-Itzhack 2000) up to O(δ²), so the answer
+     * no longer depends on which branch was picked. */
+    {
+        att_real m00 = t[0], m11 = t[1], m22 = t[2], m33 = t[3];
+        att_real m01 = C[7] - C[5], m02 = C[2] - C[6], m03 = C[3] - C[1];
+        att_real m12 = C[1] + C[3], m13 = C[2] + C[6], m23 = C[5] + C[7];
+        att_real p[4];
+        p[0] = m00 * r[0] + m01 * r[1] + m02 * r[2] + m03 * r[3];
+        p[1] = m01 * r[0] + m11 * r[1] + m12 * r[2] + m13 * r[3];
+        p[2] = m02 * r[0] + m12 * r[1] + m22 * r[2] + m23 * r[3];
+        p[3] = m03 * r[0] + m13 * r[1] + m23 * r[2] + m33 * r[3];
+        for (i = 0; i < 4; i++) {
+            r[i] = p[i];
+        }
+    }
     if (r[0] < ATT_R(0.0)) {
         r[0] = -r[0];
         r[1] = -r[1];
         r[2] = -r[2];
         r[3] = -r[3];
     }
-    /* r = 4·pivot·q: normalizing gives q (ATT_E_ARG only for a degenerate C) */
+    /* r = 16·q_best²·q: normalizing gives q (ATT_E_ARG only for a degenerate C) */
     return att_quat_normalize(r, q);
 }
 

@@ -39,7 +39,7 @@ static uint8_t mode_clocks(uint8_t mode)
     return 12u;
 }
 
-int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings)
+int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings) TLC2543_COLD
 {
     uint8_t mode = 0u;
     uint8_t polls = TLC2543_EOC_POLLS_DEFAULT;
@@ -267,60 +267,76 @@ int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n,
     return tlc2543_cycle(dev, next, codes);
 }
 
-int tlc2543_self_test_codes(tlc2543 TLC2543_DATA *dev, uint16_t TLC2543_DATA *codes)
+/* Check one self-test code; returns ATT_OK or the error naming it. */
+static int check_test_code(uint8_t index, uint16_t code)
 {
-    static const uint8_t tests[3] = {TLC2543_TEST_MID, TLC2543_TEST_REFM, TLC2543_TEST_REFP};
-    uint16_t TLC2543_DATA got[3];
-    uint8_t saved;
-    int st;
-    if (dev == 0) {
-        return ATT_E_NULL;
-    }
-    saved = (uint8_t)(dev->pending & TLC2543_MODE_MASK);
-    dev->pending = TLC2543_NO_RESULT; /* mode 0: 12-bit, MSB first, unipolar */
-    st = tlc2543_scan(dev, tests, 3u, got, TLC2543_TEST_MID);
-    dev->pending = (uint8_t)(TLC2543_NO_RESULT | saved);
-    if (st != ATT_OK) {
-        return st;
-    }
-    if (codes != 0) {
-        codes[0] = got[0];
-        codes[1] = got[1];
-        codes[2] = got[2];
-    }
-    if (got[0] < 0x800u - TLC2543_SELFTEST_TOL || got[0] > 0x800u + TLC2543_SELFTEST_TOL) {
-        return TLC2543_E_SELFTEST_MID;
-    }
-    if (got[1] > TLC2543_SELFTEST_TOL) {
-        return TLC2543_E_SELFTEST_REFM;
-    }
-    if (got[2] < 0xFFFu - TLC2543_SELFTEST_TOL) {
+    if (index == 0u) {
+        if (code < 0x800u - TLC2543_SELFTEST_TOL || code > 0x800u + TLC2543_SELFTEST_TOL) {
+            return TLC2543_E_SELFTEST_MID;
+        }
+    } else if (index == 1u) {
+        if (code > TLC2543_SELFTEST_TOL) {
+            return TLC2543_E_SELFTEST_REFM;
+        }
+    } else if (code < 0xFFFu - TLC2543_SELFTEST_TOL) {
         return TLC2543_E_SELFTEST_REFP;
     }
     return ATT_OK;
 }
 
-int tlc2543_self_test(tlc2543 TLC2543_DATA *dev)
+/*
+ * The same I/O cycles as tlc2543_scan({MID, REFM, REFP}, next = MID) from a
+ * stale output register, but each code is checked as it arrives, so only
+ * one word of RAM is needed (the AT89S51 has 128 bytes). All four cycles
+ * always run; the first failing check is returned.
+ */
+int tlc2543_self_test_codes(tlc2543 TLC2543_DATA *dev, uint16_t TLC2543_DATA *codes) TLC2543_COLD
+{
+    uint16_t w;
+    uint8_t saved, i;
+    int st, result = ATT_OK;
+    if (dev == 0) {
+        return ATT_E_NULL;
+    }
+    saved = (uint8_t)(dev->pending & TLC2543_MODE_MASK);
+    dev->pending = TLC2543_NO_RESULT; /* mode 0: 12-bit, MSB first, unipolar */
+    st = tlc2543_cycle(dev, TLC2543_TEST_MID, 0);
+    for (i = 0u; st == ATT_OK && i < 3u; i++) {
+        /* request REFM, REFP, then MID again while reading MID, REFM, REFP */
+        st = tlc2543_cycle(dev, (uint8_t)((i == 2u) ? TLC2543_TEST_MID : TLC2543_TEST_MID + 1u + i), &w);
+        if (st == ATT_OK) {
+            if (codes != 0) {
+                codes[i] = w;
+            }
+            if (result == ATT_OK) {
+                result = check_test_code(i, w);
+            }
+        }
+    }
+    /* the pending conversion has the self-test's format: mark it stale */
+    dev->pending = (uint8_t)(TLC2543_NO_RESULT | saved);
+    return (st != ATT_OK) ? st : result;
+}
+
+int tlc2543_self_test(tlc2543 TLC2543_DATA *dev) TLC2543_COLD
 {
     return tlc2543_self_test_codes(dev, 0);
 }
 
-int tlc2543_power_down(tlc2543 TLC2543_DATA *dev)
+int tlc2543_power_down(tlc2543 TLC2543_DATA *dev) TLC2543_COLD
 {
     return tlc2543_cycle(dev, TLC2543_POWER_DOWN, 0);
 }
 
-int16_t tlc2543_signed(const tlc2543 TLC2543_DATA *dev, uint16_t word)
+int16_t tlc2543_signed(const tlc2543 TLC2543_DATA *dev, uint16_t word) TLC2543_COLD
 {
-    uint8_t nclk = mode_clocks(dev->pending);
-    uint16_t sign = (uint16_t)(1u << (nclk - 1u));
-    if ((word & sign) != 0u) {
-        return (int16_t)(int32_t)((int32_t)word - (int32_t)((uint32_t)sign << 1));
-    }
-    return (int16_t)word;
+    uint16_t sign = (uint16_t)(1u << (mode_clocks(dev->pending) - 1u));
+    uint16_t mag = (uint16_t)(word & (sign - 1u));
+    /* mag - sign without leaving 16 bits: mag - (sign - 1) - 1 >= -32768 */
+    return (word & sign) ? (int16_t)((int16_t)mag - (int16_t)(sign - 1u) - 1) : (int16_t)mag;
 }
 
-uint8_t tlc2543_clocks(const tlc2543 TLC2543_DATA *dev)
+uint8_t tlc2543_clocks(const tlc2543 TLC2543_DATA *dev) TLC2543_COLD
 {
     return mode_clocks(dev->pending);
 }

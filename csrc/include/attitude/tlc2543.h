@@ -110,7 +110,7 @@ typedef struct {
 
 /* Initialise the state (no pin activity). `hal` is required on the host and
  * ignored on the 8051; `settings` may be NULL. ATT_E_ARG on a bad field. */
-int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings);
+int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings) TLC2543_COLD;
 
 /* One I/O cycle: send `address` (0..14) with the configured mode and read
  * the word clocked out (the conversion requested by the previous cycle;
@@ -134,17 +134,17 @@ int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n,
  * Returns TLC2543_E_SELFTEST_* naming the first bad one. The configured mode
  * is kept; the output register is left holding nothing usable. `codes` (may
  * be NULL) receives the three 12-bit codes (MID, REFM, REFP). */
-int tlc2543_self_test_codes(tlc2543 TLC2543_DATA *dev, uint16_t TLC2543_DATA *codes);
-int tlc2543_self_test(tlc2543 TLC2543_DATA *dev);
+int tlc2543_self_test_codes(tlc2543 TLC2543_DATA *dev, uint16_t TLC2543_DATA *codes) TLC2543_COLD;
+int tlc2543_self_test(tlc2543 TLC2543_DATA *dev) TLC2543_COLD;
 
 /* Software power-down (one I/O cycle with address 14). Any later cycle
  * wakes the chip; its output word is discarded by tlc2543_scan. */
-int tlc2543_power_down(tlc2543 TLC2543_DATA *dev);
+int tlc2543_power_down(tlc2543 TLC2543_DATA *dev) TLC2543_COLD;
 
 /* Sign-extend a bipolar word of the configured length (two's complement). */
-int16_t tlc2543_signed(const tlc2543 TLC2543_DATA *dev, uint16_t word);
+int16_t tlc2543_signed(const tlc2543 TLC2543_DATA *dev, uint16_t word) TLC2543_COLD;
 
 /* Number of I/O clocks of one cycle in the configured mode (8, 12, 16). */
-uint8_t tlc2543_clocks(const tlc2543 TLC2543_DATA *dev);
+uint8_t tlc2543_clocks(const tlc2543 TLC2543_DATA *dev) TLC2543_COLD;
 
 #endif /* ATTITUDE_TLC2543_H */

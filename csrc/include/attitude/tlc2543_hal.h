@@ -87,6 +87,9 @@ __sbit __at(0xF7) TLC2543_B7;
     do { uint8_t __data *q_ = (uint8_t __data *)(p); *q_ = (wlo); q_++; *q_ = (whi); } while (0)
 /* Driver state and result words live in internal RAM (small model). */
 #define TLC2543_DATA __data
+/* Cold functions keep their parameters and locals on the stack (only while
+ * they run) instead of in static internal RAM: the AT89S51 has 128 bytes. */
+#define TLC2543_COLD __reentrant
 #elif !defined(TLC2543_HAL_CUSTOM)
 #define TLC2543_CS(d, v) ((d)->hal->set_cs((d)->hal->ctx, (v)))
 #define TLC2543_CLOCK(d, v) ((d)->hal->set_clock((d)->hal->ctx, (v)))
@@ -111,6 +114,9 @@ __sbit __at(0xF7) TLC2543_B7;
 #endif
 #ifndef TLC2543_DATA
 #define TLC2543_DATA
+#endif
+#ifndef TLC2543_COLD
+#define TLC2543_COLD
 #endif
 
 #endif /* ATTITUDE_TLC2543_HAL_H */

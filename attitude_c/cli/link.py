@@ -1,0 +1,262 @@
+"""``attitude link-rx``, ``link-tx`` and ``link-test``: the serial link of the
+paper on real ports (any pyserial URL or device) and in simulation."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import signal
+import sys
+import threading
+from typing import Any, Iterator, Optional
+
+from ..errors import AttitudeError
+
+
+def _hex_block(b: bytes) -> str:
+    return b.hex(" ")
+
+
+def _parse_hex_line(line: str, n: int, lineno: int) -> bytes:
+    text = line.replace(" ", "").replace(",", "").strip()
+    try:
+        blk = bytes.fromhex(text)
+    except ValueError as exc:
+        raise ValueError(f"stdin line {lineno}: not hex: {line.strip()!r}") from exc
+    if len(blk) != n:
+        raise ValueError(f"stdin line {lineno}: {len(blk)} bytes, block size is {n}")
+    return blk
+
+
+def test_samples(count: Optional[int], block_size: int = 6) -> Iterator[bytes]:
+    """Test blocks: X, Y, Z as 12-bit ADC codes (TLC2543 range) in 16-bit
+    big-endian words, slow sines around mid-scale; padded/truncated to the
+    block size."""
+    i = 0
+    while count is None or i < count:
+        words = [int(2048 + 1500 * math.sin(2 * math.pi * (i / 100.0 + k / 3.0))) for k in range(3)]
+        raw = b"".join(w.to_bytes(2, "big") for w in words)
+        yield (raw * (block_size // 6 + 1))[:block_size]
+        i += 1
+
+
+def _add_common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--port", required=True, help="device or pyserial URL (/dev/ttyS1, socket://host:port, ...)")
+    p.add_argument("--baud", type=int, default=9600, help="line rate (default 9600, 8N1)")
+    p.add_argument("--block-size", type=int, default=6, help="data bytes per block N (1..64, default 6)")
+    p.add_argument("--impl", choices=("c", "python"), default="c", help="protocol end: the C machine or the Python one")
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser("link-rx", help="receiver B on a serial port: print accepted blocks as hex")
+    _add_common(p)
+    p.add_argument("--count", type=int, default=None, help="stop after N accepted blocks")
+    p.add_argument("--gap-timeout-ms", type=int, default=20, help="max gap inside a block (ms)")
+    p.add_argument("--idle-eof", type=float, default=None,
+                   help="treat this many seconds without a byte as end of input")
+    p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
+    p.set_defaults(func=cmd_rx)
+
+    p = sub.add_parser("link-tx", help="sender A on a serial port: blocks from stdin hex lines or test samples")
+    _add_common(p)
+    p.add_argument("--count", type=int, default=None, help="send at most N blocks")
+    p.add_argument("--generate", action="store_true", help="send generated test samples instead of stdin")
+    p.add_argument("--syn-timeout-ms", type=int, default=50)
+    p.add_argument("--answer-timeout-ms", type=int, default=50)
+    p.add_argument("--max-attempts", type=int, default=5)
+    p.set_defaults(func=cmd_tx)
+
+    p = sub.add_parser("link-test", help="N blocks through a pair of ends and a (bad) channel; print statistics")
+    p.add_argument("--blocks", type=int, default=1000, help="number of blocks (default 1000)")
+    p.add_argument("--block-size", type=int, default=6)
+    p.add_argument("--sender", choices=("c", "python"), default="c")
+    p.add_argument("--receiver", choices=("c", "python"), default="c")
+    p.add_argument("--transport", choices=("sim", "pty", "socket"), default="sim",
+                   help="sim: simulated line time (default); pty / socket: real time over a bridge")
+    p.add_argument("--baud", type=int, default=9600)
+    p.add_argument("--ber", type=float, default=0.0, help="bit error rate per data bit")
+    p.add_argument("--drop", type=float, default=0.0, help="probability a byte is lost")
+    p.add_argument("--insert", type=float, default=0.0, help="probability a garbage byte is inserted")
+    p.add_argument("--duplicate", type=float, default=0.0, help="probability a byte arrives twice")
+    p.add_argument("--dead", action="append", default=[], metavar="START:LENGTH",
+                   help="line dead from START for LENGTH seconds (repeatable, at most 4)")
+    p.add_argument("--reboot", action="append", default=[], metavar="TIME:sender|receiver",
+                   help="that end reboots at TIME seconds (sim only, repeatable)")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--json", action="store_true", help="print the statistics as JSON")
+    p.set_defaults(func=cmd_test)
+
+
+def _stop_on_signals() -> threading.Event:
+    ev = threading.Event()
+
+    def handler(signum: int, frame: Any) -> None:
+        ev.set()
+
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, handler)
+        signal.signal(signal.SIGTERM, handler)
+    return ev
+
+
+def cmd_rx(args: argparse.Namespace) -> int:
+    from ..link.transport import open_port, run_receiver
+
+    stop = _stop_on_signals()
+    try:
+        port = open_port(args.port, args.baud)
+    except AttitudeError as exc:
+        print(f"link-rx: {exc}", file=sys.stderr)
+        return 1
+
+    def show(b: bytes) -> None:
+        print(_hex_block(b), flush=True)
+
+    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl})",
+          file=sys.stderr, flush=True)
+
+    try:
+        rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
+                           gap_timeout_ms=args.gap_timeout_ms, count=args.count, duration=args.duration,
+                           on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+    except AttitudeError as exc:
+        print(f"link-rx: {exc}", file=sys.stderr)
+        return 2
+    finally:
+        port.close()
+    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
+    if rep.error:
+        print(f"link-rx: {rep.error}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def cmd_tx(args: argparse.Namespace) -> int:
+    from ..link.transport import BlockReport, open_port, run_sender
+
+    stop = _stop_on_signals()
+    if args.generate:
+        blocks: Any = test_samples(args.count if args.count is not None else 100, args.block_size)
+    else:
+        def from_stdin() -> Iterator[bytes]:
+            k = 0
+            for lineno, line in enumerate(sys.stdin, 1):
+                if not line.strip() or line.lstrip().startswith("#"):
+                    continue
+                if args.count is not None and k >= args.count:
+                    return
+                yield _parse_hex_line(line, args.block_size, lineno)
+                k += 1
+        blocks = from_stdin()
+    try:
+        port = open_port(args.port, args.baud)
+    except AttitudeError as exc:
+        print(f"link-tx: {exc}", file=sys.stderr)
+        return 1
+
+    def show(r: BlockReport) -> None:
+        print(f"block {r.index} {_hex_block(r.block)}: {r.outcome} after {r.attempts} attempt(s)"
+              f" (naks {r.naks}, timeouts {r.timeouts})", flush=True)
+
+    try:
+        reports, stats = run_sender(port, blocks, impl=args.impl, block_size=args.block_size,
+                                    syn_timeout_ms=args.syn_timeout_ms,
+                                    answer_timeout_ms=args.answer_timeout_ms,
+                                    max_attempts=args.max_attempts, on_result=show, stop=stop)
+    except ValueError as exc:
+        print(f"link-tx: {exc}", file=sys.stderr)
+        return 2
+    except AttitudeError as exc:
+        print(f"link-tx: {exc}", file=sys.stderr)
+        return 1
+    finally:
+        port.close()
+    print("link-tx stats: " + json.dumps(stats), file=sys.stderr)
+    return 0 if all(r.outcome == "accepted" for r in reports) else 3
+
+
+def _pair(text: str, what: str) -> tuple[str, str]:
+    if ":" not in text:
+        raise ValueError(f"{what} must look like A:B, got {text!r}")
+    a, b = text.split(":", 1)
+    return a, b
+
+
+def cmd_test(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ..link.sim import ChannelConfig, simulate_link
+
+    try:
+        dead = [tuple(float(x) for x in _pair(d, "--dead")) for d in args.dead]
+        reboots = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
+        chan = ChannelConfig(ber=args.ber, drop=args.drop, insert=args.insert, duplicate=args.duplicate,
+                             dead=dead, seed=args.seed)  # type: ignore[arg-type]
+        blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),
+                               dtype=np.uint8).reshape(args.blocks, args.block_size)
+        if args.transport == "sim":
+            run = simulate_link(blocks, channel=chan, sender=args.sender, receiver=args.receiver,
+                                baud=args.baud, reboots=reboots)
+            out = run.summary()
+            out["channel"] = run.channel_stats
+            out["engine"] = run.engine
+        else:
+            if reboots:
+                raise ValueError("--reboot is only available with --transport sim")
+            out = _real_time_test(args, chan, [bytes(r) for r in blocks])
+    except (ValueError, TypeError) as exc:
+        print(f"link-test: {exc}", file=sys.stderr)
+        return 2
+    except AttitudeError as exc:
+        print(f"link-test: {exc}", file=sys.stderr)
+        return 1
+    if args.json:
+        print(json.dumps(out, indent=2))
+    else:
+        for k, v in out.items():
+            print(f"{k:>18}: {v}")
+    return 0
+
+
+def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) -> dict[str, Any]:
+    import time
+
+    from ..link.transport import PtyPair, SocketRelay, open_port, run_receiver, run_sender
+
+    bridge: Any = PtyPair(baud=args.baud, channel=chan) if args.transport == "pty" \
+        else SocketRelay(baud=args.baud, channel=chan)
+    urls = bridge.paths if args.transport == "pty" else [bridge.url, bridge.url]
+    stop = threading.Event()
+    box: dict[str, Any] = {}
+    try:
+        pb = open_port(urls[1], args.baud)
+        th = threading.Thread(target=lambda: box.setdefault(
+            "rx", run_receiver(pb, impl=args.receiver, block_size=args.block_size, stop=stop)), daemon=True)
+        th.start()
+        pa = open_port(urls[0], args.baud)
+        t0 = time.monotonic()
+        reports, sstats = run_sender(pa, blocks, impl=args.sender, block_size=args.block_size)
+        dt = time.monotonic() - t0
+        time.sleep(0.1)
+        stop.set()
+        th.join(timeout=5)
+        pa.close()
+        pb.close()
+    finally:
+        bridge.close()
+    rx = box.get("rx")
+    got = rx.blocks if rx else []
+    sent = {b for b in blocks}
+    return {
+        "blocks": len(blocks),
+        "accepted_by_B": len(got),
+        "acked": sum(r.outcome == "accepted" for r in reports),
+        "gave_up": sum(r.outcome == "gave up" for r in reports),
+        "not_sent_blocks_accepted": sum(b not in sent for b in got),
+        "duration_s": dt,
+        "blocks_per_s": sum(r.outcome == "accepted" for r in reports) / dt if dt > 0 else 0.0,
+        "sender": sstats,
+        "receiver": rx.stats if rx else {},
+        "channel": bridge.channel_stats(),
+    }

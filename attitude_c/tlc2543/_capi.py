@@ -1,0 +1,98 @@
+"""CFFI plumbing: the C driver's HAL pointed at a Python model (extern
+"Python" callbacks) or at the C twin (csrc/host/tlc2543_model.c)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .._lib import ffi_lib
+from .model import RULES, SIGNALS, ProtocolViolation, Tlc2543Model
+
+_registered: set[str] = set()
+
+
+class Bridge:
+    """What the C callbacks see as ``ctx``: the Python model plus the first
+    exception raised inside a callback (exceptions cannot cross C frames, so
+    they are kept here and re-raised once the C call returns)."""
+
+    def __init__(self, model: Tlc2543Model) -> None:
+        self.model = model
+        self.error: BaseException | None = None
+
+    def call(self, name: str, *args: Any) -> int:
+        if self.error is not None:
+            return 0  # the driver is already off the rails; stay quiet
+        try:
+            r = getattr(self.model, name)(*args)
+        except BaseException as exc:  # noqa: BLE001 - re-raised by raise_pending()
+            self.error = exc
+            return 0
+        return int(r) if r is not None else 0
+
+    def raise_pending(self) -> None:
+        if self.error is not None:
+            exc, self.error = self.error, None
+            raise exc
+
+
+def register(precision: str) -> tuple[Any, Any]:
+    """(ffi, lib) with the Python pin callbacks registered."""
+    ffi, lib = ffi_lib(precision)
+    if precision in _registered:
+        return ffi, lib
+
+    @ffi.def_extern(name="tlc2543py_set_cs")
+    def _set_cs(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_cs", level)
+
+    @ffi.def_extern(name="tlc2543py_set_clock")
+    def _set_clock(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_clock", level)
+
+    @ffi.def_extern(name="tlc2543py_set_din")
+    def _set_din(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_din", level)
+
+    @ffi.def_extern(name="tlc2543py_get_dout")
+    def _get_dout(ctx: Any) -> int:
+        return 1 if ffi.from_handle(ctx).call("get_dout") == 1 else 0
+
+    @ffi.def_extern(name="tlc2543py_get_eoc")
+    def _get_eoc(ctx: Any) -> int:
+        return 1 if ffi.from_handle(ctx).call("get_eoc") == 1 else 0
+
+    @ffi.def_extern(name="tlc2543py_delay_ns")
+    def _delay_ns(ctx: Any, ns: int) -> None:
+        ffi.from_handle(ctx).call("delay_ns", ns)
+
+    _registered.add(precision)
+    return ffi, lib
+
+
+def python_hal(ffi: Any, lib: Any, bridge: Bridge) -> tuple[Any, Any]:
+    """A tlc2543_hal whose callbacks reach ``bridge.model``; returns
+    (hal, handle) — keep both alive as long as the driver uses them."""
+    handle = ffi.new_handle(bridge)
+    hal = ffi.new("tlc2543_hal *")
+    hal.ctx = handle
+    hal.set_cs = lib.tlc2543py_set_cs
+    hal.set_clock = lib.tlc2543py_set_clock
+    hal.set_din = lib.tlc2543py_set_din
+    hal.get_dout = lib.tlc2543py_get_dout
+    hal.get_eoc = lib.tlc2543py_get_eoc
+    hal.delay_ns = lib.tlc2543py_delay_ns
+    return hal, handle
+
+
+def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
+    """The C twin's latched violation as a ProtocolViolation (or None)."""
+    if m.violation == 0:
+        return None
+    rule = RULES[m.violation - 1]
+    return ProtocolViolation(rule, ffi.string(m.message).decode(), int(m.violation_t))
+
+
+def twin_trace(m: Any) -> list[tuple[int, str, int]]:
+    return [(int(m.trace[i].t), SIGNALS[m.trace[i].signal], int(m.trace[i].value))
+            for i in range(m.trace_len)]

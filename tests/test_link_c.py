@@ -1,0 +1,74 @@
+"""The link's C sources beyond the host test program (csrc/tests/test_link.c,
+run by test_c_programs.py): the sender compiles for the AT89S51 with SDCC
+within its RAM budget, and a libFuzzer smoke run of both machines under
+ASan + UBSan finds nothing."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+from pathlib import Path
+
+from conftest import ROOT, require_tools
+
+SDCC_FLAGS = ["-mmcs51", "--model-small", "--iram-size", "128", "--xram-size", "0", "--std-c99",
+              "--Werror", "-DATT_REAL_F32", f"-I{ROOT / 'csrc' / 'include'}"]
+FUZZ_SECONDS = 30  # CI smoke run; `invoke fuzz --seconds N` for longer runs
+
+
+def test_sender_compiles_for_8051_warning_free(tmp_path: Path):
+    require_tools("sdcc", apt="sdcc")
+    # -DATT_REAL_F32: common.h's att_real must not be double under SDCC
+    proc = subprocess.run(["sdcc", *SDCC_FLAGS, "-c", str(ROOT / "csrc/src/link_sender.c"),
+                           "-o", str(tmp_path / "link_sender.rel")],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert "warning" not in (proc.stdout + proc.stderr).lower(), proc.stderr
+
+
+def test_sender_fits_8051_ram_budget(tmp_path: Path):
+    """State (config + counters + pointers) <= 24 bytes of internal RAM; a
+    firmware-like program with the sender and a 6-byte block links in
+    4 KB of code and 128 bytes of RAM."""
+    require_tools("sdcc", apt="sdcc")
+    main = tmp_path / "fw.c"
+    main.write_text(
+        '#include "attitude/link.h"\n'
+        "typedef char sender_state_fits[(sizeof(att_link_sender) <= 24) ? 1 : -1];\n"
+        "att_link_sender S;\n"
+        "uint8_t block[6];\n"
+        "void main(void) {\n"
+        "    att_link_sender_config c; uint8_t out; uint16_t t = 0;\n"
+        "    att_link_sender_config_init(&c, 6);\n"
+        "    att_link_sender_init(&S, &c);\n"
+        "    for (;;) {\n"
+        "        if (att_link_sender_poll(&S, t, &out) == ATT_LINK_IDLE) att_link_sender_start(&S, block, t);\n"
+        "        att_link_sender_sink(&S, out, t); t++;\n"
+        "    }\n"
+        "}\n")
+    rel = tmp_path / "link_sender.rel"
+    subprocess.run(["sdcc", *SDCC_FLAGS, "-c", str(ROOT / "csrc/src/link_sender.c"), "-o", str(rel)],
+                   check=True, capture_output=True, timeout=120)
+    proc = subprocess.run(["sdcc", *SDCC_FLAGS, "--code-size", "4096", str(main), str(rel),
+                           "-o", str(tmp_path / "fw.ihx")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    mem = (tmp_path / "fw.mem").read_text()
+    m = re.search(r"ROM/EPROM/FLASH\s+0x[0-9a-f]+\s+0x[0-9a-f]+\s+(\d+)", mem)
+    assert m and int(m.group(1)) <= 4096, mem
+    m = re.search(r"Stack starts at: 0x([0-9a-f]+)", mem)
+    # data + overlay below the stack: sender 24 + block 6 + its parameters, <= half the RAM
+    assert m and int(m.group(1), 16) <= 0x60, mem
+
+
+def test_fuzz_smoke_run(tmp_path: Path):
+    require_tools("clang", apt="clang libclang-rt-14-dev")
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from toolchain.tasks.link import build_fuzzer, run_fuzzer
+
+    exe = build_fuzzer(tmp_path / "fuzz")
+    proc = run_fuzzer(exe, FUZZ_SECONDS, tmp_path / "corpus", tmp_path / "artifacts")
+    tail = "\n".join(proc.stderr.splitlines()[-15:])
+    assert proc.returncode == 0, tail
+    assert "Done" in proc.stderr and "stat::number_of_executed_units" in proc.stderr, tail
