@@ -113,7 +113,10 @@ static uint8_t queue[2][FW_BLOCK_SIZE];
 static __bit q_head;       /* slot of the oldest block (the one being sent) */
 static __bit q_any;        /* at least one block queued */
 static __bit q_full;       /* both slots used */
+static __bit q_last;       /* slot q_push() claimed last */
 static uint16_t seq;       /* number of the next sample to take */
+static uint16_t slot_seq0;  /* number of the sample in slot 0 / 1 */
+static uint16_t slot_seq1;
 static uint16_t ovr_count; /* samples lost to a full queue, not yet reported:
                               always the newest ones, seq - ovr_count .. seq - 1 */
 static uint8_t __data *wp; /* the block being written (put_word appends) */
@@ -145,7 +148,8 @@ static uint8_t q_push(void)
     if (q_full) {
         return 0;
     }
-    wp = queue[q_head ^ q_any];
+    q_last = q_head ^ q_any;
+    wp = queue[q_last];
     if (q_any) {
         q_full = 1;
     }
@@ -163,28 +167,18 @@ static void q_unpush(void)
     }
 }
 
-/* Samples lost to a full queue are announced as soon as a slot is free,
- * in their place: after every earlier block, before every later one. */
+/* Samples lost to a full queue are announced in their place (after every
+ * earlier block, before every later one), once the queue is empty: the
+ * report then leaves the other slot to the next sample, so a report never
+ * causes the next loss. */
 static void flush_overrun(void)
 {
-    if (q_push()) {
+    if (!q_any && q_push()) {
         put_report_head((uint8_t)FW_REPORT_OVERRUN);
         put_word((uint16_t)(seq - ovr_count));
         put_word(ovr_count);
         ovr_count = 0;
     }
-}
-
-/* How many sample numbers a queued block accounts for. */
-static uint16_t block_weight(const uint8_t __data *b)
-{
-    if (b[0] != (uint8_t)FW_REPORT_MARK || b[1] == (uint8_t)FW_REPORT_ADC_ERROR) {
-        return 1u;
-    }
-    if (b[1] == (uint8_t)FW_REPORT_GAVE_UP || b[1] == (uint8_t)FW_REPORT_OVERRUN) {
-        return (uint16_t)(((uint16_t)b[4] << 8) | b[5]);
-    }
-    return 0u;
 }
 
 /* ---- ADC ------------------------------------------------------------- */
@@ -205,6 +199,11 @@ static uint8_t sample_slot(void)
     if (ovr_count != 0u || !q_push()) {
         ovr_count++;
         return 0;
+    }
+    if (q_last) {
+        slot_seq1 = seq;
+    } else {
+        slot_seq0 = seq;
     }
     return 1;
 }
@@ -232,20 +231,17 @@ static void sample_store(int st)
 static uint8_t self_test_done(int st)
 {
     uint8_t i;
+    uint16_t bad = 0;
     if (st != ATT_OK) {
-        /* the code of the failed test input (MID, REFM, REFP; the codes
-         * are little-endian words in the slot), 0 for another error */
-        i = (uint8_t)(2u * (uint8_t)(TLC2543_E_SELFTEST_MID - st));
-        if (i < 6u) {
-            wp[4] = wp[i];
-            wp[3] = wp[(uint8_t)(i + 1u)];
-        } else {
-            wp[4] = 0;
-            wp[3] = 0;
+        /* the code of the failed test input (MID, REFM, REFP), 0 for
+         * another error; the codes are the slot's three words */
+        i = (uint8_t)(TLC2543_E_SELFTEST_MID - st);
+        if (i < 3u) {
+            bad = ((uint16_t __data *)wp)[i];
         }
-        wp[5] = (uint8_t)(seq > 255u ? 255u : seq);
-        wp[2] = (uint8_t)st;
         put_report_head((uint8_t)FW_REPORT_SELFTEST);
+        put_word((uint16_t)(((uint16_t)(uint8_t)st << 8) | (uint8_t)(bad >> 8)));
+        put_word((uint16_t)(((uint16_t)(uint8_t)bad << 8) | (uint8_t)seq)); /* attempt, mod 256 */
         P1_5 = 0; /* fault LED on */
 #if defined(FW_BENCH)
         /* s51's port pins read 1: the test fails, but it ran (its stack
@@ -257,7 +253,7 @@ static uint8_t self_test_done(int st)
 #endif
     }
     q_unpush(); /* passed: the slot is not needed */
-    P1_5 = 1;  /* fault LED off */
+    P1_5 = 1;   /* fault LED off */
     return 1;
 }
 
@@ -441,19 +437,13 @@ static void block_accepted(void)
  * GAVE_UP report (sent next); a report stays and is sent again. */
 static void block_given_up(void)
 {
-    /* number of the head sample: count back from seq over the queue */
-    uint16_t first = (uint16_t)(seq - ovr_count - block_weight(queue[q_head]));
     P1_5 = 0; /* fault LED on */
-    if (queue[q_head][0] == (uint8_t)FW_REPORT_MARK) {
-        return;
-    }
-    if (q_full) {
-        first -= block_weight(queue[!q_head]);
-    }
     wp = queue[q_head];
-    put_report_head((uint8_t)FW_REPORT_GAVE_UP);
-    put_word(first);
-    put_word(1u);
+    if (wp[0] != (uint8_t)FW_REPORT_MARK) {
+        put_report_head((uint8_t)FW_REPORT_GAVE_UP);
+        put_word(q_head ? slot_seq1 : slot_seq0);
+        put_word(1u);
+    }
 }
 
 /* ---- main ------------------------------------------------------------ */
