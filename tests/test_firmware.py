@@ -167,8 +167,8 @@ def test_selftest_failure_is_reported_over_the_link(out: Path, fault: str, statu
 
 def test_fastest_baud_57600(out: Path) -> None:
     _need()
-    # 20 ms; an exchange is 1.7 ms on the wire, the rest is the host's latency
-    cfg = tool.Config(baud=57600, period_ticks=72, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
+    # an exchange is 1.7 ms on the wire at 57600; the period covers the host's latency
+    cfg = tool.Config(baud=57600, period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
     img = tool.build(out, cfg, kind="sim", sim_blocks=41)
     res = tool.run(img, tool.LinkHost(), timeout=60)
     samples = _samples(res.stream)
