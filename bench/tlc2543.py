@@ -25,7 +25,7 @@ def _sizes(objs: Path) -> tuple[int, int, int]:
     """(code, static RAM, overlay RAM) bytes of tlc2543.rel from its .sym area table."""
     text = (objs / "tlc2543.sym").read_text()
     size = {m.group(1): int(m.group(2), 16)
-            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", text, re.M)}
+            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", text, re.MULTILINE)}
     return size.get("CSEG", 0) + size.get("CONST", 0), size.get("DSEG", 0), size.get("OSEG", 0)
 
 
@@ -51,8 +51,8 @@ def run(quick: bool) -> str:
         return f"| {label} | {n}{extra} | {n * US_PER_CYCLE:.1f} |"
 
     lines += [
-        "8051 (AT89S51 model `-t C51`, SDCC 4.2 small model, s51 Timer-0 counts; "
-        f"µs at {F_OSC / 1e6:.4f} MHz = {US_PER_CYCLE:.3f} µs per machine cycle):",
+        ("8051 (AT89S51 model `-t C51`, SDCC 4.2 small model, s51 Timer-0 counts; "
+         f"µs at {F_OSC / 1e6:.4f} MHz = {US_PER_CYCLE:.3f} µs per machine cycle):"),
         "",
         "| measurement | machine cycles | µs |",
         "| --- | --- | --- |",
@@ -63,10 +63,10 @@ def run(quick: bool) -> str:
         row("one 8-bit I/O cycle", "cycle8"),
         row("one 16-bit LSB-first I/O cycle (off the fast path)", "cycle16_lsbf"),
         "",
-        f"Driver size in the SDCC build: {code} bytes of code, {dseg} bytes of static internal RAM "
-        f"(+ {oseg} overlayable), state 2 bytes per ADC. On hardware add the conversion wait: "
-        f"EOC is polled until the ≤ 10 µs conversion ends (≈ {10 / US_PER_CYCLE:.0f} machine cycles "
-        "per I/O cycle at 11.0592 MHz).",
+        (f"Driver size in the SDCC build: {code} bytes of code, {dseg} bytes of static internal RAM "
+         f"(+ {oseg} overlayable), state 2 bytes per ADC. On hardware add the conversion wait: "
+         f"EOC is polled until the ≤ 10 µs conversion ends (≈ {10 / US_PER_CYCLE:.0f} machine cycles "
+         "per I/O cycle at 11.0592 MHz)."),
         "",
     ]
 
@@ -92,7 +92,7 @@ def run(quick: bool) -> str:
         "| path | rows (scans) per second |",
         "| --- | --- |",
         f"| `attitude_c.tlc2543.convert` (C driver + C twin of the model), {n} rows | {n / dt:,.0f} |",
-        f"| `Tlc2543(Tlc2543Model)` (C driver + Python model via CFFI callbacks, steady-state scans) "
-        f"| {k / dt_py:,.0f} |",
+        ("| `Tlc2543(Tlc2543Model)` (C driver + Python model via CFFI callbacks, steady-state scans) "
+         f"| {k / dt_py:,.0f} |"),
     ]
     return "\n".join(lines)

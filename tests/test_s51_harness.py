@@ -10,8 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT, require_target
+
 from toolchain import s51
 
 HERE = ROOT / "tests" / "s51"

@@ -13,6 +13,7 @@ import subprocess
 from pathlib import Path
 
 from conftest import ROOT, require_target
+
 from toolchain import s51
 
 DRIVER = ROOT / "csrc" / "src" / "tlc2543.c"
@@ -24,7 +25,7 @@ def test_driver_compiles_warning_free_with_issue_flags(tmp_path: Path) -> None:
     cmd = ["sdcc", "-mmcs51", "--model-small", "--iram-size", "128", "--xram-size", "0",
            "--std-c99", f"-I{ROOT / 'csrc' / 'include'}", "-c", str(DRIVER),
            "-o", str(tmp_path / "tlc2543.rel")]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert proc.returncode == 0, proc.stderr
     assert proc.stderr.strip() == "" and "warning" not in proc.stdout.lower(), proc.stderr + proc.stdout
 

@@ -42,9 +42,9 @@ from __future__ import annotations
 import re
 import subprocess
 import tempfile
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
 
 from . import targets
 
@@ -54,8 +54,8 @@ SIF_HEADER = HERE / "s51_sif.h"
 #: Address of the uCsim simulator interface (an unused SFR of the 8051).
 SIF_ARG = "if=sfr[0xff]"
 
-_EXIT_RE = re.compile(r"^EXIT (\d+)$", re.M)
-_CYC_RE = re.compile(r"^CYCLES (\S+) (\d+|overflow)$", re.M)
+_EXIT_RE = re.compile(r"^EXIT (\d+)$", re.MULTILINE)
+_CYC_RE = re.compile(r"^CYCLES (\S+) (\d+|overflow)$", re.MULTILINE)
 
 
 class S51Error(RuntimeError):

@@ -16,7 +16,8 @@ Docs: docs/tlc2543.md.
 
 from __future__ import annotations
 
-from typing import Any, Callable, Sequence
+from collections.abc import Sequence
+from typing import Any, Callable
 
 import numpy as np
 
@@ -33,25 +34,25 @@ from .model import HIGH_Z, RULES, SIGNALS, ProtocolViolation, Timing, Tlc2543Mod
 from .reference import ReferenceDriver
 
 __all__ = [
-    "CTwin",
+    "CH_X",
+    "CH_Y",
+    "CH_Z",
     "HIGH_Z",
-    "ProtocolViolation",
+    "POWER_DOWN",
     "RULES",
-    "ReferenceDriver",
     "SIGNALS",
+    "TEST_MID",
+    "TEST_REFM",
+    "TEST_REFP",
+    "CTwin",
+    "ProtocolViolation",
+    "ReferenceDriver",
     "SelfTestError",
     "Timing",
     "Tlc2543",
     "Tlc2543Model",
     "convert",
     "quantize",
-    "CH_X",
-    "CH_Y",
-    "CH_Z",
-    "TEST_MID",
-    "TEST_REFM",
-    "TEST_REFP",
-    "POWER_DOWN",
 ]
 
 CH_X, CH_Y, CH_Z = 0, 1, 2
@@ -315,8 +316,8 @@ def convert(volts: np.ndarray, vref_plus: float = 5.0, *, vref_minus: float = 0.
             try:
                 drv._after(st, "tlc2543 convert")
             except Exception as exc:  # attach what was converted before the error
-                setattr(exc, "codes", out[:row].astype(np.int64))
-                setattr(exc, "rows_done", row)
+                exc.codes = out[:row].astype(np.int64)  # type: ignore[attr-defined]
+                exc.rows_done = row  # type: ignore[attr-defined]
                 raise
         if progress is not None and m:
             progress(row)

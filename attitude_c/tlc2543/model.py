@@ -35,8 +35,8 @@ value 2 = high impedance) and reads ``DOUT?``/``EOC?`` (value read).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 import numpy as np
 

@@ -14,7 +14,8 @@ bit is valid) — the model must catch it.
 
 from __future__ import annotations
 
-from typing import Protocol, Sequence
+from collections.abc import Sequence
+from typing import Protocol
 
 from ..errors import DeviceError, DeviceTimeout, InvalidArgument
 

@@ -10,5 +10,6 @@
 #include "attitude/quat.h"
 #include "attitude/integrator.h"
 #include "attitude/link.h"
+#include "attitude/fixed.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

@@ -1,0 +1,205 @@
+/*
+ * libattitude — fixed-point attitude core (prefix att_fx_), integer-only.
+ *
+ * The same methods as the float integrator (attitude/integrator.h) in
+ * Q-format integer arithmetic, for cores without an FPU (ARM920T) and for
+ * the 8051 (AT89S51; SDCC, no `long long`). No float anywhere: the
+ * compiled objects reference no soft-float helper. See docs/fixed-point.md
+ * for the derivation of the formats, the rounding-noise limit and the
+ * measured accuracy.
+ *
+ * Q formats (CMSIS notation Qm.n: m integer bits including the sign, n
+ * fractional bits, stored in int32_t):
+ *
+ *   name        format  LSB            range            used for
+ *   att_q30     Q2.30   2^-30 ≈ 9.3e-10 [-2, 2)         quaternion, attitude matrix,
+ *                                                        angle increments Δθ (rad),
+ *                                                        rotation vector Φ (rad)
+ *   att_q28     Q4.28   2^-28 ≈ 3.7e-9  [-8, 8)         Euler angles and heading (rad)
+ *
+ *   (Q2.30 = "Q1.30" in TI notation: 1 sign bit, 1 integer bit, 30 fraction bits.)
+ *
+ * Dynamic range: an increment component may not exceed ATT_FX_DTHETA_MAX
+ * = 0.4 rad (2292 °/s at 100 Hz; the design point is ±1000 °/s at 100 Hz
+ * = 0.175 rad, and 10 kHz gives 1e-4 rad for 1 rad/s = 107374 LSB).
+ * With that bound every intermediate of every method provably fits its
+ * format (docs/fixed-point.md, "Headroom"); larger increments return
+ * ATT_FX_E_RANGE and never wrap.
+ *
+ * Rounding: every narrowing step is round-to-nearest, ties toward +inf
+ * (add half an LSB, then floor), applied once to an exact 64-bit sum of
+ * 32×32-bit products. Saturation: functions whose output could leave its
+ * format check it and return ATT_FX_E_RANGE (outputs untouched) instead
+ * of saturating silently; documented per function.
+ *
+ * Widening product: one primitive (csrc/src/fixed_prim.h), a 64-bit
+ * product on cores with a long multiply (host, ARM SMULL/SMLAL), four
+ * 16×16-bit partial products on the 8051; both give bit-identical results
+ * (tested).
+ *
+ * Quaternions are [λ, p1, p2, p3] (docs/conventions.md); matrices are
+ * row-major C[3*i + j]; Euler angles e = [yaw ψ, pitch θ, roll γ].
+ */
+#ifndef ATTITUDE_FIXED_H
+#define ATTITUDE_FIXED_H
+
+#include "attitude/common.h"
+
+typedef int32_t att_q30; /* Q2.30 */
+typedef int32_t att_q28; /* Q4.28 */
+
+/* Constants (enums, so that Python sees them too). */
+enum {
+    ATT_FX_Q30_ONE = 1073741824,    /* 1.0 in Q2.30 */
+    ATT_FX_Q28_ONE = 268435456,     /* 1.0 in Q4.28 */
+    ATT_FX_DTHETA_MAX = 429496730,  /* 0.4 rad in Q2.30: largest |Δθ| component accepted */
+    ATT_FX_QUAT_MAX = 1342177280,   /* 1.25 in Q2.30: largest |component| of an input
+                                       quaternion (keeps 4-term 64-bit sums exact) */
+    ATT_FX_GIMBAL_Q30 = 16          /* 2^-26 in Q2.30: cos θ below this = gimbal lock */
+};
+
+/* Methods: the same numbers as att_method of attitude/integrator.h. */
+typedef enum {
+    ATT_FX_RV1 = 0,        /* Φ = Δθ, one update per increment */
+    ATT_FX_RV2 = 1,        /* Φ = Δθ1 + Δθ2 + (2/3) Δθ1×Δθ2, one update per 2 increments */
+    ATT_FX_RV3 = 2,        /* paper eq. (5), 33/80 and 57/80, one update per 3 increments */
+    ATT_FX_RV3_CONING = 3, /* 9/20 and 27/40 (Ignagni), one update per 3 increments */
+    ATT_FX_RV3_REUSE = 4   /* one update per increment: Φ = Δθ3 + (1/720) Δθ1×Δθ2
+                              − (31/720) Δθ1×Δθ3 + (121/720) Δθ2×Δθ3 (Δθ3 newest);
+                              2nd update Φ = Δθ2 + (1/12) Δθ1×Δθ2, 1st Φ = Δθ1 */
+} att_fx_method;
+
+/* Fixed-point status codes (range -80..-99). */
+enum {
+    ATT_FX_E_RANGE = -80,  /* an input or result outside its Q format's documented range */
+    ATT_FX_E_METHOD = -81, /* unknown method */
+    ATT_FX_E_ZERO = -82    /* zero (or too small to normalize) quaternion */
+};
+
+/* att_fx_integ_update() results. */
+enum {
+    ATT_FX_PENDING = 0,    /* increment buffered, no new attitude yet */
+    ATT_FX_UPDATED = 1     /* a new attitude was written */
+};
+
+/* Caller-owned integrator state (55 bytes on the 8051). Treat as opaque. */
+typedef struct {
+    att_q30 q[4];          /* attitude quaternion, Q2.30, |q| = 1 within ±4 LSB */
+    att_q30 buf[9];        /* 3 increments (3 values each): rv2/rv3: those of the unfinished
+                              update, oldest first (the last one is scratch); rv3-reuse:
+                              the two previous increments, increment `old` the older;
+                              Q2.30 rad */
+    uint8_t method;        /* att_fx_method */
+    uint8_t nbuf;          /* valid entries of buf */
+    uint8_t old;           /* rv3-reuse: index of the older increment (0 or 1) */
+} att_fx_integ;
+
+/* ADC-code → increment converter (per axis), set up by att_fx_adc_init. */
+typedef struct {
+    int32_t zero_q8[3];    /* zero-rate code, Q24.8 (code × 256) */
+    int32_t gain[3];       /* gain mantissa in [2^30, 2^31) */
+    uint8_t shift[3];      /* Δθ(Q2.30) = round((code·256 − zero_q8) · gain / 2^shift) */
+} att_fx_adc;
+
+/* ---- primitives ------------------------------------------------------ */
+
+/* out = a ⊗ b. In/out Q2.30; 4-term sums exact in 64 bits (Q4.60), one
+ * rounding per component. |a_i|, |b_i| ≤ ATT_FX_QUAT_MAX else
+ * ATT_FX_E_RANGE; a result component outside Q2.30 → ATT_FX_E_RANGE
+ * (only possible for non-unit inputs). out may alias a or b. */
+att_status att_fx_quat_mul(const att_q30 a[4], const att_q30 b[4], att_q30 out[4]);
+
+/* out = q / |q|: integer square root of the exact 64-bit Σq² then one
+ * correction step; result within 2 LSB of the nearest unit quaternion.
+ * |q_i| ≤ ATT_FX_QUAT_MAX else ATT_FX_E_RANGE; |q| < 2^-15 → ATT_FX_E_ZERO. */
+att_status att_fx_quat_normalize(const att_q30 q[4], att_q30 out[4]);
+
+/* Rotation vector Φ (Q2.30 rad, |Φ| ≤ 3.1, |Φ_i| < 2) → q(Φ) = [cos(φ/2),
+ * sin(φ/2)/φ · Φ] (Q2.30). Series in v = φ²/8 (Q2.30, Horner, degree
+ * chosen from v so the truncation is < 2^-33; no division, no sqrt).
+ * |Φ|² > 9.6 → ATT_FX_E_RANGE. Error ≤ 2 LSB per component. */
+att_status att_fx_rotvec_to_quat(const att_q30 phi[3], att_q30 q[4]);
+
+/* Rotation vector of one update from increments (all Q2.30 rad,
+ * |Δθ_i| ≤ ATT_FX_DTHETA_MAX else ATT_FX_E_RANGE). Sum and cross
+ * products accumulated exactly in 64 bits (the coefficient first
+ * multiplied into the older increment, rounded to Q2.30), one rounding
+ * per component. d holds n×3 values oldest first: n = 1 (rv1), 2 (rv2),
+ * 3 (rv3 / rv3-coning), and for rv3-reuse n = 1, 2 or 3 (start-up forms
+ * included). */
+att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30 phi[3]);
+
+/* One rv3 update Q ← Q ⊗ q(Φ) with Φ of eq. (5) from d = [Δθ1, Δθ2, Δθ3]
+ * (9 values, Q2.30). Renormalization folded in: q is scaled by
+ * (1 − (|Q|² − 1)/2) before the product, so |Q| stays within ±4 LSB of 1
+ * with no extra rounding of Q. q must be a unit quaternion from this
+ * module (not checked here; the integrator checks its inputs). */
+att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9]);
+
+/* The same update for any method from its Φ (Q2.30 rad, |Φ|² ≤ 9.6). */
+att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3]);
+
+/* ---- integrator ------------------------------------------------------ */
+
+/* Initialize with attitude q0 (Q2.30, NULL = identity; normalized here). */
+att_status att_fx_integ_init(att_fx_integ *s, att_fx_method method, const att_q30 q0[4]);
+
+/* Feed one increment (Q2.30 rad). ATT_FX_UPDATED (q_out, may be NULL,
+ * receives the attitude), ATT_FX_PENDING, or ATT_FX_E_RANGE (state
+ * unchanged). */
+int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[4]);
+
+/* Number of attitude updates n more increments would produce. */
+size_t att_fx_integ_outputs(const att_fx_integ *s, size_t n);
+
+/* n increments (n×3 values) exactly as n att_fx_integ_update calls; q_out
+ * gets 4 values per completed update (room for att_fx_integ_outputs(s, n)),
+ * *n_out their number. All increments are checked first: on
+ * ATT_FX_E_RANGE the state is unchanged, *err_index = first bad sample,
+ * *n_out = 0. n_out, err_index may be NULL. */
+att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
+                              att_q30 *q_out, size_t *n_out, size_t *err_index);
+
+/* ---- attitude outputs ------------------------------------------------ */
+
+/* Attitude matrix of eq. (1), Q2.30, row-major. Each element an exact
+ * 64-bit sum rounded once. |q_i| ≤ ATT_FX_QUAT_MAX else ATT_FX_E_RANGE;
+ * an element outside Q2.30 (non-unit q) → ATT_FX_E_RANGE. */
+att_status att_fx_quat_to_dcm(const att_q30 q[4], att_q30 C[9]);
+
+/* Euler angles e = [ψ, θ, γ] (Q4.28 rad) of C (Q2.30): 32-bit CORDIC
+ * vectoring (30 iterations, angles accumulated as binary angles, 2^32 =
+ * 2π), θ = atan2(C32, √(C12² + C22²)), γ = atan2(−C31, C33),
+ * ψ = atan2(−C12, C22); ψ, γ in (−π, π]. Gimbal lock (√(C12² + C22²) <
+ * ATT_FX_GIMBAL_Q30): γ = 0, ψ = atan2(C21, C11). Error ≤ 3e-9 rad + the
+ * conditioning of the problem. */
+att_status att_fx_dcm_to_euler(const att_q30 C[9], att_q28 e[3]);
+
+/* Euler angles of a quaternion (via the matrix). */
+att_status att_fx_quat_to_euler(const att_q30 q[4], att_q28 e[3]);
+
+/* Heading (−ψ) mod 2π in [0, 2π), Q4.28 rad, from a quaternion. */
+att_status att_fx_quat_heading(const att_q30 q[4], att_q28 *heading);
+
+/* Four-quadrant arctangent atan2(y, x) in Q4.28 rad, (−π, π]; x, y any
+ * int32 in the same scale; atan2(0, 0) = 0. */
+att_q28 att_fx_atan2(int32_t y, int32_t x);
+
+/* ---- ADC codes → increments ------------------------------------------ */
+
+/* Set up the converter: zero-rate code (Q24.8, code × 256), scale factor
+ * (UQ0.32 rad/s per code, i.e. scale × 2^32, must be > 0) and sample
+ * period (ns, > 0), per axis for zero and scale. The gain scale·period is
+ * formed exactly (64-bit product, long division by 10^9) and kept as a
+ * 31-bit mantissa and shift (relative error ≤ 2^-31). ATT_E_ARG for a
+ * zero scale/period; ATT_FX_E_RANGE if the gain is too large (> 2^8
+ * rad per code) or too small (< 2^-40 rad per code). */
+att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3],
+                           const uint32_t scale_q32[3], uint32_t period_ns);
+
+/* Δθ_i = (code_i − zero_i) · scale_i · period, Q2.30 rad, rounded to
+ * nearest (one rounding of an exact 64-bit product). |Δθ_i| >
+ * ATT_FX_DTHETA_MAX → ATT_FX_E_RANGE (dtheta untouched). code_i ≤ 65535. */
+att_status att_fx_adc_convert(const att_fx_adc *a, const uint16_t code[3], att_q30 dtheta[3]);
+
+#endif /* ATTITUDE_FIXED_H */
