@@ -178,7 +178,7 @@ def _sdcc_flags() -> list[str]:
 
 
 def _run(cmd: list[str]) -> None:
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True)
     if proc.returncode != 0:
         raise FirmwareError(f"command failed: {' '.join(cmd)}\n{proc.stdout}{proc.stderr}")
 
@@ -247,7 +247,8 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         rels.append(str(rel))
     ihx = out_dir / (name + ".ihx")
     # Link with the 4 KB / 128 B limits of the chip: sdld fails when they are exceeded.
-    proc = subprocess.run(["sdcc", *link_flags, *rels, "-o", str(ihx)], capture_output=True, text=True)
+    proc = subprocess.run(["sdcc", *link_flags, *rels, "-o", str(ihx)], check=False, capture_output=True,
+                          text=True)
     mem = ihx.with_suffix(".mem")
     if proc.returncode != 0:
         msg = proc.stdout + proc.stderr
