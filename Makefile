@@ -73,7 +73,6 @@ ALL += $(APP)
 endif
 
 .PHONY: all install uninstall clean FORCE
-FORCE:
 all: $(ALL)
 
 $(BUILDDIR)/obj/%.o: csrc/src/%.c $(HEADERS)
@@ -143,3 +142,5 @@ uninstall:
 
 clean:
 	rm -rf $(BUILDDIR)
+
+FORCE:

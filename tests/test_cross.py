@@ -9,8 +9,8 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT, require_target, require_tools
+
 from toolchain import armv4t_check
 from toolchain.tasks.cross import cross_build_target
 

@@ -15,8 +15,6 @@ from hypothesis import strategies as st
 from attitude_c.errors import InvalidArgument, InvalidType
 from attitude_c.link import (
     OUTCOME_ACKED,
-    OUTCOME_GAVE_UP,
-    OUTCOME_LOST_REBOOT,
     ChannelConfig,
     CReceiver,
     CSender,
@@ -115,10 +113,10 @@ class TestTranscripts:
         assert rig.logs[0] == [0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, CK]
         assert rig.logs[1] == [0xBB, 0x00]
         assert rig.events == [("B", "ACCEPTED", BLK), ("A", "ACCEPTED")]
-        assert rig.a.stats.as_dict() == dict(blocks_sent=1, blocks_accepted=1, naks=0, timeouts=0,
-                                             gave_up=0, bytes_discarded=0, retries=0)
-        assert rig.b.stats.as_dict() == dict(syns=1, blocks_accepted=1, naks=0, timeouts=0, resyncs=0,
-                                             bytes_discarded=0)
+        assert rig.a.stats.as_dict() == {"blocks_sent": 1, "blocks_accepted": 1, "naks": 0, "timeouts": 0,
+                                             "gave_up": 0, "bytes_discarded": 0, "retries": 0}
+        assert rig.b.stats.as_dict() == {"syns": 1, "blocks_accepted": 1, "naks": 0, "timeouts": 0, "resyncs": 0,
+                                             "bytes_discarded": 0}
 
     def test_corrupted_block_is_resent_from_syn(self, s_impl, r_impl):
         rig = Rig(s_impl, r_impl, faults={(0, 3): 0x01})

@@ -14,19 +14,19 @@ import threading
 import time
 
 import pytest
+from conftest import ROOT
 
 from attitude_c.cli import main as cli_main
 from attitude_c.errors import LinkError
 from attitude_c.link import ChannelConfig
 from attitude_c.link.transport import PtyPair, SocketRelay, open_port, run_receiver, run_sender
-from conftest import ROOT
 
 PAIRS = list(itertools.product(("c", "python"), ("c", "python")))
 PAIR_IDS = [f"{a}-to-{b}" for a, b in PAIRS]
 BLOCKS = [bytes([i, 0xAA, i ^ 0x55, 0xBB, 0xFF - i, 0x00]) for i in range(25)]
 # Real-time ticks are milliseconds of a loaded 2-core machine: timeouts far
 # above thread-scheduling jitter, so a clean line never sees a spurious one.
-SLOW = dict(syn_timeout_ms=1000, answer_timeout_ms=1000)
+SLOW = {"syn_timeout_ms": 1000, "answer_timeout_ms": 1000}
 GAP_MS = 400
 
 
@@ -68,7 +68,7 @@ def test_pty_pair_interop(s_impl, r_impl):
 def test_socket_interop(s_impl, r_impl):
     with SocketRelay() as url:
         assert url.startswith("socket://127.0.0.1:")
-        reports, stats, rx = _exchange(url, url, s_impl, r_impl, BLOCKS)
+        reports, _stats, rx = _exchange(url, url, s_impl, r_impl, BLOCKS)
     assert rx.blocks == BLOCKS
     assert all(r.outcome == "accepted" and r.attempts == 1 for r in reports)
 
@@ -165,7 +165,7 @@ def test_cli_rx_tx_processes_over_pty():
             assert ready and b"listening" in rx.stderr.readline()
             tx = subprocess.run([sys.executable, "-m", "attitude_c", "link-tx", "--port", p0,
                                  "--syn-timeout-ms", "1000", "--answer-timeout-ms", "1000"],
-                                input="\n".join(lines) + "\n", capture_output=True, text=True,
+                                input="\n".join(lines) + "\n", check=False, capture_output=True, text=True,
                                 env=env, timeout=60)
             out, err = rx.communicate(timeout=60)
         finally:
@@ -182,7 +182,25 @@ def test_cli_rx_tx_processes_over_pty():
 def test_cli_tx_rejects_bad_hex():
     with PtyPair() as (p0, _p1):
         proc = subprocess.run([sys.executable, "-m", "attitude_c", "link-tx", "--port", p0],
-                              input="zz zz\n", capture_output=True, text=True, timeout=60,
+                              input="zz zz\n", check=False, capture_output=True, text=True, timeout=60,
                               env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert proc.returncode == 2
     assert "stdin line 1: not hex" in proc.stderr
+
+
+def test_other_pyserial_urls_loop_and_spy(tmp_path):
+    """loop:// opens at 9600 8N1 and echoes; spy:// wraps a real pty and logs
+    the exchange (the transport takes any pyserial URL)."""
+    port = open_port("loop://")
+    try:
+        assert (port.baudrate, port.bytesize, port.parity, port.stopbits) == (9600, 8, "N", 1)
+        port.write(b"\xaa\x55")
+        assert port.read(2) == b"\xaa\x55"
+    finally:
+        port.close()
+    log = tmp_path / "spy.txt"
+    with PtyPair() as (p0, p1):
+        _reports, _stats, rx = _exchange(f"spy://{p0}?file={log}", p1, "c", "c", BLOCKS[:3])
+    assert rx.blocks == BLOCKS[:3]
+    text = log.read_text().upper()
+    assert "AA" in text and "BB" in text  # the handshake bytes in the hexdump

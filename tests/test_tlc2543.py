@@ -176,6 +176,16 @@ def test_eoc_stuck_low_times_out(backend: str) -> None:
     assert len(eoc_reads) == 10  # bounded: exactly eoc_polls samples, then the error
 
 
+def test_eoc_stuck_high_is_seen_by_the_model() -> None:
+    # a driver cannot tell EOC stuck high from "done": it re-asserts CS while
+    # the chip is still converting, which the model reports
+    with pytest.raises(T.ProtocolViolation) as info:
+        T.Tlc2543(T.Tlc2543Model([1.0], stuck_eoc=1)).scan([0])
+    assert info.value.rule == "cs-too-early"
+    with pytest.raises(T.ProtocolViolation):
+        T.convert(np.ones((3, 3)), VREF, stuck_eoc=1)
+
+
 def test_reference_driver_eoc_stuck_low_times_out() -> None:
     r = T.ReferenceDriver(T.Tlc2543Model([1.0], stuck_eoc=0), eoc_polls=5)
     with pytest.raises(DeviceTimeout):

@@ -32,23 +32,15 @@ import re
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable, Sequence
 
-__all__ = ["Violation", "check_objects", "ARMV4T_BASES", "Armv4tCheckError"]
+__all__ = ["ARMV4T_BASES", "Armv4tCheckError", "Violation", "check_objects"]
 
 #: ARMv4T ARM-state mnemonics in the unified syntax objdump prints, without
 #: the optional "s" (set flags) suffix and condition code.
-ARMV4T_BASES = frozenset("""
-and eor sub rsb add adc sbc rsc tst teq cmp cmn orr mov bic mvn
-lsl lsr asr ror rrx nop adr
-mul mla umull umlal smull smlal
-ldr ldrb ldrh ldrsb ldrsh ldrt ldrbt str strb strh strt strbt
-ldm ldmia ldmib ldmda ldmdb ldmfd ldmfa ldmed ldmea
-stm stmia stmib stmda stmdb stmfd stmfa stmed stmea push pop
-swp swpb b bl bx svc swi mrs msr cdp ldc stc mcr mrc
-""".split())
+ARMV4T_BASES = frozenset(["and", "eor", "sub", "rsb", "add", "adc", "sbc", "rsc", "tst", "teq", "cmp", "cmn", "orr", "mov", "bic", "mvn", "lsl", "lsr", "asr", "ror", "rrx", "nop", "adr", "mul", "mla", "umull", "umlal", "smull", "smlal", "ldr", "ldrb", "ldrh", "ldrsb", "ldrsh", "ldrt", "ldrbt", "str", "strb", "strh", "strt", "strbt", "ldm", "ldmia", "ldmib", "ldmda", "ldmdb", "ldmfd", "ldmfa", "ldmed", "ldmea", "stm", "stmia", "stmib", "stmda", "stmdb", "stmfd", "stmfa", "stmed", "stmea", "push", "pop", "swp", "swpb", "b", "bl", "bx", "svc", "swi", "mrs", "msr", "cdp", "ldc", "stc", "mcr", "mrc"])
 
 _CONDS = "eq|ne|cs|hs|cc|lo|mi|pl|vs|vc|hi|ls|ge|lt|gt|le|al"
 _MNEM_RE = re.compile(r"^(?P<base>[a-z]+?)(?P<s>s)?(?P<cond>" + _CONDS + r")?$")
@@ -96,7 +88,7 @@ def _reason_for(mnem: str) -> str:
     for k, why in _REASONS.items():
         if base == k or (base.startswith(k) and _MNEM_RE.match(k + base[len(k):] or "")):
             return why
-    if base.startswith("v") or base.startswith("f"):
+    if base.startswith(("v", "f")):
         return "floating-point/SIMD (VFP/NEON) instruction; the ARM920T has no FPU"
     if base.startswith(("smul", "smla", "smlal", "smulw", "smlaw")):
         return "DSP multiply is ARMv5TE"
@@ -127,9 +119,9 @@ def classify(mnem: str, operands: str) -> str | None:
         return "coprocessor p10/p11 is VFP; the ARM920T has no FPU"
     # Returns / jumps that assume ARMv5 interworking (pc loaded without bx).
     regs_block = re.search(r"\{([^}]*)\}", ops)
-    if base in {"pop"} or base.startswith("ldm"):
-        if regs_block and re.search(r"(^|,)pc($|,)", regs_block.group(1)):
-            return "loads pc with LDM/POP: does not interwork on ARMv4T (return with bx)"
+    if ((base == "pop" or base.startswith("ldm")) and regs_block
+            and re.search(r"(^|,)pc($|,)", regs_block.group(1))):
+        return "loads pc with LDM/POP: does not interwork on ARMv4T (return with bx)"
     if base == "ldr" and ops.startswith("pc,") and not ops.startswith("pc,[pc"):
         return "loads pc from memory: does not interwork on ARMv4T (use bx)"
     if base == "mov" and re.fullmatch(r"pc,(r\d+|lr|ip|sl|fp|sb)", ops):
@@ -144,7 +136,7 @@ _MEMBER_RE = re.compile(r"^(\S+):\s+file format (\S+)$")
 
 def _disassemble(objdump: str, path: Path) -> str:
     proc = subprocess.run([objdump, "-d", "--no-show-raw-insn", str(path)],
-                          capture_output=True, text=True)
+                          capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         raise Armv4tCheckError(f"{objdump} -d {path} failed: {proc.stderr.strip()}")
     return proc.stdout
@@ -186,7 +178,8 @@ def _readelf_for(objdump: str) -> str | None:
 
 def check_attributes(readelf: str, path: Path) -> list[Violation]:
     """Build attributes (``readelf -A``) must say v4T and no FPU."""
-    proc = subprocess.run([readelf, "-A", str(path)], capture_output=True, text=True)
+    proc = subprocess.run([readelf, "-A", str(path)], capture_output=True, text=True,
+                          check=False)
     if proc.returncode != 0:
         raise Armv4tCheckError(f"{readelf} -A {path} failed: {proc.stderr.strip()}")
     out: list[Violation] = []
@@ -220,9 +213,10 @@ def check_objects(paths: Iterable[str | Path], objdump: str = "arm-linux-gnueabi
         if not p.exists():
             raise Armv4tCheckError(f"{p} does not exist")
         text = _disassemble(tool, p)
-        syms = (subprocess.run([readelf, "-sW", str(p)], capture_output=True, text=True).stdout
+        syms = (subprocess.run([readelf, "-sW", str(p)], capture_output=True, text=True,
+                               check=False).stdout
                 if readelf else "")
-        if re.search(r"\s\$t(\.\S*)?$", syms, re.M):
+        if re.search(r"\s\$t(\.\S*)?$", syms, re.MULTILINE):
             out.append(Violation(str(p), "-", "-", "$t", "contains Thumb code (library is built -marm)"))
         vs = check_disassembly(text, p.name)
         out.extend(vs)

@@ -25,10 +25,11 @@ import os
 import shutil
 import subprocess
 import time
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable
 
-__all__ = ["count_instructions", "per_iteration", "QemuCountError"]
+__all__ = ["QemuCountError", "count_instructions", "per_iteration"]
 
 _MARK = b"Trace "
 
@@ -37,10 +38,11 @@ class QemuCountError(RuntimeError):
     """The emulator is missing, the program failed, or it timed out."""
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _single_step_flag(qemu: str) -> str:
     try:
-        out = subprocess.run([qemu, "-h"], capture_output=True, timeout=30).stdout
+        out = subprocess.run([qemu, "-h"], capture_output=True, timeout=30,
+                             check=False).stdout
     except (OSError, subprocess.TimeoutExpired):  # pragma: no cover - reported by the caller
         return "-singlestep"
     return "-one-insn-per-tb" if b"-one-insn-per-tb" in out else "-singlestep"

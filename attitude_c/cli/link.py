@@ -9,7 +9,8 @@ import math
 import signal
 import sys
 import threading
-from typing import Any, Iterator, Optional
+from collections.abc import Iterator
+from typing import Any
 
 from ..errors import AttitudeError
 
@@ -29,7 +30,7 @@ def _parse_hex_line(line: str, n: int, lineno: int) -> bytes:
     return blk
 
 
-def test_samples(count: Optional[int], block_size: int = 6) -> Iterator[bytes]:
+def test_samples(count: int | None, block_size: int = 6) -> Iterator[bytes]:
     """Test blocks: X, Y, Z as 12-bit ADC codes (TLC2543 range) in 16-bit
     big-endian words, slow sines around mid-scale; padded/truncated to the
     block size."""

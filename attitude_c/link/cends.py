@@ -4,7 +4,7 @@ same Python interface as :mod:`attitude_c.link.protocol`.
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 from .._lib import ffi_lib
 from ..errors import InvalidArgument, LinkError, raise_for_status
@@ -99,17 +99,17 @@ class CSender:
         r = _result(self._lib.att_link_sender_sink(self._s, _byte(byte), tick & 0xFFFF),
                     "att_link_sender_sink")
         if r is Result.DISCARDED:
-            self.stats  # keep the extension exact under a flood of garbage
+            _ = self.stats  # keep the 16-bit extension exact under a flood of garbage
         return r
 
-    def poll(self, tick: int) -> tuple[Result, Optional[int]]:
+    def poll(self, tick: int) -> tuple[Result, int | None]:
         r = _result(self._lib.att_link_sender_poll(self._s, tick & 0xFFFF, self._out),
                     "att_link_sender_poll")
         if r is Result.SEND:
             return r, self._out[0]
         return r, None
 
-    def ticks_left(self, now: int) -> Optional[int]:
+    def ticks_left(self, now: int) -> int | None:
         v = self._lib.att_link_sender_ticks_left(self._s, now & 0xFFFF)
         return None if v == _NO_TIMER else int(v)
 
@@ -150,19 +150,19 @@ class CReceiver:
             self.block = bytes(self._ffi.buffer(self._buf, self.block_size))
         return r
 
-    def poll(self, tick: int) -> tuple[Result, Optional[int]]:
+    def poll(self, tick: int) -> tuple[Result, int | None]:
         r = _result(self._lib.att_link_receiver_poll(self._r, tick & 0xFFFF, self._out),
                     "att_link_receiver_poll")
         if r is Result.SEND:
             return r, self._out[0]
         return r, None
 
-    def ticks_left(self, now: int) -> Optional[int]:
+    def ticks_left(self, now: int) -> int | None:
         v = self._lib.att_link_receiver_ticks_left(self._r, now & 0xFFFF)
         return None if v == _NO_TIMER else int(v)
 
 
-def make_sender(impl: str = "c", **kw: int) -> "CSender | Any":
+def make_sender(impl: str = "c", **kw: int) -> CSender | Any:
     """A sender A: ``impl`` is ``"c"`` or ``"python"``; keywords as :class:`CSender`."""
     from .protocol import Sender
 
@@ -173,7 +173,7 @@ def make_sender(impl: str = "c", **kw: int) -> "CSender | Any":
     raise InvalidArgument(f"impl must be 'c' or 'python', got {impl!r}")
 
 
-def make_receiver(impl: str = "c", **kw: int) -> "CReceiver | Any":
+def make_receiver(impl: str = "c", **kw: int) -> CReceiver | Any:
     """A receiver B: ``impl`` is ``"c"`` or ``"python"``; keywords as :class:`CReceiver`."""
     from .protocol import Receiver
 

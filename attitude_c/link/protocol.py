@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import enum
 from dataclasses import asdict, dataclass
-from typing import Optional
 
 from ..errors import InvalidArgument, InvalidType, LinkError
 
@@ -85,7 +84,7 @@ class ReceiverStats:
         return asdict(self)
 
 
-def checksum(data: bytes) -> int:
+def checksum(data: bytes | bytearray) -> int:
     """The protocol's checksum: sum of the data bytes modulo 256."""
     return sum(data) % 256
 
@@ -145,7 +144,7 @@ class Sender:
         self._phase = "send AA"
 
     # The two waits and how long they may last.
-    def _limit(self) -> Optional[int]:
+    def _limit(self) -> int | None:
         if self._phase == "wait BB":
             return self.syn_timeout
         if self._phase == "wait answer":
@@ -179,7 +178,7 @@ class Sender:
         self.stats.bytes_discarded += 1
         return Result.DISCARDED
 
-    def poll(self, tick: int) -> tuple[Result, Optional[int]]:
+    def poll(self, tick: int) -> tuple[Result, int | None]:
         tick &= 0xFFFF
         phase = self._phase
         if phase == "idle":
@@ -214,7 +213,7 @@ class Sender:
         self._phase = "idle"
         return Result.GAVE_UP, None
 
-    def ticks_left(self, now: int) -> Optional[int]:
+    def ticks_left(self, now: int) -> int | None:
         """Ticks until poll acts on a timer (0: now), None if idle."""
         if self._phase == "idle":
             return None
@@ -241,7 +240,7 @@ class Receiver:
         self._in_block = False
         self._data = bytearray()
         self._last = 0  # tick of the last byte of the block (or of 0xBB leaving)
-        self._out: Optional[int] = None
+        self._out: int | None = None
         self._timeout_to_report = False
         self._garbage = False  # bytes discarded while idle since the last handshake
 
@@ -292,7 +291,7 @@ class Receiver:
         self._out = NAK
         return Result.REJECTED
 
-    def poll(self, tick: int) -> tuple[Result, Optional[int]]:
+    def poll(self, tick: int) -> tuple[Result, int | None]:
         tick &= 0xFFFF
         if self._gap_over(tick):
             self._drop()
@@ -307,7 +306,7 @@ class Receiver:
             return Result.SEND, out
         return (Result.NONE if self._in_block else Result.IDLE), None
 
-    def ticks_left(self, now: int) -> Optional[int]:
+    def ticks_left(self, now: int) -> int | None:
         if self._out is not None or self._timeout_to_report:
             return 0
         if not self._in_block:

@@ -15,8 +15,9 @@ Main entry point::
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Iterable, Optional, Sequence, Union
+from typing import Any, Union
 
 import numpy as np
 
@@ -97,7 +98,7 @@ class Channel:
     """The C channel model: ``transmit(direction, byte, tick) -> bytes``
     (direction 0 = A->B, 1 = B->A; tick in bit times)."""
 
-    def __init__(self, config: Optional[ChannelConfig] = None, baud: int = 9600) -> None:
+    def __init__(self, config: ChannelConfig | None = None, baud: int = 9600) -> None:
         self.config = config or ChannelConfig()
         self._ffi, self._lib = ffi_lib("f64")
         self._ch: Any = self._ffi.new("att_link_channel *")
@@ -177,8 +178,8 @@ class LinkRun:
             "undetected_errors": int(np.count_nonzero(~correct)),
             "duplicates": int(np.count_nonzero(dup)),
             "acked": int(np.count_nonzero(self.outcome == OUTCOME_ACKED)),
-            "gave_up": int(len(self.gave_up)),
-            "lost_to_reboot": int(len(self.lost_to_reboot)),
+            "gave_up": len(self.gave_up),
+            "lost_to_reboot": len(self.lost_to_reboot),
             "duration_s": self.duration,
             "blocks_per_s": unique / self.duration if self.duration > 0 else 0.0,
             "sender": dict(self.sender_stats),
@@ -195,7 +196,7 @@ def _ticks(name: str, ms: float, baud: int) -> int:
     return t
 
 
-def _as_blocks(blocks: Any, block_size: Optional[int]) -> np.ndarray:
+def _as_blocks(blocks: Any, block_size: int | None) -> np.ndarray:
     if isinstance(blocks, (bytes, bytearray)):
         raise InvalidType("blocks must be a 2-D array or a list of blocks, not one bytes object")
     arr = np.asarray([bytes(b) for b in blocks] if isinstance(blocks, list) and blocks
@@ -218,18 +219,18 @@ def _as_blocks(blocks: Any, block_size: Optional[int]) -> np.ndarray:
 def simulate_link(
     blocks: Any,
     *,
-    channel: Optional[ChannelConfig] = None,
+    channel: ChannelConfig | None = None,
     sender: str = "c",
     receiver: str = "c",
     baud: int = 9600,
-    block_size: Optional[int] = None,
+    block_size: int | None = None,
     syn_timeout_ms: float = DEFAULT_SYN_TIMEOUT_MS,
     answer_timeout_ms: float = DEFAULT_ANSWER_TIMEOUT_MS,
     gap_timeout_ms: float = DEFAULT_GAP_TIMEOUT_MS,
     max_attempts: int = DEFAULT_MAX_ATTEMPTS,
     reboots: Iterable[tuple[float, str]] = (),
-    max_time_s: Optional[float] = None,
-    engine: Optional[str] = None,
+    max_time_s: float | None = None,
+    engine: str | None = None,
 ) -> LinkRun:
     """Push ``blocks`` ((n, N) uint8, or a list of N-byte ``bytes``) through
     sender A -> :class:`ChannelConfig` line -> receiver B at ``baud`` 8N1.
@@ -241,7 +242,7 @@ def simulate_link(
     state (A also loses the block in progress and moves on).
     """
     arr = _as_blocks(blocks, block_size)
-    n_blocks, n = arr.shape
+    _n_blocks, _n = arr.shape
     if isinstance(baud, bool) or not isinstance(baud, int) or not 50 <= baud <= 4_000_000:
         raise InvalidArgument(f"baud must be an int in 50..4000000, got {baud!r}")
     chan_cfg = channel or ChannelConfig()
@@ -254,11 +255,11 @@ def simulate_link(
     for name, impl in (("sender", sender), ("receiver", receiver)):
         if impl not in ("c", "python"):
             raise InvalidArgument(f"{name} must be 'c' or 'python', got {impl!r}")
-    timing = dict(
-        syn=_ticks("syn_timeout_ms", syn_timeout_ms, baud),
-        answer=_ticks("answer_timeout_ms", answer_timeout_ms, baud),
-        gap=_ticks("gap_timeout_ms", gap_timeout_ms, baud),
-    )
+    timing = {
+        "syn": _ticks("syn_timeout_ms", syn_timeout_ms, baud),
+        "answer": _ticks("answer_timeout_ms", answer_timeout_ms, baud),
+        "gap": _ticks("gap_timeout_ms", gap_timeout_ms, baud),
+    }
     reb = []
     for time_s, who in reboots:
         if who not in ("sender", "receiver"):
@@ -386,6 +387,7 @@ def _run_py(arr: np.ndarray, chan_cfg: ChannelConfig, baud: int, timing: dict[st
                     k += 1
                     continue
                 if r is Result.SEND:
+                    assert out is not None
                     for x in channel.transmit(0, out, t):
                         la.append((t + tpb, x, cur))
                     busy_a = t + tpb
@@ -401,6 +403,7 @@ def _run_py(arr: np.ndarray, chan_cfg: ChannelConfig, baud: int, timing: dict[st
             while True:
                 r, out = b.poll(t)
                 if r is Result.SEND:
+                    assert out is not None
                     for x in channel.transmit(1, out, t):
                         lb.append((t + tpb, x))
                     busy_b = t + tpb

@@ -24,8 +24,9 @@ import socket
 import threading
 import time
 import tty
+from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable, Optional
+from typing import Any, Callable
 
 import serial
 
@@ -65,7 +66,7 @@ class _Bridge:
     """Forward bytes both ways between two endpoints, optionally paced at
     ``baud`` (one byte per 10 bit times) and through a channel model."""
 
-    def __init__(self, baud: Optional[int], channel: Optional[ChannelConfig]) -> None:
+    def __init__(self, baud: int | None, channel: ChannelConfig | None) -> None:
         self.baud = baud
         self._channel = Channel(channel, baud or 9600) if channel is not None else None
         self._lock = threading.Lock()
@@ -115,7 +116,7 @@ class _Bridge:
                         return
                     self.forwarded[direction] += len(out)
 
-    def channel_stats(self) -> Optional[dict[str, dict[str, int]]]:
+    def channel_stats(self) -> dict[str, dict[str, int]] | None:
         return self._channel.stats() if self._channel is not None else None
 
     def _stop_threads(self) -> None:
@@ -153,10 +154,10 @@ class PtyPair(_Bridge):
     """Two raw pseudo-terminals joined by a bridge: open ``.paths[0]`` for one
     end and ``.paths[1]`` for the other (``with PtyPair() as (p0, p1): ...``)."""
 
-    def __init__(self, baud: Optional[int] = None, channel: Optional[ChannelConfig] = None) -> None:
+    def __init__(self, baud: int | None = None, channel: ChannelConfig | None = None) -> None:
         super().__init__(baud, channel)
         self._fds: list[int] = []
-        masters = []
+        masters: list[int] = []
         self.paths: list[str] = []
         claimed = _paths_claimed_by_others()
         for _ in range(64):
@@ -208,7 +209,7 @@ class PtyPair(_Bridge):
     def __enter__(self) -> list[str]:
         return self.paths
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 
@@ -216,7 +217,7 @@ class SocketRelay(_Bridge):
     """A TCP relay on 127.0.0.1: the first two clients (``.url`` each, a
     pyserial ``socket://`` URL) are joined. ``with SocketRelay() as url: ...``"""
 
-    def __init__(self, baud: Optional[int] = None, channel: Optional[ChannelConfig] = None,
+    def __init__(self, baud: int | None = None, channel: ChannelConfig | None = None,
                  accept_timeout: float = 10.0) -> None:
         super().__init__(baud, channel)
         self._srv = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
@@ -267,7 +268,7 @@ class SocketRelay(_Bridge):
     def __enter__(self) -> str:
         return self.url
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
 
@@ -320,13 +321,13 @@ class ReceiverReport:
     blocks: list[bytes] = field(default_factory=list)
     stats: dict[str, int] = field(default_factory=dict)
     ended_by: str = ""  # "count", "duration", "stop", "eof", "error"
-    error: Optional[str] = None
+    error: str | None = None
 
 
 def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
-                 gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: Optional[int] = None,
-                 duration: Optional[float] = None, on_block: Optional[Callable[[bytes], None]] = None,
-                 stop: Optional[threading.Event] = None, eof_after: Optional[float] = None,
+                 gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: int | None = None,
+                 duration: float | None = None, on_block: Callable[[bytes], None] | None = None,
+                 stop: threading.Event | None = None, eof_after: float | None = None,
                  keep_blocks: bool = True) -> ReceiverReport:
     """Run receiver B on an open ``port`` until ``count`` blocks, ``duration``
     seconds, ``stop`` is set, or ``eof_after`` seconds of silence.
@@ -367,13 +368,13 @@ def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
                 while True:
                     r, o = rx.poll(tick)
                     if r is Result.SEND:
-                        out.append(o)
+                        out.append(o)  # type: ignore[arg-type]  # SEND always carries a byte
                     elif r in (Result.NONE, Result.IDLE):
                         break
             while True:
                 r, o = rx.poll(tick)
                 if r is Result.SEND:
-                    out.append(o)
+                    out.append(o)  # type: ignore[arg-type]  # SEND always carries a byte
                 elif r in (Result.NONE, Result.IDLE):
                     break
             if out:
@@ -392,8 +393,8 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
                syn_timeout_ms: int = DEFAULT_SYN_TIMEOUT_MS,
                answer_timeout_ms: int = DEFAULT_ANSWER_TIMEOUT_MS,
                max_attempts: int = DEFAULT_MAX_ATTEMPTS,
-               on_result: Optional[Callable[[BlockReport], None]] = None,
-               stop: Optional[threading.Event] = None) -> tuple[list[BlockReport], dict[str, int]]:
+               on_result: Callable[[BlockReport], None] | None = None,
+               stop: threading.Event | None = None) -> tuple[list[BlockReport], dict[str, int]]:
     """Run sender A on an open ``port`` over ``blocks`` (each ``block_size``
     bytes). Returns one :class:`BlockReport` per block and A's statistics.
     Raises :class:`LinkError` if the port fails (reports so far are passed
@@ -403,7 +404,7 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
     clock = _Clock()
     reports: list[BlockReport] = []
     it = iter(blocks)
-    cur: Optional[BlockReport] = None
+    cur: BlockReport | None = None
     index = 0
     while True:
         if stop is not None and stop.is_set():
@@ -424,7 +425,7 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
                 index += 1
                 continue
             if r is Result.SEND:
-                out.append(o)
+                out.append(o)  # type: ignore[arg-type]  # SEND always carries a byte
                 continue
             if r is Result.TIMEOUT and cur is not None:
                 cur.timeouts += 1

@@ -23,8 +23,8 @@ import os
 import re
 import shutil
 import subprocess
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from invoke import task
 
@@ -36,14 +36,14 @@ SOVERSION = "0"
 
 
 def version() -> str:
-    m = re.search(r'^version\s*=\s*"([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.M)
+    m = re.search(r'^version\s*=\s*"([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.MULTILINE)
     return m.group(1) if m else "0.0.0"
 
 
 def _run(cmd: Sequence[str], verbose: bool) -> None:
     if verbose:
         print(" ".join(map(str, cmd)), flush=True)
-    proc = subprocess.run(list(map(str, cmd)), capture_output=True, text=True)
+    proc = subprocess.run(list(map(str, cmd)), capture_output=True, text=True, check=False)
     if proc.returncode != 0:
         raise BuildError(f"command failed ({proc.returncode}): {' '.join(map(str, cmd))}\n"
                          f"{proc.stdout}{proc.stderr}")
@@ -164,7 +164,7 @@ def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
     for kind, p in products.items():
         rel = os.path.relpath(p, ROOT)
         if kind == "armv4t_check":
-            print(f"  ARMv4T check: every object is ARMv4T clean")
+            print("  ARMv4T check: every object is ARMv4T clean")
         else:
             print(f"  {kind:8s} {rel}")
 
