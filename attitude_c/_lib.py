@@ -6,6 +6,7 @@ same C sources compiled with ``att_real`` = double or float.
 
 from __future__ import annotations
 
+import importlib
 from types import ModuleType
 from typing import Any
 
@@ -20,19 +21,17 @@ def _module(precision: str) -> ModuleType:
         raise InvalidArgument(
             f"precision must be one of {_PRECISIONS!r} here, got {precision!r}"
         )
-    mod = _cache.get(precision)
-    if mod is None:
-        try:
-            if precision == "f64":
-                from . import _att_f64 as mod  # type: ignore[attr-defined,no-redef]
-            else:
-                from . import _att_f32 as mod  # type: ignore[attr-defined,no-redef]
-        except ImportError as exc:  # pragma: no cover - depends on install
-            raise ImportError(
-                "attitude_c's C extension is not built: run `pip install -e .` "
-                "(or `invoke build`) from the project root"
-            ) from exc
-        _cache[precision] = mod
+    cached = _cache.get(precision)
+    if cached is not None:
+        return cached
+    try:
+        mod = importlib.import_module(f"{__package__}._att_{precision}")
+    except ImportError as exc:  # pragma: no cover - depends on install
+        raise ImportError(
+            "attitude_c's C extension is not built: run `pip install -e .` "
+            "(or `invoke build`) from the project root"
+        ) from exc
+    _cache[precision] = mod
     return mod
 
 

@@ -8,6 +8,8 @@ user would naturally catch (pynacl style): a bad argument is both an
 
 from __future__ import annotations
 
+from typing import Mapping
+
 
 class AttitudeError(Exception):
     """Base class of every error raised by attitude_c."""
@@ -57,7 +59,7 @@ _GENERIC = {
 }
 
 
-def raise_for_status(status: int, what: str, extra: dict[int, tuple[type, str]] | None = None) -> None:
+def raise_for_status(status: int, what: str, extra: Mapping[int, tuple[type[Exception], str]] | None = None) -> None:
     """Raise the exception matching C status ``status`` (no-op for ATT_OK).
 
     ``what`` names the call or argument, so the message says what failed.
@@ -65,7 +67,7 @@ def raise_for_status(status: int, what: str, extra: dict[int, tuple[type, str]] 
     """
     if status >= 0:
         return
-    table = dict(_GENERIC)
+    table: dict[int, tuple[type[Exception], str]] = dict(_GENERIC)
     if extra:
         table.update(extra)
     cls, text = table.get(status, (AttitudeError, f"unknown status {status}"))

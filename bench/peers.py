@@ -62,7 +62,13 @@ def run(quick: bool = False) -> str:
 
     per = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1}
     inc_peer = inc_all[:n_peer]
-    for prec in ("f64", "f32"):
+    precs = ["f64", "f32"]
+    try:
+        attitude_c.integrate(inc_all[:3], method="rv3", precision="fixed")
+        precs.append("fixed")
+    except (ValueError, TypeError, ImportError):
+        pass  # the fixed-point core is not in this build
+    for prec in precs:
         for m, k in per.items():
             dt, q = _best(lambda m=m, prec=prec: attitude_c.integrate(inc_all, method=m, q0=q0,
                                                                          precision=prec), reps)

@@ -4,12 +4,9 @@ channel simulator and the C receiver."""
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import attitude_c
 from attitude_c.sim import AdcModel, SimConfig, simulate
-
-pytest.importorskip("attitude_c.link", reason="the link module has not landed in this tree")
 
 
 def _cfg(**kw) -> SimConfig:

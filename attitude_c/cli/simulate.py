@@ -143,8 +143,6 @@ def register(subparsers: Any) -> None:
     g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
     g.add_argument("--attempts", type=_int_range("--attempts", 1, 255), default=5,
                    help="link sender attempts per block before giving up")
-    g.add_argument("--firmware", choices=("none", "s51"), default="none",
-                   help="run the acquisition side as the real 8051 firmware in s51")
     g = p.add_argument_group("run")
     g.add_argument("--seed", type=_int_range("--seed", 0, 2**63 - 1), default=0,
                    help="random seed (noise, bias, channel errors)")
@@ -217,8 +215,7 @@ def build_config(args: argparse.Namespace) -> Any:
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
                      board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,
-                     link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed,
-                     firmware=None if args.firmware == "none" else args.firmware)
+                     link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed)
 
 
 def run(args: argparse.Namespace) -> int:

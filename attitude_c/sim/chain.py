@@ -69,7 +69,6 @@ class SimConfig:
     ber: float = 0.0
     link_attempts: int = 5
     seed: int = 0
-    firmware: str | None = None
 
     def validate(self) -> None:
         _integ.check_method(self.method)
@@ -96,8 +95,6 @@ class SimConfig:
                                   "ideal increments are not sent over the link")
         if not (math.isfinite(self.calibration_s) and self.calibration_s >= 0):
             raise InvalidArgument(f"calibration_s must be >= 0, got {self.calibration_s!r}")
-        if self.firmware not in (None, "s51"):
-            raise InvalidArgument(f"firmware must be None or 's51', got {self.firmware!r}")
         self.board.check(self.adc.bits)
 
     def params(self) -> dict[str, Any]:
@@ -119,7 +116,6 @@ class SimConfig:
             "ber": self.ber,
             "link_attempts": self.link_attempts,
             "seed": self.seed,
-            "firmware": self.firmware,
         }
 
 
@@ -219,9 +215,6 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
     """The sensor side of the chain: trajectory → gyros → ADC → board → link →
     calibrated increments (everything before the integrator)."""
     cfg.validate()
-    if cfg.firmware == "s51":
-        raise InvalidArgument("--firmware s51 is not available in this build: the firmware "
-                              "issue has not landed")
     h = cfg.period
     n = math.floor(cfg.duration / h + 1e-9)
     t0 = cfg.trajectory.t_start

@@ -2,70 +2,38 @@
  * libattitude — link sender A (see attitude/link.h and docs/link.md).
  *
  * Portable C99 that SDCC compiles for the AT89S51 (small model): 8/16-bit
- * arithmetic, no float, no function pointers, no library calls.
+ * arithmetic, no float, no function pointers, no library calls. This file
+ * holds only what a firmware needs (init, reset, start, sink, poll); the
+ * helpers it can do without are in link_sender_aux.c, because SDCC links
+ * whole modules and the AT89S51 has 4 KB of flash.
  */
 #include "attitude/link.h"
 
-/* Private states. */
-typedef enum {
-    SS_IDLE = 0,         /* no block */
-    SS_SEND_SYN,         /* next poll hands out 0xAA */
-    SS_WAIT_SYN_ACK,     /* waiting for 0xBB (syn timer running) */
-    SS_SEND_DATA,        /* next poll hands out block[index] */
-    SS_SEND_CHECKSUM,    /* next poll hands out the checksum */
-    SS_WAIT_ANSWER,      /* waiting for 0x00 / 0xFF (answer timer running) */
-    SS_TIMED_OUT,        /* a sink found the timer expired: next poll reports it */
-    SS_GAVE_UP,          /* next poll reports the give-up */
-    SS_COUNT
-} ss_state;
+#include "link_sender_state.h"
 
-uint8_t att_link_checksum(const uint8_t *data, uint8_t n)
-{
-    uint8_t sum = 0;
-    if (data == NULL) {
-        return 0;
-    }
-    while (n != 0) {
-        sum = (uint8_t)(sum + *data);
-        ++data;
-        --n;
-    }
-    return sum;
-}
-
-void att_link_sender_config_init(att_link_sender_config *cfg, uint8_t block_size)
-{
-    if (cfg == NULL) {
-        return;
-    }
-    cfg->syn_timeout = 50;    /* ms: 0xAA + 0xBB on the wire (2 x 1.04 ms) + B's latency */
-    cfg->answer_timeout = 50; /* ms: checksum + answer on the wire + B's latency */
-    cfg->block_size = block_size;
-    cfg->max_attempts = 5;
-}
-
-static uint8_t timeout_ok(uint16_t t)
-{
-    return (uint8_t)(t >= 1u && t <= (uint16_t)ATT_LINK_TIMEOUT_MAX);
-}
+/* 1..ATT_LINK_TIMEOUT_MAX, in one unsigned comparison (0 wraps to 0xFFFF); the block
+ * size check below uses the same trick (ATT_LINK_BLOCK_MIN is 1). */
+#define TIMEOUT_BAD(t) ((uint16_t)((t) - 1u) > (uint16_t)(ATT_LINK_TIMEOUT_MAX - 1))
 
 int att_link_sender_init(att_link_sender ATT_LINK_MEM *s, const att_link_sender_config *cfg)
 {
+    uint8_t ATT_LINK_MEM *p;
+    uint8_t n;
     if (s == NULL || cfg == NULL) {
         return ATT_LINK_E_NULL;
     }
-    if (cfg->block_size < (uint8_t)ATT_LINK_BLOCK_MIN || cfg->block_size > (uint8_t)ATT_LINK_BLOCK_MAX
-        || cfg->max_attempts == 0 || !timeout_ok(cfg->syn_timeout) || !timeout_ok(cfg->answer_timeout)) {
+    s->cfg = *cfg; /* checked in place: cheaper than through a generic pointer on the 8051 */
+    p = (uint8_t ATT_LINK_MEM *)&s->stats;
+    n = (uint8_t)sizeof(s->stats);
+    do {
+        *p++ = 0;
+    } while (--n != 0);
+    att_link_sender_reset(s);
+    if ((uint8_t)(s->cfg.block_size - 1u) > (uint8_t)(ATT_LINK_BLOCK_MAX - 1) || s->cfg.max_attempts == 0
+        || TIMEOUT_BAD(s->cfg.syn_timeout) || TIMEOUT_BAD(s->cfg.answer_timeout)) {
+        s->state = (uint8_t)SS_COUNT; /* unusable: every call reports an error */
         return ATT_LINK_E_CONFIG;
     }
-    s->cfg = *cfg;
-    s->stats.blocks_sent = 0;
-    s->stats.blocks_accepted = 0;
-    s->stats.naks = 0;
-    s->stats.timeouts = 0;
-    s->stats.gave_up = 0;
-    s->stats.bytes_discarded = 0;
-    att_link_sender_reset(s);
     return ATT_OK;
 }
 
@@ -251,25 +219,4 @@ att_link_result att_link_sender_poll(att_link_sender ATT_LINK_MEM *s, uint16_t t
     default:
         return ATT_LINK_E_STATE;
     }
-}
-
-uint16_t att_link_sender_ticks_left(const att_link_sender ATT_LINK_MEM *s, uint16_t now)
-{
-    uint16_t elapsed;
-    uint16_t limit;
-    if (s == NULL) {
-        return (uint16_t)ATT_LINK_NO_TIMER;
-    }
-    if (s->state == (uint8_t)SS_IDLE || s->state >= (uint8_t)SS_COUNT) {
-        return (uint16_t)ATT_LINK_NO_TIMER;
-    }
-    if (!waiting(s)) {
-        return 0; /* something to hand out or report now */
-    }
-    elapsed = (uint16_t)(now - s->t0);
-    limit = s->state == (uint8_t)SS_WAIT_SYN_ACK ? s->cfg.syn_timeout : s->cfg.answer_timeout;
-    if (elapsed > limit) {
-        return 0;
-    }
-    return (uint16_t)(limit - elapsed + 1u);
 }

@@ -179,6 +179,10 @@ static void test_config(void)
     CHECK_EQ_INT(att_link_sender_init(&s, &sc), ATT_LINK_E_CONFIG);
     sc.block_size = 65;
     CHECK_EQ_INT(att_link_sender_init(&s, &sc), ATT_LINK_E_CONFIG);
+    /* a sender whose init failed refuses to work instead of misbehaving */
+    CHECK_EQ_INT(att_link_sender_poll(&s, 0, buf), ATT_LINK_E_STATE);
+    CHECK_EQ_INT(att_link_sender_sink(&s, 0xBB, 0), ATT_LINK_E_STATE);
+    CHECK_EQ_INT(att_link_sender_start(&s, BLK, 0), ATT_LINK_E_BUSY);
     sc.block_size = 64;
     CHECK_EQ_INT(att_link_sender_init(&s, &sc), ATT_OK);
     sc.max_attempts = 0;

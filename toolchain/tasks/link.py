@@ -11,7 +11,7 @@ from invoke import task
 
 ROOT = Path(__file__).resolve().parents[2]
 FUZZ_SRC = ROOT / "csrc" / "fuzz" / "fuzz_link_receiver.c"
-LIB = [ROOT / "csrc" / "src" / "link_sender.c", ROOT / "csrc" / "src" / "link_receiver.c"]
+LIB = [ROOT / "csrc" / "src" / n for n in ("link_sender.c", "link_sender_aux.c", "link_receiver.c")]
 APT_HINT = "apt-get install clang libclang-rt-14-dev"
 
 

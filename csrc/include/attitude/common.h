@@ -2,7 +2,8 @@
  * libattitude — common definitions shared by every module.
  *
  * Build-time scalar type: the library is compiled either in double
- * (default) or in float (define ATT_REAL_F32). `att_real` is that type.
+ * (default) or in float (define ATT_REAL_F32; always float on SDCC).
+ * `att_real` is that type.
  *
  * Status codes: every function that can fail returns an `att_status`;
  * ATT_OK (0) is success, negative values are errors. No function ever
@@ -21,7 +22,8 @@
 #include <stdint.h>
 #endif
 
-#if defined(ATT_REAL_F32)
+/* SDCC has no double (it warns and uses float): the 8051 build is float. */
+#if defined(ATT_REAL_F32) || defined(__SDCC)
 typedef float att_real;
 #else
 typedef double att_real;

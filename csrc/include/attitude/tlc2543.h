@@ -41,11 +41,6 @@
 #ifndef ATTITUDE_TLC2543_H
 #define ATTITUDE_TLC2543_H
 
-/* SDCC has no double (it warns and uses float): say so, so that common.h
- * picks float for att_real and the 8051 build is warning-free. */
-#if defined(__SDCC) && !defined(ATT_REAL_F32)
-#define ATT_REAL_F32 1
-#endif
 #include "attitude/common.h"
 #include "attitude/tlc2543_hal.h"
 

@@ -1,0 +1,579 @@
+/*
+ * firmware/main.c — AT89S51 acquisition board of the paper (sec. 3.1, 3.3):
+ * samples the X, Y, Z gyro channels through the TLC2543 at a fixed period
+ * paced by Timer 0 and sends each sample to the Linux computer with the
+ * handshake protocol (link sender A of libattitude).
+ *
+ * Built with SDCC for the 8051 small model from the library's own sources,
+ * unchanged: csrc/src/tlc2543.c (ADC driver) and csrc/src/link_sender.c.
+ * See docs/firmware.md for the wiring, the block formats and the build.
+ *
+ *   Timer 0  mode 1, free-running: TH0 advances every 256 machine cycles
+ *            (1/3600 s at 11.0592 MHz), the firmware's tick. No interrupts
+ *            at all: the firmware is one polled loop.
+ *   Timer 1  mode 2 (auto-reload): UART baud-rate generator.
+ *   UART     mode 1 (8N1), polled: TI means "transmitter free".
+ *   P1.0-4   TLC2543 (EOC, I/O CLOCK, DATA IN, DATA OUT, CS), driven by the
+ *            driver's HAL macros; P1.5 fault LED (low = on).
+ *
+ * Main loop (never blocks longer than one X/Y/Z scan):
+ *   1. a received byte goes to the link sender (sink);
+ *   2. when the transmitter is free, the sender is polled: a byte to send,
+ *      a timeout, a give-up, or idle (then the next queued block starts);
+ *   3. when the sampling period has elapsed, one X/Y/Z scan is queued.
+ * Blocks wait in a two-slot FIFO (one being sent, one being filled: all the
+ * RAM allows next to the driver and the link sender). Every sample that cannot be
+ * delivered is replaced by a report block at its place in the stream
+ * (report.h), so the receiver always knows which sample is which.
+ *
+ * Integer arithmetic only, no dynamic memory, no __xdata.
+ */
+#include <8051.h>
+
+#include "attitude/link.h"
+#include "attitude/tlc2543.h"
+#include "config.h"
+#include "report.h"
+
+#if defined(FW_SIM)
+/* Simulation image: text output and stop through the uCsim simulator
+ * interface (sim/sim_io.c); stops after FW_SIM_BLOCKS accepted blocks and
+ * prints the link statistics. */
+#include "sim/sim_io.h"
+#ifndef FW_SIM_BLOCKS
+#define FW_SIM_BLOCKS 0 /* 0: run until the simulator is stopped */
+#endif
+#endif
+#if defined(FW_SIM_MODEL)
+#include "sim/fw_sim.h" /* ADC inputs from the TLC2543 + gyro model */
+#endif
+
+/* ---- time base: Timer 0 ---------------------------------------------- */
+
+/* Timer 0 runs free in mode 1 (16 bits) and counts machine cycles, so TH0
+ * advances once every 256 machine cycles: 1/3600 s at 11.0592 MHz, the
+ * firmware's tick. No interrupt (no stack, no CPU time): the main loop
+ * folds TH0 into a 16-bit tick counter, which only needs it to come round
+ * at least once every 255 ticks (71 ms); it comes round every few hundred
+ * machine cycles. fw_ticks is not static: the simulation's device model
+ * reads it as its clock. */
+uint16_t fw_ticks; /* its low byte is always the TH0 value last folded in */
+
+static uint16_t tick_now(void)
+{
+    uint8_t d = (uint8_t)(TH0 - (uint8_t)fw_ticks); /* ticks since the last call */
+    fw_ticks += d;
+    return fw_ticks;
+}
+
+#if defined(FW_BENCH)
+/* Machine-cycle timestamp (16 bits, wraps every 65536 cycles = 71 ms):
+ * TH0:TL0, read high-low-high so a carry between the reads is seen. */
+static uint16_t cycles_now(void)
+{
+    uint8_t h, l;
+    do {
+        h = TH0;
+        l = TL0;
+    } while (h != TH0);
+    return (uint16_t)(((uint16_t)h << 8) | l);
+}
+#endif
+
+/* ---- UART: mode 1, Timer 1 mode 2 ----------------------------------- */
+
+static void uart_init(void)
+{
+    SCON = 0x50; /* mode 1 (8-bit UART, variable baud), REN = 1 */
+    TMOD = (unsigned char)((TMOD & 0x0Fu) | 0x20u); /* Timer 1: mode 2, timer */
+    TH1 = (unsigned char)FW_TH1;
+    TL1 = (unsigned char)FW_TH1;
+#if FW_SMOD
+    PCON |= 0x80u; /* SMOD = 1: double baud rate */
+#else
+    PCON &= 0x7Fu;
+#endif
+    TR1 = 1;
+    TI = 1; /* "transmitter free": the main loop polls TI before writing SBUF */
+}
+
+static void timer0_init(void)
+{
+    TMOD = (unsigned char)((TMOD & 0xF0u) | 0x01u); /* Timer 0: mode 1 (16-bit), timer */
+    TH0 = 0;
+    TL0 = 0;
+    TR0 = 1; /* free-running; no interrupt */
+}
+
+/* ---- block queue ----------------------------------------------------- */
+
+/* Everything in internal RAM (the small model's default space): __data
+ * pointers are one byte and need no library call. */
+static uint8_t queue[2][FW_BLOCK_SIZE];
+static __bit q_head;       /* slot of the oldest block (the one being sent) */
+static __bit q_any;        /* at least one block queued */
+static __bit q_full;       /* both slots used */
+static __bit q_last;       /* slot q_push() claimed last */
+static uint16_t seq;       /* number of the next sample to take */
+static uint16_t slot_seq0;  /* number of the sample in slot 0 / 1 */
+static uint16_t slot_seq1;
+static uint16_t ovr_count; /* samples lost to a full queue, not yet reported:
+                              always the newest ones, seq - ovr_count .. seq - 1 */
+static uint8_t __data *wp; /* the block being written (put_word appends) */
+static uint8_t txb;        /* byte handed out by the link sender (its out pointer is __data) */
+
+extern att_link_sender fw_tx; /* link_state.c */
+#define tx fw_tx
+static tlc2543 adc;
+
+/* Append w big-endian at wp. */
+static void put_word(uint16_t w)
+{
+    wp[0] = (uint8_t)(w >> 8);
+    wp[1] = (uint8_t)w;
+    wp += 2;
+}
+
+/* Start a report block at wp: marker and kind (two put_word follow). */
+static void put_report_head(uint8_t kind)
+{
+    wp[0] = (uint8_t)FW_REPORT_MARK;
+    wp[1] = kind;
+    wp += 2;
+}
+
+/* Claim the free slot at the tail (wp points to it); 0 if the queue is full. */
+static uint8_t q_push(void)
+{
+    if (q_full) {
+        return 0;
+    }
+    q_last = q_head ^ q_any;
+    wp = queue[q_last];
+    if (q_any) {
+        q_full = 1;
+    }
+    q_any = 1;
+    return 1;
+}
+
+/* Give back the slot q_push() claimed last. */
+static void q_unpush(void)
+{
+    if (q_full) {
+        q_full = 0;
+    } else {
+        q_any = 0;
+    }
+}
+
+/* Samples lost to a full queue are announced in their place (after every
+ * earlier block, before every later one), once the queue is empty: the
+ * report then leaves the other slot to the next sample, so a report never
+ * causes the next loss. */
+static void flush_overrun(void)
+{
+    if (!q_any && q_push()) {
+        put_report_head((uint8_t)FW_REPORT_OVERRUN);
+        put_word((uint16_t)(seq - ovr_count));
+        put_word(ovr_count);
+        ovr_count = 0;
+    }
+}
+
+/* ---- ADC ------------------------------------------------------------- */
+
+/* X, Y, Z in one scan, then power-down (address 14): the three channels
+ * are converted within one scan (about 0.4 ms apart at most), not one
+ * sampling period apart as with next = X, and the ADC sleeps in between. */
+static const uint8_t xyz[3] = {TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z};
+
+/* Start of a sampling period: a free slot for the sample (wp), or 0 if
+ * the queue is full: then the sample is lost (counted, announced later by
+ * an OVERRUN report) and the ADC is not touched. */
+static uint8_t sample_slot(void)
+{
+    if (ovr_count != 0u) {
+        flush_overrun();
+    }
+    if (ovr_count != 0u || !q_push()) {
+        ovr_count++;
+        return 0;
+    }
+    if (q_last) {
+        slot_seq1 = seq;
+    } else {
+        slot_seq0 = seq;
+    }
+    return 1;
+}
+
+/* The scan into the slot at wp returned st: store the codes big-endian
+ * (they are little-endian words in the slot), or an ADC_ERROR report. */
+static void sample_store(int st)
+{
+    uint8_t t;
+    if (st != ATT_OK) {
+        put_report_head((uint8_t)FW_REPORT_ADC_ERROR);
+        put_word(seq);
+        put_word((uint16_t)((uint16_t)(uint8_t)st << 8));
+        return;
+    }
+    for (t = 0; t < 3u; t++) {
+        put_word(*(uint16_t __data *)wp);
+    }
+}
+
+/* Power-up self-test of the ADC (its three internal test voltages), run
+ * from main into a queue slot: the result st. A failure lights the fault
+ * LED, is reported over the link and is retried every
+ * FW_SELFTEST_RETRY_TICKS; sampling starts only once it passes (1). */
+static uint8_t self_test_done(int st)
+{
+    uint8_t i;
+    uint16_t bad = 0;
+    if (st != ATT_OK) {
+        /* the code of the failed test input (MID, REFM, REFP), 0 for
+         * another error; the codes are the slot's three words */
+        i = (uint8_t)(TLC2543_E_SELFTEST_MID - st);
+        if (i < 3u) {
+            bad = ((uint16_t __data *)wp)[i];
+        }
+        put_report_head((uint8_t)FW_REPORT_SELFTEST);
+        put_word((uint16_t)(((uint16_t)(uint8_t)st << 8) | (uint8_t)(bad >> 8)));
+        put_word((uint16_t)(((uint16_t)(uint8_t)bad << 8) | (uint8_t)seq)); /* attempt, mod 256 */
+        P1_5 = 0; /* fault LED on */
+#if defined(FW_BENCH)
+        /* s51's port pins read 1: the test fails, but it ran (its stack
+         * depth is measured); the bench goes on to sample. */
+        q_unpush();
+        return 1;
+#else
+        return 0;
+#endif
+    }
+    q_unpush(); /* passed: the slot is not needed */
+    P1_5 = 1;   /* fault LED off */
+    return 1;
+}
+
+/* ---- link events ------------------------------------------------------ */
+
+#if defined(FW_BENCH)
+/* Bench counters (machine cycles from cycles_now()). They live in SFR cells
+ * the C51 core does not implement (uCsim keeps them as memory), so the
+ * bench image has the production image's RAM use; the helpers are called
+ * where main has no live locals. */
+__sfr16 __at(0xD2D1) bench_scan_min;
+__sfr16 __at(0xD4D3) bench_scan_max;
+__sfr16 __at(0xD6D5) bench_scans;
+__sfr32 __at(0xDCDBDAD9) bench_scan_sum;
+__sfr16 __at(0xDEDD) bench_blocks;
+__sfr16 __at(0xE2E1) bench_busy_block;  /* CPU cycles of link handling, block in progress */
+__sfr16 __at(0xE4E3) bench_busy_max;
+__sfr16 __at(0xE6E5) bench_t_start;     /* block started */
+__sfr16 __at(0xE9E8) bench_t_syn;       /* 0xAA handed out */
+__sfr16 __at(0xEBEA) bench_t_sum;       /* checksum handed out */
+__sfr16 __at(0xEDEC) bench_sent;        /* tx.stats.blocks_sent seen last */
+__sfr16 __at(0xEFEE) bench_t_loop;      /* start of this loop iteration */
+__sfr16 __at(0xD8D7) bench_t_scan;
+__sfr __at(0xBE) bench_busy;           /* this iteration did link work */
+__sfr32 __at(0xF4F3F2F1) bench_busy_sum;
+__sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
+__sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
+__sfr32 __at(0xFDFCFBFA) bench_ans_wait_sum; /* checksum handed out -> answer received */
+
+static void bench_init(void)
+{
+    bench_scan_min = 0xFFFFu;
+    bench_scan_max = 0;
+    bench_scans = 0;
+    bench_scan_sum = 0;
+    bench_blocks = 0;
+    bench_busy_block = 0;
+    bench_busy_max = 0;
+    bench_sent = 0;
+    bench_busy_sum = 0;
+    bench_exch_sum = 0;
+    bench_syn_wait_sum = 0;
+    bench_ans_wait_sum = 0;
+}
+
+static void bench_loop_start(void)
+{
+    bench_t_loop = cycles_now();
+    bench_busy = 0;
+}
+
+static void bench_loop_end(void)
+{
+    if (bench_busy) {
+        bench_busy_block += (uint16_t)(cycles_now() - bench_t_loop);
+    }
+}
+
+static void bench_rx(uint8_t b)
+{
+    bench_busy = 1;
+    if (b == (uint8_t)ATT_LINK_SYN_ACK) {
+        bench_syn_wait_sum += (uint16_t)(bench_t_loop - bench_t_syn);
+    } else if (b == (uint8_t)ATT_LINK_ACK || b == (uint8_t)ATT_LINK_NAK) {
+        bench_ans_wait_sum += (uint16_t)(bench_t_loop - bench_t_sum);
+    }
+}
+
+static void bench_tx(void)
+{
+    bench_busy = 1;
+    if (tx.stats.blocks_sent != bench_sent) { /* the checksum was handed out */
+        bench_sent = tx.stats.blocks_sent;
+        bench_t_sum = bench_t_loop;
+    } else if (txb == (uint8_t)ATT_LINK_SYN && tx.index == 0u) {
+        bench_t_syn = bench_t_loop;
+    }
+}
+
+static void bench_block_start(void)
+{
+    bench_busy = 1;
+    bench_t_start = bench_t_loop;
+    bench_busy_block = 0;
+}
+
+static void bench_scan_begin(void)
+{
+    bench_t_scan = cycles_now();
+}
+
+static void bench_scan_end(void)
+{
+    uint16_t c = (uint16_t)(cycles_now() - bench_t_scan);
+    if (c < bench_scan_min) {
+        bench_scan_min = c;
+    }
+    if (c > bench_scan_max) {
+        bench_scan_max = c;
+    }
+    bench_scan_sum += c;
+    bench_scans++;
+}
+#endif
+
+#if defined(FW_SIM)
+/* Instrumentation lives in SFR cells the C51 core does not implement
+ * (uCsim keeps them as memory), so it takes none of the 128 bytes of RAM. */
+__sfr16 __at(0xCECD) sim_accepted;
+
+static void put_stat(const char *name)
+{
+    fw_sim_putc(' ');
+    fw_sim_puts(name);
+    fw_sim_putc('=');
+}
+#define STAT(name, v) do { put_stat(name); fw_sim_puthex((uint16_t)(v)); } while (0)
+#define STAT32(name, v) do { put_stat(name); fw_sim_puthex((uint16_t)((v) >> 16)); \
+                             fw_sim_puthex((uint16_t)(v)); } while (0)
+
+/* Final report of a simulation run (hex values), then stop. */
+static void sim_finish(void)
+{
+    fw_sim_puts("STATS");
+    STAT("accepted", tx.stats.blocks_accepted);
+    STAT("sent", tx.stats.blocks_sent);
+    STAT("naks", tx.stats.naks);
+    STAT("timeouts", tx.stats.timeouts);
+    STAT("gave_up", tx.stats.gave_up);
+    STAT("discarded", tx.stats.bytes_discarded);
+    STAT("samples", seq);
+    STAT("queued", (uint8_t)q_any + (uint8_t)q_full);
+    STAT("overrun_pending", ovr_count);
+    STAT("ticks", fw_ticks);
+#if defined(FW_SIM_MODEL)
+    STAT("conversions", fw_sim_conversions());
+#endif
+    fw_sim_putc('\n');
+#if defined(FW_BENCH)
+    fw_sim_puts("BENCH");
+    STAT("scans", bench_scans);
+    STAT("scan_min", bench_scan_min);
+    STAT("scan_max", bench_scan_max);
+    STAT32("scan_sum", bench_scan_sum);
+    STAT("blocks", bench_blocks);
+    STAT32("busy_sum", bench_busy_sum);
+    STAT("busy_max", bench_busy_max);
+    STAT32("exch_sum", bench_exch_sum);
+    STAT32("syn_wait_sum", bench_syn_wait_sum);
+    STAT32("ans_wait_sum", bench_ans_wait_sum);
+    fw_sim_putc('\n');
+#endif
+    fw_sim_stop(0);
+}
+#endif
+
+/* The head block was accepted by the receiver: drop it from the queue. */
+static void block_accepted(void)
+{
+    if (queue[q_head][0] != (uint8_t)FW_REPORT_MARK) {
+        P1_5 = 1; /* a sample went through: fault LED off */
+    }
+    q_head = !q_head;
+    q_unpush();
+#if defined(FW_BENCH)
+    bench_exch_sum += (uint16_t)(cycles_now() - bench_t_start);
+    bench_busy_sum += bench_busy_block;
+    if (bench_busy_block > bench_busy_max) {
+        bench_busy_max = bench_busy_block;
+    }
+    bench_blocks++;
+#endif
+#if defined(FW_SIM)
+    if ((uint16_t)FW_SIM_BLOCKS != 0u && ++sim_accepted >= (uint16_t)FW_SIM_BLOCKS) {
+        sim_finish();
+    }
+#endif
+}
+
+/* The link gave up on the head block. A sample is replaced in place by a
+ * GAVE_UP report (sent next); a report stays and is sent again. */
+static void block_given_up(void)
+{
+    P1_5 = 0; /* fault LED on */
+    wp = queue[q_head];
+    if (wp[0] != (uint8_t)FW_REPORT_MARK) {
+        put_report_head((uint8_t)FW_REPORT_GAVE_UP);
+        put_word(q_head ? slot_seq1 : slot_seq0);
+        put_word(1u);
+    }
+}
+
+/* ---- main ------------------------------------------------------------ */
+
+static const att_link_sender_config link_cfg = {
+    FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS, FW_BLOCK_SIZE, FW_MAX_ATTEMPTS
+};
+
+/* main's state is static: no local lives across a call, so main pushes
+ * nothing on the stack around the deep calls (the scan). */
+static uint16_t next_sample; /* tick of the next sample (or self-test retry) */
+static __bit sampling;       /* the self-test passed */
+
+void main(void)
+{
+    int st;
+
+    P1 = 0xFD;   /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released; LED off */
+    timer0_init();
+    uart_init();
+#if defined(FW_SIM)
+    sim_accepted = 0;
+#endif
+#if defined(FW_BENCH)
+    bench_init();
+#endif
+    (void)att_link_sender_init(&tx, &link_cfg);
+#if defined(FW_SIM_MODEL)
+    fw_sim_model_init();
+#endif
+    (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
+    (void)q_push(); /* the queue is empty: BOOT report first */
+    put_report_head((uint8_t)FW_REPORT_BOOT);
+    put_word((uint16_t)(((uint16_t)FW_VERSION << 8) | (uint8_t)(FW_PERIOD_TICKS >> 8)));
+    put_word((uint16_t)(((uint16_t)(uint8_t)FW_PERIOD_TICKS << 8) | (uint8_t)(FW_BAUD / 1200L)));
+    sampling = 0;
+    next_sample = tick_now();
+
+    for (;;) {
+        (void)tick_now(); /* fw_ticks = now */
+#if defined(FW_BENCH)
+        bench_loop_start();
+#endif
+
+        /* 1. a byte from the receiver */
+        if (RI) {
+            RI = 0;
+#if defined(FW_BENCH)
+            bench_rx(SBUF);
+#endif
+#if defined(FW_SIM_TRACE)
+            fw_sim_putc('r'); fw_sim_puthex(SBUF); fw_sim_putc('@'); fw_sim_puthex(fw_ticks); fw_sim_putc('\n');
+#endif
+            if (att_link_sender_sink(&tx, SBUF, fw_ticks) == ATT_LINK_ACCEPTED) {
+                block_accepted();
+            }
+        }
+
+        /* 2. the transmitter is free: what does the sender want? */
+        if (TI) {
+            st = att_link_sender_poll(&tx, fw_ticks, &txb);
+#if defined(FW_SIM_TRACE)
+            if (st != ATT_LINK_NONE && st != ATT_LINK_IDLE) {
+                fw_sim_putc('p'); fw_sim_puthex((uint16_t)st); fw_sim_putc(' '); fw_sim_puthex(txb);
+                fw_sim_putc('@'); fw_sim_puthex(fw_ticks); fw_sim_putc('\n');
+            }
+#endif
+            if (st == ATT_LINK_SEND) {
+                TI = 0;
+                SBUF = txb;
+#if defined(FW_BENCH)
+                bench_tx();
+#endif
+            } else if (st == ATT_LINK_IDLE) {
+                if (q_any) {
+                    (void)att_link_sender_start(&tx, queue[q_head], fw_ticks);
+#if defined(FW_BENCH)
+                    bench_block_start();
+#endif
+                }
+            } else if (st == ATT_LINK_GAVE_UP) {
+                block_given_up();
+            } else if (st < 0) {
+                att_link_sender_reset(&tx); /* corrupted state: resend the head block */
+            }
+        }
+#if defined(FW_BENCH)
+        bench_loop_end();
+#endif
+
+        /* 3. the sampling clock (or the self-test retry clock) */
+        if (ovr_count != 0u) {
+            flush_overrun();
+        }
+        if ((int16_t)(fw_ticks - next_sample) >= 0) {
+            if (sampling) {
+                next_sample += (uint16_t)FW_PERIOD_TICKS;
+                if (sample_slot()) {
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_step();
+#endif
+#if defined(FW_BENCH)
+                    bench_scan_begin();
+#endif
+                    st = tlc2543_scan(&adc, xyz, 3, (uint16_t __data *)wp, TLC2543_POWER_DOWN);
+#if defined(FW_BENCH)
+                    bench_scan_end();
+#endif
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_check();
+#endif
+                    sample_store(st);
+                }
+                seq++;
+            } else {
+                if (q_push()) { /* the report slot, also where the codes land */
+                    seq++; /* until sampling starts, seq counts the self-test attempts */
+                    st = tlc2543_self_test_codes(&adc, (uint16_t __data *)wp);
+#if defined(FW_SIM_MODEL)
+                    fw_sim_model_check();
+#endif
+                    if (self_test_done(st)) {
+                        sampling = 1;
+                        seq = 0;
+                        next_sample = fw_ticks;
+                        continue;
+                    }
+                }
+                next_sample = (uint16_t)(fw_ticks + FW_SELFTEST_RETRY_TICKS);
+            }
+        }
+    }
+}

@@ -1,0 +1,203 @@
+/*
+ * firmware/sim/tlc_model.c — behavioural model of a TLC2543 with three
+ * gyros, compiled into simulation images of the firmware (8051 C, integer
+ * only). The firmware's real driver (csrc/src/tlc2543.c, unchanged, with
+ * its production 8051 HAL) reaches it through the pin assignment of
+ * tlc_hal_sim.h, which holds the chip side (the I/O cycle, conversion,
+ * EOC, the checks). This file holds the analog side and the reports.
+ *
+ * Analog inputs (Vref+ = 5 V, Vref- = 0 V; a 16-bit value v stands for
+ * v / 65536 * Vref): AIN0..AIN2 are the X, Y, Z gyros,
+ *     v_c(k) = OFF_c + (round(32767 sin(2 pi (PH_c + k STEP_c) / 256)) >> SH_c)
+ * where k is the simulated time in sampling periods since the first
+ * sample, rounded to the nearest period: k = round((fw_ticks - t_first) /
+ * FW_PERIOD_TICKS). The firmware's main loop calls fw_sim_model_step()
+ * right before each scan (the analog world advances to "now"), so the
+ * inputs are sinusoidal angular rates read at the instants the scans
+ * really happen (Timer 0 time): a sample taken at the wrong time, a stale
+ * pipeline result or a mislabelled channel shows up as a wrong value.
+ * The 12-bit code is v >> 4 (ideal quantizer, no offset or gain error).
+ * AIN3..AIN10 are grounded (code 0); the test inputs give 0x800, 0x000,
+ * 0xFFF. FW_SIM_DOUT_STUCK=0/1 ties DATA OUT low/high, FW_SIM_EOC_STUCK
+ * keeps EOC low: the faults of the self-test and EOC-timeout tests.
+ */
+#include "attitude/tlc2543.h"
+#include "config.h"
+#include "fw_sim.h"
+#include "sim_io.h"
+#include "tlc_hal_sim.h"
+
+extern uint16_t fw_ticks; /* firmware's Timer 0 tick counter (main.c) */
+
+/* Gyro signals (see above). */
+#ifndef FW_SIM_X_OFF
+#define FW_SIM_X_OFF 32768u
+#define FW_SIM_X_SH 1
+#define FW_SIM_X_PH 0
+#define FW_SIM_X_STEP 3
+#endif
+#ifndef FW_SIM_Y_OFF
+#define FW_SIM_Y_OFF 24576u
+#define FW_SIM_Y_SH 2
+#define FW_SIM_Y_PH 64
+#define FW_SIM_Y_STEP 5
+#endif
+#ifndef FW_SIM_Z_OFF
+#define FW_SIM_Z_OFF 40960u
+#define FW_SIM_Z_SH 3
+#define FW_SIM_Z_PH 128
+#define FW_SIM_Z_STEP 7
+#endif
+
+static const int16_t quarter_sine[65] = {
+    0, 804, 1608, 2410, 3212, 4011, 4808, 5602,
+    6393, 7179, 7962, 8739, 9512, 10278, 11039, 11793,
+    12539, 13279, 14010, 14732, 15446, 16151, 16846, 17530,
+    18204, 18868, 19519, 20159, 20787, 21403, 22005, 22594,
+    23170, 23731, 24279, 24811, 25329, 25832, 26319, 26790,
+    27245, 27683, 28105, 28510, 28898, 29268, 29621, 29956,
+    30273, 30571, 30852, 31113, 31356, 31580, 31785, 31971,
+    32137, 32285, 32412, 32521, 32609, 32678, 32728, 32757,
+    32767,
+};
+
+static const uint16_t gyro_off[3] = {FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF};
+static const uint8_t gyro_sh[3] = {FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH};
+static const uint8_t gyro_step[3] = {FW_SIM_X_STEP, FW_SIM_Y_STEP, FW_SIM_Z_STEP};
+static const uint8_t gyro_phase[3] = {FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH};
+
+/* Model state beyond tlc_hal_sim.h's cells: SFR cells too, no RAM. */
+__sfr __at(0xBD) m_started;       /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
+__sfr __at(0xC7) m_k;             /* sampling periods since the first step (mod 256) */
+__sfr16 __at(0xCAC9) m_bound;     /* fw_ticks at which m_k next increments */
+__sfr16 __at(0xCCCB) m_conversions; /* gyro input evaluations so far */
+
+void fw_sim_model_init(void)
+{
+    fwm_cs_pin = 1;
+    fwm_clk_pin = 0;
+    fwm_din_pin = 0;
+    fwm_bad_count = 0;
+    fwm_bad_format = 0;
+    fwm_bad_cs = 0;
+    fwm_bad_abort = 0;
+    fwm_nclk = 0;
+    fwm_in = 0;
+    fwm_word = 0;
+    fwm_eoc_wait = 0;
+    m_started = 0;
+    m_k = 0;
+    m_bound = 0;
+    m_conversions = 0;
+#if defined(FW_SIM_DOUT_STUCK)
+    fwm_stuck_dout = FW_SIM_DOUT_STUCK;
+#endif
+}
+
+/* Gyro c's input now, as a 12-bit code << 4. */
+static uint16_t gyro(uint8_t c)
+{
+    uint8_t p = (uint8_t)(gyro_phase[c] + (uint8_t)(m_k * gyro_step[c]));
+    uint8_t i = (uint8_t)(p & 63u);
+    uint8_t q = (uint8_t)(p >> 6);
+    uint16_t v;
+    if (q & 1u) {
+        i = (uint8_t)(64u - i);
+    }
+    v = (uint16_t)(quarter_sine[i] >> gyro_sh[c]);
+    if (q & 2u) {
+        v = (uint16_t)-v;
+    }
+    return (uint16_t)((uint16_t)(gyro_off[c] + v) & 0xFFF0u);
+}
+
+#ifndef FW_SIM_CONV_POLLS
+#define FW_SIM_CONV_POLLS 2 /* EOC reads low after a conversion starts */
+#endif
+
+unsigned char fwm_end_cycle(void)
+{
+    uint8_t a = (uint8_t)(fwm_in >> 4);
+    if (fwm_nclk != 12u) {
+        fwm_bad_count = 1;
+    }
+    if ((fwm_in & 0x0Fu) != 0u) {
+        fwm_bad_format = 1;
+    }
+    if (fwm_clk_pin) {
+        fwm_bad_cs = 1;
+    }
+    fwm_nclk = 0;
+    fwm_eoc_wait = 0;
+    if (a == TLC2543_POWER_DOWN) {
+        fwm_word = 0u; /* output register undefined after power-down; the model gives 0 */
+        return 1u;
+    }
+    if (a == TLC2543_CH_X) {
+        fwm_word = fwm_vx;
+    } else if (a == TLC2543_CH_Y) {
+        fwm_word = fwm_vy;
+    } else if (a == TLC2543_CH_Z) {
+        fwm_word = fwm_vz;
+    } else if (a == TLC2543_TEST_MID) {
+        fwm_word = 0x8000u;
+    } else if (a == TLC2543_TEST_REFP) {
+        fwm_word = 0xFFF0u;
+    } else {
+        fwm_word = 0u; /* Vref-, grounded inputs */
+    }
+#if defined(FW_SIM_EOC_STUCK)
+    fwm_eoc_wait = 255u; /* fault: EOC stays low past the driver's bound */
+#else
+    fwm_eoc_wait = FW_SIM_CONV_POLLS - 1; /* this read is the first low one */
+#endif
+    return 0u;
+}
+
+void fw_sim_model_step(void)
+{
+    uint16_t t = fw_ticks;
+    if (!m_started) {
+        m_started = 1;
+        m_bound = (uint16_t)(t + (uint16_t)(FW_PERIOD_TICKS - FW_PERIOD_TICKS / 2));
+    }
+    /* k = round((fw_ticks - t_first) / period), kept incrementally:
+     * m_bound is the next half-period boundary. */
+    while ((int16_t)(t - m_bound) >= 0) {
+        m_k++;
+        m_bound += (uint16_t)FW_PERIOD_TICKS;
+    }
+    fwm_vx = gyro(0);
+    fwm_vy = gyro(1);
+    fwm_vz = gyro(2);
+    m_conversions++;
+}
+
+static void violation(const char *what)
+{
+    fw_sim_puts("MODEL ERROR ");
+    fw_sim_puts(what);
+    fw_sim_putc('\n');
+    fw_sim_stop(2);
+}
+
+void fw_sim_model_check(void)
+{
+    if (fwm_bad_count) {
+        violation("I/O cycle without exactly 12 clocks");
+    }
+    if (fwm_bad_format) {
+        violation("format is not 12-bit MSB-first unipolar");
+    }
+    if (fwm_bad_cs) {
+        violation("DATA OUT read with CS high");
+    }
+    if (fwm_bad_abort) {
+        violation("I/O cycle during a conversion (EOC low)");
+    }
+}
+
+uint16_t fw_sim_conversions(void)
+{
+    return m_conversions;
+}

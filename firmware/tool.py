@@ -1,0 +1,585 @@
+"""Build the AT89S51 firmware with SDCC and run it in s51 against the host end of the link.
+
+Three kinds of image come from the same sources (firmware/main.c + the
+library's csrc/src/tlc2543.c and csrc/src/link_sender.c, unchanged):
+
+* ``production`` — what goes into the chip: TLC2543 on P1.0-P1.4.
+* ``sim`` — the same firmware, but the driver's pin HAL calls a TLC2543 +
+  gyro device model compiled into the image (firmware/sim/tlc_model.c), and
+  the program stops itself through the uCsim simulator interface after a
+  given number of accepted blocks, printing its link statistics.
+* ``bench`` — production pins plus machine-cycle counters (Timer 0 based).
+
+Running: s51 (``-t C51``, 128 B RAM) gets its UART on one end of a
+``socat pty,raw,echo=0`` pair; this module's :class:`LinkHost` (the C
+receiver B of libattitude through CFFI, or the Python one) answers on the
+other end, optionally injecting faults (NAKs, silence after 0xAA).
+
+    img = build(BUILD / "fw", Config(), kind="sim", sim_blocks=50)
+    res = run(img, LinkHost())
+    stream = decode_stream(res.host.blocks)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+FW_DIR = ROOT / "firmware"
+CSRC = ROOT / "csrc"
+TOOLCHAIN = ROOT / "toolchain"
+BUILD = ROOT / "build" / "firmware"
+
+XTAL_HZ = 11_059_200
+MACHINE_HZ = XTAL_HZ // 12          #: machine cycles per second (12-clock core)
+TICK_HZ = MACHINE_HZ // 256         #: Timer 0 ticks per second (3600)
+FLASH_SIZE = 4096
+IRAM_SIZE = 128
+BLOCK_SIZE = 6
+#: UART rates Timer 1 in mode 2 makes exactly from 11.0592 MHz (SMOD 0 or 1).
+BAUD_RATES = (1200, 2400, 4800, 9600, 14400, 19200, 28800, 57600)
+#: Bytes on the wire per delivered block: 0xAA, 0xBB, N data, checksum, answer.
+WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
+
+REPORT_MARK = 0xFE
+REPORT_KINDS = {0: "boot", 1: "selftest", 2: "gave_up", 3: "overrun", 4: "adc_error"}
+
+SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c"]
+SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
+
+
+class FirmwareError(RuntimeError):
+    """Build or simulation failure (message says what and where)."""
+
+
+class FirmwareTooBig(FirmwareError):
+    """The image does not fit the AT89S51 (4 KB flash, 128 B RAM)."""
+
+
+class SimTimeout(FirmwareError, TimeoutError):
+    """The simulation did not stop by itself within the wall-clock limit."""
+
+
+# -- configuration --------------------------------------------------------
+
+@dataclass(frozen=True)
+class Config:
+    """Build-time settings (firmware/config.h). Times are Timer 0 ticks (1/3600 s)."""
+
+    baud: int = 9600
+    period_ticks: int = 72            #: 20 ms: 50 samples/s
+    syn_timeout: int = 180            #: 50 ms
+    answer_timeout: int = 180         #: 50 ms
+    max_attempts: int = 5
+    selftest_retry: int = 3600        #: 1 s
+
+    def __post_init__(self) -> None:
+        if self.baud not in BAUD_RATES:
+            raise ValueError(f"baud must be one of {BAUD_RATES} (exact with an 11.0592 MHz crystal), "
+                             f"got {self.baud}")
+        for name in ("period_ticks", "syn_timeout", "answer_timeout", "selftest_retry"):
+            v = getattr(self, name)
+            if not 1 <= v <= 32767:
+                raise ValueError(f"{name} must be 1..32767 ticks, got {v}")
+        if not 1 <= self.max_attempts <= 255:
+            raise ValueError(f"max_attempts must be 1..255, got {self.max_attempts}")
+
+    @property
+    def period_s(self) -> float:
+        return self.period_ticks / TICK_HZ
+
+    def defines(self) -> list[str]:
+        return [f"FW_BAUD={self.baud}L", f"FW_PERIOD_TICKS={self.period_ticks}",
+                f"FW_SYN_TIMEOUT_TICKS={self.syn_timeout}",
+                f"FW_ANSWER_TIMEOUT_TICKS={self.answer_timeout}",
+                f"FW_MAX_ATTEMPTS={self.max_attempts}",
+                f"FW_SELFTEST_RETRY_TICKS={self.selftest_retry}"]
+
+
+@dataclass(frozen=True)
+class Gyro:
+    """One simulated gyro channel of the device model (firmware/sim/tlc_model.c).
+
+    Its output, as a fraction of Vref, for the k-th conversion of the channel
+    (the sample taken at t = k * period) is
+    ``(offset + 32767 sin(2 pi (phase + k step) / 256) / 2**shift) / 65536``.
+    """
+
+    offset: int
+    shift: int
+    phase: int
+    step: int
+
+    def fraction(self, k: int) -> float:
+        """Analog input / Vref for sample k (exact sine, no table)."""
+        s = 32767.0 * math.sin(2.0 * math.pi * ((self.phase + k * self.step) % 256) / 256.0)
+        return (self.offset + s / 2.0 ** self.shift) / 65536.0
+
+    def volts(self, k: int, vref: float = 5.0) -> float:
+        return vref * self.fraction(k)
+
+    def lsb(self, k: int) -> float:
+        """The analog input of sample k in 12-bit LSB (an ideal code is its floor)."""
+        return 4096.0 * self.fraction(k)
+
+
+#: X, Y, Z: different offsets, amplitudes (1024, 512, 256 LSB), phases and
+#: frequencies, so a swapped or shifted channel cannot match by accident.
+GYROS = (Gyro(32768, 1, 0, 3), Gyro(24576, 2, 64, 5), Gyro(40960, 3, 128, 7))
+
+
+def _gyro_defines(gyros: Sequence[Gyro]) -> list[str]:
+    out = []
+    for name, g in zip("XYZ", gyros):
+        out += [f"FW_SIM_{name}_OFF={g.offset}u", f"FW_SIM_{name}_SH={g.shift}",
+                f"FW_SIM_{name}_PH={g.phase}", f"FW_SIM_{name}_STEP={g.step}"]
+    return out
+
+
+# -- build ----------------------------------------------------------------
+
+@dataclass
+class Image:
+    """A linked firmware image and its memory use (from SDCC's .mem report)."""
+
+    ihx: Path
+    kind: str
+    config: Config
+    flash: int          #: bytes of code + constants
+    ram_static: int     #: bytes of internal RAM below the stack (registers, variables, bits)
+    stack_start: int    #: first stack byte (SP is set to stack_start - 1 at reset)
+    stack_free: int     #: bytes from stack_start to the end of RAM (0x7F)
+
+    def size_report(self) -> str:
+        flash = (f"flash {self.flash} / {FLASH_SIZE} bytes ({FLASH_SIZE - self.flash} free)"
+                 if self.kind == "production" else
+                 f"code {self.flash} bytes ({self.kind} image: model/counters, not for the chip)")
+        return (f"{self.ihx.name}: {flash}, RAM {self.ram_static} / {IRAM_SIZE} bytes static, "
+                f"stack 0x{self.stack_start:02X}..0x7F = {self.stack_free} bytes free")
+
+
+def _sdcc_flags() -> list[str]:
+    from toolchain import targets
+
+    t = targets.load("mcs51")
+    t.require()
+    return list(t.cflags)
+
+
+def _run(cmd: list[str]) -> None:
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise FirmwareError(f"command failed: {' '.join(cmd)}\n{proc.stdout}{proc.stderr}")
+
+
+def parse_mem(mem: Path) -> tuple[int, int, int]:
+    """(flash bytes, stack start, stack bytes available) from an SDCC .mem file."""
+    text = mem.read_text()
+    m = re.search(r"ROM/EPROM/FLASH\s+0x[0-9a-fA-F]+\s+0x[0-9a-fA-F]+\s+(\d+)", text)
+    s = re.search(r"Stack starts at: 0x([0-9a-fA-F]+) \(sp set to 0x[0-9a-fA-F]+\) with (\d+) bytes available", text)
+    if not m or not s:
+        raise FirmwareError(f"cannot read the memory report {mem}")
+    return int(m.group(1)), int(s.group(1), 16), int(s.group(2))
+
+
+def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
+          sim_blocks: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
+          extra_defines: Iterable[str] = (), name: str | None = None,
+          code_size: int = FLASH_SIZE) -> Image:
+    """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
+
+    ``kind``: ``production``, ``sim`` (device model + simulator stop after
+    ``sim_blocks`` accepted blocks, 0 = never) or ``bench`` (production pins,
+    self-test skipped because s51's port pins read 1, cycle counters).
+    ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck``.
+    """
+    if kind not in ("production", "sim", "bench"):
+        raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
+    out_dir = Path(out_dir)
+    name = name or f"fw_{kind}_{config.baud}"
+    objdir = out_dir / (name + ".objs")
+    shutil.rmtree(objdir, ignore_errors=True)
+    objdir.mkdir(parents=True, exist_ok=True)
+    flags = _sdcc_flags()
+    incs = [f"-I{CSRC / 'include'}", f"-I{FW_DIR}"]
+    defines = ["ATT_REAL_F32", *config.defines(), *extra_defines]
+    extra: list[str] = []
+    sources = list(SOURCES)
+    fault_defs = {"dout_stuck_high": "FW_SIM_DOUT_STUCK=1", "dout_stuck_low": "FW_SIM_DOUT_STUCK=0",
+                  "eoc_stuck": "FW_SIM_EOC_STUCK=1"}
+    faults = list(faults)
+    if faults and kind != "sim":
+        raise ValueError("faults need kind='sim'")
+    if kind in ("sim", "bench"):
+        defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}"]
+        sources.append(FW_DIR / "sim" / "sim_io.c")
+    if kind == "sim":
+        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
+        for f in faults:
+            if f not in fault_defs:
+                raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)}")
+            defines.append(fault_defs[f])
+        extra.append(f"-Wp-include,{SIM_HAL_HEADER}")
+        sources.insert(1, FW_DIR / "sim" / "tlc_model.c")
+    if kind == "bench":
+        defines += ["FW_BENCH"]
+    link_flags = [f for f in flags if f not in ("--code-size", "4096")] + ["--code-size", str(code_size)]
+    if kind != "production":
+        # The simulation images carry the device model / counters and the
+        # simulator-interface output: they may exceed 4 KB (s51's code
+        # memory is 64 KB); RAM stays the chip's 128 bytes.
+        link_flags = [f for f in flags if f not in ("--code-size", "4096")] + ["--code-size", "65536"]
+    rels = []
+    for src in sources:
+        rel = objdir / (src.stem + ".rel")
+        _run(["sdcc", *flags, *incs, *[f"-D{d}" for d in defines], *extra, "-c", str(src), "-o", str(rel)])
+        rels.append(str(rel))
+    ihx = out_dir / (name + ".ihx")
+    # Link with the 4 KB / 128 B limits of the chip: sdld fails when they are exceeded.
+    proc = subprocess.run(["sdcc", *link_flags, *rels, "-o", str(ihx)], check=False, capture_output=True,
+                          text=True)
+    mem = ihx.with_suffix(".mem")
+    if proc.returncode != 0:
+        msg = proc.stdout + proc.stderr
+        if "Insufficient" in msg or "Could not get" in msg:
+            raise FirmwareTooBig(f"{name} does not fit the AT89S51 ({code_size} B flash, 128 B RAM):\n{msg}")
+        raise FirmwareError(f"link failed for {name}:\n{msg}")
+    flash, stack_start, stack_free = parse_mem(mem)
+    img = Image(ihx=ihx, kind=kind, config=config, flash=flash, ram_static=stack_start,
+                stack_start=stack_start, stack_free=stack_free)
+    if (kind == "production" and flash > code_size) or stack_start + stack_free > IRAM_SIZE or stack_free <= 0:
+        raise FirmwareTooBig(img.size_report())
+    return img
+
+
+# -- the block stream -------------------------------------------------------
+
+@dataclass
+class Sample:
+    seq: int
+    codes: tuple[int, int, int]
+
+
+@dataclass
+class Report:
+    kind: str
+    raw: bytes
+
+    @property
+    def first(self) -> int:
+        return (self.raw[2] << 8) | self.raw[3]
+
+    @property
+    def count(self) -> int:
+        return (self.raw[4] << 8) | self.raw[5]
+
+    @property
+    def status(self) -> int:
+        """Self-test / ADC error status (negative att_status)."""
+        b = self.raw[2] if self.kind == "selftest" else self.raw[4]
+        return b - 256 if b >= 128 else b
+
+    @property
+    def bad_code(self) -> int:
+        return (self.raw[3] << 8) | self.raw[4]
+
+    @property
+    def attempt(self) -> int:
+        return self.raw[5]
+
+
+def decode_stream(blocks: Iterable[bytes]) -> list[Sample | Report]:
+    """Number the samples of a block stream (firmware/report.h).
+
+    Samples are counted from 0; a gave_up / overrun / adc_error report says
+    which samples will never come, and must start exactly at the next number.
+    """
+    out: list[Sample | Report] = []
+    seq = 0
+    for b in blocks:
+        if len(b) != BLOCK_SIZE:
+            raise FirmwareError(f"block of {len(b)} bytes, expected {BLOCK_SIZE}: {b.hex()}")
+        if b[0] == REPORT_MARK:
+            kind = REPORT_KINDS.get(b[1])
+            if kind is None:
+                raise FirmwareError(f"unknown report kind in {b.hex()}")
+            r = Report(kind, bytes(b))
+            out.append(r)
+            if kind == "boot":
+                seq = 0
+            elif kind in ("gave_up", "overrun"):
+                if r.first != seq & 0xFFFF:
+                    raise FirmwareError(f"{kind} report for sample {r.first}, expected {seq}")
+                seq += r.count
+            elif kind == "adc_error":
+                if r.first != seq & 0xFFFF:
+                    raise FirmwareError(f"adc_error report for sample {r.first}, expected {seq}")
+                seq += 1
+            continue
+        if b[0] > 0x0F or b[2] > 0x0F or b[4] > 0x0F:
+            raise FirmwareError(f"not a sample block (code > 4095): {b.hex()}")
+        out.append(Sample(seq, ((b[0] << 8) | b[1], (b[2] << 8) | b[3], (b[4] << 8) | b[5])))
+        seq += 1
+    return out
+
+
+# -- host end of the link -----------------------------------------------------
+
+@dataclass
+class Attempt:
+    """One data block the host received (what the firmware sent, before fault injection)."""
+
+    index: int            #: number of blocks accepted before it
+    data: bytes           #: N data bytes + checksum as on the wire
+    answer: int | None    #: 0x00 / 0xFF, None if the receiver dropped it
+
+
+class _CReceiver:
+    """libattitude's receiver B (C, through CFFI)."""
+
+    def __init__(self, block_size: int, gap_timeout: int) -> None:
+        from attitude_c._lib import ffi_lib
+
+        self.ffi, self.lib = ffi_lib("f64")
+        self.r = self.ffi.new("att_link_receiver *")
+        self.buf = self.ffi.new("uint8_t[]", block_size)
+        cfg = self.ffi.new("att_link_receiver_config *")
+        self.lib.att_link_receiver_config_init(cfg, block_size)
+        cfg.gap_timeout = gap_timeout
+        st = self.lib.att_link_receiver_init(self.r, cfg, self.buf)
+        if st != 0:
+            raise FirmwareError(f"att_link_receiver_init failed: {st}")
+        self.out = self.ffi.new("uint8_t *")
+        self.n = block_size
+        L = self.lib
+        self.names = {L.ATT_LINK_NONE: "none", L.ATT_LINK_IDLE: "idle", L.ATT_LINK_SEND: "send",
+                      L.ATT_LINK_DISCARDED: "discarded", L.ATT_LINK_SYN_RX: "syn",
+                      L.ATT_LINK_DATA_RX: "data", L.ATT_LINK_ACCEPTED: "accepted",
+                      L.ATT_LINK_REJECTED: "rejected", L.ATT_LINK_TIMEOUT: "timeout"}
+
+    def sink(self, byte: int, tick: int) -> str:
+        r = self.lib.att_link_receiver_sink(self.r, byte, tick & 0xFFFF)
+        return self.names.get(r, f"error{r}")
+
+    def poll(self, tick: int) -> tuple[str, int]:
+        r = self.lib.att_link_receiver_poll(self.r, tick & 0xFFFF, self.out)
+        return self.names.get(r, f"error{r}"), self.out[0]
+
+    def block(self) -> bytes:
+        return bytes(self.ffi.buffer(self.buf, self.n))
+
+    def stats(self) -> dict[str, int]:
+        s = self.r.stats
+        return {k: int(getattr(s, k)) for k in ("syns", "blocks_accepted", "naks", "timeouts",
+                                                 "resyncs", "bytes_discarded")}
+
+
+class LinkHost:
+    """The Linux side on the host end of the pty: receiver B plus fault injection.
+
+    ``nak_blocks``: indices n (number of blocks accepted so far) whose first
+    attempt gets one data bit flipped before the receiver sees it, so the
+    receiver itself answers 0xFF. ``silent``: n -> how many 0xAA to ignore
+    while n blocks have been accepted (no 0xBB: the firmware times out).
+    Ticks are wall-clock milliseconds; the gap timeout is long (1 s)
+    because s51 runs slower than real time and may be descheduled on a
+    loaded machine: the firmware's own timeouts (simulated time) are what
+    the tests exercise.
+    """
+
+    def __init__(self, impl: str = "c", *, block_size: int = BLOCK_SIZE, gap_timeout_ms: int = 1000,
+                 nak_blocks: Iterable[int] = (), silent: dict[int, int] | None = None) -> None:
+        if impl != "c":
+            raise ValueError(f"impl must be 'c', got {impl!r}")
+        self.rx = _CReceiver(block_size, gap_timeout_ms)
+        self.n = block_size
+        self.nak_blocks = set(nak_blocks)
+        self.silent = dict(silent or {})
+        self.blocks: list[bytes] = []
+        self.attempts: list[Attempt] = []
+        self.ignored_syn: list[int] = []      #: accepted count at each ignored 0xAA
+        self.wire: list[tuple[str, int]] = []  #: ("A"|"B", byte) in order
+        self.wire_t: list[float] = []          #: host wall time of each wire entry (s)
+        self._data: bytearray | None = None
+        self._corrupted: set[int] = set()
+        self._t0 = time.monotonic()
+
+    def tick(self) -> int:
+        return int((time.monotonic() - self._t0) * 1000.0)
+
+    def receive(self, data: bytes) -> bytes:
+        """Bytes from the firmware; returns the bytes to send back."""
+        out = bytearray()
+        for b in data:
+            self.wire.append(("A", b))
+            self.wire_t.append(time.monotonic())
+            now = self.tick()
+            k = len(self.blocks)
+            if self._data is None and b == 0xAA and self.silent.get(k, 0) > 0:
+                self.silent[k] -= 1
+                self.ignored_syn.append(k)
+                continue
+            fed = b
+            if self._data is not None:
+                if not self._data and k in self.nak_blocks and k not in self._corrupted:
+                    self._corrupted.add(k)
+                    fed = b ^ 0x01
+                self._data.append(b)
+            res = self.rx.sink(fed, now)
+            if res in ("accepted", "rejected"):
+                self.attempts.append(Attempt(k, bytes(self._data or b""), 0x00 if res == "accepted" else 0xFF))
+                self._data = None
+                if res == "accepted":
+                    self.blocks.append(self.rx.block())
+            out += self._poll(now)
+        out += self._poll(self.tick())
+        return bytes(out)
+
+    def _poll(self, now: int) -> bytes:
+        out = bytearray()
+        while True:
+            res, byte = self.rx.poll(now)
+            if res == "send":
+                out.append(byte)
+                self.wire.append(("B", byte))
+                self.wire_t.append(time.monotonic())
+                if byte == 0xBB:
+                    self._data = bytearray()
+            elif res == "timeout":
+                if self._data is not None:
+                    self.attempts.append(Attempt(len(self.blocks), bytes(self._data), None))
+                self._data = None
+            else:
+                return bytes(out)
+
+    def stats(self) -> dict[str, int]:
+        return self.rx.stats()
+
+
+# -- simulation -------------------------------------------------------------
+
+@dataclass
+class SimResult:
+    output: str                     #: text the firmware wrote through the simulator interface
+    console: str                    #: s51 console (state command output included)
+    stats: dict[str, int]           #: the firmware's STATS line
+    bench: dict[str, int]           #: the BENCH line (bench images)
+    max_sp: int                     #: highest stack pointer s51 saw
+    sim_seconds: float              #: simulated time
+    wall_seconds: float
+    host: LinkHost
+
+    @property
+    def stream(self) -> list[Sample | Report]:
+        return decode_stream(self.host.blocks)
+
+
+def _kill_group(proc: subprocess.Popen[Any] | None) -> None:
+    if proc is None or proc.poll() is not None:
+        return
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:
+        pass
+    try:
+        proc.wait(timeout=5)
+    except subprocess.TimeoutExpired:
+        pass
+
+
+def _parse_kv(line_tag: str, text: str) -> dict[str, int]:
+    m = re.search(rf"^{line_tag}((?: \w+=[0-9A-F]+)*)\s*$", text, re.MULTILINE)
+    if not m:
+        return {}
+    return {k: int(v, 16) for k, v in re.findall(r"(\w+)=([0-9A-F]+)", m.group(1))}
+
+
+def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) -> SimResult:
+    """Run a sim/bench image in ``s51 -t C51`` with its UART on a pty pair and ``host`` on the other end.
+
+    The firmware stops itself (simulator interface) after the configured
+    number of accepted blocks; s51 then prints its ``state`` (maximum stack
+    pointer) and is told to ``kill`` itself. Raises :class:`SimTimeout` if
+    that has not happened after ``timeout`` wall-clock seconds, and
+    :class:`FirmwareError` if the program did not stop through ``s51_exit``
+    with code 0 (e.g. the device model detected a protocol violation).
+    """
+    if image.kind == "production":
+        raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
+    for tool in ("s51", "socat"):
+        if shutil.which(tool) is None:
+            raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
+    import serial  # pyserial
+
+    host = host or LinkHost()
+    tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
+    dev_fw, dev_host = tmp / "uart_fw", tmp / "uart_host"
+    sif_out = tmp / "sif.out"
+    cmds = tmp / "cmds"
+    cmds.write_text(f'file "{image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
+    socat = s51 = None
+    port = None
+    t_start = time.monotonic()
+    console = ""
+    try:
+        socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={dev_fw}", f"pty,raw,echo=0,link={dev_host}"],
+                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                 stderr=subprocess.PIPE, start_new_session=True)
+        while not (dev_fw.exists() and dev_host.exists()):
+            if socat.poll() is not None:
+                raise FirmwareError(f"socat failed: {socat.stderr.read().decode() if socat.stderr else ''}")
+            if time.monotonic() - t_start > 10:
+                raise SimTimeout("socat did not create the pty pair within 10 s")
+            time.sleep(0.01)
+        port = serial.Serial(str(dev_host), image.config.baud, timeout=0.01)
+        s51 = subprocess.Popen(["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
+                                "-s", str(dev_fw), "-C", str(cmds)],
+                               stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               start_new_session=True, cwd=tmp)
+        deadline = time.monotonic() + timeout
+        while s51.poll() is None:
+            if time.monotonic() > deadline:
+                _kill_group(s51)
+                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+                raise SimTimeout(f"s51 did not stop within {timeout} s; firmware output so far:\n"
+                                 + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
+                                 + "\ns51 console (end):\n" + con[-3000:]
+                                 + f"\nhost: {len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
+                                 f"receiver {host.stats()}")
+            data = port.read(max(1, port.in_waiting))
+            if data:
+                reply = host.receive(data)
+            else:
+                reply = host._poll(host.tick())
+            if reply:
+                port.write(reply)
+        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+    finally:
+        if port is not None:
+            port.close()
+        _kill_group(s51)
+        _kill_group(socat)
+    wall = time.monotonic() - t_start
+    output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
+    shutil.rmtree(tmp, ignore_errors=True)
+    m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
+    if m is None or int(m.group(1)) != 0:
+        raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\nconsole:\n{console[-2000:]}")
+    sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
+    clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
+    if sp is None or clk is None:
+        raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
+    return SimResult(output=output, console=console, stats=_parse_kv("STATS", output),
+                     bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
+                     sim_seconds=float(clk.group(1)), wall_seconds=wall, host=host)

@@ -1,0 +1,191 @@
+"""AT89S51 firmware (firmware/): SDCC build limits and whole-firmware runs in s51.
+
+Every run is ``s51 -t C51 -R 1`` with the UART on a ``socat`` pty pair and
+libattitude's C receiver B (through CFFI) on the other end
+(:class:`firmware.tool.LinkHost`); the firmware stops itself through the
+simulator interface after a given number of accepted blocks, and every
+s51/socat process is killed in a ``finally`` (wall-clock timeouts on all).
+
+Images (firmware/tool.py): ``production`` (what goes into the chip),
+``bench`` (production pins and RAM layout, cycle counters in unused SFR
+cells) and ``sim`` (the production driver and HAL with the pins pointed at
+a TLC2543 + gyro model kept in unused SFR cells: same RAM layout again).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from conftest import require_target, require_tools
+
+from firmware import tool
+
+#: Stack margin we require in the production RAM layout: the highest SP
+#: s51 sees running the bench image (production code, RAM layout and call
+#: depth) must leave at least this many bytes below 0x80.
+STACK_MARGIN = 4
+
+#: Sampling period of the long runs: 144 ticks = 40 ms. One exchange is 10
+#: byte times = 10.4 ms at 9600 baud, plus the host's latency, which s51
+#: (slower than real time with a pty) stretches to ~20 ms of simulated time,
+#: more on a loaded machine; 40 ms and the two-slot queue keep every sample.
+PERIOD = 144
+#: Link timeouts of the test images: 720 ticks = 200 ms of simulated time,
+#: so a host descheduled for a while on a loaded machine is not mistaken
+#: for a silent one (the silence test counts timeouts exactly).
+TIMEOUT = 720
+
+
+def _need() -> None:
+    require_target("mcs51")
+    require_tools("socat", apt="socat")
+
+
+@pytest.fixture(scope="module")
+def out(build_root: Path) -> Path:
+    return build_root / "firmware"
+
+
+def _samples(stream: list) -> list[tool.Sample]:
+    return [x for x in stream if isinstance(x, tool.Sample)]
+
+
+def _assert_match_model(samples: list[tool.Sample]) -> None:
+    """Each code within 1 LSB of its gyro's analog input at the sample's time.
+
+    The model quantizes v >> 4 (floor of the input in LSB), and its sine
+    table is rounded to 1/32767 (< 0.02 LSB at these amplitudes): the code
+    is within 1 LSB of the exact analog value, never more.
+    """
+    for s in samples:
+        for c, g in enumerate(tool.GYROS):
+            exact = g.lsb(s.seq)
+            assert abs(s.codes[c] - exact) <= 1.0, (s.seq, "XYZ"[c], s.codes[c], exact)
+
+
+# -- build ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("baud", [9600, 57600])
+def test_production_image_fits_the_at89s51(out: Path, baud: int) -> None:
+    require_target("mcs51")
+    img = tool.build(out, tool.Config(baud=baud), kind="production")
+    print(img.size_report())
+    assert img.flash <= tool.FLASH_SIZE
+    assert img.stack_start + img.stack_free == tool.IRAM_SIZE
+    # static RAM leaves room for the stack the bench run measures (15 bytes)
+    assert img.stack_free >= 15 + STACK_MARGIN
+
+
+def test_build_fails_when_the_image_does_not_fit(out: Path) -> None:
+    require_target("mcs51")
+    with pytest.raises(tool.FirmwareTooBig, match="does not fit"):
+        tool.build(out, kind="production", code_size=2048, name="too_small")
+
+
+def test_config_rejects_rates_the_crystal_cannot_make() -> None:
+    with pytest.raises(ValueError, match="baud"):
+        tool.Config(baud=38400)  # 11.0592 MHz / 384 / 38400 = 0.75: not an integer reload
+    with pytest.raises(ValueError, match="period_ticks"):
+        tool.Config(period_ticks=0)
+
+
+# -- whole firmware in s51 ---------------------------------------------------------
+
+def test_stack_in_the_production_layout(out: Path) -> None:
+    """Bench image (production code and RAM layout): handshakes and the stack high-water mark."""
+    _need()
+    img = tool.build(out, tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT), kind="bench", sim_blocks=20)
+    res = tool.run(img, tool.LinkHost(), timeout=60)
+    print(img.size_report(), f"max SP 0x{res.max_sp:02X}")
+    assert res.stats["accepted"] == 20 and res.host.stats()["blocks_accepted"] == 20
+    assert res.bench["scans"] >= 15
+    assert res.max_sp <= 0x7F - STACK_MARGIN
+
+
+def test_200_samples_match_the_analog_inputs(out: Path) -> None:
+    _need()
+    img = tool.build(out, tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT), kind="sim", sim_blocks=201)
+    res = tool.run(img, tool.LinkHost(), timeout=120)
+    print(f"{img.size_report()}; {res.sim_seconds:.2f} s simulated in {res.wall_seconds:.1f} s, "
+          f"max SP 0x{res.max_sp:02X}; host {res.host.stats()}")
+    stream = res.stream
+    assert isinstance(stream[0], tool.Report) and stream[0].kind == "boot"
+    samples = _samples(stream)
+    assert len(stream) == 201 and len(samples) == 200  # no report: nothing lost
+    assert [s.seq for s in samples] == list(range(200))  # in order, no gap
+    _assert_match_model(samples)
+    # every block went through at the first attempt
+    assert res.stats["naks"] == 0 and res.stats["timeouts"] == 0 and res.stats["gave_up"] == 0
+    assert sum(1 for d, b in res.host.wire if d == "A" and b == 0xAA) == 201
+    assert res.stats["conversions"] == 200  # one model step per scan
+    assert res.max_sp <= 0x7F  # the sim image has the production RAM layout
+
+
+def test_nak_resends_exactly_those_blocks_and_silence_times_out(out: Path) -> None:
+    _need()
+    cfg = tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT, max_attempts=3)
+    img = tool.build(out, cfg, kind="sim", sim_blocks=24, name="fw_faults")
+    host = tool.LinkHost(nak_blocks={3, 8}, silent={12: 2, 16: 3})
+    res = tool.run(img, host, timeout=90)
+    print(f"firmware {res.stats}; host {host.stats()}")
+    # 0xFF: the receiver rejected the corrupted first attempt of blocks 3 and 8 ...
+    naks = [i for i, a in enumerate(host.attempts) if a.answer == 0xFF]
+    assert [host.attempts[i].index for i in naks] == [3, 8]
+    for i in naks:  # ... and the firmware sent exactly the same block again, accepted
+        again = host.attempts[i + 1]
+        assert again.index == host.attempts[i].index and again.answer == 0x00
+        assert again.data == host.attempts[i].data
+    # silence after 0xAA: 2 timeouts then success for block 12; 3 = max_attempts for block 16
+    assert host.ignored_syn == [12, 12, 16, 16, 16]
+    assert res.stats["naks"] == 2 and res.stats["timeouts"] == 5 and res.stats["gave_up"] == 1
+    stream = res.stream  # decode_stream checks every loss report's sample number
+    gave_up = [x for x in stream if isinstance(x, tool.Report) and x.kind == "gave_up"]
+    assert len(gave_up) == 1 and gave_up[0].count == 1
+    assert stream.index(gave_up[0]) == 16  # reported in the place of the block given up
+    samples = _samples(stream)
+    assert gave_up[0].first not in {s.seq for s in samples}
+    _assert_match_model(samples)  # the numbering survived the losses
+
+
+@pytest.mark.parametrize("fault,status,code", [
+    ("dout_stuck_high", -41, 0xFFF),  # mid-scale test input reads 0xFFF
+    ("dout_stuck_low", -41, 0x000),   # ... reads 0x000
+    ("eoc_stuck", -40, 0x000),        # EOC never rises: timeout
+])
+def test_selftest_failure_is_reported_over_the_link(out: Path, fault: str, status: int, code: int) -> None:
+    _need()
+    cfg = tool.Config(selftest_retry=36)  # retry every 10 ms
+    img = tool.build(out, cfg, kind="sim", sim_blocks=3, faults=[fault], name=f"fw_{fault}")
+    res = tool.run(img, tool.LinkHost(), timeout=60)
+    stream = res.stream
+    assert [x.kind for x in stream] == ["boot", "selftest", "selftest"]
+    for attempt, rep in enumerate(stream[1:], start=1):
+        assert (rep.status, rep.bad_code, rep.attempt) == (status, code, attempt)
+    assert res.stats["samples"] >= 2  # no sampling: seq counts the failed attempts
+
+
+def test_fastest_baud_57600(out: Path) -> None:
+    _need()
+    # an exchange is 1.7 ms on the wire at 57600; the period covers the host's latency
+    cfg = tool.Config(baud=57600, period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
+    img = tool.build(out, cfg, kind="sim", sim_blocks=41)
+    res = tool.run(img, tool.LinkHost(), timeout=60)
+    samples = _samples(res.stream)
+    assert [s.seq for s in samples] == list(range(40))
+    _assert_match_model(samples)
+    assert res.stream[0].raw[5] == 57600 // 1200  # the BOOT report carries the rate
+
+
+# -- stream decoding (pure Python) --------------------------------------------------
+
+def test_decode_stream_numbers_samples_across_loss_reports() -> None:
+    boot = bytes([0xFE, 0, 1, 0, 108, 8])
+    s = lambda a: bytes([0, a, 0, a, 0, a])
+    over = bytes([0xFE, 3, 0, 2, 0, 3])  # samples 2, 3, 4 lost
+    out = tool.decode_stream([boot, s(1), s(2), over, s(3)])
+    assert [x.seq for x in out if isinstance(x, tool.Sample)] == [0, 1, 5]
+    with pytest.raises(tool.FirmwareError, match="expected 2"):
+        tool.decode_stream([boot, s(1), s(2), bytes([0xFE, 2, 0, 7, 0, 1])])
+    with pytest.raises(tool.FirmwareError, match="code > 4095"):
+        tool.decode_stream([bytes([0x10, 0, 0, 0, 0, 0])])

@@ -1,0 +1,65 @@
+"""Firmware tasks: ``invoke firmware.build`` and ``invoke firmware.sim`` (see docs/firmware.md)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from invoke import task
+
+ROOT = Path(__file__).resolve().parents[2]
+NAMESPACE = True
+
+
+def _tool():  # type: ignore[no-untyped-def]
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    from firmware import tool
+
+    return tool
+
+
+@task(help={
+    "baud": "UART rate (1200 ... 57600; exact rates of the 11.0592 MHz crystal only)",
+    "period_ticks": "sampling period in Timer 0 ticks of 1/3600 s (72 = 20 ms)",
+    "max_attempts": "link attempts per block before giving up",
+    "out": "output directory (default build/firmware)",
+})
+def build(c, baud=9600, period_ticks=72, max_attempts=5, out=""):
+    """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM) and print flash, RAM and free stack."""
+    tool = _tool()
+    cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), max_attempts=int(max_attempts))
+    try:
+        img = tool.build(Path(out) if out else tool.BUILD, cfg, kind="production", name="attitude_fw")
+    except tool.FirmwareTooBig as exc:
+        print(f"firmware does not fit: {exc}", file=sys.stderr)
+        raise SystemExit(1) from None
+    print(img.size_report())
+    print(f"image: {img.ihx}")
+
+
+@task(help={
+    "samples": "samples to receive (the firmware stops after them)",
+    "baud": "UART rate",
+    "period_ticks": "sampling period in ticks of 1/3600 s (108 = 30 ms: no overruns against a host on a pty)",
+    "fault": "ADC model fault: dout_stuck_high, dout_stuck_low or eoc_stuck",
+    "timeout": "wall-clock limit in seconds",
+})
+def sim(c, samples=20, baud=9600, period_ticks=108, fault="", timeout=120):
+    """Run the firmware in s51 -t C51 against the C receiver on a socat pty pair; print the samples received."""
+    tool = _tool()
+    cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), selftest_retry=360)
+    blocks = int(samples) + 1 if not fault else 3
+    img = tool.build(tool.BUILD, cfg, kind="sim", sim_blocks=blocks, faults=[fault] if fault else [])
+    print(img.size_report())
+    res = tool.run(img, tool.LinkHost(), timeout=float(timeout))
+    print(f"# {res.sim_seconds:.3f} s simulated in {res.wall_seconds:.1f} s; max SP 0x{res.max_sp:02X}")
+    print("# seq    X     Y     Z   (12-bit codes; model input in LSB in brackets)")
+    for x in res.stream:
+        if isinstance(x, tool.Sample):
+            exp = " ".join(f"{g.lsb(x.seq):7.1f}" for g in tool.GYROS)
+            print(f"{x.seq:5d} {x.codes[0]:5d} {x.codes[1]:5d} {x.codes[2]:5d}   [{exp}]")
+        else:
+            print(f"# report {x.kind}: {x.raw.hex()}")
+    print(f"# firmware: {res.stats}")
+    print(f"# receiver: {res.host.stats()}")
