@@ -8,6 +8,8 @@
  *         fx-rv3-kernel K calls of att_fx_update_rv3 (9 increments each)
  *         fx-reuse      K rv3-reuse updates, fixed point (1 increment each)
  *         fx-rv3-batch  K rv3 updates through att_fx_integ_batch (64 updates per call)
+ *         loop-kernel   the fx-rv3-kernel loop calling an empty function instead
+ *                       (the driver's own share of the fx-rv3-kernel figure)
  *         fx-reuse-batch  the same for rv3-reuse
  *         fl-rv3        K rv3 updates, att_real build (float or double), 3 increments each
  *         fl-reuse      K rv3-reuse updates, att_real build
@@ -22,6 +24,13 @@
 #define NTAB 64
 
 static att_q30 tab_fx[NTAB][3];
+
+/* stand-in for att_fx_update_rv3 in loop-kernel mode (not inlined) */
+__attribute__((noinline)) static att_status no_update(att_q30 q[4], const att_q30 d[9])
+{
+    __asm__ volatile("" : : "r"(q), "r"(d) : "memory");
+    return ATT_OK;
+}
 static att_real tab_fl[NTAB][3];
 
 static void make_tables(void)
@@ -52,7 +61,8 @@ int main(int argc, char **argv)
         att_fx_integ s;
         att_q30 q[4] = {ATT_FX_Q30_ONE, 0, 0, 0};
         int reuse = (strcmp(mode, "fx-reuse") == 0);
-        int kernel = (strcmp(mode, "fx-rv3-kernel") == 0);
+        int kernel = (strcmp(mode, "fx-rv3-kernel") == 0) || (strcmp(mode, "fx-loop-kernel") == 0);
+        int empty = (strcmp(mode, "fx-loop-kernel") == 0);
         if (strcmp(mode, "fx-rv3-batch") == 0 || strcmp(mode, "fx-reuse-batch") == 0) {
             static att_q30 big[192][3];
             static att_q30 qo[192][4];
@@ -77,7 +87,7 @@ int main(int argc, char **argv)
                 d[0] = tab_fx[j][0]; d[1] = tab_fx[j][1]; d[2] = tab_fx[j][2];
                 d[3] = tab_fx[j + 1][0]; d[4] = tab_fx[j + 1][1]; d[5] = tab_fx[j + 1][2];
                 d[6] = tab_fx[j + 2][0]; d[7] = tab_fx[j + 2][1]; d[8] = tab_fx[j + 2][2];
-                if (att_fx_update_rv3(q, d) != ATT_OK) {
+                if ((empty ? no_update(q, d) : att_fx_update_rv3(q, d)) != ATT_OK) {
                     return 1;
                 }
             }

@@ -14,7 +14,8 @@
  *   Timer 1  mode 2 (auto-reload): UART baud-rate generator.
  *   UART     mode 1 (8N1), polled: TI means "transmitter free".
  *   P1.0-4   TLC2543 (EOC, I/O CLOCK, DATA IN, DATA OUT, CS), driven by the
- *            driver's HAL macros; P1.5 fault LED (low = on).
+ *            driver's HAL macros. P3.5: fault LED (low = on). P1.5-P1.7 stay
+ *            free for in-system programming (MOSI, MISO, SCK).
  *
  * Main loop (never blocks longer than one X/Y/Z scan):
  *   1. a received byte goes to the link sender (sink);
@@ -242,7 +243,7 @@ static uint8_t self_test_done(int st)
         put_report_head((uint8_t)FW_REPORT_SELFTEST);
         put_word((uint16_t)(((uint16_t)(uint8_t)st << 8) | (uint8_t)(bad >> 8)));
         put_word((uint16_t)(((uint16_t)(uint8_t)bad << 8) | (uint8_t)seq)); /* attempt, mod 256 */
-        P1_5 = 0; /* fault LED on */
+        P3_5 = 0; /* fault LED on */
 #if defined(FW_BENCH)
         /* s51's port pins read 1: the test fails, but it ran (its stack
          * depth is measured); the bench goes on to sample. */
@@ -253,7 +254,7 @@ static uint8_t self_test_done(int st)
 #endif
     }
     q_unpush(); /* passed: the slot is not needed */
-    P1_5 = 1;   /* fault LED off */
+    P3_5 = 1;   /* fault LED off */
     return 1;
 }
 
@@ -414,7 +415,7 @@ static void sim_finish(void)
 static void block_accepted(void)
 {
     if (queue[q_head][0] != (uint8_t)FW_REPORT_MARK) {
-        P1_5 = 1; /* a sample went through: fault LED off */
+        P3_5 = 1; /* a sample went through: fault LED off */
     }
     q_head = !q_head;
     q_unpush();
@@ -437,7 +438,7 @@ static void block_accepted(void)
  * GAVE_UP report (sent next); a report stays and is sent again. */
 static void block_given_up(void)
 {
-    P1_5 = 0; /* fault LED on */
+    P3_5 = 0; /* fault LED on */
     wp = queue[q_head];
     if (wp[0] != (uint8_t)FW_REPORT_MARK) {
         put_report_head((uint8_t)FW_REPORT_GAVE_UP);
@@ -461,7 +462,7 @@ void main(void)
 {
     int st;
 
-    P1 = 0xFD;   /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released; LED off */
+    P1 = 0xFD;   /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released */
     timer0_init();
     uart_init();
 #if defined(FW_SIM)

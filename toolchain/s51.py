@@ -126,12 +126,14 @@ def build(sources: Sequence[Path | str], out: Path | str, *,
 
 
 def run(ihx: Path | str, *, timeout: float = 30.0, uart_input: bytes = b"",
-        commands: Sequence[str] = (), check: bool = True) -> S51Result:
+        commands: Sequence[str] = (), check: bool = True, cpu: str | None = None) -> S51Result:
     """Run ``ihx`` in s51 (C51 core) until it calls ``s51_exit``.
 
     ``timeout`` is wall-clock seconds (s51 simulates several million machine
     cycles per second). ``commands`` are uCsim console commands executed
-    before the program starts. With ``check`` (default) a missing ``EXIT`` line
+    before the program starts. ``cpu`` overrides the simulated core type (``-t``,
+    default C51 from mcs51.toml; "8052" has 256 bytes of internal RAM). With
+    ``check`` (default) a missing ``EXIT`` line
     raises :class:`S51Error`; without it ``exit_code`` is -1 in that case.
     """
     t = target()
@@ -139,7 +141,10 @@ def run(ihx: Path | str, *, timeout: float = 30.0, uart_input: bytes = b"",
         d = Path(tmp)
         sif_out, uart_in, uart_out = d / "sif.out", d / "uart.in", d / "uart.out"
         uart_in.write_bytes(uart_input)
-        cmd = [*t.run_cmd, "-R", "1", "-I", f"{SIF_ARG},out={sif_out}",
+        run_cmd = list(t.run_cmd)
+        if cpu is not None:  # e.g. "8052": 256 bytes of internal RAM (AT89S52)
+            run_cmd[run_cmd.index("-t") + 1] = cpu
+        cmd = [*run_cmd, "-R", "1", "-I", f"{SIF_ARG},out={sif_out}",
                "-S", f"in={uart_in},out={uart_out}", "-G"]
         if commands:
             cfile = d / "cmds"

@@ -51,12 +51,15 @@ FX_STATIC int32_t fx_u2s(uint32_t u)
     return -(int32_t)(~u) - 1;
 }
 
+#ifndef FX_PRIM_MINIMAL /* the compact kernel (fixed_rv.c on the 8051) needs only the above */
+
 /* Arithmetic shift right (floor division by 2^n), 0 ≤ n ≤ 31, no
  * implementation-defined right shift of a negative value. */
 FX_STATIC int32_t fx_asr(int32_t x, uint8_t n)
 {
     return (x < 0) ? ~(~x >> n) : (x >> n);
 }
+
 
 /* ---- halves: 2×32-bit words, 16×16 partial products ------------------ */
 typedef struct {
@@ -383,5 +386,7 @@ FX_STATIC int32_t fx_mul(int32_t x, int32_t y, uint8_t sh)
     fx_mac(&a, x, y);
     return fx_round(&a, sh);
 }
+
+#endif /* FX_PRIM_MINIMAL */
 
 #endif /* ATT_FIXED_PRIM_H */
