@@ -18,7 +18,7 @@ and return the raw integers for bit-exact work (tests, firmware vectors).
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -27,12 +27,26 @@ from ._lib import ffi_lib
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = [
-    "Q30_ONE", "Q28_ONE", "DTHETA_MAX", "METHODS",
-    "to_q30", "from_q30", "from_q28",
-    "integrate", "integrate_q30", "Integrator",
-    "rotation_vector", "rotvec_to_quat", "quat_mul", "quat_normalize",
-    "quat_to_dcm", "dcm_to_euler", "quat_to_euler", "heading", "atan2",
+    "DTHETA_MAX",
+    "METHODS",
+    "Q28_ONE",
+    "Q30_ONE",
     "AdcConverter",
+    "Integrator",
+    "atan2",
+    "dcm_to_euler",
+    "from_q28",
+    "from_q30",
+    "heading",
+    "integrate",
+    "integrate_q30",
+    "quat_mul",
+    "quat_normalize",
+    "quat_to_dcm",
+    "quat_to_euler",
+    "rotation_vector",
+    "rotvec_to_quat",
+    "to_q30",
 ]
 
 Q30_ONE = 1 << 30
@@ -61,7 +75,7 @@ def _check(status: int, what: str) -> None:
     raise_for_status(status, what, _FX_STATUS)
 
 
-def _as_float(x: ArrayLike, name: str, last: Optional[tuple[int, ...]] = None) -> NDArray[np.float64]:
+def _as_float(x: ArrayLike, name: str, last: tuple[int, ...] | None = None) -> NDArray[np.float64]:
     try:
         a = np.asarray(x)
     except Exception as exc:  # pragma: no cover - numpy raises on odd objects
@@ -124,7 +138,7 @@ def _dtheta_q30(dtheta: ArrayLike, name: str = "dtheta") -> NDArray[np.int32]:
     return np.ascontiguousarray(q.astype(np.int32))
 
 
-def _q0_q30(q0: Optional[ArrayLike]) -> Optional[NDArray[np.int32]]:
+def _q0_q30(q0: ArrayLike | None) -> NDArray[np.int32] | None:
     if q0 is None:
         return None
     a = _as_float(q0, "q0", (4,))
@@ -137,7 +151,7 @@ def _q0_q30(q0: Optional[ArrayLike]) -> Optional[NDArray[np.int32]]:
 
 
 def integrate_q30(dtheta_q30: ArrayLike, method: str = "rv3",
-                  q0_q30: Optional[ArrayLike] = None) -> NDArray[np.int32]:
+                  q0_q30: ArrayLike | None = None) -> NDArray[np.int32]:
     """Bit-exact integer form of :func:`integrate`: Q2.30 in, (M, 4) Q2.30 out."""
     ffi, lib = _lib()
     m = _method(method)
@@ -164,7 +178,7 @@ def integrate_q30(dtheta_q30: ArrayLike, method: str = "rv3",
     return out[: int(n_out[0])]
 
 
-def integrate(dtheta: ArrayLike, method: str = "rv3", q0: Optional[ArrayLike] = None) -> NDArray[np.float64]:
+def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = None) -> NDArray[np.float64]:
     """Integrate body-frame angle increments (rad, shape (N, 3)) in fixed point.
 
     Same contract as the float builds: returns the attitude quaternion after
@@ -182,14 +196,14 @@ def integrate(dtheta: ArrayLike, method: str = "rv3", q0: Optional[ArrayLike] = 
 class Integrator:
     """Streaming fixed-point integrator (one increment at a time)."""
 
-    def __init__(self, method: str = "rv3", q0: Optional[ArrayLike] = None) -> None:
+    def __init__(self, method: str = "rv3", q0: ArrayLike | None = None) -> None:
         self._ffi, self._lib_ = _lib()
         self.method = method
         self._m = _method(method)
         self._s = self._ffi.new("att_fx_integ *")
         self.reset(q0)
 
-    def reset(self, q0: Optional[ArrayLike] = None) -> None:
+    def reset(self, q0: ArrayLike | None = None) -> None:
         """Back to attitude ``q0`` (identity if None), buffers cleared."""
         q = _q0_q30(q0)
         if q is None:
@@ -199,7 +213,7 @@ class Integrator:
             st = self._lib_.att_fx_integ_init(self._s, self._m, self._ffi.cast("int32_t *", q.ctypes.data))
         _check(st, "q0")
 
-    def update(self, dtheta: ArrayLike) -> Optional[NDArray[np.float64]]:
+    def update(self, dtheta: ArrayLike) -> NDArray[np.float64] | None:
         """Feed one increment (rad, shape (3,)); the new attitude, or None if buffered."""
         d = _dtheta_q30(np.asarray(dtheta, dtype=np.float64).reshape(1, 3) if np.ndim(dtheta) == 1
                         else dtheta)
@@ -347,7 +361,7 @@ class AdcConverter:
             raise InvalidArgument(f"period: expected 0 < period < 4.29 s, got {p}")
         self.zero_q8 = np.floor(z * 256 + 0.5).astype(np.int32)
         self.scale_q32 = np.floor(sc * 2**32 + 0.5).astype(np.uint32)
-        self.period_ns = int(round(p * 1e9))
+        self.period_ns = round(p * 1e9)
         self._ffi, self._lib_ = ffi, lib
         self._a = ffi.new("att_fx_adc *")
         _check(lib.att_fx_adc_init(self._a, ffi.new("int32_t[3]", self.zero_q8.tolist()),

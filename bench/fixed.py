@@ -60,7 +60,7 @@ def _arm(quick: bool, tmp: Path) -> tuple[list[tuple[str, float]], float]:
 def _area_sizes(sym: Path) -> dict[str, int]:
     text = sym.read_text()
     return {m.group(1): int(m.group(2), 16)
-            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", text, re.M)}
+            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", text, re.MULTILINE)}
 
 
 def _rom(mem: Path) -> int:
@@ -77,7 +77,7 @@ def _s51(tmp: Path) -> dict[str, object]:
                     defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"],
                     extra_cflags=["--stack-auto", "--iram-size", "256", "--code-size", "8192"])
     res = s51.run(ihx, timeout=120, cpu="8052")
-    out["cycles"] = {k: int(v) for k, v in re.findall(r"^CYC (\w+) (\d+)$", res.output, re.M)}
+    out["cycles"] = {k: int(v) for k, v in re.findall(r"^CYC (\w+) (\d+)$", res.output, re.MULTILINE)}
     # flash of rv3 alone: one image calling att_fx_update_rv3, one not (small
     # model, 128 B IRAM flags as the firmware; link-only sizes, not run)
     src = tmp / "sz"
@@ -150,12 +150,12 @@ def run(quick: bool) -> str:
             lines.append(f"| {label} | {n:,.0f} |")
         lines += [
             "",
-            f"The driver's own loop (copying 9 increments, one call) is {loop:.0f} instructions of "
+            (f"The driver's own loop (copying 9 increments, one call) is {loop:.0f} instructions of "
             f"the first row: **{fixed_rv3:.0f} instructions per fixed-point rv3 update in the "
             f"library** (target ≤ 400), {float_rv3 / fixed_rv3:.1f}× fewer than the float build "
             f"(target ≥ 8×). Increments ≈ 1e-3 rad (1 rad/s at 1 kHz, series degree 1); larger "
             "increments add ~12 instructions per extra series degree (degree 2 from |Φ| = 0.0145 "
-            "rad, 4 at 0.43 rad).",
+            "rad, 4 at 0.43 rad)."),
             "",
         ]
         s = _s51(tmp)
@@ -167,25 +167,25 @@ def run(quick: bool) -> str:
             "",
             "| figure | value |",
             "| --- | ---: |",
-            f"| machine cycles per rv3 update, increments ≈ ±4.9e-4 rad (series degree 1) | "
-            f"{cyc.get('small', -1):,} |",
-            f"| machine cycles per rv3 update, increments ±0.25 rad (series degree ≤ 4) | "
-            f"{cyc.get('big', -1):,} |",
-            f"| time per rv3 update at 11.0592 MHz (12 clocks per cycle), small increments | "
-            f"{cyc.get('small', 0) * 12 / 11.0592e6 * 1e3:.1f} ms |",
-            f"| code of rv3 alone, small model: fixed_rv.rel (ATT_FX_RV3_ONLY) | "
-            f"{rel.get('CSEG', 0) + rel.get('CONST', 0):,} bytes |",
-            f"| static RAM of fixed_rv.rel, small model (DSEG + OSEG) | "
+            (f"| machine cycles per rv3 update, increments ≈ ±4.9e-4 rad (series degree 1) | "
+            f"{cyc.get('small', -1):,} |"),
+            (f"| machine cycles per rv3 update, increments ±0.25 rad (series degree ≤ 4) | "
+            f"{cyc.get('big', -1):,} |"),
+            (f"| time per rv3 update at 11.0592 MHz (12 clocks per cycle), small increments | "
+            f"{cyc.get('small', 0) * 12 / 11.0592e6 * 1e3:.1f} ms |"),
+            (f"| code of rv3 alone, small model: fixed_rv.rel (ATT_FX_RV3_ONLY) | "
+            f"{rel.get('CSEG', 0) + rel.get('CONST', 0):,} bytes |"),
+            (f"| static RAM of fixed_rv.rel, small model (DSEG + OSEG) | "
             f"{rel.get('DSEG', 0) + rel.get('OSEG', 0)} bytes"
-            f"{' (does not link in 128 B: ' + str(s.get('err_with_small')) + ')' if s.get('rom_with_small') is None else ''} |",
-            f"| flash of rv3 alone, --stack-auto (image with the call − image without, SDCC "
+            f"{' (does not link in 128 B: ' + str(s.get('err_with_small')) + ')' if s.get('rom_with_small') is None else ''} |"),
+            (f"| flash of rv3 alone, --stack-auto (image with the call − image without, SDCC "
             f"library routines included; as run in s51) | "
-            f"{(s['rom_with_stack-auto'] or 0) - (s['rom_without_stack-auto'] or 0):,} bytes |",
+            f"{(s['rom_with_stack-auto'] or 0) - (s['rom_without_stack-auto'] or 0):,} bytes |"),
             f"| static RAM of fixed_rv.rel, --stack-auto | {rela.get('DSEG', 0) + rela.get('OSEG', 0)} bytes |",
             "",
-            "The AT89S51 has 4 KB of flash and 128 bytes of RAM: rv3 alone does not fit it with "
+            ("The AT89S51 has 4 KB of flash and 128 bytes of RAM: rv3 alone does not fit it with "
             "room for the firmware (see docs/fixed-point.md); it runs, bit-identical to the host, "
-            "on the 8052 core (256 bytes of RAM, e.g. the pin-compatible AT89S52 with 8 KB).",
+            "on the 8052 core (256 bytes of RAM, e.g. the pin-compatible AT89S52 with 8 KB)."),
             "",
         ]
     acc = _accuracy(quick)
