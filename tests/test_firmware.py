@@ -103,10 +103,12 @@ def test_stack_in_the_production_layout(out: Path) -> None:
     assert res.max_sp <= 0x7F - STACK_MARGIN
 
 
-def test_200_samples_match_the_analog_inputs(out: Path) -> None:
+@pytest.mark.parametrize("impl", ["c", "python"])
+def test_200_samples_match_the_analog_inputs(out: Path, impl: str) -> None:
     _need()
-    img = tool.build(out, tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT), kind="sim", sim_blocks=201)
-    res = tool.run(img, tool.LinkHost(), timeout=120)
+    cfg = tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
+    img = tool.build(out, cfg, kind="sim", sim_blocks=201, name=f"fw_200_{impl}")
+    res = tool.run(img, tool.LinkHost(impl), timeout=120)
     print(f"{img.size_report()}; {res.sim_seconds:.2f} s simulated in {res.wall_seconds:.1f} s, "
           f"max SP 0x{res.max_sp:02X}; host {res.host.stats()}")
     stream = res.stream
