@@ -107,18 +107,19 @@ def register(subparsers: Any) -> None:
                    help="simulated time (s)")
     g.add_argument("--period", type=_positive("--period"), default=0.08, metavar="S",
                    help="gyro sample period: one angle increment per period (s); the paper: 0.08")
-    g.add_argument("--amplitude", type=_triple("--amplitude"), default=(30.0, 20.0, 25.0),
+    g.add_argument("--amplitude", type=_triple("--amplitude"), default="30,20,25",
                    metavar="Y,P,R", help="paper trajectory: sinusoid amplitudes (deg)")
-    g.add_argument("--frequency", type=_triple("--frequency"), default=(0.20, 0.25, 0.30),
+    g.add_argument("--frequency", type=_triple("--frequency"), default="0.20,0.25,0.30",
                    metavar="Y,P,R", help="paper trajectory: frequencies (Hz)")
-    g.add_argument("--phase", type=_triple("--phase"), default=(0.0, 30.0, 60.0),
+    g.add_argument("--phase", type=_triple("--phase"), default="0,30,60",
                    metavar="Y,P,R", help="paper trajectory: phases (deg)")
     g.add_argument("--cone-angle", type=_nonneg("--cone-angle"), default=20.0, metavar="DEG",
                    help="coning trajectory: half-angle (deg)")
     g.add_argument("--cone-frequency", type=_nonneg("--cone-frequency"), default=0.5, metavar="HZ",
                    help="coning trajectory: coning frequency (Hz)")
-    g.add_argument("--rate", type=_triple("--rate"), default=(10.0, -5.0, 20.0), metavar="X,Y,Z",
-                   help="constant-rate trajectory: body rate (deg/s)")
+    g.add_argument("--rate", type=_triple("--rate"), default="10,-5,20", metavar="X,Y,Z",
+                   help="constant-rate trajectory: body rate (deg/s; write --rate=-10,5,0 when "
+                   "it starts with a minus)")
     g = p.add_argument_group("system")
     g.add_argument("--method", default="rv3", choices=_METHODS, help="integrator method")
     g.add_argument("--precision", default="f64", choices=("f64", "f32", "fixed"),
