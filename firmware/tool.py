@@ -555,9 +555,9 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
             port.close()
         _kill_group(s51)
         _kill_group(socat)
+        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
+        shutil.rmtree(tmp, ignore_errors=True)
     wall = time.monotonic() - t_start
-    output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
-    shutil.rmtree(tmp, ignore_errors=True)
     m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
     if m is None or int(m.group(1)) != 0:
         raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\nconsole:\n{console[-2000:]}")
