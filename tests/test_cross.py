@@ -20,10 +20,20 @@ EXAMPLE_C = r"""
 #include "attitude/attitude.h"
 int main(void)
 {
-    printf("att_real=%d ok=%s\n", att_real_size(), att_status_str(ATT_OK));
+    const att_real d[9] = {0, 0, 0.01, 0, 0, 0.01, 0, 0, 0.01}; /* 0.03 rad about z */
+    att_real q[4];
+    att_integ s;
+    size_t n = 0;
+    if (att_integ_init(&s, ATT_METHOD_RV3, NULL) != ATT_OK
+        || att_integ_batch(&s, d, 3, q, &n, NULL) != ATT_OK || n != 1)
+        return 1;
+    printf("att_real=%d ok=%s q=%.6f %.6f\n", att_real_size(), att_status_str(ATT_OK),
+           (double)q[0], (double)q[3]);
     return 0;
 }
 """
+# q = [cos(0.015), 0, 0, sin(0.015)] to 6 decimals (the same in float and double)
+Q_TEXT = "q=0.999888 0.014999"
 
 SNIPPET_C = r"""
 unsigned lead(unsigned a) { return (unsigned)__builtin_clz(a); }
@@ -115,7 +125,7 @@ def test_cross_build_armv4t(tmp_path: Path) -> None:
     exe = _example_against(t, out, tmp_path)
     assert armv4t_check.check_objects([out / "libattitude.a"], objdump=t.objdump) == []
     res = t.run([exe], timeout=60)
-    assert res.stdout.decode().strip() == "att_real=8 ok=ok"
+    assert res.stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 
 
 @pytest.mark.parametrize("name", ["host", "armv4t-bare", "armv7hf", "aarch64", "mcs51"])
@@ -130,7 +140,7 @@ def test_cross_build_other_targets(name: str, tmp_path: Path) -> None:
     if name == "host":
         exe = _example_against(t, out, tmp_path)
         assert subprocess.run([exe], capture_output=True, text=True, check=True).stdout.strip() \
-            == "att_real=8 ok=ok"
+            == f"att_real=8 ok=ok {Q_TEXT}"
 
 
 def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
@@ -141,7 +151,7 @@ def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
     assert "-DATT_REAL_F32" in (out / "attitude.pc").read_text()
     exe = _example_against(t, out, tmp_path)
     assert subprocess.run([exe], capture_output=True, text=True, check=True).stdout.strip() \
-        == "att_real=4 ok=ok"
+        == f"att_real=4 ok=ok {Q_TEXT}"
 
 
 # -- plain Makefile and CMake -----------------------------------------------
@@ -187,7 +197,7 @@ def test_makefile_cross_compile_install_and_link(tmp_path: Path) -> None:
     exe = tmp_path / "example"
     subprocess.run(["arm-linux-gnueabi-gcc", *arch.split(), str(ex), "-o", str(exe), "-static", *flags],
                    check=True, capture_output=True)
-    assert t.run([exe], timeout=60).stdout.decode().strip() == "att_real=8 ok=ok"
+    assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 
 
 def test_cmake_armv4t_toolchain(tmp_path: Path) -> None:

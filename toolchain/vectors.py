@@ -180,7 +180,98 @@ def generate(seed: int = 20100601, n: int = 64) -> list[Case]:
     blk = rng.integers(0, 256, size=(1, 64)).astype(np.float64)
     cases.append(Case(f"link_checksum.{len(cases)}", "link_checksum", blk.reshape(-1, 1).T,
                       expected=np.array([[float(int(blk.sum()) % 256)]]), ops=0))
+    for c in link_cases(rng):
+        c.id = f"{c.id}.{len(cases)}"
+        cases.append(c)
     return cases
+
+
+def _link_transcript(machine: Any, events: np.ndarray, block: bytes | None) -> np.ndarray:
+    """Rows (event, kind, value) as run_vectors.c prints them, from the Python end."""
+    from attitude_c.link import Result
+
+    rows: list[tuple[int, int, int]] = []
+    for i, (byte, tick) in enumerate(events.astype(int)):
+        tick &= 0xFFFF
+        if byte == -2:
+            machine.start(block, tick)
+            rows.append((i, 0, 0))
+        elif byte >= 0:
+            rows.append((i, 0, int(machine.sink(int(byte), tick))))
+        for _ in range(2 * 64 + 8):
+            res, out = machine.poll(tick)
+            rows.append((i, 1, int(res)))
+            if res == Result.SEND:
+                rows.append((i, 2, int(out)))
+            if res in (Result.NONE, Result.IDLE):
+                break
+    st = machine.stats
+    names = (("blocks_sent", "blocks_accepted", "naks", "timeouts", "gave_up", "bytes_discarded")
+             if block is not None else
+             ("syns", "blocks_accepted", "naks", "timeouts", "resyncs", "bytes_discarded"))
+    rows += [(len(events), 3, int(getattr(st, k))) for k in names]
+    return np.array(rows, dtype=np.float64)
+
+
+def link_cases(rng: np.random.Generator) -> list[Case]:
+    """Byte-level transcripts of receiver B and sender A; expected from the Python
+    ends of attitude_c.link (written from the protocol spec, not from the C)."""
+    from attitude_c.link import Receiver, Sender
+
+    out: list[Case] = []
+    # Receiver B: good blocks, bad checksum, garbage, 0xAA inside data, a gap
+    # that drops a partial block, random bytes; ticks wrap through 65535.
+    n_blk, gap = 6, 20
+    ev: list[tuple[int, int]] = []
+    tick = 65400
+
+    def put(bs: Sequence[int], step: int = 1) -> None:
+        nonlocal tick
+        for b in bs:
+            ev.append((b, tick))
+            tick += step
+
+    for k in range(12):
+        data = [int(x) for x in rng.integers(0, 256, n_blk)]
+        if k == 3:
+            data[2] = 0xAA
+        put([0xAA, *data, (sum(data) + (1 if k == 5 else 0)) % 256])
+        if k == 7:
+            put([0x13, 0x37])            # garbage, then the next handshake
+        if k == 9:
+            put([0xAA, 1, 2])            # truncated block ...
+            ev.append((-1, tick + gap + 5))  # ... a poll after the gap drops it
+            tick += gap + 10
+        if k == 10:
+            put([0xAA, 9])
+            tick += gap + 3              # next byte arrives after the gap
+    put([int(x) for x in rng.integers(0, 256, 60)], step=3)
+    events = np.array(ev, dtype=np.float64)
+    out.append(Case(f"link_rx.{len(out)}", "link_rx", events, params=[str(n_blk), str(gap)],
+                    expected=_link_transcript(Receiver(n_blk, gap), events, None), ops=0))
+    # Sender A: normal exchange, NAK + resend, lost 0xBB (timeout), lost answer,
+    # garbage, give up after max attempts; ticks wrap.
+    blk = bytes(int(x) for x in rng.integers(0, 256, 4))
+    syn_to, ans_to, attempts = 50, 40, 3
+    ev = []
+    tick = 65500
+
+    def at(b: int, dt: int = 1) -> None:
+        nonlocal tick
+        tick += dt
+        ev.append((b, tick))
+
+    at(-2); at(0xBB); at(0x00)                    # accepted first time
+    at(-2); at(0x42); at(0xBB); at(0xFF); at(0xBB); at(0x00)  # garbage, NAK, resend
+    at(-2); at(-1, syn_to + 1); at(0xBB); at(-1, ans_to + 1); at(0xBB); at(0x00)  # timeouts
+    at(-2); at(-1, syn_to + 1); at(-1, syn_to + 1); at(-1, syn_to + 1); at(-1, 5)  # gives up
+    at(0x00); at(-2); at(0xBB, syn_to + 5); at(-1)                  # late 0xBB
+    events = np.array(ev, dtype=np.float64)
+    out.append(Case(f"link_tx.{len(out)}", "link_tx", events,
+                    params=[str(len(blk)), str(syn_to), str(ans_to), str(attempts), *map(str, blk)],
+                    expected=_link_transcript(Sender(len(blk), syn_to, ans_to, attempts), events, blk),
+                    ops=0))
+    return out
 
 
 def write(cases: Sequence[Case], path: str | Path) -> Path:

@@ -16,7 +16,13 @@
  *   dcm_heading (9 -> 1)                 -- the array (_n) forms, PARAMS none;
  *   integ METHOD q0 q1 q2 q3             -- N increments (3) -> a quaternion per update;
  *   rk4 H q0 q1 q2 q3                    -- N rates (3), step H -> a quaternion per update;
- *   link_checksum                        -- N bytes (one record of N values) -> 1.
+ *   link_checksum                        -- N bytes (one record of N values) -> 1;
+ *   link_rx BLOCK GAP                    -- N events "byte tick" for receiver B;
+ *   link_tx BLOCK SYN_TO ANS_TO ATTEMPTS BYTES... -- N events for sender A;
+ *     event byte: 0..255 = sink it, -1 = poll only, -2 = (sender) start the block.
+ *     After each event the machine is polled until NONE or IDLE; output rows
+ *     "event kind value": kind 0 = sink/start result, 1 = poll result,
+ *     2 = byte handed out; then one row per statistics counter (kind 3).
  * Output per case:
  *   = ID STATUS ERR_INDEX NOUT           (ERR_INDEX -1 when none)
  *   NOUT lines of output values
@@ -125,9 +131,97 @@ static const struct {
     {"rv3-coning", ATT_METHOD_RV3_CONING}, {"rv3-reuse", ATT_METHOD_RV3_REUSE},
 };
 
+
 static void result(const char *id, int status, long err, size_t nout)
 {
     printf("= %s %d %ld %lu\n", id, status, err, (unsigned long)nout);
+}
+
+static size_t nrows;
+
+static void row(size_t ev, int kind, long value)
+{
+    out_buf[3 * nrows] = (att_real)ev;
+    out_buf[3 * nrows + 1] = (att_real)kind;
+    out_buf[3 * nrows + 2] = (att_real)value;
+    nrows++;
+}
+
+/* Transcript of one link state machine (records: byte tick). */
+static int run_link(const char *id, int tx, size_t n)
+{
+    att_link_receiver r;
+    att_link_receiver_config rc;
+    att_link_sender s;
+    att_link_sender_config sc;
+    static uint8_t block[ATT_LINK_BLOCK_MAX], rxbuf[ATT_LINK_BLOCK_MAX];
+    double v[4];
+    size_t i, k;
+    int st;
+    if (number(&v[0]) != 0 || number(&v[1]) != 0 || v[0] < 1 || v[0] > ATT_LINK_BLOCK_MAX)
+        return -1;
+    if (tx) {
+        if (number(&v[2]) != 0 || number(&v[3]) != 0)
+            return -1;
+        att_link_sender_config_init(&sc, (uint8_t)v[0]);
+        sc.syn_timeout = (uint16_t)v[1];
+        sc.answer_timeout = (uint16_t)v[2];
+        sc.max_attempts = (uint8_t)v[3];
+        for (k = 0; k < (size_t)v[0]; k++) {
+            double b;
+            if (number(&b) != 0)
+                return -1;
+            block[k] = (uint8_t)b;
+        }
+        st = att_link_sender_init(&s, &sc);
+    } else {
+        att_link_receiver_config_init(&rc, (uint8_t)v[0]);
+        rc.gap_timeout = (uint16_t)v[1];
+        st = att_link_receiver_init(&r, &rc, rxbuf);
+    }
+    if (st != ATT_OK || read_values(in_buf, 2 * n) != 0)
+        return -1;
+    nrows = 0;
+    for (i = 0; i < n; i++) {
+        long byte = (long)in_buf[2 * i];
+        uint16_t tick = (uint16_t)(long)in_buf[2 * i + 1];
+        int guard;
+        if (3 * (nrows + 2 * ATT_LINK_BLOCK_MAX + 16) > MAX_OUT)
+            return -1; /* transcript too long for the output buffer */
+        if (byte == -2 && tx)
+            row(i, 0, att_link_sender_start(&s, block, tick));
+        else if (byte >= 0)
+            row(i, 0, tx ? att_link_sender_sink(&s, (uint8_t)byte, tick)
+                         : att_link_receiver_sink(&r, (uint8_t)byte, tick));
+        for (guard = 0; guard < 2 * ATT_LINK_BLOCK_MAX + 8; guard++) {
+            uint8_t out = 0;
+            att_link_result res = tx ? att_link_sender_poll(&s, tick, &out)
+                                     : att_link_receiver_poll(&r, tick, &out);
+            row(i, 1, res);
+            if (res == ATT_LINK_SEND)
+                row(i, 2, out);
+            if (res == ATT_LINK_NONE || res == ATT_LINK_IDLE || res < 0)
+                break;
+        }
+    }
+    if (tx) {
+        const att_link_sender_stats *t = &s.stats;
+        long sv[6];
+        sv[0] = t->blocks_sent; sv[1] = t->blocks_accepted; sv[2] = t->naks;
+        sv[3] = t->timeouts; sv[4] = t->gave_up; sv[5] = t->bytes_discarded;
+        for (k = 0; k < 6; k++)
+            row(n, 3, sv[k]);
+    } else {
+        const att_link_receiver_stats *t = &r.stats;
+        long sv[6];
+        sv[0] = (long)t->syns; sv[1] = (long)t->blocks_accepted; sv[2] = (long)t->naks;
+        sv[3] = (long)t->timeouts; sv[4] = (long)t->resyncs; sv[5] = (long)t->bytes_discarded;
+        for (k = 0; k < 6; k++)
+            row(n, 3, sv[k]);
+    }
+    result(id, ATT_OK, -1L, nrows);
+    print_records(out_buf, nrows, 3);
+    return 0;
 }
 
 static int run_case(const char *id, const char *fn, size_t n)
@@ -179,6 +273,8 @@ static int run_case(const char *id, const char *fn, size_t n)
         print_records(out_buf, 1, 1);
         return 0;
     }
+    if (strcmp(fn, "link_rx") == 0 || strcmp(fn, "link_tx") == 0)
+        return run_link(id, strcmp(fn, "link_tx") == 0, n);
     if (strcmp(fn, "integ") == 0 || strcmp(fn, "rk4") == 0) {
         char mname[32];
         att_real q0[4], h = 0;
