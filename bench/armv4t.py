@@ -183,7 +183,8 @@ def run(quick: bool) -> str:
         out.append("")
         out.append("Max rate: the sender sends the next block as soon as the previous `0x00` arrives, so it is "
                    "bounded by the handshake round trips over the pty (Python sender included), not by the "
-                   "integrator. On the board at 9600 baud one 6-byte block takes 10 byte times in the "
+                   "integrator, and varies by a factor of ~3 between runs on this shared 2-core machine. "
+                   "On the board at 9600 baud one 6-byte block takes 10 byte times in the "
                    "protocol (~10.4 ms), so the line, not the CPU, limits the rate to ~96 samples/s.")
     return "\n".join(out)
 
