@@ -52,14 +52,14 @@ def run(quick: bool) -> str:
     us = 1e6 / tool.MACHINE_HZ
     p = prod[9600]
     lines = [
-        f"Image (`invoke firmware.build`): flash **{p.flash} / 4096 bytes**, internal RAM "
-        f"**{p.ram_static} / 128 bytes** static (registers, variables, bits), stack "
-        f"0x{p.stack_start:02X}..0x7F = {p.stack_free} bytes; highest SP seen in s51 "
-        f"0x{m[9600]['max_sp']:02X} ({0x7F - m[9600]['max_sp']} bytes never used). "
-        f"The rate only changes constants: the 57600-baud image is {prod[57600].flash} bytes.",
+        (f"Image (`invoke firmware.build`): flash **{p.flash} / 4096 bytes**, internal RAM "
+         f"**{p.ram_static} / 128 bytes** static (registers, variables, bits), stack "
+         f"0x{p.stack_start:02X}..0x7F = {p.stack_free} bytes; highest SP seen in s51 "
+         f"0x{m[9600]['max_sp']:02X} ({0x7F - m[9600]['max_sp']} bytes never used). "
+         f"The rate only changes constants: the 57600-baud image is {prod[57600].flash} bytes."),
         "",
-        f"Machine cycle = 12 clocks = {us:.3f} us at 11.0592 MHz; {blocks} blocks per rate, "
-        "sampling period 40 ms (144 ticks).",
+        (f"Machine cycle = 12 clocks = {us:.3f} us at 11.0592 MHz; {blocks} blocks per rate, "
+         "sampling period 40 ms (144 ticks)."),
         "",
         "| | 9600 baud | 57600 baud |",
         "|---|---:|---:|",
@@ -79,12 +79,12 @@ def run(quick: bool) -> str:
     row("CPU-only limit 1 / (block CPU + scan), samples/s", "cpu_rate", "{:.0f}")
     lines += [
         "",
-        "The firmware is one polled loop: a scan delays the next byte it hands to the UART, so "
-        "the sustained limit counts scan and exchange in series. At 9600 baud the wire dominates "
-        "(the firmware reaches "
-        f"{100 * m[9600]['fw_rate'] / m[9600]['line_rate']:.0f} % of the protocol's line rate); at "
-        "57600 baud the CPU work per byte is comparable to a byte time, so the firmware reaches "
-        f"{100 * m[57600]['fw_rate'] / m[57600]['line_rate']:.0f} %. The default period (20 ms, "
-        "50 samples/s) leaves room for one resend per sample at 9600 baud.",
+        ("The firmware is one polled loop: a scan delays the next byte it hands to the UART, so "
+         "the sustained limit counts scan and exchange in series. At 9600 baud the wire dominates "
+         "(the firmware reaches "
+         f"{100 * m[9600]['fw_rate'] / m[9600]['line_rate']:.0f} % of the protocol's line rate); at "
+         "57600 baud the CPU work per byte is comparable to a byte time, so the firmware reaches "
+         f"{100 * m[57600]['fw_rate'] / m[57600]['line_rate']:.0f} %. The default period (20 ms, "
+         "50 samples/s) leaves room for one resend per sample at 9600 baud."),
     ]
     return "\n".join(lines)

@@ -345,48 +345,33 @@ class Attempt:
     answer: int | None    #: 0x00 / 0xFF, None if the receiver dropped it
 
 
-class _CReceiver:
-    """libattitude's receiver B (C, through CFFI)."""
+class _Receiver:
+    """Receiver B of libattitude (``attitude_c.link``): the C machine or the Python one."""
 
-    def __init__(self, block_size: int, gap_timeout: int) -> None:
-        from attitude_c._lib import ffi_lib
+    def __init__(self, impl: str, block_size: int, gap_timeout: int) -> None:
+        from attitude_c.link.cends import make_receiver
 
-        self.ffi, self.lib = ffi_lib("f64")
-        self.r = self.ffi.new("att_link_receiver *")
-        self.buf = self.ffi.new("uint8_t[]", block_size)
-        cfg = self.ffi.new("att_link_receiver_config *")
-        self.lib.att_link_receiver_config_init(cfg, block_size)
-        cfg.gap_timeout = gap_timeout
-        st = self.lib.att_link_receiver_init(self.r, cfg, self.buf)
-        if st != 0:
-            raise FirmwareError(f"att_link_receiver_init failed: {st}")
-        self.out = self.ffi.new("uint8_t *")
-        self.n = block_size
-        L = self.lib
-        self.names = {L.ATT_LINK_NONE: "none", L.ATT_LINK_IDLE: "idle", L.ATT_LINK_SEND: "send",
-                      L.ATT_LINK_DISCARDED: "discarded", L.ATT_LINK_SYN_RX: "syn",
-                      L.ATT_LINK_DATA_RX: "data", L.ATT_LINK_ACCEPTED: "accepted",
-                      L.ATT_LINK_REJECTED: "rejected", L.ATT_LINK_TIMEOUT: "timeout"}
+        self.r = make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout)
 
     def sink(self, byte: int, tick: int) -> str:
-        r = self.lib.att_link_receiver_sink(self.r, byte, tick & 0xFFFF)
-        return self.names.get(r, f"error{r}")
+        return str(self.r.sink(byte, tick & 0xFFFF).name.lower())
 
     def poll(self, tick: int) -> tuple[str, int]:
-        r = self.lib.att_link_receiver_poll(self.r, tick & 0xFFFF, self.out)
-        return self.names.get(r, f"error{r}"), self.out[0]
+        res, out = self.r.poll(tick & 0xFFFF)
+        return str(res.name.lower()), (out if out is not None else -1)
 
     def block(self) -> bytes:
-        return bytes(self.ffi.buffer(self.buf, self.n))
+        return bytes(self.r.block)
 
     def stats(self) -> dict[str, int]:
-        s = self.r.stats
-        return {k: int(getattr(s, k)) for k in ("syns", "blocks_accepted", "naks", "timeouts",
-                                                 "resyncs", "bytes_discarded")}
+        return dict(self.r.stats.as_dict())
 
 
 class LinkHost:
     """The Linux side on the host end of the pty: receiver B plus fault injection.
+
+    ``impl``: ``"c"`` (libattitude's C receiver through CFFI) or ``"python"``
+    (the Python receiver of :mod:`attitude_c.link`, written from the spec).
 
     ``nak_blocks``: indices n (number of blocks accepted so far) whose first
     attempt gets one data bit flipped before the receiver sees it, so the
@@ -400,9 +385,9 @@ class LinkHost:
 
     def __init__(self, impl: str = "c", *, block_size: int = BLOCK_SIZE, gap_timeout_ms: int = 1000,
                  nak_blocks: Iterable[int] = (), silent: dict[int, int] | None = None) -> None:
-        if impl != "c":
-            raise ValueError(f"impl must be 'c', got {impl!r}")
-        self.rx = _CReceiver(block_size, gap_timeout_ms)
+        if impl not in ("c", "python"):
+            raise ValueError(f"impl must be 'c' or 'python', got {impl!r}")
+        self.rx = _Receiver(impl, block_size, gap_timeout_ms)
         self.n = block_size
         self.nak_blocks = set(nak_blocks)
         self.silent = dict(silent or {})
@@ -570,9 +555,9 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
             port.close()
         _kill_group(s51)
         _kill_group(socat)
+        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
+        shutil.rmtree(tmp, ignore_errors=True)
     wall = time.monotonic() - t_start
-    output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
-    shutil.rmtree(tmp, ignore_errors=True)
     m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
     if m is None or int(m.group(1)) != 0:
         raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\nconsole:\n{console[-2000:]}")

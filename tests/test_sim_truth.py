@@ -174,3 +174,16 @@ def test_trajectory_argument_errors() -> None:
         ConingTrajectory(half_angle=-1.0)
     s = StaticTrajectory()
     assert np.all(s.increments(0, 0.1, 4) == 0)
+
+
+def test_firmware_trajectory_truth() -> None:
+    """The --firmware s51 motion: its grid truth (rv3 on closed-form increments
+    at h/64) against RK4 on the rates at 200 Hz (both ~1e-12 rad)."""
+    from attitude_c.sim.firmware import FirmwareTrajectory
+
+    tr = FirmwareTrajectory(period=0.08, rad_per_s_per_code=8.5e-4, duration=7.0)
+    q = _rk4_attitude(tr, 6.0, 0.005)
+    assert quat_angle_between(q, tr.quat(6.0)) < 1e-9
+    # between grid points quat() adds one midpoint-rate rotation vector over
+    # ≤ 3.75 ms: its O(|ω||ω̇|dt³) error is ~1e-9 rad (used for plots only)
+    assert quat_angle_between(_rk4_attitude(tr, 2.5, 0.005), tr.quat(2.5)) < 1e-8

@@ -107,18 +107,19 @@ def register(subparsers: Any) -> None:
                    help="simulated time (s)")
     g.add_argument("--period", type=_positive("--period"), default=0.08, metavar="S",
                    help="gyro sample period: one angle increment per period (s); the paper: 0.08")
-    g.add_argument("--amplitude", type=_triple("--amplitude"), default=(30.0, 20.0, 25.0),
+    g.add_argument("--amplitude", type=_triple("--amplitude"), default="30,20,25",
                    metavar="Y,P,R", help="paper trajectory: sinusoid amplitudes (deg)")
-    g.add_argument("--frequency", type=_triple("--frequency"), default=(0.20, 0.25, 0.30),
+    g.add_argument("--frequency", type=_triple("--frequency"), default="0.20,0.25,0.30",
                    metavar="Y,P,R", help="paper trajectory: frequencies (Hz)")
-    g.add_argument("--phase", type=_triple("--phase"), default=(0.0, 30.0, 60.0),
+    g.add_argument("--phase", type=_triple("--phase"), default="0,30,60",
                    metavar="Y,P,R", help="paper trajectory: phases (deg)")
     g.add_argument("--cone-angle", type=_nonneg("--cone-angle"), default=20.0, metavar="DEG",
                    help="coning trajectory: half-angle (deg)")
     g.add_argument("--cone-frequency", type=_nonneg("--cone-frequency"), default=0.5, metavar="HZ",
                    help="coning trajectory: coning frequency (Hz)")
-    g.add_argument("--rate", type=_triple("--rate"), default=(10.0, -5.0, 20.0), metavar="X,Y,Z",
-                   help="constant-rate trajectory: body rate (deg/s)")
+    g.add_argument("--rate", type=_triple("--rate"), default="10,-5,20", metavar="X,Y,Z",
+                   help="constant-rate trajectory: body rate (deg/s; write --rate=-10,5,0 when "
+                   "it starts with a minus)")
     g = p.add_argument_group("system")
     g.add_argument("--method", default="rv3", choices=_METHODS, help="integrator method")
     g.add_argument("--precision", default="f64", choices=("f64", "f32", "fixed"),
@@ -138,6 +139,10 @@ def register(subparsers: Any) -> None:
     g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ideal"),
                    help="tlc2543: C driver against the device model; ideal: vectorized quantizer; "
                    "auto: tlc2543 when built")
+    g.add_argument("--firmware", choices=("none", "s51"), default="none",
+                   help="s51: the acquisition side is the real AT89S51 firmware running in s51 "
+                   "(needs sdcc, s51, socat and a source checkout); the motion is then the "
+                   "firmware's own sinusoidal body rates")
     g.add_argument("--link", default="c", choices=("c", "none"),
                    help="c: every sample through the C link sender and receiver; none: direct")
     g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
@@ -189,7 +194,18 @@ class _Progress:
 def build_config(args: argparse.Namespace) -> Any:
     from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
 
-    if args.trajectory == "csv":
+    if args.firmware == "s51":
+        from ..sim.firmware import FirmwareTrajectory
+        from ..sim.sensors import DEG, Conditioning
+
+        if args.trajectory != "paper" or args.trajectory_file:
+            raise ValueError("--firmware s51 uses the firmware's own motion: drop --trajectory")
+        gyro = gyro_preset(args.gyro)
+        cond = Conditioning()
+        k = cond.vref / 4096 / (gyro.scale_v_per_dps / DEG * cond.gain(gyro))
+        traj: Any = FirmwareTrajectory(period=args.period, rad_per_s_per_code=k,
+                                       duration=args.duration)
+    elif args.trajectory == "csv":
         if not args.trajectory_file:
             raise ValueError("--trajectory csv needs --trajectory-file CSV")
         traj = make_trajectory("csv", path=args.trajectory_file)
@@ -215,7 +231,8 @@ def build_config(args: argparse.Namespace) -> Any:
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
                      board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,
-                     link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed)
+                     link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed,
+                     firmware=None if args.firmware == "none" else args.firmware)
 
 
 def run(args: argparse.Namespace) -> int:

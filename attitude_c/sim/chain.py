@@ -69,6 +69,7 @@ class SimConfig:
     ber: float = 0.0
     link_attempts: int = 5
     seed: int = 0
+    firmware: str | None = None
 
     def validate(self) -> None:
         _integ.check_method(self.method)
@@ -96,6 +97,17 @@ class SimConfig:
         if not (math.isfinite(self.calibration_s) and self.calibration_s >= 0):
             raise InvalidArgument(f"calibration_s must be >= 0, got {self.calibration_s!r}")
         self.board.check(self.adc.bits)
+        if self.firmware not in (None, "s51"):
+            raise InvalidArgument(f"firmware must be None or 's51', got {self.firmware!r}")
+        if self.firmware == "s51":
+            from .firmware import FirmwareTrajectory
+
+            if not isinstance(self.trajectory, FirmwareTrajectory):
+                raise InvalidArgument("firmware='s51' runs the firmware's own gyro model: use a "
+                                      "FirmwareTrajectory (attitude simulate --firmware s51 does)")
+            if self.sensors == "ideal" or self.ber > 0:
+                raise InvalidArgument("firmware='s51' takes the firmware's codes: sensors must "
+                                      "not be 'ideal' and ber must be 0 (the pty link is clean)")
 
     def params(self) -> dict[str, Any]:
         return {
@@ -116,6 +128,7 @@ class SimConfig:
             "ber": self.ber,
             "link_attempts": self.link_attempts,
             "seed": self.seed,
+            "firmware": self.firmware,
         }
 
 
@@ -222,7 +235,19 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
     backends: dict[str, Any] = {}
     link_stats: dict[str, Any] = {"link": "none"}
     calib = None
-    if cfg.sensors == "ideal":
+    if cfg.firmware == "s51":
+        from .firmware import run_firmware
+
+        codes, idx, link_stats = run_firmware(n, h, cfg.trajectory,  # type: ignore[arg-type]
+                                              cfg.link_attempts, progress)
+        # one truncating conversion per period (the in-image model: code = v >> 4)
+        calib = Calibration(zero_sum=np.full(3, 2047.5),
+                            rad_per_s_per_code=cfg.trajectory.rad_per_s_per_code,  # type: ignore[attr-defined]
+                            oversample=1)
+        inc = calib.increments(codes, h)
+        backends["sensors"] = "AT89S51 firmware in s51 (TLC2543 + gyro model in the image)"
+        backends["link"] = "firmware link sender → pty → C receiver"
+    elif cfg.sensors == "ideal":
         inc = cfg.trajectory.increments(t0, h, n)
         idx = np.arange(n)
         backends["sensors"] = "exact increments"

@@ -44,15 +44,16 @@ def build(c, baud=9600, period_ticks=72, max_attempts=5, out=""):
     "period_ticks": "sampling period in ticks of 1/3600 s (108 = 30 ms: no overruns against a host on a pty)",
     "fault": "ADC model fault: dout_stuck_high, dout_stuck_low or eoc_stuck",
     "timeout": "wall-clock limit in seconds",
+    "impl": "host receiver: c (libattitude through CFFI) or python (attitude_c.link)",
 })
-def sim(c, samples=20, baud=9600, period_ticks=108, fault="", timeout=120):
+def sim(c, samples=20, baud=9600, period_ticks=108, fault="", timeout=120, impl="c"):
     """Run the firmware in s51 -t C51 against the C receiver on a socat pty pair; print the samples received."""
     tool = _tool()
     cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), selftest_retry=360)
     blocks = int(samples) + 1 if not fault else 3
     img = tool.build(tool.BUILD, cfg, kind="sim", sim_blocks=blocks, faults=[fault] if fault else [])
     print(img.size_report())
-    res = tool.run(img, tool.LinkHost(), timeout=float(timeout))
+    res = tool.run(img, tool.LinkHost(impl), timeout=float(timeout))
     print(f"# {res.sim_seconds:.3f} s simulated in {res.wall_seconds:.1f} s; max SP 0x{res.max_sp:02X}")
     print("# seq    X     Y     Z   (12-bit codes; model input in LSB in brackets)")
     for x in res.stream:
