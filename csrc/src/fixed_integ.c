@@ -175,7 +175,6 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
     if (s == 0 || dtheta == 0) {
         return ATT_E_NULL;
     }
-    t = fx_dither_seed(s->q);
     if (FX_DBAD(dtheta[0]) || FX_DBAD(dtheta[1]) || FX_DBAD(dtheta[2])) {
         return (att_status)ATT_FX_E_RANGE;
     }
@@ -186,12 +185,14 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
             s->nbuf++;
             return ATT_FX_PENDING;
         }
+        t = fx_dither_seed(s->q);
         if (m == ATT_FX_RV3) {
             att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
         } else {
             att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
         }
     } else if (m == ATT_FX_RV3_REUSE) {
+        t = fx_dither_seed(s->q);
         if (s->nbuf == 2u) {
             att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta, t, phi);
         } else if (s->nbuf == 1u) {
@@ -205,8 +206,10 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
             s->nbuf = 1;
             return ATT_FX_PENDING;
         }
+        t = fx_dither_seed(s->q);
         fx_phi2(s->buf, dtheta, ATT_FX_K_RV2, 1, t, phi);
     } else if (m == ATT_FX_RV1) {
+        t = fx_dither_seed(s->q);
         fx_copy3(phi, dtheta);
     } else {
         return (att_status)ATT_FX_E_METHOD;
