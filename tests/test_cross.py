@@ -234,3 +234,15 @@ def test_qemu_count_exact_loop(tmp_path: Path) -> None:
     b = count_instructions(exe, ["1001"])
     assert b - a == 2000  # exactly subs + bne per extra iteration
     assert per_iteration(exe, lambda k: [f"{k:04d}"], 1, 501) == 2.0
+
+
+@pytest.mark.parametrize("cc", ["gcc", "clang"])
+def test_app_and_runner_are_warning_free(cc: str) -> None:
+    """csrc/app and csrc/vectors: -std=c99 -Wall -Wextra -Wpedantic -Werror, f64 and f32."""
+    require_tools(cc, apt=cc)
+    srcs = [str(p) for p in sorted((ROOT / "csrc" / "app").glob("*.c"))
+            + sorted((ROOT / "csrc" / "vectors").glob("*.c"))]
+    for d in ([], ["-DATT_REAL_F32"]):
+        subprocess.run([cc, "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "-fsyntax-only",
+                        f"-I{ROOT / 'csrc' / 'include'}", f"-I{ROOT / 'csrc' / 'app'}", *d, *srcs],
+                       check=True, capture_output=True)
