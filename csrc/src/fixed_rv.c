@@ -15,12 +15,12 @@
  *   cos(φ/2)          = Σ (−v)^n · 2^n/(2n)!
  *   sin(φ/2) / (φ/2)  = Σ (−v)^n · 2^n/(2n+1)!
  * (the n-th power of φ²/4 = 2v). */
-static const int32_t fx_cos_k[8] = {
-    1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L
+static const int32_t fx_cs_k[2][8] = {
+    {1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L},
+    {1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L}
 };
-static const int32_t fx_sin_k[8] = {
-    1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L
-};
+#define fx_cos_k fx_cs_k[0]
+#define fx_sin_k fx_cs_k[1]
 /* Largest v (Q2.30) for which degree n+1 suffices: the first omitted term
  * v^(n+2)·2^(n+2)/(2n+4)! of the cosine series is below 2^-33 (the sine
  * series converges faster). Degree 7 covers v ≤ 1.2 (φ ≤ 3.1). */
@@ -64,9 +64,11 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
  * one multiply-accumulate routine on byte limbs (fxa_mac: sixteen 8 × 8 →
  * 16-bit products, the 8051's MUL AB, into an 8-byte accumulator); no
  * 32-bit multiply routine of the compiler's library is linked. Products
- * to subtract negate the accumulator around the addition (exact). The
- * caller's arrays are read through one loader each (generic pointers are
- * costly on the 8051). Not reentrant: no interrupt handler may call
+ * to subtract use a negated copy of an operand (exact). Two register
+ * indices are packed into one byte argument (FX_M): one-parameter
+ * functions take it in a register, with no static parameter block. The
+ * caller's arrays are read through one loader (fx_ld7; generic pointers
+ * are costly on the 8051). Not reentrant: no interrupt handler may call
  * these functions.
  *
  * Words are read as their little-endian bytes through unions (SDCC's
@@ -89,7 +91,17 @@ typedef union {
     uint8_t b[4];
 } fx_word;
 
-enum { FX_R7 = 7, FX_NREG = 8, FX_NEG = 0x80 };
+enum {
+    FX_R7 = 7,     /* the operand register */
+    FX_NREG = 8,
+    FX_Q = 0x10,   /* fx_ld7: load from Q (else from the increments) */
+    FX_ADD = 0x20, /* fx_ld7: R7 += value */
+    FX_SUB = 0x40, /* fx_ld7: R7 −= value */
+    FX_NEGL = 0x60, /* fx_ld7: R7 = −value */
+    FX_SH30 = 0x10 /* fxa_out: shift 30 (else 31) */
+};
+/* fxa_mac argument: x register in the high nibble, y in the low one */
+#define FX_M(x, y) ((uint8_t)(((x) << 4) | (y)))
 static FX_DATA fx_word fxr[FX_NREG];
 static FX_DATA union {
     struct {
@@ -103,35 +115,35 @@ static att_q30 *fx_qp;           /* attitude being updated */
 static uint32_t fx_t;            /* dither seed of the update (0: plain rounding) */
 static uint8_t fx_i, fx_j, fx_k; /* loop indices of the phases */
 
-static int32_t fx_d(uint8_t i) { return fx_dp[i]; }
-static int32_t fx_q(uint8_t i) { return fx_qp[i]; }
-
-/* fxa = −fxa */
-static void fxa_neg(void)
+/* R7 = / += / −= / = − (op & 0x60) the value d[op & 15] or, with FX_Q, q[op & 15] */
+static void fx_ld7(uint8_t op)
 {
-    uint8_t k;
-    uint16_t s = 1;
-    for (k = 0; k < 8u; ++k) {
-        s += (uint8_t)~fxa.b[k];
-        fxa.b[k] = (uint8_t)s;
-        s >>= 8;
+    fx_word v;
+    uint8_t i = (uint8_t)(op & 15u);
+    v.s = (op & FX_Q) ? fx_qp[i] : fx_dp[i];
+    op &= 0x60u;
+    if (op == 0u) {
+        fxr[FX_R7].s = v.s;
+    } else if (op == FX_ADD) {
+        fxr[FX_R7].u += v.u;
+    } else {
+        if (op == FX_NEGL) {
+            fxr[FX_R7].u = 0;
+        }
+        fxr[FX_R7].u -= v.u;
     }
 }
 
-/* fxa += fxr[ix] · fxr[iy] (ix | FX_NEG: fxa −= ...), signed 32 × 32 →
- * 64 bits, modulo 2^64: the unsigned product row by row from 8 × 8 →
- * 16-bit products (partial sum + byte + carry ≤ 0xFFFF), then the two's-
- * complement correction x·y = ux·uy − 2^32·((x < 0 ? uy : 0) +
- * (y < 0 ? ux : 0)) mod 2^64. */
-static void fxa_mac(uint8_t ix, uint8_t iy)
+/* fxa += fxr[xy >> 4] · fxr[xy & 15], signed 32 × 32 → 64 bits, modulo
+ * 2^64: the unsigned product row by row from 8 × 8 → 16-bit products
+ * (partial sum + byte + carry ≤ 0xFFFF), then the two's-complement
+ * correction x·y = ux·uy − 2^32·((x < 0 ? uy : 0) + (y < 0 ? ux : 0)). */
+static void fxa_mac(uint8_t xy)
 {
     uint8_t i, k, j;
     uint16_t s;
-    FX_DATA fx_word *x = &fxr[ix & 7u];
-    FX_DATA fx_word *y = &fxr[iy];
-    if (ix & FX_NEG) {
-        fxa_neg();
-    }
+    FX_DATA fx_word *x = &fxr[xy >> 4];
+    FX_DATA fx_word *y = &fxr[xy & 15u];
     for (i = 0; i < 4u; ++i) {
         s = 0;
         for (k = i; k < 8u; ++k) {
@@ -152,9 +164,6 @@ static void fxa_mac(uint8_t ix, uint8_t iy)
     if (y->s < 0) {
         fxa.w.hi -= x->u;
     }
-    if (ix & FX_NEG) {
-        fxa_neg();
-    }
 }
 
 static void fxa_set(uint32_t lo)
@@ -163,28 +172,32 @@ static void fxa_set(uint32_t lo)
     fxa.w.hi = 0;
 }
 
-/* fxr[dst] = floor(fxa / 2^(32 − n)) (low 32 bits), n = 1 or 2 (shift 31
- * or 30); fxa is consumed */
-static void fxa_out(uint8_t dst, uint8_t n)
+/* fxr[dn & 15] = floor(fxa / 2^31), or 2^30 with FX_SH30 (low 32 bits);
+ * fxa is consumed */
+static void fxa_out(uint8_t dn)
 {
     uint8_t k, c, t;
-    do {
+    for (;;) {
         c = 0;
         for (k = 0; k < 8u; ++k) {
             t = fxa.b[k];
             fxa.b[k] = (uint8_t)((t << 1) | c);
             c = (uint8_t)(t >> 7);
         }
-    } while (--n != 0u);
-    fxr[dst].u = fxa.w.hi;
+        if (!(dn & FX_SH30)) {
+            break;
+        }
+        dn &= 15u;
+    }
+    fxr[dn].u = fxa.w.hi;
 }
 
 /* fxr[dst] = round(fxr[R7] · fxr[dst] / 2^30) */
 static void fxa_mul30(uint8_t dst)
 {
     fxa_set(0x20000000ul);
-    fxa_mac(FX_R7, dst);
-    fxa_out(dst, 2);
+    fxa_mac(FX_M(FX_R7, dst));
+    fxa_out((uint8_t)(dst | FX_SH30));
 }
 
 /* fx_t *= m (low 32 bits of the product; uses R6, R7) */
@@ -193,7 +206,7 @@ static void fxc_tmul(uint32_t m)
     fxr[6].u = fx_t;
     fxr[FX_R7].u = m;
     fxa_set(0);
-    fxa_mac(6, FX_R7);
+    fxa_mac(FX_M(6, FX_R7));
     fx_t = fxa.w.lo;
 }
 
@@ -202,7 +215,8 @@ static void fxc_seed(void)
 {
     fx_t = 0;
     for (fx_i = 0; fx_i < 4u; ++fx_i) {
-        fx_t ^= (uint32_t)fx_q(fx_i);
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fx_t ^= fxr[FX_R7].u;
     }
     fx_t ^= fx_t >> 16;
     fxc_tmul(0x85EBCA6Bul);
@@ -221,7 +235,11 @@ static void fxa_dither(uint8_t k)
     if (fx_t != 0u) {
         fxa.w.lo = fx_t;
         while (k-- != 0u) {
-            fxa.w.lo = (fxa.w.lo >> 1) | ((fxa.b[0] & 1u) ? 0x80000000ul : 0u);
+            uint8_t c = (uint8_t)(fxa.b[0] & 1u);
+            fxa.w.lo >>= 1;
+            if (c != 0u) {
+                fxa.b[3] |= 0x80u;
+            }
         }
         fxa.w.lo >>= 2;
     }
@@ -236,40 +254,41 @@ static const uint8_t fx_phid[3] = {6, 2, 5};
  * Φ of the increments at fx_dp into fxr[0..2], coefficients k13, k23 in
  * fxr[6], fxr[5] on entry. Registers: a = k13 Δθ1 in R0..R2, b = k23 Δθ2
  * in R3..R5, operand in R7; Φ_0 goes to R6, Φ_1 over a2 (component 2 uses
- * a0, a1, b0, b1 only), Φ_2 over b2. Subtracted products: FX_NEG.
+ * a0, a1, b0, b1 only), Φ_2 over b2. Subtracted products use a negated
+ * increment: −a_k e_j = a_k·(−e_j), −b_k w_j = b_k·(Δθ1_j − e_j).
  */
 static void fxc_phi_rv3(void)
 {
     for (fx_i = 0; fx_i < 6u; ++fx_i) {
-        /* R7 = k13 for i < 3, k23 after (R5 is b2, written last) */
-        fxr[FX_R7] = fxr[fx_i < 3u ? 6u : 5u];
-        fxr[fx_i].s = fx_d(fx_i);
+        /* R_i = k13 for i < 3, k23 after (R5 is b2, written last); R7 = Δθ */
+        fxr[fx_i].u = fxr[fx_i < 3u ? 6u : 5u].u;
+        fx_ld7(fx_i);
         fxa_mul30(fx_i);
     }
     for (fx_i = 0; fx_i < 3u; ++fx_i) {
         fx_j = fx_jk[fx_i];
         fx_k = fx_jk[fx_i + 1u];
         fxa_dither(fx_rot[fx_i]);
-        fxr[FX_R7].s = fx_d((uint8_t)(6u + fx_k));
-        fxa_mac(fx_j, FX_R7);                              /* a_j e_k */
-        fxr[FX_R7].s = fx_d((uint8_t)(6u + fx_j));
-        fxa_mac((uint8_t)(fx_k | FX_NEG), FX_R7);          /* − a_k e_j */
-        fxr[FX_R7].s = fx_d((uint8_t)(6u + fx_k));
-        fxr[FX_R7].s -= fx_d(fx_k);
-        fxa_mac((uint8_t)(3u + fx_j), FX_R7);              /* b_j w_k */
-        fxr[FX_R7].s = fx_d((uint8_t)(6u + fx_j));
-        fxr[FX_R7].s -= fx_d(fx_j);
-        fxa_mac((uint8_t)((3u + fx_k) | FX_NEG), FX_R7);   /* − b_k w_j */
-        fxr[FX_R7].s = fx_d(fx_i);
-        fxr[FX_R7].s += fx_d((uint8_t)(3u + fx_i));
-        fxr[FX_R7].s += fx_d((uint8_t)(6u + fx_i));
+        fx_ld7((uint8_t)(6u + fx_k));
+        fxa_mac(FX_M(fx_j, FX_R7));                 /* a_j e_k */
+        fx_ld7((uint8_t)((6u + fx_j) | FX_NEGL));
+        fxa_mac(FX_M(fx_k, FX_R7));                 /* − a_k e_j */
+        fx_ld7((uint8_t)(6u + fx_k));
+        fx_ld7((uint8_t)(fx_k | FX_SUB));
+        fxa_mac(FX_M(3u + fx_j, FX_R7));            /* b_j w_k */
+        fx_ld7(fx_j);
+        fx_ld7((uint8_t)((6u + fx_j) | FX_SUB));
+        fxa_mac(FX_M(3u + fx_k, FX_R7));            /* − b_k w_j */
+        fx_ld7(fx_i);
+        fx_ld7((uint8_t)((3u + fx_i) | FX_ADD));
+        fx_ld7((uint8_t)((6u + fx_i) | FX_ADD));
         fx_j = fx_phid[fx_i];
-        fxa_out(fx_j, 2);
-        fxr[fx_j].s += fxr[FX_R7].s;
+        fxa_out((uint8_t)(fx_j | FX_SH30));
+        fxr[fx_j].u += fxr[FX_R7].u;
     }
-    fxr[0] = fxr[6];
-    fxr[1] = fxr[2];
-    fxr[2] = fxr[5];
+    fxr[0].u = fxr[6].u;
+    fxr[1].u = fxr[2].u;
+    fxr[2].u = fxr[5].u;
 }
 
 #ifndef ATT_FX_RV3_ONLY /* -DATT_FX_RV3_ONLY: att_fx_update_rv3 alone (8051 flash) */
@@ -286,20 +305,27 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
 }
 #endif
 
-/* Series coefficient n of c (m = 0) or s (m = 1), see fx_cos_k / fx_sin_k */
-static int32_t fx_csk(uint8_t m, uint8_t n)
+/* Horner step on c (R3, mn = 0x3n) or s (R4, mn = 0x4n): R = k_n − R, or
+ * with bit 3 set R = k_(n & 7) (fx_cos_k / fx_sin_k) */
+static void fxc_k(uint8_t mn)
 {
-    return m != 0u ? fx_sin_k[n] : fx_cos_k[n];
+    FX_DATA fx_word *r = &fxr[mn >> 4];
+    if (mn & 8u) {
+        r->s = 0;
+    } else {
+        r->u = 0u - r->u;
+    }
+    r->u += (uint32_t)fx_cs_k[(mn >> 4) - 3u][mn & 7u];
 }
 
 /* c, s into R3, R4 for Φ in R0..R2 (v in R7). Degree 1 (c = 1 − v·1,
  * s = 1 − v·(1/6)) is the Horner loop's first step. */
 static void fxc_cs(void)
 {
-    uint8_t n, m;
+    uint8_t n;
     fxa_set(0);
     for (n = 0; n < 3u; ++n) {
-        fxa_mac(n, n);
+        fxa_mac(FX_M(n, n));
     }
     fxr[FX_R7].u = (fxa.w.hi + 1u) >> 1; /* v = round(Σ/2^33): the half is 2^32 */
     n = 0;
@@ -307,15 +333,14 @@ static void fxc_cs(void)
         ++n;
     }
     ++n; /* degree */
-    for (m = 0; m < 2u; ++m) {
-        fxr[3u + m].s = fx_csk(m, n);
-    }
+    fxc_k((uint8_t)(0x38u | n));
+    fxc_k((uint8_t)(0x48u | n));
     do {
         --n;
-        for (m = 3; m < 5u; ++m) {
-            fxa_mul30(m);
-            fxr[m].s = fx_csk((uint8_t)(m - 3u), n) - fxr[m].s;
-        }
+        fxa_mul30(3);
+        fxc_k((uint8_t)(0x30u | n));
+        fxa_mul30(4);
+        fxc_k((uint8_t)(0x40u | n));
     } while (n != 0u);
 }
 
@@ -338,6 +363,12 @@ static const uint8_t fx_ph[4][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}, {2, 1, 0}};
 static const uint8_t fx_pneg[4] = {7, 4, 2, 4}; /* bit k set: subtract term k */
 static const uint8_t fx_res[4] = {4, 5, 6, 7};
 
+/* q_i = result i */
+static void fx_st(uint8_t i)
+{
+    fx_qp[i] = fxr[fx_res[i]].s;
+}
+
 /* Q ← Q ⊗ q(Φ) for Q at fx_qp, Φ in R0..R2. Registers: h in R0..R2 (over
  * Φ), c then c2 in R3, s in R4, then the results r0..r3 in R4..R7 (r3:
  * the operand register, free after the last product), operand in R7. */
@@ -346,8 +377,8 @@ static att_status fxc_apply(void)
     fxc_cs();
     fxa_set(0);
     for (fx_i = 0; fx_i < 4u; ++fx_i) {
-        fxr[FX_R7].s = fx_q(fx_i);
-        fxa_mac(FX_R7, FX_R7);
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fxa_mac(FX_M(FX_R7, FX_R7));
     }
     fxa.w.hi -= 0x10000000ul; /* − 2^60 */
     if ((uint32_t)(fxa.w.hi + 0x100u) >= 0x200u) { /* |e| ≥ 2^-20 */
@@ -358,31 +389,38 @@ static att_status fxc_apply(void)
     if (fxa.w.lo < 0x40000000ul) {
         fxa.w.hi++;
     }
-    fxa_out(FX_R7, 1);
-    fxr[3].s -= fxr[FX_R7].s;
+    fxa_out(FX_R7);
+    fxr[3].u -= fxr[FX_R7].u;
     /* c2 = 2c − 2^31 (mod 2^32; fits int32: 0 ≤ c < 2^31) */
     fxr[3].u <<= 1;
     fxr[3].b[3] ^= 0x80u;
     for (fx_i = 0; fx_i < 3u; ++fx_i) {
         fxa_dither(fx_rot[3u + fx_i]);
-        fxa_mac(4, fx_i);
-        fxa_out(fx_i, 2);
+        fxa_mac(FX_M(4, fx_i));
+        fxa_out((uint8_t)(fx_i | FX_SH30));
     }
     for (fx_i = 0; fx_i < 4u; ++fx_i) {
         /* q_i·2^31 + 2^30, then + q_i·c2 (= 2·q_i·c) */
-        fxr[FX_R7].s = fx_q(fx_i);
-        fxa.w.lo = (fxr[FX_R7].u << 31) | 0x40000000ul;
-        fxa.w.hi = (fxr[FX_R7].u >> 1) | (fxr[FX_R7].u & 0x80000000ul);
-        fxa_mac(FX_R7, 3);
-        for (fx_k = 0; fx_k < 3u; ++fx_k) {
-            fxr[FX_R7].s = fx_q(fx_pq[fx_i][fx_k]);
-            fxa_mac((uint8_t)(FX_R7 | (((fx_pneg[fx_i] >> fx_k) & 1u) ? FX_NEG : 0u)),
-                    fx_ph[fx_i][fx_k]);
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fxa.w.lo = 0x40000000ul;
+        if (fxr[FX_R7].b[0] & 1u) {
+            fxa.b[3] = 0xC0u;
         }
-        fxa_out(fx_res[fx_i], 1);
+        fxa.w.hi = fxr[FX_R7].u >> 1;
+        if (fxr[FX_R7].b[3] & 0x80u) {
+            fxa.b[7] |= 0x80u;
+        }
+        fxa_mac(FX_M(FX_R7, 3));
+        for (fx_k = 0; fx_k < 3u; ++fx_k) {
+            /* − q·h as (−q)·h */
+            fx_ld7((uint8_t)(fx_pq[fx_i][fx_k] | FX_Q
+                             | (((fx_pneg[fx_i] >> fx_k) & 1u) ? FX_NEGL : 0u)));
+            fxa_mac(FX_M(FX_R7, fx_ph[fx_i][fx_k]));
+        }
+        fxa_out(fx_res[fx_i]);
     }
     for (fx_i = 0; fx_i < 4u; ++fx_i) {
-        fx_qp[fx_i] = fxr[fx_res[fx_i]].s;
+        fx_st(fx_i);
     }
     return ATT_OK;
 }
@@ -407,7 +445,7 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
     fxa_set(0);
     for (n = 0; n < 3u; ++n) {
         fxr[n].s = phi[n];
-        fxa_mac(n, n);
+        fxa_mac(FX_M(n, n));
     }
     /* |Φ|² ≤ 9.6: round(Σ/2^36) ≤ 161061274, i.e. (hi + 8) >> 4 */
     if (((fxa.w.hi + 8u) >> 4) > 161061274ul) {
@@ -419,16 +457,17 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
 
 att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
 {
-    if (q == 0 || d == 0) {
+    fx_qp = q;
+    fx_dp = d;
+    if (fx_qp == 0 || fx_dp == 0) {
         return ATT_E_NULL;
     }
-    fx_dp = d;
     for (fx_i = 0; fx_i < 9u; ++fx_i) {
-        if (FX_DBAD(fx_d(fx_i))) {
+        fx_ld7(fx_i);
+        if (FX_DBAD(fxr[FX_R7].s)) {
             return (att_status)ATT_FX_E_RANGE;
         }
     }
-    fx_qp = q;
     fxc_seed();
     fxr[6].s = ATT_FX_K_RV3_13;
     fxr[5].s = ATT_FX_K_RV3_23;
