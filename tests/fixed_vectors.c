@@ -142,6 +142,36 @@ int main(void)
             }
         }
     }
+    /* gains over the whole accepted range (shifts 1..62), codes around the
+     * zero code (negative products, exact ties) */
+    {
+        att_fx_adc cv;
+        int32_t zero[3] = {2048L * 256, 128, 65535L * 256};
+        for (m = 0; m < 300; ++m) {
+            uint32_t scale[3];
+            uint32_t period = 1u + (rnd() >> (rnd() & 31u));
+            int st2;
+            scale[0] = 1u + (rnd() >> (rnd() & 31u));
+            scale[1] = 1u + (rnd() >> (rnd() & 31u));
+            scale[2] = 1u + (rnd() >> (rnd() & 31u));
+            st2 = att_fx_adc_init(&cv, zero, scale, period);
+            hash32(st2);
+            if (st2 != ATT_OK) {
+                continue;
+            }
+            hashn(cv.gain, 3);
+            hash32(cv.shift[0] | (cv.shift[1] << 8) | ((int32_t)cv.shift[2] << 16));
+            for (i = 0; i < 20; ++i) {
+                uint16_t code[3];
+                att_q30 d[3] = {0, 0, 0};
+                code[0] = (uint16_t)(2048 + (int)(rnd() % 9u) - 4);
+                code[1] = (uint16_t)(rnd() % 3u);
+                code[2] = (uint16_t)(65535u - rnd() % 5u);
+                hash32(att_fx_adc_convert(&cv, code, d));
+                hashn(d, 3);
+            }
+        }
+    }
     printf("adc %08lx\n", (unsigned long)h);
     return 0;
 }

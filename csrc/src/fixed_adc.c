@@ -1,92 +1,97 @@
 /*
  * libattitude fixed point: ADC codes → Q2.30 angle increments, so that the
  * 8051 can do the "simple data processing" step itself. Integer-only.
+ * The set-up (att_fx_adc_init) is in fixed_adc_init.c, so firmware whose
+ * converter constants come from the host links only the conversion.
  */
 #include "attitude/fixed.h"
 
 #include "fixed_internal.h"
+#if defined(__SDCC) || defined(ATT_FX_COMPACT)
+/* the 8051 build: only this file's two primitives, no 64-bit accumulator
+ * (SDCC compiles every static function of fixed_prim.h, used or not) */
+#define FX_PRIM_MINIMAL
 #include "fixed_prim.h"
 
-/*
- * gain per Q24.8 code unit, in Q2.30 rad: G = N / (10^9 · 2^10) with
- * N = scale_q32 · period_ns (exact 64-bit product): scale_q32/2^32 rad/s
- * per code × period_ns/10^9 s, /2^8 per Q8 unit, ×2^30 for Q2.30.
- * Long division of N by 10^9, bit by bit (remainder < 2^30, no overflow),
- * until 32 significant quotient bits; rounded to a 31-bit mantissa m and
- * shift s with G = m / 2^s (relative error ≤ 2^-31).
- */
-static att_status fx_adc_gain(uint32_t scale_q32, uint32_t period_ns, int32_t *m_out, uint8_t *s_out)
+/* (hi:lo) = x · y, unsigned 32 × 32 → 64 bits from 16 × 16-bit products
+ * (also used by att_fx_adc_init in fixed_adc_init.c) */
+void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
 {
-    uint32_t hi, lo, rem = 0, m = 0, bit;
-    int16_t p;
-    uint8_t nb = 0, qb;
-    int16_t ex;
-    fx_uprod(scale_q32, period_ns, &hi, &lo);
-    for (p = 63; p > -80 && nb < 32u; --p) {
-        if (p >= 32) {
-            bit = (hi >> (uint8_t)(p - 32)) & 1u;
-        } else if (p >= 0) {
-            bit = (lo >> (uint8_t)p) & 1u;
-        } else {
-            bit = 0;
-        }
-        rem = (rem << 1) | bit;
-        qb = (rem >= 1000000000ul) ? 1u : 0u;
-        if (qb) {
-            rem -= 1000000000ul;
-        }
-        if (nb > 0u || qb) {
-            m = (m << 1) | qb;
-            ++nb;
-        }
+    uint32_t p0 = (uint32_t)(uint16_t)x * (uint16_t)y;
+    uint32_t p1 = (uint32_t)(uint16_t)x * (uint16_t)(y >> 16);
+    uint32_t p2 = (uint32_t)(uint16_t)(x >> 16) * (uint16_t)y;
+    uint32_t h = (uint32_t)(uint16_t)(x >> 16) * (uint16_t)(y >> 16);
+    uint32_t mid = p1 + p2;
+    if (mid < p1) {
+        h += 0x10000ul;
     }
-    if (nb < 32u) {
-        return (att_status)ATT_FX_E_RANGE;
+    h += mid >> 16;
+    mid <<= 16;
+    p0 += mid;
+    if (p0 < mid) {
+        h++;
     }
-    /* quotient ≈ m · 2^(p+1); round m to 31 bits */
-    ex = (int16_t)(p + 2);
-    m = (m >> 1) + (m & 1u);
-    if (m >= 0x80000000ul) {
-        m >>= 1;
-        ++ex;
-    }
-    /* G = m · 2^ex / 2^10, shift s = 10 − ex */
-    if (10 - ex < 1 || 10 - ex > 62) {
-        return (att_status)ATT_FX_E_RANGE;
-    }
-    *m_out = (int32_t)m;
-    *s_out = (uint8_t)(10 - ex);
-    return ATT_OK;
+    *hi = h;
+    *lo = p0;
 }
 
-att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3],
-                           const uint32_t scale_q32[3], uint32_t period_ns)
+/* round(d · m / 2^sh) (nearest, ties toward +inf) for |d| < 2^24,
+ * 0 < m < 2^31, 1 ≤ sh ≤ 62, if its magnitude is ≤ ATT_FX_DTHETA_MAX;
+ * returns 0 and *out, or -1. Works on the magnitude u = |d|·m:
+ * d ≥ 0: floor((u + h)/2^sh); d < 0: −floor((u + h − 1)/2^sh), h = 2^(sh−1),
+ * which is floor((d·m + h)/2^sh) of the signed product. */
+static int fx_adc_scale(int32_t d, int32_t m, uint8_t sh, int32_t *out)
 {
-    int32_t m[3];
-    uint8_t s[3], i;
-    att_status st;
-    if (a == 0 || zero_q8 == 0 || scale_q32 == 0) {
-        return ATT_E_NULL;
-    }
-    if (period_ns == 0u) {
-        return ATT_E_ARG;
-    }
-    for (i = 0; i < 3; ++i) {
-        if (scale_q32[i] == 0u || zero_q8[i] < 0 || zero_q8[i] > 16777215L) {
-            return ATT_E_ARG;
+    uint32_t hi, lo, add, r;
+    att_fx_uprod_(d < 0 ? 0u - (uint32_t)d : (uint32_t)d, (uint32_t)m, &hi, &lo);
+    if (sh <= 32u) {
+        add = (1ul << (sh - 1u)) - (d < 0 ? 1u : 0u);
+        lo += add;
+        if (lo < add) {
+            hi++;
         }
-        st = fx_adc_gain(scale_q32[i], period_ns, &m[i], &s[i]);
-        if (st != ATT_OK) {
-            return st;
+        r = (sh == 32u) ? hi : ((lo >> sh) | (hi << (32u - sh)));
+        if (sh < 32u && (hi >> sh) != 0u) {
+            return -1;
         }
+    } else {
+        /* the half is 2^(sh−1) ≥ 2^32: added to hi; the −1 borrows from it
+         * only when lo == 0 */
+        add = 1ul << (sh - 33u);
+        if (d < 0 && lo == 0u) {
+            add -= 1u;
+        }
+        hi += add;
+        r = hi >> (sh - 32u);
     }
-    for (i = 0; i < 3; ++i) {
-        a->zero_q8[i] = zero_q8[i];
-        a->gain[i] = m[i];
-        a->shift[i] = s[i];
+    if (r > (uint32_t)ATT_FX_DTHETA_MAX) {
+        return -1;
     }
-    return ATT_OK;
+    *out = d < 0 ? -(int32_t)r : (int32_t)r;
+    return 0;
 }
+#else
+#include "fixed_prim.h"
+
+void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
+{
+    fx_uprod(x, y, hi, lo);
+}
+
+static int fx_adc_scale(int32_t d, int32_t m, uint8_t sh, int32_t *out)
+{
+    fx_acc acc;
+    int32_t r;
+    fx_zero(&acc);
+    fx_mac(&acc, d, m);
+    if (fx_round_sat(&acc, sh, &r) != 0 || r > (int32_t)ATT_FX_DTHETA_MAX
+        || r < -(int32_t)ATT_FX_DTHETA_MAX) {
+        return -1;
+    }
+    *out = r;
+    return 0;
+}
+#endif
 
 /* d = code·256 − zero (|d| < 2^24, exact); Δθ = round(d · m / 2^s) from the
  * exact 64-bit product (< 2^55), range-checked against ATT_FX_DTHETA_MAX. */
@@ -94,16 +99,12 @@ att_status att_fx_adc_convert(const att_fx_adc *a, const uint16_t code[3], att_q
 {
     att_q30 r[3];
     uint8_t i;
-    fx_acc acc;
     if (a == 0 || code == 0 || dtheta == 0) {
         return ATT_E_NULL;
     }
     for (i = 0; i < 3; ++i) {
         int32_t d = (int32_t)((uint32_t)code[i] << 8) - a->zero_q8[i];
-        fx_zero(&acc);
-        fx_mac(&acc, d, a->gain[i]);
-        if (fx_round_sat(&acc, a->shift[i], &r[i]) != 0 || r[i] > (att_q30)ATT_FX_DTHETA_MAX
-            || r[i] < -(att_q30)ATT_FX_DTHETA_MAX) {
+        if (fx_adc_scale(d, a->gain[i], a->shift[i], &r[i]) != 0) {
             return (att_status)ATT_FX_E_RANGE;
         }
     }

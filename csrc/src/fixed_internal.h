@@ -44,6 +44,9 @@ uint32_t att_fx_dither_seed_(const att_q30 q[4]);
 #define FX_DBAD(x) ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > \
                     2u * (uint32_t)ATT_FX_DTHETA_MAX)
 
+/* (hi:lo) = x · y, unsigned 32 × 32 → 64 bits (fixed_adc.c) */
+void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo);
+
 /* 1 if every one of the n values satisfies |x| ≤ ATT_FX_DTHETA_MAX. */
 int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n);
 

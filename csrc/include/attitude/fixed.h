@@ -199,7 +199,7 @@ att_status att_fx_quat_heading(const att_q30 q[4], att_q28 *heading);
  * int32 in the same scale; atan2(0, 0) = 0. */
 att_q28 att_fx_atan2(int32_t y, int32_t x);
 
-/* ---- ADC codes → increments ------------------------------------------ */
+/* ---- ADC codes → increments (fixed_adc.c; set-up in fixed_adc_init.c) -- */
 
 /* Set up the converter: zero-rate code (Q24.8, code × 256), scale factor
  * (UQ0.32 rad/s per code, i.e. scale × 2^32, must be > 0) and sample
