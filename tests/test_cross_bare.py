@@ -16,11 +16,15 @@ import pytest
 from conftest import ROOT, require_target
 
 C_TESTS = sorted((ROOT / "csrc" / "tests").glob("test_*.c"))
+# test_integrator's long runs (10^6 updates) take ~30 s per build on the emulated core: run it
+# in float only (the soft-float build the ARM920T cares about); the double integrator is
+# covered on this core by the test vectors (tests/test_vectors.py). Keeps this file ~1 min.
+CASES = [(src, prec) for src in C_TESTS for prec in ("f64", "f32")
+         if not (src.stem == "test_integrator" and prec == "f64")]
 
 
 @pytest.mark.qemu
-@pytest.mark.parametrize("precision", ["f64", "f32"])
-@pytest.mark.parametrize("src", C_TESTS, ids=[p.stem for p in C_TESTS])
+@pytest.mark.parametrize(("src", "precision"), CASES, ids=[f"{s.stem}-{p}" for s, p in CASES])
 def test_c_program_on_armv4t_core(src: Path, precision: str, build_root: Path) -> None:
     t = require_target("armv4t-bare")
     exe = t.build_program([src], build_root / "armv4t-bare" / precision / src.stem,
