@@ -39,8 +39,9 @@
  *
  * Widening product: one primitive (csrc/src/fixed_prim.h), a 64-bit
  * product on cores with a long multiply (host, ARM SMULL/SMLAL), four
- * 16×16-bit partial products on the 8051; both give bit-identical results
- * (tested).
+ * 16×16-bit partial products without a 64-bit type (-DATT_FX_FORCE_HALVES),
+ * and in the 8051 update kernel 8×8-bit products (MUL AB); all give
+ * bit-identical results (tested).
  *
  * Quaternions are [λ, p1, p2, p3] (docs/conventions.md); matrices are
  * row-major C[3*i + j]; Euler angles e = [yaw ψ, pitch θ, roll γ].
@@ -145,7 +146,8 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
  * (|Q|² − 1)/2 before the product, so |Q| stays within ±4 LSB of 1
  * (measured ≤ 1.7) with no extra rounding of Q. Q must be a unit
  * quaternion within 2^-20 (else ATT_FX_E_RANGE, Q untouched). On the 8051
- * (SDCC) this is the compact, non-reentrant build of the same arithmetic;
+ * (SDCC) this is the compact, non-reentrant build of the same arithmetic
+ * (AT89S51: 2.5 KB code, 64 bytes of static RAM, d may be in code memory);
  * -DATT_FX_RV3_ONLY leaves only this update in fixed_rv.c. */
 att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9]);
 
