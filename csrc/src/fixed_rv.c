@@ -136,26 +136,32 @@ static void fx_ld7(uint8_t op)
 
 /* fxa += fxr[xy >> 4] · fxr[xy & 15], signed 32 × 32 → 64 bits, modulo
  * 2^64: the unsigned product row by row from 8 × 8 → 16-bit products
- * (partial sum + byte + carry ≤ 0xFFFF), then the two's-complement
+ * (product + accumulator byte + carry ≤ 0xFE01 + 0xFF + 0xFF = 0xFFFF; the
+ * row's carry then rippled into the upper bytes), then the two's-complement
  * correction x·y = ux·uy − 2^32·((x < 0 ? uy : 0) + (y < 0 ? ux : 0)). */
 static void fxa_mac(uint8_t xy)
 {
-    uint8_t i, k, j;
+    uint8_t i, j, c, xi;
     uint16_t s;
     FX_DATA fx_word *x = &fxr[xy >> 4];
     FX_DATA fx_word *y = &fxr[xy & 15u];
+    FX_DATA uint8_t *a;
     for (i = 0; i < 4u; ++i) {
-        s = 0;
-        for (k = i; k < 8u; ++k) {
-            j = (uint8_t)(k - i);
-            if (j < 4u) {
-                s += (uint16_t)(x->b[i] * y->b[j]);
-            } else if (s == 0u) {
-                break;
-            }
-            s += fxa.b[k];
-            fxa.b[k] = (uint8_t)s;
-            s >>= 8;
+        xi = x->b[i];
+        a = &fxa.b[i];
+        c = 0;
+        for (j = 0; j < 4u; ++j) {
+            s = (uint16_t)(xi * y->b[j]);
+            s += *a;
+            s += c;
+            *a++ = (uint8_t)s;
+            c = (uint8_t)(s >> 8);
+        }
+        /* propagate the carry into bytes i + 4 .. 7 */
+        for (j = (uint8_t)(i + 4u); c != 0u && j < 8u; ++j) {
+            s = (uint16_t)(*a + c);
+            *a++ = (uint8_t)s;
+            c = (uint8_t)(s >> 8);
         }
     }
     if (x->s < 0) {
