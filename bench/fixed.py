@@ -179,9 +179,9 @@ def run(quick: bool) -> str:
             f"{cyc.get('small', 0) * 12 / 11.0592e6 * 1e3:.1f} ms |"),
             (f"| code of rv3 alone: fixed_rv.rel (ATT_FX_RV3_ONLY; CSEG + CONST) | "
             f"{rel.get('CSEG', 0) + rel.get('CONST', 0):,} bytes |"),
-            (f"| flash of rv3 alone (image with the call − image without, SDCC library "
-            f"routines included) | "
-            f"{alone if alone is not None else 'does not link: ' + str(s.get('err_with'))} bytes |"),
+            ("| flash of rv3 alone (image with the call − image without, SDCC library "
+             "routines included) | "
+             + (f"{alone:,} bytes |" if alone is not None else f"does not link: {s.get('err_with')} |")),
             (f"| static RAM of fixed_rv.rel (DSEG + OSEG) | "
             f"{rel.get('DSEG', 0) + rel.get('OSEG', 0)} bytes |"),
             (f"| test program on the AT89S51 (tests/s51/fixed_rv3.c + s51_sif.c + rv3): flash, "
