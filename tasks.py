@@ -13,7 +13,7 @@ for t in (core.build, core.test, core.lint, core.clean, core.bench):
     ns.add_task(t)
 
 # Areas that add their own tasks (top-level tasks and/or a namespace).
-import importlib  # noqa: E402
+import importlib
 
 for _name in ("cross", "link", "sim", "firmware"):
     try:

@@ -8,7 +8,7 @@ user would naturally catch (pynacl style): a bad argument is both an
 
 from __future__ import annotations
 
-from typing import Mapping
+from collections.abc import Mapping
 
 
 class AttitudeError(Exception):

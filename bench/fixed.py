@@ -8,9 +8,11 @@ ARMv4T: bench/fixed_ops.c built for armv4t-bare (arm-none-eabi-gcc -O2
 instruction is a ``Trace`` line (toolchain/qemu_count.py) and the per-update
 figure is the difference between K and 2K updates, so start-up cancels.
 
-8051: tests/s51/fixed_rv3.c in s51 (8052 core), Timer 0 + overflow
-interrupt around one update; sizes from SDCC's .sym area tables and from
-two linked images (with and without the call).
+8051: tests/s51/fixed_rv3.c in s51 on the C51 core (AT89S51 configuration
+of toolchain/mcs51.toml: small model, 128 B internal RAM, no external RAM,
+4 KB code), Timer 0 + overflow interrupt around one update; sizes from
+SDCC's .sym area tables, from two linked images (with and without the
+call) and from the linker's internal RAM map (free stack).
 """
 
 from __future__ import annotations
@@ -69,17 +71,27 @@ def _rom(mem: Path) -> int:
 
 
 def _s51(tmp: Path) -> dict[str, object]:
+    import subprocess
+
     from toolchain import s51
+    from toolchain import targets as T
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from test_fixed_targets import write_rv3_header  # type: ignore
 
     out: dict[str, object] = {}
     ihx = s51.build([ROOT / "tests" / "s51" / "fixed_rv3.c"], tmp / "s51" / "rv3",
                     lib_sources=[ROOT / "csrc" / "src" / "fixed_rv.c"],
                     defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"],
-                    extra_cflags=["--stack-auto", "--iram-size", "256", "--code-size", "8192"])
-    res = s51.run(ihx, timeout=120, cpu="8052")
+                    include_dirs=[write_rv3_header(tmp / "s51" / "inc", 6)])
+    res = s51.run(ihx, timeout=120)
     out["cycles"] = {k: int(v) for k, v in re.findall(r"^CYC (\w+) (\d+)$", res.output, re.MULTILINE)}
-    # flash of rv3 alone: one image calling att_fx_update_rv3, one not (small
-    # model, 128 B IRAM flags as the firmware; link-only sizes, not run)
+    m = re.search(r"Stack starts at: 0x([0-9a-fA-F]+) .* with (\d+) bytes available",
+                  ihx.with_suffix(".mem").read_text())
+    out["stack_free"] = int(m.group(2)) if m else -1
+    out["rom_test"] = _rom(ihx.with_suffix(".mem"))
+    # flash of rv3 alone: one image calling att_fx_update_rv3, one not (the
+    # AT89S51 flags of the firmware; link-only sizes, not run)
     src = tmp / "sz"
     src.mkdir(parents=True, exist_ok=True)
     for name, body in (("with", "att_fx_update_rv3(q, d);"), ("without", "q[0] ^= d[0];")):
@@ -87,27 +99,19 @@ def _s51(tmp: Path) -> dict[str, object]:
             '#include "attitude/fixed.h"\n'
             "static att_q30 q[4];\nstatic __code const att_q30 d[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};\n"
             f"void main(void) {{ {body} for (;;) {{ }} }}\n")
-    from toolchain import targets as T
-
     t = T.load("mcs51")
-    import subprocess
-
     for name in ("with", "without"):
         libs = [ROOT / "csrc" / "src" / "fixed_rv.c"] if name == "with" else []
-        for variant, extra in (("small", ["--code-size", "65536"]),
-                               ("stack-auto", ["--stack-auto", "--code-size", "65536",
-                                               "--iram-size", "256"])):
-            try:
-                ihx2 = t.build_program([src / f"{name}.c", *libs], src / f"{name}_{variant}",
-                                       defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"],
-                                       extra_cflags=extra, with_lib=False)
-                out[f"rom_{name}_{variant}"] = _rom(ihx2.with_suffix(".mem"))
-            except subprocess.CalledProcessError as exc:  # does not link (RAM)
-                out[f"rom_{name}_{variant}"] = None
-                out[f"err_{name}_{variant}"] = " ".join(
-                    ln.strip() for ln in (exc.stdout + exc.stderr).splitlines() if "Error" in ln)
-            if name == "with":
-                out[f"rel_{variant}"] = _area_sizes(src / f"{name}_{variant}.objs" / "fixed_rv.sym")
+        try:
+            ihx2 = t.build_program([src / f"{name}.c", *libs], src / name,
+                                   defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"], with_lib=False)
+            out[f"rom_{name}"] = _rom(ihx2.with_suffix(".mem"))
+        except subprocess.CalledProcessError as exc:  # does not link
+            out[f"rom_{name}"] = None
+            out[f"err_{name}"] = " ".join(
+                ln.strip() for ln in (exc.stdout + exc.stderr).splitlines() if "Error" in ln)
+        if name == "with":
+            out["rel"] = _area_sizes(src / f"{name}.objs" / "fixed_rv.sym")
     return out
 
 
@@ -160,10 +164,10 @@ def run(quick: bool) -> str:
         ]
         s = _s51(tmp)
         cyc = s["cycles"]
-        rel = s["rel_small"]
-        rela = s["rel_stack-auto"]
+        rel = s["rel"]
+        alone = ((s["rom_with"] or 0) - (s["rom_without"] or 0)) if s["rom_with"] else None
         lines += [
-            "### 8051 (SDCC 4.2, s51)",
+            "### 8051 (SDCC 4.2, s51 -t C51: AT89S51, 128 B RAM, 4 KB flash)",
             "",
             "| figure | value |",
             "| --- | ---: |",
@@ -173,19 +177,19 @@ def run(quick: bool) -> str:
             f"{cyc.get('big', -1):,} |"),
             (f"| time per rv3 update at 11.0592 MHz (12 clocks per cycle), small increments | "
             f"{cyc.get('small', 0) * 12 / 11.0592e6 * 1e3:.1f} ms |"),
-            (f"| code of rv3 alone, small model: fixed_rv.rel (ATT_FX_RV3_ONLY) | "
+            (f"| code of rv3 alone: fixed_rv.rel (ATT_FX_RV3_ONLY; CSEG + CONST) | "
             f"{rel.get('CSEG', 0) + rel.get('CONST', 0):,} bytes |"),
-            (f"| static RAM of fixed_rv.rel, small model (DSEG + OSEG) | "
-            f"{rel.get('DSEG', 0) + rel.get('OSEG', 0)} bytes"
-            f"{' (does not link in 128 B: ' + str(s.get('err_with_small')) + ')' if s.get('rom_with_small') is None else ''} |"),
-            (f"| flash of rv3 alone, --stack-auto (image with the call − image without, SDCC "
-            f"library routines included; as run in s51) | "
-            f"{(s['rom_with_stack-auto'] or 0) - (s['rom_without_stack-auto'] or 0):,} bytes |"),
-            f"| static RAM of fixed_rv.rel, --stack-auto | {rela.get('DSEG', 0) + rela.get('OSEG', 0)} bytes |",
+            (f"| flash of rv3 alone (image with the call − image without, SDCC library "
+            f"routines included) | "
+            f"{alone if alone is not None else 'does not link: ' + str(s.get('err_with'))} bytes |"),
+            (f"| static RAM of fixed_rv.rel (DSEG + OSEG) | "
+            f"{rel.get('DSEG', 0) + rel.get('OSEG', 0)} bytes |"),
+            (f"| test program on the AT89S51 (tests/s51/fixed_rv3.c + s51_sif.c + rv3): flash, "
+            f"free stack | {s['rom_test']:,} bytes, {s['stack_free']} bytes |"),
             "",
-            ("The AT89S51 has 4 KB of flash and 128 bytes of RAM: rv3 alone does not fit it with "
-            "room for the firmware (see docs/fixed-point.md); it runs, bit-identical to the host, "
-            "on the 8052 core (256 bytes of RAM, e.g. the pin-compatible AT89S52 with 8 KB)."),
+            ("The update links and runs in the AT89S51 configuration (small model, 128 bytes "
+            "of internal RAM, no external RAM, 4 KB code) on s51's C51 core, bit-identical to "
+            "the host (tests/test_fixed_targets.py)."),
             "",
         ]
     acc = _accuracy(quick)

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from toolchain import targets as _targets  # noqa: E402
+from toolchain import targets as _targets
 
 IN_CI = bool(os.environ.get("CI"))
 

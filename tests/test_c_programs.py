@@ -12,7 +12,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-
 from conftest import ROOT, require_target
 
 C_TESTS = sorted((ROOT / "csrc" / "tests").glob("test_*.c"))

@@ -15,9 +15,9 @@ import os
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -103,8 +103,6 @@ class Target:
                     extra_cflags: Sequence[str] = (), include_dirs: Sequence[Path | str] = ()) -> list[str]:
         incs = [f"-I{d}" for d in (INCLUDE, *include_dirs)]
         defs = [f"-D{d}" for d in defines]
-        if self.kind == "sdcc":
-            return [self.cc, *self.cflags, *incs, *defs, *extra_cflags, "-c", str(src), "-o", str(obj)]
         return [self.cc, *self.cflags, *incs, *defs, *extra_cflags, "-c", str(src), "-o", str(obj)]
 
     def build_program(self, sources: Iterable[Path | str], out: Path | str, *,
@@ -147,14 +145,14 @@ class Target:
             timeout: float = 600, check: bool = True, extra_run_args: Sequence[str] = ()) -> subprocess.CompletedProcess:
         """Run a program built for this target (through its emulator if any)."""
         cmd = [*self.run_cmd, *extra_run_args, *map(str, argv)]
-        proc = subprocess.run(cmd, input=input, capture_output=True, timeout=timeout)
+        proc = subprocess.run(cmd, check=False, input=input, capture_output=True, timeout=timeout)
         if check and proc.returncode != 0:
             raise subprocess.CalledProcessError(proc.returncode, cmd, proc.stdout, proc.stderr)
         return proc
 
 
 def _run(cmd: list[str]) -> None:
-    proc = subprocess.run(cmd, capture_output=True, text=True)
+    proc = subprocess.run(cmd, check=False, capture_output=True, text=True)
     if proc.returncode != 0:
         raise subprocess.CalledProcessError(proc.returncode, cmd, proc.stdout, proc.stderr)
 

@@ -7,21 +7,20 @@
 #include "attitude/fixed.h"
 
 #include "fixed_internal.h"
-#if defined(__SDCC) || defined(ATT_FX_COMPACT)
-#define FX_PRIM_MINIMAL
-#endif
+#if !defined(__SDCC) && !defined(ATT_FX_COMPACT) /* the compact build has its own */
 #include "fixed_prim.h"
+#endif
 
 /* Series coefficients in Q2.30 for v = φ²/8 (φ = |Φ|):
  *   cos(φ/2)          = Σ (−v)^n · 2^n/(2n)!
  *   sin(φ/2) / (φ/2)  = Σ (−v)^n · 2^n/(2n+1)!
  * (the n-th power of φ²/4 = 2v). */
-static const int32_t fx_cos_k[8] = {
-    1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L
+static const int32_t fx_cs_k[2][8] = {
+    {1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L},
+    {1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L}
 };
-static const int32_t fx_sin_k[8] = {
-    1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L
-};
+#define fx_cos_k fx_cs_k[0]
+#define fx_sin_k fx_cs_k[1]
 /* Largest v (Q2.30) for which degree n+1 suffices: the first omitted term
  * v^(n+2)·2^(n+2)/(2n+4)! of the cosine series is below 2^-33 (the sine
  * series converges faster). Degree 7 covers v ≤ 1.2 (φ ≤ 3.1). */
@@ -29,6 +28,7 @@ static const int32_t fx_deg_vmax[6] = {
     28378L, 2349547L, 24989211L, 113507487L, 331839229L, 747556367L
 };
 
+#if !(defined(ATT_FX_RV3_ONLY) && (defined(__SDCC) || defined(ATT_FX_COMPACT)))
 uint32_t att_fx_dither_seed_(const att_q30 q[4])
 {
     uint32_t x = (uint32_t)q[0] ^ (uint32_t)q[1] ^ (uint32_t)q[2] ^ (uint32_t)q[3];
@@ -50,126 +50,245 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
     }
     return 1;
 }
+#endif
 
 #if defined(__SDCC) || defined(ATT_FX_COMPACT)
 /*
- * Compact build (the 8051; on a host with -DATT_FX_COMPACT for testing):
- * the same arithmetic, bit for bit, written for 128 bytes of RAM and a
- * few KB of flash. SDCC's default (non-reentrant) model makes every local
- * variable a static one anyway; here they are shared explicitly: one
- * 64-bit accumulator (fxa_hi:fxa_lo), the multiplier operands, and an
- * 8-word scratch fxs reused by the phases of an update. Loops over small
- * index tables instead of unrolled code; the caller's arrays are read
- * through one loader each (generic pointers are costly on the 8051). The
- * functions are not reentrant (no interrupt handler may call them).
+ * Compact build (the 8051: AT89S51, 4 KB flash, 128 bytes of RAM; on a
+ * host with -DATT_FX_COMPACT for testing): the same arithmetic, bit for
+ * bit, written for code size and RAM. The working values live in a
+ * register file of eight 32-bit words (fxr, in directly addressed RAM),
+ * addressed by one-byte indices, so that every step is a short call with
+ * constant arguments; each phase's use of the registers is documented at
+ * the phase. Every product — the dither hash's included — goes through
+ * one multiply-accumulate routine on byte limbs (fxa_mac: sixteen 8 × 8 →
+ * 16-bit products, the 8051's MUL AB, into an 8-byte accumulator); no
+ * 32-bit multiply routine of the compiler's library is linked. Products
+ * to subtract use a negated copy of an operand (exact). Two register
+ * indices are packed into one byte argument (FX_M): one-parameter
+ * functions take it in a register, with no static parameter block. The
+ * caller's arrays are read through one loader (fx_ld7; generic pointers
+ * are costly on the 8051). Not reentrant: no interrupt handler may call
+ * these functions.
+ *
+ * Words are read as their little-endian bytes through unions (SDCC's
+ * mcs51 port and the test hosts are little-endian).
  */
-static uint32_t fxa_lo, fxa_hi;  /* accumulator (hi:lo), two's complement */
-static int32_t fxa_x, fxa_y;     /* operands of fxa_mac */
-static int32_t fxs[8];           /* scratch, see each function */
+#if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__)
+#if __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the compact fixed-point build reads words as little-endian bytes"
+#endif
+#endif
+#ifdef __SDCC
+#define FX_DATA __data
+#else
+#define FX_DATA
+#endif
+
+typedef union {
+    int32_t s;
+    uint32_t u;
+    uint8_t b[4];
+} fx_word;
+
+enum {
+    FX_R7 = 7,     /* the operand register */
+    FX_NREG = 8,
+    FX_Q = 0x10,   /* fx_ld7: load from Q (else from the increments) */
+    FX_ADD = 0x20, /* fx_ld7: R7 += value */
+    FX_SUB = 0x40, /* fx_ld7: R7 −= value */
+    FX_NEGL = 0x60, /* fx_ld7: R7 = −value */
+    FX_SH30 = 0x10 /* fxa_out: shift 30 (else 31) */
+};
+/* fxa_mac argument: x register in the high nibble, y in the low one */
+#define FX_M(x, y) ((uint8_t)(((x) << 4) | (y)))
+static FX_DATA fx_word fxr[FX_NREG];
+static FX_DATA union {
+    struct {
+        uint32_t lo;
+        uint32_t hi;
+    } w;
+    uint8_t b[8];
+} fxa;                           /* accumulator (hi:lo), two's complement */
 static const att_q30 *fx_dp;     /* increments of the update */
 static att_q30 *fx_qp;           /* attitude being updated */
 static uint32_t fx_t;            /* dither seed of the update (0: plain rounding) */
+static uint8_t fx_i, fx_j, fx_k; /* loop indices of the phases */
 
-static int32_t fx_d(uint8_t i) { return fx_dp[i]; }
-static int32_t fx_q(uint8_t i) { return fx_qp[i]; }
-
-/* fxa += fxa_x · fxa_y: four 16 × 16 → 32-bit partial products, then the
- * two's-complement correction of the high word. */
-static void fxa_mac(void)
+/* R7 = / += / −= / = − (op & 0x60) the value d[op & 15] or, with FX_Q, q[op & 15] */
+static void fx_ld7(uint8_t op)
 {
-    uint32_t p;
-    uint16_t xl = (uint16_t)fxa_x, xh = (uint16_t)((uint32_t)fxa_x >> 16);
-    uint16_t yl = (uint16_t)fxa_y, yh = (uint16_t)((uint32_t)fxa_y >> 16);
-    p = (uint32_t)xl * yl;
-    fxa_lo += p;
-    if (fxa_lo < p) {
-        fxa_hi++;
+    fx_word v;
+    uint8_t i = (uint8_t)(op & 15u);
+    v.s = (op & FX_Q) ? fx_qp[i] : fx_dp[i];
+    op &= 0x60u;
+    if (op == 0u) {
+        fxr[FX_R7].s = v.s;
+    } else if (op == FX_ADD) {
+        fxr[FX_R7].u += v.u;
+    } else {
+        if (op == FX_NEGL) {
+            fxr[FX_R7].u = 0;
+        }
+        fxr[FX_R7].u -= v.u;
     }
-    fxa_hi += (uint32_t)xh * yh;
-    p = (uint32_t)xl * yh;
-    fxa_hi += p >> 16;
-    p <<= 16;
-    fxa_lo += p;
-    if (fxa_lo < p) {
-        fxa_hi++;
+}
+
+/* fxa += fxr[xy >> 4] · fxr[xy & 15], signed 32 × 32 → 64 bits, modulo
+ * 2^64: the unsigned product row by row from 8 × 8 → 16-bit products
+ * (partial sum + byte + carry ≤ 0xFFFF), then the two's-complement
+ * correction x·y = ux·uy − 2^32·((x < 0 ? uy : 0) + (y < 0 ? ux : 0)). */
+static void fxa_mac(uint8_t xy)
+{
+    uint8_t i, k, j;
+    uint16_t s;
+    FX_DATA fx_word *x = &fxr[xy >> 4];
+    FX_DATA fx_word *y = &fxr[xy & 15u];
+    for (i = 0; i < 4u; ++i) {
+        s = 0;
+        for (k = i; k < 8u; ++k) {
+            j = (uint8_t)(k - i);
+            if (j < 4u) {
+                s += (uint16_t)(x->b[i] * y->b[j]);
+            } else if (s == 0u) {
+                break;
+            }
+            s += fxa.b[k];
+            fxa.b[k] = (uint8_t)s;
+            s >>= 8;
+        }
     }
-    p = (uint32_t)xh * yl;
-    fxa_hi += p >> 16;
-    p <<= 16;
-    fxa_lo += p;
-    if (fxa_lo < p) {
-        fxa_hi++;
+    if (x->s < 0) {
+        fxa.w.hi -= y->u;
     }
-    if (fxa_x < 0) {
-        fxa_hi -= (uint32_t)fxa_y;
-    }
-    if (fxa_y < 0) {
-        fxa_hi -= (uint32_t)fxa_x;
+    if (y->s < 0) {
+        fxa.w.hi -= x->u;
     }
 }
 
 static void fxa_set(uint32_t lo)
 {
-    fxa_lo = lo;
-    fxa_hi = 0;
+    fxa.w.lo = lo;
+    fxa.w.hi = 0;
 }
 
-static void fxa_muladd(int32_t x, int32_t y)
+/* fxr[dn & 15] = floor(fxa / 2^31), or 2^30 with FX_SH30 (low 32 bits);
+ * fxa is consumed */
+static void fxa_out(uint8_t dn)
 {
-    fxa_x = x;
-    fxa_y = y;
-    fxa_mac();
+    uint8_t k, c, t;
+    for (;;) {
+        c = 0;
+        for (k = 0; k < 8u; ++k) {
+            t = fxa.b[k];
+            fxa.b[k] = (uint8_t)((t << 1) | c);
+            c = (uint8_t)(t >> 7);
+        }
+        if (!(dn & FX_SH30)) {
+            break;
+        }
+        dn &= 15u;
+    }
+    fxr[dn].u = fxa.w.hi;
 }
 
-/* floor(fxa / 2^sh) for sh = 30 or 31 (low 32 bits) */
-static int32_t fxa_floor(uint8_t sh)
-{
-    return fx_u2s((fxa_lo >> sh) | (fxa_hi << (32u - sh)));
-}
-
-/* round(x · y / 2^30) */
-static int32_t fxa_mul30(int32_t x, int32_t y)
+/* fxr[dst] = round(fxr[R7] · fxr[dst] / 2^30) */
+static void fxa_mul30(uint8_t dst)
 {
     fxa_set(0x20000000ul);
-    fxa_muladd(x, y);
-    return fxa_floor(30);
+    fxa_mac(FX_M(FX_R7, dst));
+    fxa_out((uint8_t)(dst | FX_SH30));
 }
 
-/* D of FX_DITHER30 for rotation k */
-static uint32_t fxa_dither(uint8_t k)
+/* fx_t *= m (low 32 bits of the product; uses R6, R7) */
+static void fxc_tmul(uint32_t m)
 {
-    return FX_DITHER30(fx_t, k);
+    fxr[6].u = fx_t;
+    fxr[FX_R7].u = m;
+    fxa_set(0);
+    fxa_mac(FX_M(6, FX_R7));
+    fx_t = fxa.w.lo;
+}
+
+/* fx_t = fx_dither_seed(Q) (the same MurmurHash3 finalizer) */
+static void fxc_seed(void)
+{
+    fx_t = 0;
+    for (fx_i = 0; fx_i < 4u; ++fx_i) {
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fx_t ^= fxr[FX_R7].u;
+    }
+    fx_t ^= fx_t >> 16;
+    fxc_tmul(0x85EBCA6Bul);
+    fx_t ^= fx_t >> 13;
+    fxc_tmul(0xC2B2AE35ul);
+    fx_t ^= fx_t >> 16;
+    if (fx_t == 0u) {
+        fx_t = 1u;
+    }
+}
+
+/* fxa = D of FX_DITHER30(fx_t, k): fx_t rotated right by k, top 30 bits */
+static void fxa_dither(uint8_t k)
+{
+    fxa_set(0x20000000ul);
+    if (fx_t != 0u) {
+        fxa.w.lo = fx_t;
+        while (k-- != 0u) {
+            uint8_t c = (uint8_t)(fxa.b[0] & 1u);
+            fxa.w.lo >>= 1;
+            if (c != 0u) {
+                fxa.b[3] |= 0x80u;
+            }
+        }
+        fxa.w.lo >>= 2;
+    }
 }
 
 /* cross-product index pairs: component i uses j = (i+1)%3, k = (i+2)%3 */
-static const uint8_t fx_j[3] = {1, 2, 0};
-static const uint8_t fx_k[3] = {2, 0, 1};
+static const uint8_t fx_jk[4] = {1, 2, 0, 1};
 static const uint8_t fx_rot[6] = {1, 11, 22, 6, 17, 27};
+static const uint8_t fx_phid[3] = {6, 2, 5};
 
-/* Φ of the increments at fx_dp (scratch: a = k13 Δθ1 in fxs[0..2],
- * b = k23 Δθ2 in fxs[3..5], Φ_0, Φ_1 in fxs[6], fxs[7] until the end;
- * the result in fxs[0..2]). */
-static void fxc_phi_rv3(int32_t k13, int32_t k23)
+/*
+ * Φ of the increments at fx_dp into fxr[0..2], coefficients k13, k23 in
+ * fxr[6], fxr[5] on entry. Registers: a = k13 Δθ1 in R0..R2, b = k23 Δθ2
+ * in R3..R5, operand in R7; Φ_0 goes to R6, Φ_1 over a2 (component 2 uses
+ * a0, a1, b0, b1 only), Φ_2 over b2. Subtracted products use a negated
+ * increment: −a_k e_j = a_k·(−e_j), −b_k w_j = b_k·(Δθ1_j − e_j).
+ */
+static void fxc_phi_rv3(void)
 {
-    uint8_t i, j, k;
-    for (i = 0; i < 3; ++i) {
-        fxs[i] = fxa_mul30(k13, fx_d(i));
-        fxs[3 + i] = fxa_mul30(k23, fx_d((uint8_t)(3 + i)));
+    for (fx_i = 0; fx_i < 6u; ++fx_i) {
+        /* R_i = k13 for i < 3, k23 after (R5 is b2, written last); R7 = Δθ */
+        fxr[fx_i].u = fxr[fx_i < 3u ? 6u : 5u].u;
+        fx_ld7(fx_i);
+        fxa_mul30(fx_i);
     }
-    for (i = 0; i < 3; ++i) {
-        j = fx_j[i];
-        k = fx_k[i];
-        fxa_set(fxa_dither(fx_rot[i]));
-        fxa_muladd(fxs[j], fx_d((uint8_t)(6 + k)));
-        fxa_muladd(-fxs[k], fx_d((uint8_t)(6 + j)));
-        fxa_muladd(fxs[3 + j], fx_d((uint8_t)(6 + k)) - fx_d(k));
-        fxa_muladd(-fxs[3 + k], fx_d((uint8_t)(6 + j)) - fx_d(j));
-        /* component 2 uses a0, a1, b0, b1 only: it may overwrite a2 */
-        fxs[i < 2u ? 6u + i : 2u] = fx_d(i) + fx_d((uint8_t)(3 + i)) + fx_d((uint8_t)(6 + i))
-                                    + fxa_floor(30);
+    for (fx_i = 0; fx_i < 3u; ++fx_i) {
+        fx_j = fx_jk[fx_i];
+        fx_k = fx_jk[fx_i + 1u];
+        fxa_dither(fx_rot[fx_i]);
+        fx_ld7((uint8_t)(6u + fx_k));
+        fxa_mac(FX_M(fx_j, FX_R7));                 /* a_j e_k */
+        fx_ld7((uint8_t)((6u + fx_j) | FX_NEGL));
+        fxa_mac(FX_M(fx_k, FX_R7));                 /* − a_k e_j */
+        fx_ld7((uint8_t)(6u + fx_k));
+        fx_ld7((uint8_t)(fx_k | FX_SUB));
+        fxa_mac(FX_M(3u + fx_j, FX_R7));            /* b_j w_k */
+        fx_ld7(fx_j);
+        fx_ld7((uint8_t)((6u + fx_j) | FX_SUB));
+        fxa_mac(FX_M(3u + fx_k, FX_R7));            /* − b_k w_j */
+        fx_ld7(fx_i);
+        fx_ld7((uint8_t)((3u + fx_i) | FX_ADD));
+        fx_ld7((uint8_t)((6u + fx_i) | FX_ADD));
+        fx_j = fx_phid[fx_i];
+        fxa_out((uint8_t)(fx_j | FX_SH30));
+        fxr[fx_j].u += fxr[FX_R7].u;
     }
-    fxs[0] = fxs[6];
-    fxs[1] = fxs[7];
+    fxr[0].u = fxr[6].u;
+    fxr[1].u = fxr[2].u;
+    fxr[2].u = fxr[5].u;
 }
 
 #ifndef ATT_FX_RV3_ONLY /* -DATT_FX_RV3_ONLY: att_fx_update_rv3 alone (8051 flash) */
@@ -177,51 +296,63 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
 {
     fx_dp = d;
     fx_t = t;
-    fxc_phi_rv3(k13, k23);
-    phi[0] = fxs[0];
-    phi[1] = fxs[1];
-    phi[2] = fxs[2];
+    fxr[6].s = k13;
+    fxr[5].s = k23;
+    fxc_phi_rv3();
+    phi[0] = fxr[0].s;
+    phi[1] = fxr[1].s;
+    phi[2] = fxr[2].s;
 }
 #endif
 
-/* c, s into fxs[3], fxs[4] for Φ in fxs[0..2] (v in fxs[5]) */
+/* Horner step on c (R3, mn = 0x3n) or s (R4, mn = 0x4n): R = k_n − R, or
+ * with bit 3 set R = k_(n & 7) (fx_cos_k / fx_sin_k) */
+static void fxc_k(uint8_t mn)
+{
+    FX_DATA fx_word *r = &fxr[mn >> 4];
+    if (mn & 8u) {
+        r->s = 0;
+    } else {
+        r->u = 0u - r->u;
+    }
+    r->u += (uint32_t)fx_cs_k[(mn >> 4) - 3u][mn & 7u];
+}
+
+/* c, s into R3, R4 for Φ in R0..R2 (v in R7). Degree 1 (c = 1 − v·1,
+ * s = 1 − v·(1/6)) is the Horner loop's first step. */
 static void fxc_cs(void)
 {
-    int8_t n, deg;
+    uint8_t n;
     fxa_set(0);
-    for (n = 0; n < 3; ++n) {
-        fxa_muladd(fxs[n], fxs[n]);
+    for (n = 0; n < 3u; ++n) {
+        fxa_mac(FX_M(n, n));
     }
-    fxs[5] = (int32_t)((fxa_hi + 1u) >> 1); /* round(Σ/2^33): the half is 2^32 */
-    if (fxs[5] <= fx_deg_vmax[0]) {
-        fxs[3] = (int32_t)ATT_FX_Q30_ONE - fxs[5];
-        fxs[4] = (int32_t)ATT_FX_Q30_ONE - fxa_mul30(fxs[5], fx_sin_k[1]);
-        return;
+    fxr[FX_R7].u = (fxa.w.hi + 1u) >> 1; /* v = round(Σ/2^33): the half is 2^32 */
+    n = 0;
+    while (n < 6u && fxr[FX_R7].s > fx_deg_vmax[n]) {
+        ++n;
     }
-    deg = 7;
-    for (n = 1; n < 6; ++n) {
-        if (fxs[5] <= fx_deg_vmax[n]) {
-            deg = (int8_t)(n + 1);
-            break;
-        }
-    }
-    fxs[3] = fx_cos_k[deg];
-    fxs[4] = fx_sin_k[deg];
-    for (n = (int8_t)(deg - 1); n >= 0; --n) {
-        fxs[3] = fx_cos_k[n] - fxa_mul30(fxs[5], fxs[3]);
-        fxs[4] = fx_sin_k[n] - fxa_mul30(fxs[5], fxs[4]);
-    }
+    ++n; /* degree */
+    fxc_k((uint8_t)(0x38u | n));
+    fxc_k((uint8_t)(0x48u | n));
+    do {
+        --n;
+        fxa_mul30(3);
+        fxc_k((uint8_t)(0x30u | n));
+        fxa_mul30(4);
+        fxc_k((uint8_t)(0x40u | n));
+    } while (n != 0u);
 }
 
 #ifndef ATT_FX_RV3_ONLY
 void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
-    fxs[0] = phi[0];
-    fxs[1] = phi[1];
-    fxs[2] = phi[2];
+    fxr[0].s = phi[0];
+    fxr[1].s = phi[1];
+    fxr[2].s = phi[2];
     fxc_cs();
-    *cp = fxs[3];
-    *sp = fxs[4];
+    *cp = fxr[3].s;
+    *sp = fxr[4].s;
 }
 #endif
 
@@ -230,52 +361,66 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 static const uint8_t fx_pq[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
 static const uint8_t fx_ph[4][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}, {2, 1, 0}};
 static const uint8_t fx_pneg[4] = {7, 4, 2, 4}; /* bit k set: subtract term k */
-static const uint8_t fx_res[3] = {4, 6, 7};
+static const uint8_t fx_res[4] = {4, 5, 6, 7};
 
-/* Q ← Q ⊗ q(Φ) for Q at fx_qp, Φ in fxs[0..2]. Scratch: h in fxs[0..2]
- * (over Φ), c then c2 in fxs[3], s in fxs[4] then r0, r1 and r2 in
- * fxs[6], fxs[7]; r3 goes straight to Q (Q is not read after it). */
+/* q_i = result i */
+static void fx_st(uint8_t i)
+{
+    fx_qp[i] = fxr[fx_res[i]].s;
+}
+
+/* Q ← Q ⊗ q(Φ) for Q at fx_qp, Φ in R0..R2. Registers: h in R0..R2 (over
+ * Φ), c then c2 in R3, s in R4, then the results r0..r3 in R4..R7 (r3:
+ * the operand register, free after the last product), operand in R7. */
 static att_status fxc_apply(void)
 {
-    uint8_t i, k;
     fxc_cs();
     fxa_set(0);
-    for (i = 0; i < 4; ++i) {
-        fxa_muladd(fx_q(i), fx_q(i));
+    for (fx_i = 0; fx_i < 4u; ++fx_i) {
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fxa_mac(FX_M(FX_R7, FX_R7));
     }
-    fxa_hi -= 0x10000000ul; /* − 2^60 */
-    if ((uint32_t)(fxa_hi + 0x100u) >= 0x200u) { /* |e| ≥ 2^-20 */
+    fxa.w.hi -= 0x10000000ul; /* − 2^60 */
+    if ((uint32_t)(fxa.w.hi + 0x100u) >= 0x200u) { /* |e| ≥ 2^-20 */
         return (att_status)ATT_FX_E_RANGE;
     }
     /* e/2 = round(Σ/2^31): add 2^30 then floor */
-    fxa_lo += 0x40000000ul;
-    if (fxa_lo < 0x40000000ul) {
-        fxa_hi++;
+    fxa.w.lo += 0x40000000ul;
+    if (fxa.w.lo < 0x40000000ul) {
+        fxa.w.hi++;
     }
-    fxs[3] -= fxa_floor(31);
-    fxs[3] = fx_u2s((uint32_t)fxs[3] * 2u - 0x80000000ul); /* c2 */
-    for (i = 0; i < 3; ++i) {
-        fxa_set(fxa_dither(fx_rot[3 + i]));
-        fxa_muladd(fxs[4], fxs[i]);
-        fxs[i] = fxa_floor(30);
+    fxa_out(FX_R7);
+    fxr[3].u -= fxr[FX_R7].u;
+    /* c2 = 2c − 2^31 (mod 2^32; fits int32: 0 ≤ c < 2^31) */
+    fxr[3].u <<= 1;
+    fxr[3].b[3] ^= 0x80u;
+    for (fx_i = 0; fx_i < 3u; ++fx_i) {
+        fxa_dither(fx_rot[3u + fx_i]);
+        fxa_mac(FX_M(4, fx_i));
+        fxa_out((uint8_t)(fx_i | FX_SH30));
     }
-    for (i = 0; i < 4; ++i) {
-        /* q_i·2^31 + 2^30 */
-        fxa_lo = ((uint32_t)fx_q(i) << 31) | 0x40000000ul;
-        fxa_hi = ((uint32_t)fx_q(i) >> 1) | ((uint32_t)fx_q(i) & 0x80000000ul);
-        fxa_muladd(fx_q(i), fxs[3]);
-        for (k = 0; k < 3; ++k) {
-            int32_t hv = fxs[fx_ph[i][k]];
-            fxa_muladd(fx_q(fx_pq[i][k]), (fx_pneg[i] >> k) & 1u ? -hv : hv);
+    for (fx_i = 0; fx_i < 4u; ++fx_i) {
+        /* q_i·2^31 + 2^30, then + q_i·c2 (= 2·q_i·c) */
+        fx_ld7((uint8_t)(fx_i | FX_Q));
+        fxa.w.lo = 0x40000000ul;
+        if (fxr[FX_R7].b[0] & 1u) {
+            fxa.b[3] = 0xC0u;
         }
-        if (i < 3u) {
-            fxs[fx_res[i]] = fxa_floor(31);
-        } else {
-            fx_qp[3] = fxa_floor(31);
+        fxa.w.hi = fxr[FX_R7].u >> 1;
+        if (fxr[FX_R7].b[3] & 0x80u) {
+            fxa.b[7] |= 0x80u;
         }
+        fxa_mac(FX_M(FX_R7, 3));
+        for (fx_k = 0; fx_k < 3u; ++fx_k) {
+            /* − q·h as (−q)·h */
+            fx_ld7((uint8_t)(fx_pq[fx_i][fx_k] | FX_Q
+                             | (((fx_pneg[fx_i] >> fx_k) & 1u) ? FX_NEGL : 0u)));
+            fxa_mac(FX_M(FX_R7, fx_ph[fx_i][fx_k]));
+        }
+        fxa_out(fx_res[fx_i]);
     }
-    for (i = 0; i < 3; ++i) {
-        fx_qp[i] = fxs[fx_res[i]];
+    for (fx_i = 0; fx_i < 4u; ++fx_i) {
+        fx_st(fx_i);
     }
     return ATT_OK;
 }
@@ -283,9 +428,9 @@ static att_status fxc_apply(void)
 #ifndef ATT_FX_RV3_ONLY
 att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 {
-    fxs[0] = phi[0];
-    fxs[1] = phi[1];
-    fxs[2] = phi[2];
+    fxr[0].s = phi[0];
+    fxr[1].s = phi[1];
+    fxr[2].s = phi[2];
     fx_qp = q;
     fx_t = t;
     return fxc_apply();
@@ -298,11 +443,12 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
         return ATT_E_NULL;
     }
     fxa_set(0);
-    for (n = 0; n < 3; ++n) {
-        fxa_muladd(phi[n], phi[n]);
+    for (n = 0; n < 3u; ++n) {
+        fxr[n].s = phi[n];
+        fxa_mac(FX_M(n, n));
     }
     /* |Φ|² ≤ 9.6: round(Σ/2^36) ≤ 161061274, i.e. (hi + 8) >> 4 */
-    if (((fxa_hi + 8u) >> 4) > 161061274ul) {
+    if (((fxa.w.hi + 8u) >> 4) > 161061274ul) {
         return (att_status)ATT_FX_E_RANGE;
     }
     return att_fx_apply_(q, phi, fx_dither_seed(q));
@@ -311,16 +457,21 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
 
 att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
 {
-    if (q == 0 || d == 0) {
+    fx_qp = q;
+    fx_dp = d;
+    if (fx_qp == 0 || fx_dp == 0) {
         return ATT_E_NULL;
     }
-    if (!att_fx_dtheta_ok_(d, 9)) {
-        return (att_status)ATT_FX_E_RANGE;
+    for (fx_i = 0; fx_i < 9u; ++fx_i) {
+        fx_ld7(fx_i);
+        if (FX_DBAD(fxr[FX_R7].s)) {
+            return (att_status)ATT_FX_E_RANGE;
+        }
     }
-    fx_dp = d;
-    fx_qp = q;
-    fx_t = fx_dither_seed(q);
-    fxc_phi_rv3(ATT_FX_K_RV3_13, ATT_FX_K_RV3_23);
+    fxc_seed();
+    fxr[6].s = ATT_FX_K_RV3_13;
+    fxr[5].s = ATT_FX_K_RV3_23;
+    fxc_phi_rv3();
     return fxc_apply();
 }
 

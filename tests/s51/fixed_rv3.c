@@ -1,43 +1,33 @@
 /*
  * 8051 run of the fixed-point rv3 update (tests/test_fixed_targets.py).
  *
- * K = NUPD updates Q ← Q ⊗ q(Φ_rv3) from increments made by a 32-bit LCG
- * (the test replays the same LCG on the host and compares every
+ * K = NUPD updates Q ← Q ⊗ q(Φ_rv3) from the increments of the generated
+ * header fixed_rv3_inc.h (tests/test_fixed_targets.py writes it from a
+ * 32-bit LCG and replays the same increments on the host, comparing every
  * quaternion bit for bit). Prints one line per update: the four Q2.30
- * components as 8 hex digits. The last update is timed in machine cycles
- * with Timer 0 plus an overflow interrupt (the ~20 cycles of each ISR
- * entry are inside the count: < 0.1 %); the last two updates are timed,
- * one with small increments (≈ ±4.9e-4 rad: the degree-1 series) and one
- * with large ones (±0.25 rad: up to degree 4).
+ * components as 8 hex digits. The last two updates are timed in machine
+ * cycles with Timer 0 plus an overflow interrupt (the ~20 cycles of each
+ * ISR entry are inside the count: < 0.1 %), one with small increments
+ * (≈ ±4.9e-4 rad: the degree-1 series) and one with large ones (±0.25 rad:
+ * up to degree 4).
  *
- * RAM: the update needs ~60 bytes of its own plus the caller's 52-byte Q and
- * Δθ: more than an AT89S51 (128 bytes) can spare beside a stack, so the test
- * builds with --stack-auto for 256 bytes of internal RAM and runs on s51's
- * 8052 core (AT89S52); see docs/fixed-point.md.
+ * Built for the AT89S51 (s51 -t C51): small model, 128 bytes of internal
+ * RAM, no external RAM, 4 KB of code. The increments sit in code memory
+ * (the update reads them through a generic pointer), so the program's own
+ * RAM is Q (16 bytes) beside the update's static RAM and the stack.
  */
 #include <8051.h>
 
 #include "attitude/fixed.h"
 #include "s51_sif.h"
 
-#ifndef NUPD
-#define NUPD 6
-#endif
+#include "fixed_rv3_inc.h" /* NUPD, fx_inc[NUPD][9] (generated) */
 
 static volatile unsigned char ovf;
 
 void t0_isr(void) __interrupt(1)
 {
     ovf++;
-}
-
-static uint32_t x = 12345ul;
-
-static int32_t next_inc(unsigned char big)
-{
-    x = x * 1664525ul + 1013904223ul;
-    /* big: [-2^28, 2^28) = ±0.25 rad; small: [-2^19, 2^19) ≈ ±4.9e-4 rad */
-    return big ? (int32_t)(x >> 3) - 268435456L : (int32_t)(x >> 12) - 524288L;
 }
 
 static void put32(int32_t v)
@@ -48,11 +38,10 @@ static void put32(int32_t v)
 }
 
 static att_q30 q[4];
-static att_q30 d[9];
 
 void main(void)
 {
-    unsigned char k, i;
+    unsigned char k;
     unsigned int lo;
     int st;
     q[0] = ATT_FX_Q30_ONE;
@@ -60,9 +49,6 @@ void main(void)
     q[2] = 0;
     q[3] = 0;
     for (k = 0; k < NUPD; ++k) {
-        for (i = 0; i < 9; ++i) {
-            d[i] = next_inc((unsigned char)(k & 1u));
-        }
         if (k >= NUPD - 2) {
             ovf = 0;
             TR0 = 0;
@@ -74,7 +60,7 @@ void main(void)
             EA = 1;
             TR0 = 1;
         }
-        st = att_fx_update_rv3(q, d);
+        st = att_fx_update_rv3(q, fx_inc[k]);
         if (k >= NUPD - 2) {
             TR0 = 0;
             EA = 0;

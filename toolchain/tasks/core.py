@@ -5,7 +5,6 @@ from __future__ import annotations
 import datetime
 import importlib
 import platform
-import re
 import shutil
 import sys
 from pathlib import Path
