@@ -9,8 +9,9 @@ cd "$(dirname "$0")/.."
 APT_PACKAGES=(
   gcc clang libclang-rt-14-dev make cmake pkg-config  # host builds, sanitizers, fuzzing
   gcc-arm-none-eabi libnewlib-arm-none-eabi           # ARMv4T bare metal (semihosting)
-  gcc-arm-linux-gnueabi                               # ARMv4T embedded Linux (armel)
-  gcc-arm-linux-gnueabihf gcc-aarch64-linux-gnu       # other Linux targets
+  gcc-arm-linux-gnueabi libc6-dev-armel-cross         # ARMv4T embedded Linux (armel)
+  gcc-arm-linux-gnueabihf libc6-dev-armhf-cross       # other Linux targets
+  gcc-aarch64-linux-gnu libc6-dev-arm64-cross
   qemu-user                                           # qemu-arm -cpu ti925t, qemu-aarch64
   sdcc sdcc-ucsim                                     # AT89S51 firmware and the s51 simulator
   socat                                               # pseudo-terminal pairs for UART tests
@@ -25,7 +26,8 @@ if [ ${#missing[@]} -gt 0 ]; then
   [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   echo "setup: installing Debian packages: ${missing[*]}"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  # with recommends: the cross compilers recommend their C libraries, which we need
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}" >/dev/null
 fi
 
 PY=${PYTHON:-python3}
