@@ -304,6 +304,16 @@ def _write(port: Any, data: bytes) -> None:
         raise LinkError(f"port {getattr(port, 'name', port)!r} failed on write: {exc}") from exc
 
 
+def _drain(rx: Any, tick: int, out: bytearray) -> None:
+    """Collect every byte receiver ``rx`` wants to send now (its answers) into ``out``."""
+    while True:
+        r, o = rx.poll(tick)
+        if r is Result.SEND:
+            out.append(o)
+        elif r in (Result.NONE, Result.IDLE):
+            return
+
+
 @dataclass
 class BlockReport:
     """What happened to one block A sent."""
@@ -365,18 +375,8 @@ def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
                     if on_block is not None:
                         on_block(blk)
                 # answer as soon as the byte asks for it
-                while True:
-                    r, o = rx.poll(tick)
-                    if r is Result.SEND:
-                        out.append(o)  # type: ignore[arg-type]  # SEND always carries a byte
-                    elif r in (Result.NONE, Result.IDLE):
-                        break
-            while True:
-                r, o = rx.poll(tick)
-                if r is Result.SEND:
-                    out.append(o)  # type: ignore[arg-type]  # SEND always carries a byte
-                elif r in (Result.NONE, Result.IDLE):
-                    break
+                _drain(rx, tick, out)
+            _drain(rx, tick, out)
             if out:
                 _write(port, bytes(out))
             if count is not None and rx.stats.blocks_accepted >= count:

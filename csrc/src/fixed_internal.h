@@ -40,6 +40,11 @@
 uint32_t att_fx_dither_seed_(const att_q30 q[4]);
 #define fx_dither_seed att_fx_dither_seed_
 
+/* Domain of q(Φ): |Φ|² ≤ 9.6 rad². The check forms the exact sum of
+ * squares (Q4.60, unsigned, < 3·2^62), rounds it to Q.24 (shift 36) and
+ * compares with 9.6·2^24 rounded down. */
+#define FX_PHI2_MAX_Q24 161061274ul
+
 /* |x| > ATT_FX_DTHETA_MAX, one add and one unsigned compare */
 #define FX_DBAD(x) ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > \
                     2u * (uint32_t)ATT_FX_DTHETA_MAX)

@@ -387,6 +387,18 @@ FX_STATIC int32_t fx_mul(int32_t x, int32_t y, uint8_t sh)
     return fx_round(&a, sh);
 }
 
+/* 1 if |Φ|² ≤ FX_PHI2_MAX_Q24 / 2^24 (the domain of q(Φ), see
+ * fixed_internal.h): exact sum of squares rounded once. */
+FX_STATIC int fx_phi_in_range(const int32_t phi[3], uint32_t max_q24)
+{
+    fx_acc acc;
+    fx_zero(&acc);
+    fx_mac(&acc, phi[0], phi[0]);
+    fx_mac(&acc, phi[1], phi[1]);
+    fx_mac(&acc, phi[2], phi[2]);
+    return fx_round_u(&acc, 36) <= max_q24;
+}
+
 #endif /* FX_PRIM_MINIMAL */
 
 #endif /* ATT_FIXED_PRIM_H */

@@ -74,16 +74,11 @@ att_status att_fx_quat_mul(const att_q30 a[4], const att_q30 b[4], att_q30 out[4
  * part Q2.30 × Q2.30 → shift 31. |Φ|² > 9.6 → ATT_FX_E_RANGE. */
 att_status att_fx_rotvec_to_quat(const att_q30 phi[3], att_q30 q[4])
 {
-    fx_acc acc;
     int32_t c, s;
     if (phi == 0 || q == 0) {
         return ATT_E_NULL;
     }
-    fx_zero(&acc);
-    fx_mac(&acc, phi[0], phi[0]);
-    fx_mac(&acc, phi[1], phi[1]);
-    fx_mac(&acc, phi[2], phi[2]);
-    if (fx_round_u(&acc, 36) > 161061274ul) { /* 9.6 · 2^24 */
+    if (!fx_phi_in_range(phi, FX_PHI2_MAX_Q24)) {
         return (att_status)ATT_FX_E_RANGE;
     }
     att_fx_cs_(phi, &c, &s);

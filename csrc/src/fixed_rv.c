@@ -453,8 +453,8 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
         fxr[n].s = phi[n];
         fxa_mac(FX_M(n, n));
     }
-    /* |Φ|² ≤ 9.6: round(Σ/2^36) ≤ 161061274, i.e. (hi + 8) >> 4 */
-    if (((fxa.w.hi + 8u) >> 4) > 161061274ul) {
+    /* |Φ|² ≤ 9.6: round(Σ/2^36) ≤ FX_PHI2_MAX_Q24, i.e. (hi + 8) >> 4 */
+    if (((fxa.w.hi + 8u) >> 4) > FX_PHI2_MAX_Q24) {
         return (att_status)ATT_FX_E_RANGE;
     }
     return att_fx_apply_(q, phi, fx_dither_seed(q));
@@ -664,17 +664,10 @@ att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 
 att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
 {
-    fx_acc acc;
     if (q == 0 || phi == 0) {
         return ATT_E_NULL;
     }
-    /* |Φ|² ≤ 9.6: exact sum of squares (unsigned, < 3·2^62) in Q4.60,
-     * rounded to Q?.24 (shift 36, ≤ 12·2^24) */
-    fx_zero(&acc);
-    fx_mac(&acc, phi[0], phi[0]);
-    fx_mac(&acc, phi[1], phi[1]);
-    fx_mac(&acc, phi[2], phi[2]);
-    if (fx_round_u(&acc, 36) > 161061274ul) { /* 9.6 · 2^24 */
+    if (!fx_phi_in_range(phi, FX_PHI2_MAX_Q24)) {
         return (att_status)ATT_FX_E_RANGE;
     }
     {

@@ -222,27 +222,23 @@ static att_real wrap_pi(att_real a)
     return (a <= -ATT_PI) ? ATT_PI : a;
 }
 
-/* Euler angles from the five matrix elements they need. */
-static void euler_from_elements(att_real c11, att_real c12, att_real c21, att_real c22,
-                                att_real c31, att_real c32, att_real c33, att_real e[3])
-{
-    att_real ct = att_sqrt(c12 * c12 + c22 * c22);
-    e[1] = att_atan2(c32, ct);
-    if (ct < ATT_GIMBAL_COS) {
-        e[0] = wrap_pi(att_atan2(c21, c11));
-        e[2] = ATT_R(0.0);
-    } else {
-        e[0] = wrap_pi(att_atan2(-c12, c22));
-        e[2] = wrap_pi(att_atan2(-c31, c33));
-    }
-}
-
+/* z-x-y Euler angles (docs/conventions.md): θ = atan2(C32, √(C12² + C22²))
+ * (= asin C32, accurate near ±90°); at gimbal lock γ = 0, ψ = atan2(C21, C11). */
 att_status att_dcm_to_euler(const att_real C[9], att_real e[3])
 {
+    att_real ct;
     if (!finite_n(C, 9)) {
         return ATT_E_NONFINITE;
     }
-    euler_from_elements(C[0], C[1], C[3], C[4], C[6], C[7], C[8], e);
+    ct = att_sqrt(C[1] * C[1] + C[4] * C[4]);
+    e[1] = att_atan2(C[7], ct);
+    if (ct < ATT_GIMBAL_COS) {
+        e[0] = wrap_pi(att_atan2(C[3], C[0]));
+        e[2] = ATT_R(0.0);
+    } else {
+        e[0] = wrap_pi(att_atan2(-C[1], C[4]));
+        e[2] = wrap_pi(att_atan2(-C[6], C[8]));
+    }
     return ATT_OK;
 }
 
@@ -272,24 +268,12 @@ att_status att_euler_to_dcm(const att_real e[3], att_real C[9])
 
 att_status att_quat_to_euler(const att_real q[4], att_real e[3])
 {
-    att_real u[4], l, a, b, c;
-    att_status st = att_quat_normalize(q, u);
+    att_real C[9];
+    att_status st = att_quat_to_dcm(q, C);
     if (st != ATT_OK) {
         return st;
     }
-    l = u[0];
-    a = u[1];
-    b = u[2];
-    c = u[3];
-    euler_from_elements(l * l + a * a - b * b - c * c,    /* C11 */
-                        ATT_R(2.0) * (a * b - l * c),     /* C12 */
-                        ATT_R(2.0) * (a * b + l * c),     /* C21 */
-                        l * l - a * a + b * b - c * c,    /* C22 */
-                        ATT_R(2.0) * (a * c - l * b),     /* C31 */
-                        ATT_R(2.0) * (b * c + l * a),     /* C32 */
-                        l * l - a * a - b * b + c * c,    /* C33 */
-                        e);
-    return ATT_OK;
+    return att_dcm_to_euler(C, e);
 }
 
 att_status att_euler_to_quat(const att_real e[3], att_real q[4])
