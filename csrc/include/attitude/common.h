@@ -30,7 +30,11 @@ typedef double att_real;
 #endif
 
 /* Status codes. Ranges: generic -1..-19, integrator -20..-39,
- * TLC2543 -40..-59, link -60..-79, fixed point -80..-99. */
+ * TLC2543 -40..-59, link -60..-79, fixed point -80..-99, block format
+ * -100..-119, aiding solvers (alignment, TRIAD, Gauss-Newton, magnetometer
+ * calibration) -120..-139, attitude filter -140..-159, wavelet denoiser
+ * -160..-179, AD7927 -180..-199, link v2 -200..-219. Each module's header
+ * defines its own codes inside its range. */
 typedef enum {
     ATT_OK = 0,
     ATT_E_NULL = -1,       /* a required pointer argument is NULL */
