@@ -9,7 +9,7 @@ from invoke import Collection
 from toolchain.tasks import core
 
 ns = Collection()
-for t in (core.build, core.test, core.lint, core.clean, core.bench):
+for t in (core.build, core.test, core.lint, core.format, core.clean, core.bench):
     ns.add_task(t)
 
 # Areas that add their own tasks (top-level tasks and/or a namespace).

@@ -59,7 +59,7 @@ int main(int argc, char **argv)
     make_tables();
     if (mode[0] == 'f' && mode[1] == 'x') {
         att_fx_integ s;
-        att_q30 q[4] = {ATT_FX_Q30_ONE, 0, 0, 0};
+        att_q30 q[4] = { ATT_FX_Q30_ONE, 0, 0, 0 };
         int reuse = (strcmp(mode, "fx-reuse") == 0);
         int kernel = (strcmp(mode, "fx-rv3-kernel") == 0) || (strcmp(mode, "fx-loop-kernel") == 0);
         int empty = (strcmp(mode, "fx-loop-kernel") == 0);
@@ -84,9 +84,15 @@ int main(int argc, char **argv)
             att_q30 d[9];
             for (i = 0; i < n; ++i) {
                 int j = (int)(i & (NTAB - 4));
-                d[0] = tab_fx[j][0]; d[1] = tab_fx[j][1]; d[2] = tab_fx[j][2];
-                d[3] = tab_fx[j + 1][0]; d[4] = tab_fx[j + 1][1]; d[5] = tab_fx[j + 1][2];
-                d[6] = tab_fx[j + 2][0]; d[7] = tab_fx[j + 2][1]; d[8] = tab_fx[j + 2][2];
+                d[0] = tab_fx[j][0];
+                d[1] = tab_fx[j][1];
+                d[2] = tab_fx[j][2];
+                d[3] = tab_fx[j + 1][0];
+                d[4] = tab_fx[j + 1][1];
+                d[5] = tab_fx[j + 1][2];
+                d[6] = tab_fx[j + 2][0];
+                d[7] = tab_fx[j + 2][1];
+                d[8] = tab_fx[j + 2][2];
                 if ((empty ? no_update(q, d) : att_fx_update_rv3(q, d)) != ATT_OK) {
                     return 1;
                 }

@@ -59,10 +59,10 @@
 /* Timer 1 mode 2: baud = 2^SMOD * XTAL / (384 * (256 - TH1)). */
 #if ((FW_XTAL_HZ / 384L) % FW_BAUD) == 0 && (FW_XTAL_HZ / 384L / FW_BAUD) <= 255
 #define FW_SMOD 0
-#define FW_TH1 (256 - (FW_XTAL_HZ / 384L / FW_BAUD))
+#define FW_TH1  (256 - (FW_XTAL_HZ / 384L / FW_BAUD))
 #elif ((FW_XTAL_HZ / 192L) % FW_BAUD) == 0 && (FW_XTAL_HZ / 192L / FW_BAUD) <= 255
 #define FW_SMOD 1
-#define FW_TH1 (256 - (FW_XTAL_HZ / 192L / FW_BAUD))
+#define FW_TH1  (256 - (FW_XTAL_HZ / 192L / FW_BAUD))
 #else
 #error "FW_BAUD cannot be made exactly from FW_XTAL_HZ with Timer 1 in mode 2"
 #endif
@@ -70,8 +70,8 @@
 #if FW_PERIOD_TICKS < 1 || FW_PERIOD_TICKS > 32767
 #error "FW_PERIOD_TICKS must be 1..32767"
 #endif
-#if FW_SYN_TIMEOUT_TICKS < 1 || FW_SYN_TIMEOUT_TICKS > 32767 || \
-    FW_ANSWER_TIMEOUT_TICKS < 1 || FW_ANSWER_TIMEOUT_TICKS > 32767
+#if FW_SYN_TIMEOUT_TICKS < 1 || FW_SYN_TIMEOUT_TICKS > 32767 || FW_ANSWER_TIMEOUT_TICKS < 1 \
+    || FW_ANSWER_TIMEOUT_TICKS > 32767
 #error "link timeouts must be 1..32767 ticks"
 #endif
 #if FW_MAX_ATTEMPTS < 1 || FW_MAX_ATTEMPTS > 255

@@ -85,7 +85,7 @@ static uint16_t cycles_now(void)
 
 static void uart_init(void)
 {
-    SCON = 0x50; /* mode 1 (8-bit UART, variable baud), REN = 1 */
+    SCON = 0x50;                                    /* mode 1 (8-bit UART, variable baud), REN = 1 */
     TMOD = (unsigned char)((TMOD & 0x0Fu) | 0x20u); /* Timer 1: mode 2, timer */
     TH1 = (unsigned char)FW_TH1;
     TL1 = (unsigned char)FW_TH1;
@@ -116,7 +116,7 @@ static __bit q_any;        /* at least one block queued */
 static __bit q_full;       /* both slots used */
 static __bit q_last;       /* slot q_push() claimed last */
 static uint16_t seq;       /* number of the next sample to take */
-static uint16_t slot_seq0;  /* number of the sample in slot 0 / 1 */
+static uint16_t slot_seq0; /* number of the sample in slot 0 / 1 */
 static uint16_t slot_seq1;
 static uint16_t ovr_count; /* samples lost to a full queue, not yet reported:
                               always the newest ones, seq - ovr_count .. seq - 1 */
@@ -187,7 +187,7 @@ static void flush_overrun(void)
 /* X, Y, Z in one scan, then power-down (address 14): the three channels
  * are converted within one scan (about 0.4 ms apart at most), not one
  * sampling period apart as with next = X, and the ADC sleeps in between. */
-static const uint8_t xyz[3] = {TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z};
+static const uint8_t xyz[3] = { TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z };
 
 /* Start of a sampling period: a free slot for the sample (wp), or 0 if
  * the queue is full: then the sample is lost (counted, announced later by
@@ -243,7 +243,7 @@ static uint8_t self_test_done(int st)
         put_report_head((uint8_t)FW_REPORT_SELFTEST);
         put_word((uint16_t)(((uint16_t)(uint8_t)st << 8) | (uint8_t)(bad >> 8)));
         put_word((uint16_t)(((uint16_t)(uint8_t)bad << 8) | (uint8_t)seq)); /* attempt, mod 256 */
-        P3_5 = 0; /* fault LED on */
+        P3_5 = 0;                                                           /* fault LED on */
 #if defined(FW_BENCH)
         /* s51's port pins read 1: the test fails, but it ran (its stack
          * depth is measured); the bench goes on to sample. */
@@ -270,15 +270,15 @@ __sfr16 __at(0xD4D3) bench_scan_max;
 __sfr16 __at(0xD6D5) bench_scans;
 __sfr32 __at(0xDCDBDAD9) bench_scan_sum;
 __sfr16 __at(0xDEDD) bench_blocks;
-__sfr16 __at(0xE2E1) bench_busy_block;  /* CPU cycles of link handling, block in progress */
+__sfr16 __at(0xE2E1) bench_busy_block; /* CPU cycles of link handling, block in progress */
 __sfr16 __at(0xE4E3) bench_busy_max;
-__sfr16 __at(0xE6E5) bench_t_start;     /* block started */
-__sfr16 __at(0xE9E8) bench_t_syn;       /* 0xAA handed out */
-__sfr16 __at(0xEBEA) bench_t_sum;       /* checksum handed out */
-__sfr16 __at(0xEDEC) bench_sent;        /* tx.stats.blocks_sent seen last */
-__sfr16 __at(0xEFEE) bench_t_loop;      /* start of this loop iteration */
+__sfr16 __at(0xE6E5) bench_t_start; /* block started */
+__sfr16 __at(0xE9E8) bench_t_syn;   /* 0xAA handed out */
+__sfr16 __at(0xEBEA) bench_t_sum;   /* checksum handed out */
+__sfr16 __at(0xEDEC) bench_sent;    /* tx.stats.blocks_sent seen last */
+__sfr16 __at(0xEFEE) bench_t_loop;  /* start of this loop iteration */
 __sfr16 __at(0xD8D7) bench_t_scan;
-__sfr __at(0xBE) bench_busy;           /* this iteration did link work */
+__sfr __at(0xBE) bench_busy; /* this iteration did link work */
 __sfr32 __at(0xF4F3F2F1) bench_busy_sum;
 __sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
 __sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
@@ -371,9 +371,17 @@ static void put_stat(const char *name)
     fw_sim_puts(name);
     fw_sim_putc('=');
 }
-#define STAT(name, v) do { put_stat(name); fw_sim_puthex((uint16_t)(v)); } while (0)
-#define STAT32(name, v) do { put_stat(name); fw_sim_puthex((uint16_t)((v) >> 16)); \
-                             fw_sim_puthex((uint16_t)(v)); } while (0)
+#define STAT(name, v)                 \
+    do {                              \
+        put_stat(name);               \
+        fw_sim_puthex((uint16_t)(v)); \
+    } while (0)
+#define STAT32(name, v)                       \
+    do {                                      \
+        put_stat(name);                       \
+        fw_sim_puthex((uint16_t)((v) >> 16)); \
+        fw_sim_puthex((uint16_t)(v));         \
+    } while (0)
 
 /* Final report of a simulation run (hex values), then stop. */
 static void sim_finish(void)
@@ -449,9 +457,8 @@ static void block_given_up(void)
 
 /* ---- main ------------------------------------------------------------ */
 
-static const att_link_sender_config link_cfg = {
-    FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS, FW_BLOCK_SIZE, FW_MAX_ATTEMPTS
-};
+static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS, FW_BLOCK_SIZE,
+                                                 FW_MAX_ATTEMPTS };
 
 /* main's state is static: no local lives across a call, so main pushes
  * nothing on the stack around the deep calls (the scan). */
@@ -462,7 +469,7 @@ void main(void)
 {
     int st;
 
-    P1 = 0xFD;   /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released */
+    P1 = 0xFD; /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released */
     timer0_init();
     uart_init();
 #if defined(FW_SIM)
@@ -476,7 +483,7 @@ void main(void)
     fw_sim_model_init();
 #endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
-    (void)q_push(); /* the queue is empty: BOOT report first */
+    (void)q_push();                 /* the queue is empty: BOOT report first */
     put_report_head((uint8_t)FW_REPORT_BOOT);
     put_word((uint16_t)(((uint16_t)FW_VERSION << 8) | (uint8_t)(FW_PERIOD_TICKS >> 8)));
     put_word((uint16_t)(((uint16_t)(uint8_t)FW_PERIOD_TICKS << 8) | (uint8_t)(FW_BAUD / 1200L)));
@@ -496,7 +503,11 @@ void main(void)
             bench_rx(SBUF);
 #endif
 #if defined(FW_SIM_TRACE)
-            fw_sim_putc('r'); fw_sim_puthex(SBUF); fw_sim_putc('@'); fw_sim_puthex(fw_ticks); fw_sim_putc('\n');
+            fw_sim_putc('r');
+            fw_sim_puthex(SBUF);
+            fw_sim_putc('@');
+            fw_sim_puthex(fw_ticks);
+            fw_sim_putc('\n');
 #endif
             if (att_link_sender_sink(&tx, SBUF, fw_ticks) == ATT_LINK_ACCEPTED) {
                 block_accepted();
@@ -508,8 +519,13 @@ void main(void)
             st = att_link_sender_poll(&tx, fw_ticks, &txb);
 #if defined(FW_SIM_TRACE)
             if (st != ATT_LINK_NONE && st != ATT_LINK_IDLE) {
-                fw_sim_putc('p'); fw_sim_puthex((uint16_t)st); fw_sim_putc(' '); fw_sim_puthex(txb);
-                fw_sim_putc('@'); fw_sim_puthex(fw_ticks); fw_sim_putc('\n');
+                fw_sim_putc('p');
+                fw_sim_puthex((uint16_t)st);
+                fw_sim_putc(' ');
+                fw_sim_puthex(txb);
+                fw_sim_putc('@');
+                fw_sim_puthex(fw_ticks);
+                fw_sim_putc('\n');
             }
 #endif
             if (st == ATT_LINK_SEND) {
@@ -561,7 +577,7 @@ void main(void)
                 seq++;
             } else {
                 if (q_push()) { /* the report slot, also where the codes land */
-                    seq++; /* until sampling starts, seq counts the self-test attempts */
+                    seq++;      /* until sampling starts, seq counts the self-test attempts */
                     st = tlc2543_self_test_codes(&adc, (uint16_t __data *)wp);
 #if defined(FW_SIM_MODEL)
                     fw_sim_model_check();

@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 
 APT_PACKAGES=(
   gcc clang libclang-rt-14-dev make cmake pkg-config  # host builds, sanitizers, fuzzing
+  clang-format                                        # C style (.clang-format), checked by the tests
   gcc-arm-none-eabi libnewlib-arm-none-eabi           # ARMv4T bare metal (semihosting)
   gcc-arm-linux-gnueabi libc6-dev-armel-cross         # ARMv4T embedded Linux (armel)
   gcc-arm-linux-gnueabihf libc6-dev-armhf-cross       # other Linux targets

@@ -22,7 +22,10 @@ static uint32_t rnd(void)
 }
 
 static uint32_t h;
-static void hash_reset(void) { h = 2166136261u; }
+static void hash_reset(void)
+{
+    h = 2166136261u;
+}
 static void hash32(int32_t v)
 {
     uint32_t u = (uint32_t)v;
@@ -125,15 +128,15 @@ int main(void)
     hash_reset();
     {
         att_fx_adc cv;
-        int32_t zero[3] = {2048L * 256, 2047L * 256 + 77, 1999L * 256};
-        uint32_t scale[3] = {136520000ul, 140000000ul, 3000000ul};
-        uint32_t periods[4] = {10000000ul, 1000000ul, 100000ul, 3333333ul};
+        int32_t zero[3] = { 2048L * 256, 2047L * 256 + 77, 1999L * 256 };
+        uint32_t scale[3] = { 136520000ul, 140000000ul, 3000000ul };
+        uint32_t periods[4] = { 10000000ul, 1000000ul, 100000ul, 3333333ul };
         for (m = 0; m < 4; ++m) {
             hash32(att_fx_adc_init(&cv, zero, scale, periods[m]));
             hashn(cv.gain, 3);
             for (i = 0; i < 200; ++i) {
                 uint16_t code[3];
-                att_q30 d[3] = {0, 0, 0};
+                att_q30 d[3] = { 0, 0, 0 };
                 code[0] = (uint16_t)(rnd() & 0xFFFu);
                 code[1] = (uint16_t)(rnd() & 0xFFFu);
                 code[2] = (uint16_t)(rnd() & 0xFFFFu);
@@ -146,7 +149,7 @@ int main(void)
      * zero code (negative products, exact ties) */
     {
         att_fx_adc cv;
-        int32_t zero[3] = {2048L * 256, 128, 65535L * 256};
+        int32_t zero[3] = { 2048L * 256, 128, 65535L * 256 };
         for (m = 0; m < 300; ++m) {
             uint32_t scale[3];
             uint32_t period = 1u + (rnd() >> (rnd() & 31u));
@@ -163,7 +166,7 @@ int main(void)
             hash32(cv.shift[0] | (cv.shift[1] << 8) | ((int32_t)cv.shift[2] << 16));
             for (i = 0; i < 20; ++i) {
                 uint16_t code[3];
-                att_q30 d[3] = {0, 0, 0};
+                att_q30 d[3] = { 0, 0, 0 };
                 code[0] = (uint16_t)(2048 + (int)(rnd() % 9u) - 4);
                 code[1] = (uint16_t)(rnd() % 3u);
                 code[2] = (uint16_t)(65535u - rnd() % 5u);

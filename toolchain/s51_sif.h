@@ -22,10 +22,19 @@
 
 __sfr __at(0xff) S51_SIF;
 
-#define S51_CYCLES_BEGIN() \
-    do { TR0 = 0; TMOD = (unsigned char)((TMOD & 0xF0) | 0x01); \
-         TH0 = 0; TL0 = 0; TF0 = 0; TR0 = 1; } while (0)
-#define S51_CYCLES_END() do { TR0 = 0; } while (0)
+#define S51_CYCLES_BEGIN()                            \
+    do {                                              \
+        TR0 = 0;                                      \
+        TMOD = (unsigned char)((TMOD & 0xF0) | 0x01); \
+        TH0 = 0;                                      \
+        TL0 = 0;                                      \
+        TF0 = 0;                                      \
+        TR0 = 1;                                      \
+    } while (0)
+#define S51_CYCLES_END() \
+    do {                 \
+        TR0 = 0;         \
+    } while (0)
 
 /* Machine cycles between BEGIN and END (0xFFFF on overflow). */
 unsigned int s51_cycles(void);

@@ -31,13 +31,13 @@
 typedef struct {
     rx_config cfg;
     rx_queue queue;
-    int fd;                 /* serial port (owned by the receiver thread once started) */
-    int wake_rd, wake_wr;   /* self-pipe: stop requests (signal handler, --count) */
-    att_link_receiver_stats link;  /* copied by the receiver thread when it ends */
-    unsigned long samples;  /* samples received in accepted blocks */
+    int fd;                       /* serial port (owned by the receiver thread once started) */
+    int wake_rd, wake_wr;         /* self-pipe: stop requests (signal handler, --count) */
+    att_link_receiver_stats link; /* copied by the receiver thread when it ends */
+    unsigned long samples;        /* samples received in accepted blocks */
     unsigned long port_errors, reopens;
     unsigned long integrated, updates, integ_errors;
-    int out_error;          /* stdout failed (closed pipe) */
+    int out_error; /* stdout failed (closed pipe) */
 } rx_app;
 
 static int g_wake_wr = -1; /* for the signal handler only */
@@ -218,16 +218,16 @@ static int print_update(rx_app *app, const rx_sample *s, const att_real q[4])
         e[0] = e[1] = e[2] = h = (att_real)0;
     if (app->cfg.format == RX_FORMAT_CSV)
         rc = printf("%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g\n", t, (unsigned long)s->seq,
-                    s->code[0], s->code[1], s->code[2], digits, (double)q[0], digits, (double)q[1],
-                    digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
+                    s->code[0], s->code[1], s->code[2], digits, (double)q[0], digits, (double)q[1], digits,
+                    (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
                     (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
     else
-        rc = printf("{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
-                    "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g}\n",
-                    t, (unsigned long)s->seq, s->code[0], s->code[1], s->code[2], digits, (double)q[0],
-                    digits, (double)q[1], digits, (double)q[2], digits, (double)q[3], digits,
-                    (double)e[0] * r2d, digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits,
-                    (double)h * r2d);
+        rc =
+            printf("{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
+                   "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g}\n",
+                   t, (unsigned long)s->seq, s->code[0], s->code[1], s->code[2], digits, (double)q[0], digits,
+                   (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d,
+                   digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
     if (rc < 0 || fflush(stdout) != 0)
         return -1;
     return 0;
@@ -337,9 +337,8 @@ int main(int argc, char **argv)
     sa.sa_handler = SIG_IGN;
     sigaction(SIGPIPE, &sa, NULL); /* a closed stdout is reported by printf */
 
-    fprintf(stderr, "attitude-rx: %s at %ld baud 8N1, block %u bytes, method %s, period %g s\n",
-            app.cfg.port, app.cfg.baud, app.cfg.block_size, rx_method_name(app.cfg.method),
-            app.cfg.period);
+    fprintf(stderr, "attitude-rx: %s at %ld baud 8N1, block %u bytes, method %s, period %g s\n", app.cfg.port,
+            app.cfg.baud, app.cfg.block_size, rx_method_name(app.cfg.method), app.cfg.period);
     if (pthread_create(&att_thr, NULL, attitude_thread, &app) != 0
         || pthread_create(&rx_thr, NULL, receiver_thread, &app) != 0) {
         fprintf(stderr, "attitude-rx: cannot start threads\n");
@@ -357,8 +356,8 @@ int main(int argc, char **argv)
             "attitude-rx: link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu "
             "bytes_discarded=%lu\n",
             (unsigned long)app.link.syns, (unsigned long)app.link.blocks_accepted,
-            (unsigned long)app.link.naks, (unsigned long)app.link.timeouts,
-            (unsigned long)app.link.resyncs, (unsigned long)app.link.bytes_discarded);
+            (unsigned long)app.link.naks, (unsigned long)app.link.timeouts, (unsigned long)app.link.resyncs,
+            (unsigned long)app.link.bytes_discarded);
     fprintf(stderr,
             "attitude-rx: samples: received=%lu integrated=%lu queue_overflows=%lu "
             "queue_high_water=%u updates=%lu integrator_errors=%lu port_errors=%lu reopens=%lu\n",

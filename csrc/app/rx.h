@@ -15,40 +15,43 @@
 /* Exit codes (the BSD sysexits values, so shell scripts can tell them apart). */
 enum {
     RX_EXIT_OK = 0,
-    RX_EXIT_USAGE = 64,   /* bad command line */
-    RX_EXIT_NOPORT = 66,  /* port does not exist */
+    RX_EXIT_USAGE = 64,  /* bad command line */
+    RX_EXIT_NOPORT = 66, /* port does not exist */
     RX_EXIT_INTERNAL = 70,
-    RX_EXIT_IOERR = 74,   /* port cannot be configured (not a tty...) */
-    RX_EXIT_NOPERM = 77,  /* no permission to open the port */
-    RX_EXIT_CONFIG = 78   /* bad config file or value */
+    RX_EXIT_IOERR = 74,  /* port cannot be configured (not a tty...) */
+    RX_EXIT_NOPERM = 77, /* no permission to open the port */
+    RX_EXIT_CONFIG = 78  /* bad config file or value */
 };
 
 enum {
-    RX_QUEUE_MAX = 4096,  /* largest --queue */
+    RX_QUEUE_MAX = 4096, /* largest --queue */
     RX_PATH_MAX = 256,
     RX_MSG_MAX = 256
 };
 
-typedef enum { RX_FORMAT_CSV = 0, RX_FORMAT_JSONL = 1 } rx_format;
+typedef enum {
+    RX_FORMAT_CSV = 0,
+    RX_FORMAT_JSONL = 1
+} rx_format;
 
 /* Everything the command line / config file sets. */
 typedef struct {
     char port[RX_PATH_MAX];
-    long baud;                /* bits per second */
-    double period;            /* s, gyro sample period */
-    double zero[3];           /* ADC code at zero rate, per channel */
-    double scale[3];          /* rad/s per code, per channel */
-    int axis_src[3];          /* body axis i = sign[i] * channel axis_src[i] */
+    long baud;       /* bits per second */
+    double period;   /* s, gyro sample period */
+    double zero[3];  /* ADC code at zero rate, per channel */
+    double scale[3]; /* rad/s per code, per channel */
+    int axis_src[3]; /* body axis i = sign[i] * channel axis_src[i] */
     int axis_sign[3];
     att_method method;
     rx_format format;
-    unsigned block_size;      /* link block N: a multiple of 6 (3 x 16-bit codes per sample) */
-    unsigned queue_size;      /* samples the queue holds (1..RX_QUEUE_MAX) */
-    unsigned gap_ms;          /* link receiver gap timeout, ms */
-    unsigned long count;      /* stop after this many output lines (0 = run until signalled) */
-    double consumer_delay;    /* s the attitude thread sleeps per sample (diagnostics/tests) */
-    double reopen_delay;      /* s between attempts to reopen a port that went away */
-    int header;               /* print the CSV header line */
+    unsigned block_size;   /* link block N: a multiple of 6 (3 x 16-bit codes per sample) */
+    unsigned queue_size;   /* samples the queue holds (1..RX_QUEUE_MAX) */
+    unsigned gap_ms;       /* link receiver gap timeout, ms */
+    unsigned long count;   /* stop after this many output lines (0 = run until signalled) */
+    double consumer_delay; /* s the attitude thread sleeps per sample (diagnostics/tests) */
+    double reopen_delay;   /* s between attempts to reopen a port that went away */
+    int header;            /* print the CSV header line */
 } rx_config;
 
 /* Defaults: 9600 baud, 0.01 s, zero 2048, scale = 90 deg/s per 2048 codes,
@@ -72,8 +75,8 @@ void rx_usage(const char *prog, void *stream);
 
 /* ---- bounded sample queue (one producer, one consumer) ---- */
 typedef struct {
-    uint16_t code[3];   /* raw ADC codes X, Y, Z as received */
-    uint32_t seq;       /* sample number since start (0-based) */
+    uint16_t code[3]; /* raw ADC codes X, Y, Z as received */
+    uint32_t seq;     /* sample number since start (0-based) */
 } rx_sample;
 
 typedef struct {

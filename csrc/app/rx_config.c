@@ -14,9 +14,12 @@ static const struct {
     const char *name;
     att_method method;
 } methods[] = {
-    {"rv1", ATT_METHOD_RV1}, {"rv2", ATT_METHOD_RV2}, {"rv3", ATT_METHOD_RV3},
-    {"rv3-coning", ATT_METHOD_RV3_CONING}, {"rv3-reuse", ATT_METHOD_RV3_REUSE},
-    {"rk4", ATT_METHOD_RK4},
+    { "rv1", ATT_METHOD_RV1 },
+    { "rv2", ATT_METHOD_RV2 },
+    { "rv3", ATT_METHOD_RV3 },
+    { "rv3-coning", ATT_METHOD_RV3_CONING },
+    { "rv3-reuse", ATT_METHOD_RV3_REUSE },
+    { "rk4", ATT_METHOD_RK4 },
 };
 
 const char *rx_method_name(att_method m)
@@ -135,10 +138,20 @@ static int parse_axes(const char *s, int src[3], int sign[3])
         if (tok[0] == '\0' || tok[1] != '\0')
             return -1;
         switch (tolower((unsigned char)tok[0])) {
-        case 'x': case '0': ch = 0; break;
-        case 'y': case '1': ch = 1; break;
-        case 'z': case '2': ch = 2; break;
-        default: return -1;
+        case 'x':
+        case '0':
+            ch = 0;
+            break;
+        case 'y':
+        case '1':
+            ch = 1;
+            break;
+        case 'z':
+        case '2':
+            ch = 2;
+            break;
+        default:
+            return -1;
         }
         if (seen & (1 << ch))
             return -1; /* each channel once */
@@ -167,19 +180,22 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         strcpy(c->port, value);
     } else if (strcmp(name, "baud") == 0) {
         if (parse_ulong(value, &u) != 0 || !rx_serial_baud_ok((long)u))
-            return fail(msg, len, RX_EXIT_CONFIG,
-                        "baud: '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 230400)",
-                        value);
+            return fail(
+                msg, len, RX_EXIT_CONFIG,
+                "baud: '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 230400)",
+                value);
         c->baud = (long)u;
     } else if (strcmp(name, "period") == 0) {
         if (parse_double(value, &d) != 0 || !(d > 0.0) || d > 10.0)
-            return fail(msg, len, RX_EXIT_CONFIG, "period: '%s' must be a sample period in seconds, 0 < T <= 10", value);
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "period: '%s' must be a sample period in seconds, 0 < T <= 10", value);
         c->period = d;
     } else if (strcmp(name, "gyro-zero") == 0) {
         double v[3];
-        if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > 65535
-            || v[1] > 65535 || v[2] > 65535)
-            return fail(msg, len, RX_EXIT_CONFIG, "gyro-zero: '%s' must be CODE or CODE,CODE,CODE (0..65535)", value);
+        if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > 65535 || v[1] > 65535
+            || v[2] > 65535)
+            return fail(msg, len, RX_EXIT_CONFIG, "gyro-zero: '%s' must be CODE or CODE,CODE,CODE (0..65535)",
+                        value);
         memcpy(c->zero, v, sizeof v);
     } else if (strcmp(name, "gyro-scale") == 0) {
         double v[3];
@@ -190,7 +206,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
     } else if (strcmp(name, "axes") == 0) {
         if (parse_axes(value, c->axis_src, c->axis_sign) != 0)
             return fail(msg, len, RX_EXIT_CONFIG,
-                        "axes: '%s' must name each channel once with an optional sign, e.g. x,y,z or -y,+x,z", value);
+                        "axes: '%s' must name each channel once with an optional sign, e.g. x,y,z or -y,+x,z",
+                        value);
     } else if (strcmp(name, "method") == 0) {
         for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
             if (strcmp(value, methods[i].name) == 0)
@@ -209,7 +226,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
     } else if (strcmp(name, "block-size") == 0) {
         if (parse_ulong(value, &u) != 0 || u == 0 || u % 6 != 0 || u > ATT_LINK_BLOCK_MAX)
             return fail(msg, len, RX_EXIT_CONFIG,
-                        "block-size: '%s' must be a multiple of 6 (3 x 16-bit codes per sample) up to 60", value);
+                        "block-size: '%s' must be a multiple of 6 (3 x 16-bit codes per sample) up to 60",
+                        value);
         c->block_size = (unsigned)u;
     } else if (strcmp(name, "queue") == 0) {
         if (parse_ulong(value, &u) != 0 || u == 0 || u > RX_QUEUE_MAX)
@@ -217,7 +235,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         c->queue_size = (unsigned)u;
     } else if (strcmp(name, "gap-ms") == 0) {
         if (parse_ulong(value, &u) != 0 || u == 0 || u > ATT_LINK_TIMEOUT_MAX)
-            return fail(msg, len, RX_EXIT_CONFIG, "gap-ms: '%s' must be 1..%d ms", value, ATT_LINK_TIMEOUT_MAX);
+            return fail(msg, len, RX_EXIT_CONFIG, "gap-ms: '%s' must be 1..%d ms", value,
+                        ATT_LINK_TIMEOUT_MAX);
         c->gap_ms = (unsigned)u;
     } else if (strcmp(name, "count") == 0) {
         if (parse_ulong(value, &u) != 0)
@@ -357,10 +376,12 @@ int rx_config_parse(rx_config *c, int argc, char **argv, int *help, char *msg, s
         rc = rx_config_set(c, name, value, msg, len);
         if (rc != 0)
             return rc == RX_EXIT_CONFIG && strncmp(msg, "unknown setting", 15) == 0
-                ? fail(msg, len, RX_EXIT_USAGE, "unknown option --%s (see --help)", name) : rc;
+                       ? fail(msg, len, RX_EXIT_USAGE, "unknown option --%s (see --help)", name)
+                       : rc;
     }
     if (c->port[0] == '\0')
-        return fail(msg, len, RX_EXIT_USAGE, "no serial port: give --port PATH (or port = PATH in --config FILE)");
+        return fail(msg, len, RX_EXIT_USAGE,
+                    "no serial port: give --port PATH (or port = PATH in --config FILE)");
     return 0;
 }
 

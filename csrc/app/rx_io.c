@@ -84,8 +84,8 @@ static const struct {
     long rate;
     speed_t code;
 } bauds[] = {
-    {1200, B1200}, {2400, B2400}, {4800, B4800}, {9600, B9600}, {19200, B19200},
-    {38400, B38400}, {57600, B57600}, {115200, B115200}, {230400, B230400},
+    { 1200, B1200 },   { 2400, B2400 },   { 4800, B4800 },     { 9600, B9600 },     { 19200, B19200 },
+    { 38400, B38400 }, { 57600, B57600 }, { 115200, B115200 }, { 230400, B230400 },
 };
 
 static int baud_code(long baud, speed_t *code)
@@ -140,8 +140,7 @@ int rx_serial_open(const char *path, long baud, char *msg, size_t len)
     tio.c_iflag &= ~(tcflag_t)(IXON | IXOFF | IXANY);
     tio.c_cc[VMIN] = 1;
     tio.c_cc[VTIME] = 0;
-    if (cfsetispeed(&tio, code) != 0 || cfsetospeed(&tio, code) != 0
-        || tcsetattr(fd, TCSANOW, &tio) != 0) {
+    if (cfsetispeed(&tio, code) != 0 || cfsetospeed(&tio, code) != 0 || tcsetattr(fd, TCSANOW, &tio) != 0) {
         e = errno;
         snprintf(msg, len, "cannot configure port %s: %s", path, strerror(e));
         close(fd);

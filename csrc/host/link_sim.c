@@ -184,9 +184,8 @@ static uint64_t min_u64(uint64_t a, uint64_t b)
     return a < b ? a : b;
 }
 
-int att_link_sim_run(const att_link_sim_config *cfg, att_link_channel *ch,
-                     const uint8_t *blocks, uint32_t n_blocks,
-                     uint8_t *acc_data, int64_t *acc_index, uint64_t *acc_tick,
+int att_link_sim_run(const att_link_sim_config *cfg, att_link_channel *ch, const uint8_t *blocks,
+                     uint32_t n_blocks, uint8_t *acc_data, int64_t *acc_index, uint64_t *acc_tick,
                      uint32_t acc_capacity, uint8_t *outcome, att_link_sim_result *res)
 {
     att_link_sender a;
@@ -195,8 +194,8 @@ int att_link_sim_run(const att_link_sim_config *cfg, att_link_channel *ch,
     line la, lb; /* la: A -> B, lb: B -> A */
     sender_ext ext;
     uint64_t t = 0;
-    uint32_t k = 0;    /* next block to start */
-    int64_t cur = -1;  /* block A is sending */
+    uint32_t k = 0;   /* next block to start */
+    int64_t cur = -1; /* block A is sending */
     uint32_t reb_done = 0;
     uint8_t n;
     int rc, i, j;

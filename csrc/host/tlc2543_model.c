@@ -289,8 +289,8 @@ void tlc2543m_set_cs(void *ctx, int level)
         set_dout(m, out_bit(m, 0u));
     } else {
         if (m->nclk == 0u || m->n_fall < m->nclk) {
-            fail(m, TLC2543M_V_CS_MID_CYCLE, "CS raised after %u I/O clocks of %u",
-                 (unsigned)m->n_fall, (unsigned)m->nclk);
+            fail(m, TLC2543M_V_CS_MID_CYCLE, "CS raised after %u I/O clocks of %u", (unsigned)m->n_fall,
+                 (unsigned)m->nclk);
         }
         m->cs = 1u;
         log_event(m, TLC2543M_SIG_CS, 1u);
@@ -320,13 +320,12 @@ void tlc2543m_set_clock(void *ctx, int level)
                  (long long)(m->t - m->t_fall), (int)tm->t_clk_low);
         }
         if (m->nclk != 0u && m->n_rise >= m->nclk) {
-            fail(m, TLC2543M_V_CLOCK_COUNT, "I/O clock %u in a %u-clock cycle",
-                 (unsigned)m->n_rise + 1u, (unsigned)m->nclk);
+            fail(m, TLC2543M_V_CLOCK_COUNT, "I/O clock %u in a %u-clock cycle", (unsigned)m->n_rise + 1u,
+                 (unsigned)m->nclk);
         }
         if (m->n_rise < 8u) {
             if (m->t - m->t_din < tm->t_din_setup) {
-                fail(m, TLC2543M_V_DIN_SETUP,
-                     "DATA INPUT changed %lld ns before the rising edge (min %d ns)",
+                fail(m, TLC2543M_V_DIN_SETUP, "DATA INPUT changed %lld ns before the rising edge (min %d ns)",
                      (long long)(m->t - m->t_din), (int)tm->t_din_setup);
             }
             m->in_byte = (uint8_t)((m->in_byte << 1) | m->din);
@@ -409,9 +408,8 @@ int tlc2543m_get_eoc(void *ctx)
     return m->eoc_level;
 }
 
-int tlc2543m_convert(tlc2543m *m, tlc2543 *dev, const uint8_t *channels, uint8_t nch,
-                     const double *volts, size_t n, int32_t *codes, int self_test,
-                     size_t *rows_done)
+int tlc2543m_convert(tlc2543m *m, tlc2543 *dev, const uint8_t *channels, uint8_t nch, const double *volts,
+                     size_t n, int32_t *codes, int self_test, size_t *rows_done)
 {
     size_t row;
     uint8_t k;

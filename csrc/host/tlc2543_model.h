@@ -57,28 +57,28 @@ typedef struct {
 } tlc2543m_event;
 
 typedef struct {
-    int32_t t_cs_setup, t_dout_enable, t_din_setup, t_din_hold, t_clk_high, t_clk_low,
-        t_dout_valid, t_eoc_fall, t_conv, t_cs_reassert; /* ns, as model.Timing */
+    int32_t t_cs_setup, t_dout_enable, t_din_setup, t_din_hold, t_clk_high, t_clk_low, t_dout_valid,
+        t_eoc_fall, t_conv, t_cs_reassert; /* ns, as model.Timing */
 } tlc2543m_timing;
 
 typedef struct {
     /* configuration (set by tlc2543m_init; may be changed between cycles) */
-    double inputs[11];  /* AIN0..AIN10, V */
-    double vref_plus;   /* V */
-    double vref_minus;  /* V */
+    double inputs[11]; /* AIN0..AIN10, V */
+    double vref_plus;  /* V */
+    double vref_minus; /* V */
     tlc2543m_timing timing;
-    int8_t stuck_eoc;   /* -1: not stuck; 0/1: stuck level */
-    int8_t stuck_dout;  /* -1: not stuck; 0/1: stuck level (when driven) */
+    int8_t stuck_eoc;  /* -1: not stuck; 0/1: stuck level */
+    int8_t stuck_dout; /* -1: not stuck; 0/1: stuck level (when driven) */
     /* trace: caller-owned buffer (may be NULL / 0) */
     tlc2543m_event *trace;
     size_t trace_cap;
     size_t trace_len;
     size_t trace_dropped; /* events that did not fit */
     /* result */
-    int violation;         /* TLC2543M_V_* of the first violation */
-    int64_t violation_t;   /* its time, ns */
-    char message[160];     /* its description */
-    uint32_t conversions;  /* conversions completed */
+    int violation;        /* TLC2543M_V_* of the first violation */
+    int64_t violation_t;  /* its time, ns */
+    char message[160];    /* its description */
+    uint32_t conversions; /* conversions completed */
     /* simulation state (private) */
     int64_t t;
     uint8_t cs, clock, din, dout_level, eoc_level;
@@ -127,8 +127,7 @@ void tlc2543m_delay_ns(void *ctx, uint32_t ns);
  * voltage) or TLC2543M_E_VIOLATION; *rows_done = rows fully converted
  * (their codes are stored).
  */
-int tlc2543m_convert(tlc2543m *m, tlc2543 *dev, const uint8_t *channels, uint8_t nch,
-                     const double *volts, size_t n, int32_t *codes, int self_test,
-                     size_t *rows_done);
+int tlc2543m_convert(tlc2543m *m, tlc2543 *dev, const uint8_t *channels, uint8_t nch, const double *volts,
+                     size_t n, int32_t *codes, int self_test, size_t *rows_done);
 
 #endif /* ATTITUDE_TLC2543_MODEL_H */

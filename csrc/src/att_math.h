@@ -11,23 +11,23 @@
 #include "attitude/common.h"
 
 #if defined(ATT_REAL_F32)
-#define att_sqrt sqrtf
-#define att_sin sinf
-#define att_cos cosf
-#define att_atan2 atan2f
-#define att_fabs fabsf
+#define att_sqrt       sqrtf
+#define att_sin        sinf
+#define att_cos        cosf
+#define att_atan2      atan2f
+#define att_fabs       fabsf
 #define ATT_GIMBAL_COS ((att_real)2.44140625e-4) /* 2^-12 ~ sqrt(FLT_EPSILON) */
 #else
-#define att_sqrt sqrt
-#define att_sin sin
-#define att_cos cos
-#define att_atan2 atan2
-#define att_fabs fabs
+#define att_sqrt       sqrt
+#define att_sin        sin
+#define att_cos        cos
+#define att_atan2      atan2
+#define att_fabs       fabs
 #define ATT_GIMBAL_COS ((att_real)1.4901161193847656e-8) /* 2^-26 = sqrt(DBL_EPSILON) */
 #endif
 
-#define ATT_R(x) ((att_real)(x))
-#define ATT_PI ATT_R(3.14159265358979323846)
+#define ATT_R(x)   ((att_real)(x))
+#define ATT_PI     ATT_R(3.14159265358979323846)
 #define ATT_TWO_PI ATT_R(6.28318530717958647692)
 
 /* Below this φ² the rotation-vector quaternion uses its Taylor series
@@ -51,9 +51,14 @@ static inline void att__rotvec_delta(const att_real phi[3], att_real d[4])
     att_real p2 = phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2];
     att_real c1, s;
     if (p2 < ATT_ROTVEC_SERIES_PHI2) {
-        c1 = p2 * (ATT_R(-0.125) + p2 * (ATT_R(1.0 / 384.0) + p2 * (ATT_R(-1.0 / 46080.0)
-                                   + p2 * ATT_R(1.0 / 10321920.0))));
-        s = ATT_R(0.5) + p2 * (ATT_R(-1.0 / 48.0) + p2 * (ATT_R(1.0 / 3840.0)
+        c1 = p2
+             * (ATT_R(-0.125)
+                + p2 * (ATT_R(1.0 / 384.0) + p2 * (ATT_R(-1.0 / 46080.0) + p2 * ATT_R(1.0 / 10321920.0))));
+        s = ATT_R(0.5)
+            + p2
+                  * (ATT_R(-1.0 / 48.0)
+                     + p2
+                           * (ATT_R(1.0 / 3840.0)
                               + p2 * (ATT_R(-1.0 / 645120.0) + p2 * ATT_R(1.0 / 185794560.0))));
     } else {
         att_real p = att_sqrt(p2);

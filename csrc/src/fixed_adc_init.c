@@ -58,8 +58,8 @@ static att_status fx_adc_gain(uint32_t scale_q32, uint32_t period_ns, int32_t *m
     return ATT_OK;
 }
 
-att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3],
-                           const uint32_t scale_q32[3], uint32_t period_ns)
+att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3], const uint32_t scale_q32[3],
+                           uint32_t period_ns)
 {
     int32_t m[3];
     uint8_t s[3], i;
@@ -86,4 +86,3 @@ att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3],
     }
     return ATT_OK;
 }
-

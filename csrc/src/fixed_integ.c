@@ -15,18 +15,18 @@
  * Q4.60 sum; per component the four cross terms accumulated exactly and
  * rounded once (shift 30), the integer d3 added. |Φ_i| ≤ 0.4 + 0.02 < 2.
  */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3],
-                       uint32_t t, att_q30 phi[3])
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint32_t t,
+                       att_q30 phi[3])
 {
     int32_t p0, p1, p2, u0, u1, u2;
     fx_acc acc;
     p0 = fx_mul(ATT_FX_K_RV3R_12, d1[0], 30);
     p1 = fx_mul(ATT_FX_K_RV3R_12, d1[1], 30);
     p2 = fx_mul(ATT_FX_K_RV3R_12, d1[2], 30);
-#define FX_U(u, i)                                  \
-    fx_zero(&acc);                                  \
-    fx_mac(&acc, ATT_FX_K_RV3R_13, d1[i]);          \
-    fx_mac(&acc, ATT_FX_K_RV3R_23, d2[i]);          \
+#define FX_U(u, i)                         \
+    fx_zero(&acc);                         \
+    fx_mac(&acc, ATT_FX_K_RV3R_13, d1[i]); \
+    fx_mac(&acc, ATT_FX_K_RV3R_23, d2[i]); \
     u = fx_round(&acc, 30)
     FX_U(u0, 0);
     FX_U(u1, 1);
@@ -59,8 +59,8 @@ void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d
  * k·a rounded to Q2.30; cross terms exact in Q4.60, rounded once; integer
  * sum added. |Φ_i| ≤ 0.8 + 2/3·2·0.16 < 1.1.
  */
-static void fx_phi2(const att_q30 a[3], const att_q30 b[3], int32_t k, uint8_t with_a,
-                    uint32_t t, att_q30 phi[3])
+static void fx_phi2(const att_q30 a[3], const att_q30 b[3], int32_t k, uint8_t with_a, uint32_t t,
+                    att_q30 phi[3])
 {
     int32_t k0, k1, k2;
     fx_acc acc;
@@ -89,8 +89,7 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
     if ((unsigned int)method > (unsigned int)ATT_FX_RV3_REUSE) {
         return (att_status)ATT_FX_E_METHOD;
     }
-    if (n < 1u || n > 3u
-        || (method == ATT_FX_RV1 && n != 1u) || (method == ATT_FX_RV2 && n != 2u)
+    if (n < 1u || n > 3u || (method == ATT_FX_RV1 && n != 1u) || (method == ATT_FX_RV2 && n != 2u)
         || ((method == ATT_FX_RV3 || method == ATT_FX_RV3_CONING) && n != 3u)) {
         return ATT_E_ARG;
     }
@@ -255,8 +254,8 @@ size_t att_fx_integ_outputs(const att_fx_integ *s, size_t n)
     }
 }
 
-att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
-                              att_q30 *q_out, size_t *n_out, size_t *err_index)
+att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n, att_q30 *q_out, size_t *n_out,
+                              size_t *err_index)
 {
     size_t i, m = 0;
     int r;
@@ -279,8 +278,7 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
         /* fast paths (same arithmetic as att_fx_integ_update, no copies):
          * a whole rv3 frame straight from the caller's array, and rv3-reuse
          * with its two previous increments also in the array */
-        if (s->nbuf == 0u && i + 3u <= n
-            && (s->method == ATT_FX_RV3 || s->method == ATT_FX_RV3_CONING)) {
+        if (s->nbuf == 0u && i + 3u <= n && (s->method == ATT_FX_RV3 || s->method == ATT_FX_RV3_CONING)) {
             att_q30 phi[3];
             uint32_t t = fx_dither_seed(s->q);
             if (s->method == ATT_FX_RV3) {
@@ -293,8 +291,7 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
         } else if (s->method == ATT_FX_RV3_REUSE && i >= 2u) {
             att_q30 phi[3];
             uint32_t t = fx_dither_seed(s->q);
-            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i, t,
-                              phi);
+            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i, t, phi);
             r = att_fx_apply_(s->q, phi, t);
             if (r == ATT_OK && i + 1u == n) { /* leave the history in the state */
                 fx_copy3(s->buf, dtheta + 3u * (i - 1u));

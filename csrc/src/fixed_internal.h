@@ -8,15 +8,15 @@
 
 /* Method coefficients in Q2.30 (k = NUM/DEN of attitude/integrator.h,
  * rounded to nearest). */
-#define ATT_FX_K_RV2 715827883L     /* 2/3 */
-#define ATT_FX_K_RV3_13 442918502L  /* 33/80 */
-#define ATT_FX_K_RV3_23 765041050L  /* 57/80 (= k12) */
-#define ATT_FX_K_RV3C_13 483183821L /* 9/20 */
-#define ATT_FX_K_RV3C_23 724775731L /* 27/40 (= k12) */
-#define ATT_FX_K_RV3R_12 1491308L   /* 1/720 */
-#define ATT_FX_K_RV3R_13 (-46230551L) /* -31/720 */
-#define ATT_FX_K_RV3R_23 180448279L /* 121/720 */
-#define ATT_FX_K_RV3R_START 89478485L /* 1/12 */
+#define ATT_FX_K_RV2        715827883L   /* 2/3 */
+#define ATT_FX_K_RV3_13     442918502L   /* 33/80 */
+#define ATT_FX_K_RV3_23     765041050L   /* 57/80 (= k12) */
+#define ATT_FX_K_RV3C_13    483183821L   /* 9/20 */
+#define ATT_FX_K_RV3C_23    724775731L   /* 27/40 (= k12) */
+#define ATT_FX_K_RV3R_12    1491308L     /* 1/720 */
+#define ATT_FX_K_RV3R_13    (-46230551L) /* -31/720 */
+#define ATT_FX_K_RV3R_23    180448279L   /* 121/720 */
+#define ATT_FX_K_RV3R_START 89478485L    /* 1/12 */
 
 /*
  * Dithered rounding. A rounding whose input varies slowly (the coning
@@ -34,7 +34,7 @@
  * is needed. The seed is never 0; t == 0 gives plain
  * round-to-nearest (D = 2^29), used by the public att_fx_phi().
  */
-#define FX_ROR(x, k) ((uint32_t)(((x) >> (k)) | ((x) << (32u - (k)))))
+#define FX_ROR(x, k)      ((uint32_t)(((x) >> (k)) | ((x) << (32u - (k)))))
 #define FX_DITHER30(t, k) ((t) != 0u ? FX_ROR(t, k) >> 2 : 0x20000000ul)
 
 uint32_t att_fx_dither_seed_(const att_q30 q[4]);
@@ -46,8 +46,8 @@ uint32_t att_fx_dither_seed_(const att_q30 q[4]);
 #define FX_PHI2_MAX_Q24 161061274ul
 
 /* |x| > ATT_FX_DTHETA_MAX, one add and one unsigned compare */
-#define FX_DBAD(x) ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > \
-                    2u * (uint32_t)ATT_FX_DTHETA_MAX)
+#define FX_DBAD(x) \
+    ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > 2u * (uint32_t)ATT_FX_DTHETA_MAX)
 
 /* (hi:lo) = x · y, unsigned 32 × 32 → 64 bits (fixed_adc.c) */
 void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo);
@@ -61,8 +61,8 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
 
 /* rv3-reuse with two previous increments: Φ = d3 + (k12 d1) × d2 +
  * (k13 d1 + k23 d2) × d3, inputs checked by the caller. */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3],
-                       uint32_t t, att_q30 phi[3]);
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint32_t t,
+                       att_q30 phi[3]);
 
 /* c = cos(φ/2), s = sin(φ/2)/(φ/2) (Q2.30) for Φ with |Φ|² ≤ 9.6. */
 void att_fx_cs_(const att_q30 phi[3], int32_t *c, int32_t *s);

@@ -32,7 +32,7 @@
 #include <stdint.h>
 
 #if defined(__SDCC)
-#define FX_STATIC static
+#define FX_STATIC  static
 #define FX_NO_WIDE 1
 #else
 #define FX_STATIC static inline
@@ -59,7 +59,6 @@ FX_STATIC int32_t fx_asr(int32_t x, uint8_t n)
 {
     return (x < 0) ? ~(~x >> n) : (x >> n);
 }
-
 
 /* ---- halves: 2×32-bit words, 16×16 partial products ------------------ */
 typedef struct {
@@ -99,7 +98,7 @@ FX_STATIC void fxh_uprod(uint32_t ux, uint32_t uy, uint32_t *hi, uint32_t *lo)
     uint32_t p2 = (uint32_t)x1 * y0;
     uint32_t p3 = (uint32_t)x1 * y1;
     uint32_t mid = p1 + p2;
-    uint32_t c1 = (mid < p1) ? 0x10000ul : 0u;   /* carry out of the middle sum */
+    uint32_t c1 = (mid < p1) ? 0x10000ul : 0u; /* carry out of the middle sum */
     uint32_t l = p0 + (mid << 16);
     uint32_t c2 = (l < p0) ? 1u : 0u;
     *hi = p3 + (mid >> 16) + c1 + c2;
@@ -259,9 +258,15 @@ typedef struct {
     uint64_t v;
 } fxw_acc;
 
-FX_STATIC void fxw_zero(fxw_acc *a) { a->v = 0; }
+FX_STATIC void fxw_zero(fxw_acc *a)
+{
+    a->v = 0;
+}
 
-FX_STATIC void fxw_init_u(fxw_acc *a, uint32_t u) { a->v = u; }
+FX_STATIC void fxw_init_u(fxw_acc *a, uint32_t u)
+{
+    a->v = u;
+}
 
 FX_STATIC void fxw_init_shl31(fxw_acc *a, int32_t x)
 {
@@ -348,34 +353,34 @@ FX_STATIC int fxw_round_sat(const fxw_acc *a, uint8_t sh, int32_t *out)
 /* ---- selection -------------------------------------------------------- */
 #if defined(FX_USE_HALVES)
 typedef fxh_acc fx_acc;
-#define fx_zero fxh_zero
-#define fx_init_u fxh_init_u
+#define fx_zero       fxh_zero
+#define fx_init_u     fxh_init_u
 #define fx_init_shl31 fxh_init_shl31
-#define fx_floor fxh_floor
-#define fx_uprod fxh_uprod
-#define fx_mac fxh_mac
-#define fx_mac2 fxh_mac2
-#define fx_msc fxh_msc
-#define fx_add_shl fxh_add_shl
-#define fx_round fxh_round
-#define fx_round_u fxh_round_u
-#define fx_round_sat fxh_round_sat
-#define fx_small fxh_small
+#define fx_floor      fxh_floor
+#define fx_uprod      fxh_uprod
+#define fx_mac        fxh_mac
+#define fx_mac2       fxh_mac2
+#define fx_msc        fxh_msc
+#define fx_add_shl    fxh_add_shl
+#define fx_round      fxh_round
+#define fx_round_u    fxh_round_u
+#define fx_round_sat  fxh_round_sat
+#define fx_small      fxh_small
 #else
 typedef fxw_acc fx_acc;
-#define fx_zero fxw_zero
-#define fx_init_u fxw_init_u
+#define fx_zero       fxw_zero
+#define fx_init_u     fxw_init_u
 #define fx_init_shl31 fxw_init_shl31
-#define fx_floor fxw_floor
-#define fx_uprod fxw_uprod
-#define fx_mac fxw_mac
-#define fx_mac2 fxw_mac2
-#define fx_msc fxw_msc
-#define fx_add_shl fxw_add_shl
-#define fx_round fxw_round
-#define fx_round_u fxw_round_u
-#define fx_round_sat fxw_round_sat
-#define fx_small fxw_small
+#define fx_floor      fxw_floor
+#define fx_uprod      fxw_uprod
+#define fx_mac        fxw_mac
+#define fx_mac2       fxw_mac2
+#define fx_msc        fxw_msc
+#define fx_add_shl    fxw_add_shl
+#define fx_round      fxw_round
+#define fx_round_u    fxw_round_u
+#define fx_round_sat  fxw_round_sat
+#define fx_small      fxw_small
 #endif
 
 /* round(x · y / 2^sh), the caller guarantees the result fits (0 ≤ sh ≤ 62) */

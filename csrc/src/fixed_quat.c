@@ -160,9 +160,9 @@ att_status att_fx_quat_normalize(const att_q30 q[4], att_q30 out[4])
     }
     r = (m < 2L * (int32_t)ATT_FX_Q28_ONE) ? 912680550L /* 0.85 */ : 644245094L /* 0.6 */;
     for (k = 0; k < 6; ++k) {
-        int32_t r2 = fx_mul(r, r, 30);                      /* Q2.30, ≤ 1 */
+        int32_t r2 = fx_mul(r, r, 30);                                /* Q2.30, ≤ 1 */
         int32_t g = 3L * (int32_t)ATT_FX_Q28_ONE - fx_mul(m, r2, 30); /* Q4.28 */
-        r = fx_mul(r, g, 29);                               /* Q2.30 × Q4.28 / 2 */
+        r = fx_mul(r, g, 29);                                         /* Q2.30 × Q4.28 / 2 */
     }
     for (i = 0; i < 4; ++i) {
         t[i] = fx_mul(t[i], r, (uint8_t)(30 - e2));
@@ -176,8 +176,8 @@ att_status att_fx_quat_normalize(const att_q30 q[4], att_q30 out[4])
 
 /* Off-diagonal element 2(q_a1 q_b1 ± q_a2 q_b2) (minus if neg): exact Q4.60
  * sum, shift 29, range-checked. Returns 0 or -1. */
-static int fx_off(const att_q30 q[4], uint8_t a1, uint8_t b1, uint8_t a2, uint8_t b2,
-                  uint8_t neg, int32_t *out)
+static int fx_off(const att_q30 q[4], uint8_t a1, uint8_t b1, uint8_t a2, uint8_t b2, uint8_t neg,
+                  int32_t *out)
 {
     fx_acc acc;
     fx_zero(&acc);
@@ -219,11 +219,11 @@ att_status att_fx_quat_to_dcm(const att_q30 q[4], att_q30 C[9])
             return (att_status)ATT_FX_E_RANGE;
         }
     }
-    if (fx_off(q, 1, 2, 0, 3, 1, &r[1]) != 0      /* C12 = 2(p1p2 − λp3) */
-        || fx_off(q, 1, 3, 0, 2, 0, &r[2]) != 0   /* C13 = 2(p1p3 + λp2) */
-        || fx_off(q, 1, 2, 0, 3, 0, &r[3]) != 0   /* C21 = 2(p1p2 + λp3) */
-        || fx_off(q, 2, 3, 0, 1, 1, &r[5]) != 0   /* C23 = 2(p2p3 − λp1) */
-        || fx_off(q, 1, 3, 0, 2, 1, &r[6]) != 0   /* C31 = 2(p1p3 − λp2) */
+    if (fx_off(q, 1, 2, 0, 3, 1, &r[1]) != 0       /* C12 = 2(p1p2 − λp3) */
+        || fx_off(q, 1, 3, 0, 2, 0, &r[2]) != 0    /* C13 = 2(p1p3 + λp2) */
+        || fx_off(q, 1, 2, 0, 3, 0, &r[3]) != 0    /* C21 = 2(p1p2 + λp3) */
+        || fx_off(q, 2, 3, 0, 1, 1, &r[5]) != 0    /* C23 = 2(p2p3 − λp1) */
+        || fx_off(q, 1, 3, 0, 2, 1, &r[6]) != 0    /* C31 = 2(p1p3 − λp2) */
         || fx_off(q, 2, 3, 0, 1, 0, &r[7]) != 0) { /* C32 = 2(p2p3 + λp1) */
         return (att_status)ATT_FX_E_RANGE;
     }
@@ -234,13 +234,12 @@ att_status att_fx_quat_to_dcm(const att_q30 q[4], att_q30 C[9])
 }
 
 /* CORDIC arctangent table: atan(2^-i) as binary angles (2^32 = 2π), rounded. */
-static const uint32_t fx_atan_bam[30] = {
-    536870912ul, 316933406ul, 167458907ul, 85004756ul, 42667331ul, 21354465ul,
-    10679838ul, 5340245ul, 2670163ul, 1335087ul, 667544ul, 333772ul,
-    166886ul, 83443ul, 41722ul, 20861ul, 10430ul, 5215ul,
-    2608ul, 1304ul, 652ul, 326ul, 163ul, 81ul,
-    41ul, 20ul, 10ul, 5ul, 3ul, 1ul
-};
+static const uint32_t fx_atan_bam[30] = { 536870912ul, 316933406ul, 167458907ul, 85004756ul, 42667331ul,
+                                          21354465ul,  10679838ul,  5340245ul,   2670163ul,  1335087ul,
+                                          667544ul,    333772ul,    166886ul,    83443ul,    41722ul,
+                                          20861ul,     10430ul,     5215ul,      2608ul,     1304ul,
+                                          652ul,       326ul,       163ul,       81ul,       41ul,
+                                          20ul,        10ul,        5ul,         3ul,        1ul };
 
 /*
  * CORDIC vectoring: angle of (x, y) as a binary angle (uint32, 2^32 = 2π)
@@ -329,10 +328,10 @@ att_status att_fx_dcm_to_euler(const att_q30 C[9], att_q28 e[3])
         return ATT_E_NULL;
     }
     psi = fx_cordic(C[4], fx_u2s(0u - (uint32_t)C[1]), &r); /* ψ = atan2(−C12, C22) */
-    th = fx_cordic(r, C[7], 0);                               /* θ = atan2(C32, cos θ) */
+    th = fx_cordic(r, C[7], 0);                             /* θ = atan2(C32, cos θ) */
     if (r < (int32_t)ATT_FX_GIMBAL_Q30) {
         ga = 0;
-        psi = fx_cordic(C[0], C[3], 0);                        /* ψ = atan2(C21, C11) */
+        psi = fx_cordic(C[0], C[3], 0); /* ψ = atan2(C21, C11) */
     } else {
         ga = fx_cordic(C[8], fx_u2s(0u - (uint32_t)C[6]), 0); /* γ = atan2(−C31, C33) */
     }

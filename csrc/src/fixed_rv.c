@@ -16,17 +16,15 @@
  *   sin(φ/2) / (φ/2)  = Σ (−v)^n · 2^n/(2n+1)!
  * (the n-th power of φ²/4 = 2v). */
 static const int32_t fx_cs_k[2][8] = {
-    {1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L},
-    {1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L}
+    { 1073741824L, 1073741824L, 178956971L, 11930465L, 426088L, 9469L, 143L, 2L },
+    { 1073741824L, 357913941L, 35791394L, 1704352L, 47343L, 861L, 11L, 0L }
 };
 #define fx_cos_k fx_cs_k[0]
 #define fx_sin_k fx_cs_k[1]
 /* Largest v (Q2.30) for which degree n+1 suffices: the first omitted term
  * v^(n+2)·2^(n+2)/(2n+4)! of the cosine series is below 2^-33 (the sine
  * series converges faster). Degree 7 covers v ≤ 1.2 (φ ≤ 3.1). */
-static const int32_t fx_deg_vmax[6] = {
-    28378L, 2349547L, 24989211L, 113507487L, 331839229L, 747556367L
-};
+static const int32_t fx_deg_vmax[6] = { 28378L, 2349547L, 24989211L, 113507487L, 331839229L, 747556367L };
 
 #if !(defined(ATT_FX_RV3_ONLY) && (defined(__SDCC) || defined(ATT_FX_COMPACT)))
 uint32_t att_fx_dither_seed_(const att_q30 q[4])
@@ -92,13 +90,13 @@ typedef union {
 } fx_word;
 
 enum {
-    FX_R7 = 7,     /* the operand register */
+    FX_R7 = 7, /* the operand register */
     FX_NREG = 8,
-    FX_Q = 0x10,   /* fx_ld7: load from Q (else from the increments) */
-    FX_ADD = 0x20, /* fx_ld7: R7 += value */
-    FX_SUB = 0x40, /* fx_ld7: R7 −= value */
+    FX_Q = 0x10,    /* fx_ld7: load from Q (else from the increments) */
+    FX_ADD = 0x20,  /* fx_ld7: R7 += value */
+    FX_SUB = 0x40,  /* fx_ld7: R7 −= value */
     FX_NEGL = 0x60, /* fx_ld7: R7 = −value */
-    FX_SH30 = 0x10 /* fxa_out: shift 30 (else 31) */
+    FX_SH30 = 0x10  /* fxa_out: shift 30 (else 31) */
 };
 /* fxa_mac argument: x register in the high nibble, y in the low one */
 #define FX_M(x, y) ((uint8_t)(((x) << 4) | (y)))
@@ -252,9 +250,9 @@ static void fxa_dither(uint8_t k)
 }
 
 /* cross-product index pairs: component i uses j = (i+1)%3, k = (i+2)%3 */
-static const uint8_t fx_jk[4] = {1, 2, 0, 1};
-static const uint8_t fx_rot[6] = {1, 11, 22, 6, 17, 27};
-static const uint8_t fx_phid[3] = {6, 2, 5};
+static const uint8_t fx_jk[4] = { 1, 2, 0, 1 };
+static const uint8_t fx_rot[6] = { 1, 11, 22, 6, 17, 27 };
+static const uint8_t fx_phid[3] = { 6, 2, 5 };
 
 /*
  * Φ of the increments at fx_dp into fxr[0..2], coefficients k13, k23 in
@@ -276,15 +274,15 @@ static void fxc_phi_rv3(void)
         fx_k = fx_jk[fx_i + 1u];
         fxa_dither(fx_rot[fx_i]);
         fx_ld7((uint8_t)(6u + fx_k));
-        fxa_mac(FX_M(fx_j, FX_R7));                 /* a_j e_k */
+        fxa_mac(FX_M(fx_j, FX_R7)); /* a_j e_k */
         fx_ld7((uint8_t)((6u + fx_j) | FX_NEGL));
-        fxa_mac(FX_M(fx_k, FX_R7));                 /* − a_k e_j */
+        fxa_mac(FX_M(fx_k, FX_R7)); /* − a_k e_j */
         fx_ld7((uint8_t)(6u + fx_k));
         fx_ld7((uint8_t)(fx_k | FX_SUB));
-        fxa_mac(FX_M(3u + fx_j, FX_R7));            /* b_j w_k */
+        fxa_mac(FX_M(3u + fx_j, FX_R7)); /* b_j w_k */
         fx_ld7(fx_j);
         fx_ld7((uint8_t)((6u + fx_j) | FX_SUB));
-        fxa_mac(FX_M(3u + fx_k, FX_R7));            /* − b_k w_j */
+        fxa_mac(FX_M(3u + fx_k, FX_R7)); /* − b_k w_j */
         fx_ld7(fx_i);
         fx_ld7((uint8_t)((3u + fx_i) | FX_ADD));
         fx_ld7((uint8_t)((6u + fx_i) | FX_ADD));
@@ -364,10 +362,10 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 
 /* rows of Q ⊗ [c, h] besides the 2·q_i·c term: output i adds
  * sign · q[fx_pq] · h[fx_ph] (signs as in the fast version) */
-static const uint8_t fx_pq[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-static const uint8_t fx_ph[4][3] = {{0, 1, 2}, {0, 2, 1}, {1, 2, 0}, {2, 1, 0}};
-static const uint8_t fx_pneg[4] = {7, 4, 2, 4}; /* bit k set: subtract term k */
-static const uint8_t fx_res[4] = {4, 5, 6, 7};
+static const uint8_t fx_pq[4][3] = { { 1, 2, 3 }, { 0, 2, 3 }, { 0, 1, 3 }, { 0, 1, 2 } };
+static const uint8_t fx_ph[4][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 2, 0 }, { 2, 1, 0 } };
+static const uint8_t fx_pneg[4] = { 7, 4, 2, 4 }; /* bit k set: subtract term k */
+static const uint8_t fx_res[4] = { 4, 5, 6, 7 };
 
 /* q_i = result i */
 static void fx_st(uint8_t i)
@@ -386,7 +384,7 @@ static att_status fxc_apply(void)
         fx_ld7((uint8_t)(fx_i | FX_Q));
         fxa_mac(FX_M(FX_R7, FX_R7));
     }
-    fxa.w.hi -= 0x10000000ul; /* − 2^60 */
+    fxa.w.hi -= 0x10000000ul;                      /* − 2^60 */
     if ((uint32_t)(fxa.w.hi + 0x100u) >= 0x200u) { /* |e| ≥ 2^-20 */
         return (att_status)ATT_FX_E_RANGE;
     }
@@ -419,8 +417,7 @@ static att_status fxc_apply(void)
         fxa_mac(FX_M(FX_R7, 3));
         for (fx_k = 0; fx_k < 3u; ++fx_k) {
             /* − q·h as (−q)·h */
-            fx_ld7((uint8_t)(fx_pq[fx_i][fx_k] | FX_Q
-                             | (((fx_pneg[fx_i] >> fx_k) & 1u) ? FX_NEGL : 0u)));
+            fx_ld7((uint8_t)(fx_pq[fx_i][fx_k] | FX_Q | (((fx_pneg[fx_i] >> fx_k) & 1u) ? FX_NEGL : 0u)));
             fxa_mac(FX_M(FX_R7, fx_ph[fx_i][fx_k]));
         }
         fxa_out(fx_res[fx_i]);
@@ -620,9 +617,9 @@ att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
     e = fx_round(&acc, 31);
     c -= e;
 
-#define FX_H(hk, ROT, pk)                                                         \
-    fx_init_u(&acc, FX_DITHER30(t, ROT));                                         \
-    fx_mac(&acc, s, pk);                                                          \
+#define FX_H(hk, ROT, pk)                 \
+    fx_init_u(&acc, FX_DITHER30(t, ROT)); \
+    fx_mac(&acc, s, pk);                  \
     hk = fx_floor(&acc, 30)
     FX_H(h1, 6u, phi[0]);
     FX_H(h2, 17u, phi[1]);
@@ -683,8 +680,8 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
     if (q == 0 || d == 0) {
         return ATT_E_NULL;
     }
-    if (FX_DBAD(d[0]) || FX_DBAD(d[1]) || FX_DBAD(d[2]) || FX_DBAD(d[3]) || FX_DBAD(d[4])
-        || FX_DBAD(d[5]) || FX_DBAD(d[6]) || FX_DBAD(d[7]) || FX_DBAD(d[8])) {
+    if (FX_DBAD(d[0]) || FX_DBAD(d[1]) || FX_DBAD(d[2]) || FX_DBAD(d[3]) || FX_DBAD(d[4]) || FX_DBAD(d[5])
+        || FX_DBAD(d[6]) || FX_DBAD(d[7]) || FX_DBAD(d[8])) {
         return (att_status)ATT_FX_E_RANGE;
     }
     t = fx_dither_seed(q);

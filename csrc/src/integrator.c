@@ -208,8 +208,7 @@ int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4])
         break;
     case ATT_METHOD_RV3_REUSE:
         if (s->nbuf == 1) {
-            att__cross_acc(phi, ATT_R(ATT_RV3R_START_K_NUM) / ATT_R(ATT_RV3R_START_DEN),
-                           s->buf[1], dtheta);
+            att__cross_acc(phi, ATT_R(ATT_RV3R_START_K_NUM) / ATT_R(ATT_RV3R_START_DEN), s->buf[1], dtheta);
         } else if (s->nbuf >= 2) {
             att__cross_acc(phi, s->k[0], s->buf[0], s->buf[1]);
             att__cross_acc(phi, s->k[1], s->buf[0], dtheta);
@@ -331,8 +330,8 @@ int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att
 
 /* Feed increments one by one through att_integ_update (used for the
  * partial frames at both ends of a batch). */
-static att_status feed_single(att_integ *s, const att_real *dth, size_t i0, size_t i1,
-                              att_real *q_out, size_t *nout, size_t *err_index)
+static att_status feed_single(att_integ *s, const att_real *dth, size_t i0, size_t i1, att_real *q_out,
+                              size_t *nout, size_t *err_index)
 {
     size_t i;
     for (i = i0; i < i1; i++) {
@@ -465,8 +464,8 @@ static size_t reuse_fast(att_integ *s, const att_real *dth, size_t i0, size_t n,
     return n;
 }
 
-att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out,
-                           size_t *n_out, size_t *err_index)
+att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out, size_t *n_out,
+                           size_t *err_index)
 {
     att_integ saved;
     att_status st = ATT_OK;
@@ -539,8 +538,8 @@ att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_r
     return ATT_OK;
 }
 
-att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h,
-                               size_t n_h, att_real *q_out, size_t *n_out, size_t *err_index)
+att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h, size_t n_h,
+                               att_real *q_out, size_t *n_out, size_t *err_index)
 {
     att_integ saved;
     size_t i, nout = 0, need;

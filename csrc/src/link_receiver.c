@@ -5,9 +5,9 @@
 
 /* Private states. */
 typedef enum {
-    RS_IDLE = 0,     /* hunting for 0xAA */
-    RS_DATA,         /* storing data bytes (index < N) */
-    RS_CHECKSUM,     /* all N data bytes in, next byte is the checksum */
+    RS_IDLE = 0, /* hunting for 0xAA */
+    RS_DATA,     /* storing data bytes (index < N) */
+    RS_CHECKSUM, /* all N data bytes in, next byte is the checksum */
     RS_COUNT
 } rs_state;
 
@@ -91,7 +91,7 @@ static void drop_partial(att_link_receiver *r)
     r->sum = 0;
     r->state = (uint8_t)RS_IDLE;
     if (r->flags & RF_OUT_IS_SYN_ACK) { /* a 0xBB not handed out yet is void now */
-        r->flags &= (uint8_t)~(RF_OUT_PENDING | RF_OUT_IS_SYN_ACK);
+        r->flags &= (uint8_t) ~(RF_OUT_PENDING | RF_OUT_IS_SYN_ACK);
     }
 }
 
@@ -188,7 +188,7 @@ att_link_result att_link_receiver_poll(att_link_receiver *r, uint16_t tick, uint
         if ((r->flags & RF_OUT_IS_SYN_ACK) && r->state == (uint8_t)RS_DATA && r->index == 0) {
             r->t_last = tick; /* the gap timer counts from 0xBB leaving */
         }
-        r->flags &= (uint8_t)~(RF_OUT_PENDING | RF_OUT_IS_SYN_ACK);
+        r->flags &= (uint8_t) ~(RF_OUT_PENDING | RF_OUT_IS_SYN_ACK);
         *out_byte = r->out_byte;
         return ATT_LINK_SEND;
     }

@@ -13,7 +13,7 @@
 
 /* 1..ATT_LINK_TIMEOUT_MAX, in one unsigned comparison (0 wraps to 0xFFFF); the block
  * size check below uses the same trick (ATT_LINK_BLOCK_MIN is 1). */
-#define TIMEOUT_BAD(t) ((uint16_t)((t) - 1u) > (uint16_t)(ATT_LINK_TIMEOUT_MAX - 1))
+#define TIMEOUT_BAD(t) ((uint16_t)((t)-1u) > (uint16_t)(ATT_LINK_TIMEOUT_MAX - 1))
 
 int att_link_sender_init(att_link_sender ATT_LINK_MEM *s, const att_link_sender_config *cfg)
 {
@@ -138,7 +138,8 @@ att_link_result att_link_sender_sink(att_link_sender ATT_LINK_MEM *s, uint8_t by
 
 /* -- poll: one function per state ------------------------------------ */
 
-static att_link_result poll_send_syn(att_link_sender ATT_LINK_MEM *s, uint16_t tick, uint8_t ATT_LINK_MEM *out)
+static att_link_result poll_send_syn(att_link_sender ATT_LINK_MEM *s, uint16_t tick,
+                                     uint8_t ATT_LINK_MEM *out)
 {
     s->attempts++;
     s->t0 = tick;
@@ -167,7 +168,8 @@ static att_link_result poll_send_data(att_link_sender ATT_LINK_MEM *s, uint8_t A
     return ATT_LINK_SEND;
 }
 
-static att_link_result poll_send_checksum(att_link_sender ATT_LINK_MEM *s, uint16_t tick, uint8_t ATT_LINK_MEM *out)
+static att_link_result poll_send_checksum(att_link_sender ATT_LINK_MEM *s, uint16_t tick,
+                                          uint8_t ATT_LINK_MEM *out)
 {
     uint8_t i;
     uint8_t sum = 0;
@@ -195,7 +197,8 @@ static att_link_result poll_gave_up(att_link_sender ATT_LINK_MEM *s)
     return ATT_LINK_GAVE_UP;
 }
 
-att_link_result att_link_sender_poll(att_link_sender ATT_LINK_MEM *s, uint16_t tick, uint8_t ATT_LINK_MEM *out_byte)
+att_link_result att_link_sender_poll(att_link_sender ATT_LINK_MEM *s, uint16_t tick,
+                                     uint8_t ATT_LINK_MEM *out_byte)
 {
     if (s == NULL || out_byte == NULL) {
         return ATT_LINK_E_NULL;

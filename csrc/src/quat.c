@@ -341,21 +341,20 @@ att_status att_dcm_heading(const att_real C[9], att_real *heading)
 
 /* ---- array forms ------------------------------------------------------ */
 
-#define ATT_ARRAY_FORM(NAME, FUNC, IN_STRIDE, OUT_STRIDE, IN_T, OUT_T)                    \
-    att_status NAME(const att_real *in, att_real *out, size_t n, size_t *err_index)      \
-    {                                                                                     \
-        size_t i;                                                                         \
-        for (i = 0; i < n; i++) {                                                         \
-            att_status st = FUNC((const IN_T)(in + (IN_STRIDE) * i),                      \
-                                 (OUT_T)(out + (OUT_STRIDE) * i));                        \
-            if (st != ATT_OK) {                                                           \
-                if (err_index != NULL) {                                                  \
-                    *err_index = i;                                                       \
-                }                                                                         \
-                return st;                                                                \
-            }                                                                             \
-        }                                                                                 \
-        return ATT_OK;                                                                    \
+#define ATT_ARRAY_FORM(NAME, FUNC, IN_STRIDE, OUT_STRIDE, IN_T, OUT_T)                             \
+    att_status NAME(const att_real *in, att_real *out, size_t n, size_t *err_index)                \
+    {                                                                                              \
+        size_t i;                                                                                  \
+        for (i = 0; i < n; i++) {                                                                  \
+            att_status st = FUNC((const IN_T)(in + (IN_STRIDE)*i), (OUT_T)(out + (OUT_STRIDE)*i)); \
+            if (st != ATT_OK) {                                                                    \
+                if (err_index != NULL) {                                                           \
+                    *err_index = i;                                                                \
+                }                                                                                  \
+                return st;                                                                         \
+            }                                                                                      \
+        }                                                                                          \
+        return ATT_OK;                                                                             \
     }
 
 ATT_ARRAY_FORM(att_quat_normalize_n, att_quat_normalize, 4, 4, att_real *, att_real *)
@@ -370,8 +369,7 @@ ATT_ARRAY_FORM(att_euler_to_quat_n, att_euler_to_quat, 3, 4, att_real *, att_rea
 ATT_ARRAY_FORM(att_quat_heading_n, att_quat_heading, 4, 1, att_real *, att_real *)
 ATT_ARRAY_FORM(att_dcm_heading_n, att_dcm_heading, 9, 1, att_real *, att_real *)
 
-att_status att_quat_mul_n(const att_real *a, const att_real *b, att_real *out, size_t n,
-                          size_t *err_index)
+att_status att_quat_mul_n(const att_real *a, const att_real *b, att_real *out, size_t n, size_t *err_index)
 {
     size_t i;
     for (i = 0; i < n; i++) {

@@ -23,9 +23,9 @@ enum {
 };
 
 #define TLC2543_MODE_MASK 0x0Fu
-#define TLC2543_LSBF 0x02u
-#define TLC2543_BIP 0x01u
-#define TLC2543_LEN_MASK 0x0Cu
+#define TLC2543_LSBF      0x02u
+#define TLC2543_BIP       0x01u
+#define TLC2543_LEN_MASK  0x0Cu
 
 static uint8_t mode_clocks(uint8_t mode)
 {
@@ -39,7 +39,8 @@ static uint8_t mode_clocks(uint8_t mode)
     return 12u;
 }
 
-int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings) TLC2543_COLD
+int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal,
+                 const tlc2543_settings *settings) TLC2543_COLD
 {
     uint8_t mode = 0u;
     uint8_t polls = TLC2543_EOC_POLLS_DEFAULT;
@@ -55,9 +56,9 @@ int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc254
     (void)hal;
 #endif
     if (settings != 0) {
-        if ((settings->length != TLC2543_LEN_8 && settings->length != TLC2543_LEN_12 &&
-             settings->length != TLC2543_LEN_16) ||
-            settings->lsb_first > 1u || settings->bipolar > 1u) {
+        if ((settings->length != TLC2543_LEN_8 && settings->length != TLC2543_LEN_12
+             && settings->length != TLC2543_LEN_16)
+            || settings->lsb_first > 1u || settings->bipolar > 1u) {
             return ATT_E_ARG;
         }
         mode = (uint8_t)((settings->length << 2) | (settings->lsb_first << 1) | settings->bipolar);
@@ -80,34 +81,34 @@ int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc254
  * others shift DATA OUT into a byte (`rx <<= 1; if (DOUT) rx |= 1;` becomes
  * MOV C,P1.3 / ADDC A,rx: 6 machine cycles with the clock pulse).
  */
-#define CLOCK_PULSE(dev)                           \
-    do {                                           \
-        TLC2543_CLOCK(dev, 1);                     \
-        TLC2543_DELAY_NS(dev, T_CLK_HIGH_NS);      \
-        TLC2543_CLOCK(dev, 0);                     \
-        TLC2543_DELAY_NS(dev, T_DOUT_VALID_NS);    \
+#define CLOCK_PULSE(dev)                        \
+    do {                                        \
+        TLC2543_CLOCK(dev, 1);                  \
+        TLC2543_DELAY_NS(dev, T_CLK_HIGH_NS);   \
+        TLC2543_CLOCK(dev, 0);                  \
+        TLC2543_DELAY_NS(dev, T_DOUT_VALID_NS); \
     } while (0)
-#define CLOCK_SR(dev, sr, k)                                  \
-    do {                                                      \
-        TLC2543_DIN(dev, TLC2543_SR_BIT(sr, k));              \
-        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS);                \
-        TLC2543_SR_PUT(sr, k, TLC2543_DOUT(dev));             \
-        CLOCK_PULSE(dev);                                     \
+#define CLOCK_SR(dev, sr, k)                      \
+    do {                                          \
+        TLC2543_DIN(dev, TLC2543_SR_BIT(sr, k));  \
+        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS);    \
+        TLC2543_SR_PUT(sr, k, TLC2543_DOUT(dev)); \
+        CLOCK_PULSE(dev);                         \
     } while (0)
-#define CLOCK_RX(dev, rx)                          \
-    do {                                           \
-        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS);     \
-        rx <<= 1;                                  \
-        if (TLC2543_DOUT(dev)) {                   \
-            rx |= 1u;                              \
-        }                                          \
-        CLOCK_PULSE(dev);                          \
+#define CLOCK_RX(dev, rx)                      \
+    do {                                       \
+        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS); \
+        rx <<= 1;                              \
+        if (TLC2543_DOUT(dev)) {               \
+            rx |= 1u;                          \
+        }                                      \
+        CLOCK_PULSE(dev);                      \
     } while (0)
-#define CLOCK_SR_RX(dev, sr, k)                               \
-    do {                                                      \
-        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS);                \
-        TLC2543_SR_PUT(sr, k, TLC2543_DOUT(dev));             \
-        CLOCK_PULSE(dev);                                     \
+#define CLOCK_SR_RX(dev, sr, k)                   \
+    do {                                          \
+        TLC2543_DELAY_NS(dev, T_DIN_SETUP_NS);    \
+        TLC2543_SR_PUT(sr, k, TLC2543_DOUT(dev)); \
+        CLOCK_PULSE(dev);                         \
     } while (0)
 
 /* n receive-only clocks (1..8) off the fast path: not unrolled. */
@@ -140,8 +141,7 @@ static uint16_t reverse_bits(uint16_t w, uint8_t nbits)
  * the word is meaningful (a mode change makes the pending result stale:
  * tlc2543_scan discards it). Stores the word if `word` is not NULL.
  */
-static void finish_other_modes(tlc2543 TLC2543_DATA *dev, uint8_t in, uint8_t hi,
-                               uint16_t TLC2543_DATA *word)
+static void finish_other_modes(tlc2543 TLC2543_DATA *dev, uint8_t in, uint8_t hi, uint16_t TLC2543_DATA *word)
 {
     uint8_t nclk = mode_clocks(in);
     uint16_t w;
@@ -230,8 +230,8 @@ int tlc2543_cycle(tlc2543 TLC2543_DATA *dev, uint8_t address, uint16_t TLC2543_D
     return ATT_OK;
 }
 
-int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n,
-                 uint16_t TLC2543_DATA *codes, uint8_t next)
+int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n, uint16_t TLC2543_DATA *codes,
+                 uint8_t next)
 {
     uint8_t ch;
     int st;

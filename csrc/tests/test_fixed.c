@@ -33,15 +33,19 @@ static int32_t rnd_s(void)
 {
     uint32_t u = rnd();
     switch (u & 7u) {
-    case 0: return (int32_t)(rnd() >> 16) - 32768; /* small */
-    case 1: return fx_u2s(rnd() | 0x80000000ul);    /* negative, large */
-    default: return fx_u2s(rnd());
+    case 0:
+        return (int32_t)(rnd() >> 16) - 32768; /* small */
+    case 1:
+        return fx_u2s(rnd() | 0x80000000ul); /* negative, large */
+    default:
+        return fx_u2s(rnd());
     }
 }
 
-static const int32_t edge[] = {0, 1, -1, 2, -2, 0x7FFFFFFF, -0x7FFFFFFF - 1, 0x40000000,
-                               -0x40000000, 0xFFFF, -0xFFFF, 0x10000, -0x10000, 0x7FFF8000,
-                               12345678, -87654321};
+static const int32_t edge[] = {
+    0,           1,      -1,      2,       -2,       0x7FFFFFFF, -0x7FFFFFFF - 1, 0x40000000,
+    -0x40000000, 0xFFFF, -0xFFFF, 0x10000, -0x10000, 0x7FFF8000, 12345678,        -87654321
+};
 #define NEDGE (int)(sizeof edge / sizeof edge[0])
 
 static int acc_equal(const fxw_acc *w, const fxh_acc *h)
@@ -102,9 +106,18 @@ static void test_primitive(void)
         for (k = 0; k < n; ++k) {
             int32_t x = rnd_s(), y = rnd_s();
             switch (rnd() % 4u) {
-            case 0: fxw_mac(&w, x, y); fxh_mac(&h, x, y); break;
-            case 1: fxw_msc(&w, x, y); fxh_msc(&h, x, y); break;
-            case 2: fxw_mac2(&w, x, y); fxh_mac2(&h, x, y); break;
+            case 0:
+                fxw_mac(&w, x, y);
+                fxh_mac(&h, x, y);
+                break;
+            case 1:
+                fxw_msc(&w, x, y);
+                fxh_msc(&h, x, y);
+                break;
+            case 2:
+                fxw_mac2(&w, x, y);
+                fxh_mac2(&h, x, y);
+                break;
             default: {
                 uint8_t s = (uint8_t)(rnd() % 32u);
                 fxw_add_shl(&w, x, s);
@@ -118,7 +131,10 @@ static void test_primitive(void)
         }
         if (fxw_round(&w, sh) != fxh_round(&h, sh) || fxw_floor(&w, sh31) != fxh_floor(&h, sh31)
             || fxw_small(&w, b) != fxh_small(&h, b)) {
-            if (bad < 3) printf("r sh=%d %ld %ld f %ld %ld s %d %d\n", sh, (long)fxw_round(&w, sh), (long)fxh_round(&h, sh), (long)fxw_floor(&w, sh31), (long)fxh_floor(&h, sh31), fxw_small(&w, b), fxh_small(&h, b));
+            if (bad < 3)
+                printf("r sh=%d %ld %ld f %ld %ld s %d %d\n", sh, (long)fxw_round(&w, sh),
+                       (long)fxh_round(&h, sh), (long)fxw_floor(&w, sh31), (long)fxh_floor(&h, sh31),
+                       fxw_small(&w, b), fxh_small(&h, b));
             ++bad;
         }
         rw = rh = 0;
@@ -136,7 +152,9 @@ static void test_primitive(void)
             int64_t q = (v >> sh) + (((v & (((int64_t)1 << sh) - 1)) + half) >> sh);
             int fits = (q >= INT32_MIN && q <= INT32_MAX);
             if (fits != (sw == 0) || (fits && q != rw)) {
-                if (bad < 3) printf("sat sh=%d v=%lld q=%lld rw=%ld sw=%d\n", sh, (long long)v, (long long)q, (long)rw, sw);
+                if (bad < 3)
+                    printf("sat sh=%d v=%lld q=%lld rw=%ld sw=%d\n", sh, (long long)v, (long long)q, (long)rw,
+                           sw);
                 ++bad;
             }
         }
@@ -165,7 +183,7 @@ static void test_primitive(void)
 
 static void test_quat(void)
 {
-    att_q30 id[4] = {ONE, 0, 0, 0}, a[4], r[4], big[4] = {ATT_FX_QUAT_MAX + 1, 0, 0, 0};
+    att_q30 id[4] = { ONE, 0, 0, 0 }, a[4], r[4], big[4] = { ATT_FX_QUAT_MAX + 1, 0, 0, 0 };
     att_q30 C[9], q90[4];
     att_q28 e[3], hd;
     int i;
@@ -187,15 +205,15 @@ static void test_quat(void)
     /* product of two 1.25-quaternions: 1.5625 fits Q2.30; four terms of
      * 1.25² = 6.25 would not: the result is range-checked, never wrapped */
     {
-        att_q30 m[4] = {ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX};
-        att_q30 n[4] = {ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX};
+        att_q30 m[4] = { ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX, ATT_FX_QUAT_MAX };
+        att_q30 n[4] = { ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX, -ATT_FX_QUAT_MAX };
         r[0] = 77;
         CHECK_EQ_INT(att_fx_quat_mul(m, n, r), ATT_FX_E_RANGE);
         CHECK_EQ_INT(r[0], 77); /* outputs untouched on error */
     }
     /* normalization: tiny and large inputs, zero */
     {
-        att_q30 t[4] = {3, 4, 0, 0}, z[4] = {0, 0, 0, 0};
+        att_q30 t[4] = { 3, 4, 0, 0 }, z[4] = { 0, 0, 0, 0 };
         CHECK_EQ_INT(att_fx_quat_normalize(t, r), ATT_OK);
         /* 3/5 and 4/5 of 2^30, within 2 LSB (Newton + one correction step) */
         CHECK(labs(r[0] - 644245094L) <= 2 && labs(r[1] - 858993459L) <= 2);
@@ -222,7 +240,7 @@ static void test_quat(void)
     CHECK(labs(att_fx_atan2(-0x7FFFFFFF - 1, -0x7FFFFFFF - 1) + 632486143L) <= 4);
     /* gimbal lock: pitch +90° about x: C32 = 1, C12 = C22 = 0 → γ = 0 */
     {
-        att_q30 g[4] = {759250125L, 759250125L, 0, 0};
+        att_q30 g[4] = { 759250125L, 759250125L, 0, 0 };
         CHECK_EQ_INT(att_fx_quat_to_euler(g, e), ATT_OK);
         CHECK(labs(e[1] - 421657428L) <= 8 && e[2] == 0);
     }
@@ -253,7 +271,7 @@ static void test_integrator(void)
     CHECK_EQ_INT(att_fx_update_rv3(q, d), ATT_OK);
     /* a non-unit state is refused, not integrated */
     {
-        att_q30 nq[4] = {ONE, ONE / 1000, 0, 0};
+        att_q30 nq[4] = { ONE, ONE / 1000, 0, 0 };
         CHECK_EQ_INT(att_fx_update_rv3(nq, d), ATT_FX_E_RANGE);
         CHECK_EQ_INT(nq[1], ONE / 1000);
     }
@@ -324,11 +342,11 @@ static void test_integrator(void)
 static void test_adc(void)
 {
     att_fx_adc a;
-    int32_t zero[3] = {2048 * 256, 2048 * 256 + 128, 2000 * 256};
+    int32_t zero[3] = { 2048 * 256, 2048 * 256 + 128, 2000 * 256 };
     /* CG-L53 at 0.67 mV/(°/s), 12-bit ADC over 5 V: 0.031786 rad/s per code */
-    uint32_t scale[3] = {136520000ul, 136520000ul, 136520000ul};
-    uint16_t code[3] = {2148, 2048, 1900};
-    att_q30 d[3] = {5, 5, 5};
+    uint32_t scale[3] = { 136520000ul, 136520000ul, 136520000ul };
+    uint16_t code[3] = { 2148, 2048, 1900 };
+    att_q30 d[3] = { 5, 5, 5 };
     double g = 136520000.0 / 4294967296.0 * 0.01; /* rad per code at 100 Hz */
     CHECK_EQ_INT(att_fx_adc_init(&a, zero, scale, 10000000ul), ATT_OK);
     CHECK_EQ_INT(att_fx_adc_convert(&a, code, d), ATT_OK);

@@ -39,7 +39,7 @@ static void exact(const double w[3], double t, double q[4])
 
 static void test_constant_rate(void)
 {
-    const double w[3] = {0.3, -0.5, 1.0}, dt = 0.01;
+    const double w[3] = { 0.3, -0.5, 1.0 }, dt = 0.01;
     att_integ s;
     size_t nout = 0, err = 0;
     double q[4];
@@ -122,8 +122,8 @@ static void test_bad_input(void)
 {
     att_integ s, before;
     size_t nout = 5, err = 0;
-    att_real q0[4] = {0, 0, 0, 0}, d[3] = {0, 0, 0};
-    fill_constant((const double[3]){0.1, 0.2, 0.3}, 0.01);
+    att_real q0[4] = { 0, 0, 0, 0 }, d[3] = { 0, 0, 0 };
+    fill_constant((const double[3]){ 0.1, 0.2, 0.3 }, 0.01);
     CHECK_EQ_INT(att_integ_init(&s, (att_method)17, NULL), ATT_E_INTEG_METHOD);
     CHECK_EQ_INT(att_integ_init(&s, ATT_METHOD_RV1, q0), ATT_E_ARG);
     q0[1] = NAN;
@@ -166,7 +166,7 @@ static void test_bad_input(void)
 
 static void test_rk4(void)
 {
-    const double w[3] = {0.3, -0.5, 1.0}, h = 0.01;
+    const double w[3] = { 0.3, -0.5, 1.0 }, h = 0.01;
     att_real om[2 * 100 + 1][3], hh = (att_real)h, q2[4];
     att_integ s;
     size_t nout = 0, err = 0, i;
@@ -203,8 +203,7 @@ static void test_rk4(void)
 static double angle_between(const double a[4], const att_real b[4])
 {
     double d = fabs(a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]);
-    double nb = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2]
-                     + (double)b[3] * b[3]);
+    double nb = sqrt((double)b[0] * b[0] + (double)b[1] * b[1] + (double)b[2] * b[2] + (double)b[3] * b[3]);
     d /= nb;
     return 2.0 * acos(d < 1.0 ? d : 1.0);
 }
@@ -212,8 +211,8 @@ static double angle_between(const double a[4], const att_real b[4])
 static void test_long_run(void)
 {
     att_integ s;
-    att_real naive[4] = {1, 0, 0, 0};
-    double ref[4] = {1, 0, 0, 0};
+    att_real naive[4] = { 1, 0, 0, 0 };
+    double ref[4] = { 1, 0, 0, 0 };
     long i;
     int k;
     double e_lib, e_naive;
@@ -257,8 +256,8 @@ static void test_long_run(void)
     }
     e_lib = angle_between(ref, s.q);
     e_naive = angle_between(ref, naive);
-    printf("10^6 updates: library %.3g rad, naive %.3g rad (att_real of %d bytes)\n", e_lib,
-           e_naive, (int)sizeof(att_real));
+    printf("10^6 updates: library %.3g rad, naive %.3g rad (att_real of %d bytes)\n", e_lib, e_naive,
+           (int)sizeof(att_real));
 #if defined(ATT_REAL_F32)
     CHECK(e_lib <= 2e-4);          /* issue 2 target */
     CHECK(e_naive > 10.0 * e_lib); /* the increment form is what makes float usable */

@@ -153,7 +153,7 @@ static int same(const uint8_t *a, int na, const uint8_t *b, int nb)
     return na == nb && memcmp(a, b, (size_t)na) == 0;
 }
 
-static const uint8_t BLK[6] = {0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC};
+static const uint8_t BLK[6] = { 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC };
 /* checksum = 0x12+0x34+0x56+0x78+0x9A+0xBC = 0x26A -> 0x6A */
 
 static void test_checksum(void)
@@ -229,8 +229,8 @@ static void test_config(void)
 static void test_normal(void)
 {
     rig r;
-    static const uint8_t want_a[] = {0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A};
-    static const uint8_t want_b[] = {0xBB, 0x00};
+    static const uint8_t want_a[] = { 0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A };
+    static const uint8_t want_b[] = { 0xBB, 0x00 };
     rig_init(&r, 6, 20, 20, 5, 3);
     rig_send(&r, BLK, 0, 100);
     CHECK(same(r.a_log, r.a_n, want_a, sizeof want_a));
@@ -250,9 +250,9 @@ static void test_corrupted_block(void)
 {
     rig r;
     /* data byte 3 (wire index 3) corrupted once: B answers 0xFF, A resends from 0xAA */
-    static const uint8_t want_a[] = {0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A,
-                                     0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A};
-    static const uint8_t want_b[] = {0xBB, 0xFF, 0xBB, 0x00};
+    static const uint8_t want_a[] = { 0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A,
+                                      0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A };
+    static const uint8_t want_b[] = { 0xBB, 0xFF, 0xBB, 0x00 };
     rig_init(&r, 6, 20, 20, 5, 3);
     r.a_flip_at = 3;
     r.a_flip = 0x01;
@@ -272,7 +272,7 @@ static void test_two_bit_error_undetected(void)
     rig r;
     /* bit 1 flipped in 0x12 (-> 0x10, -2) and in 0x34 (-> 0x36, +2): the sum
      * is unchanged and B accepts a wrong block -- the 8-bit sum's weakness */
-    static const uint8_t wrong[6] = {0x10, 0x36, 0x56, 0x78, 0x9A, 0xBC};
+    static const uint8_t wrong[6] = { 0x10, 0x36, 0x56, 0x78, 0x9A, 0xBC };
     rig_init(&r, 6, 20, 20, 5, 3);
     r.a_flip_at = 1;
     r.a_flip = 0x02;
@@ -287,8 +287,8 @@ static void test_two_bit_error_undetected(void)
 static void test_lost_syn_ack(void)
 {
     rig r;
-    static const uint8_t want_a[] = {0xAA, 0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A};
-    static const uint8_t want_b[] = {0xBB, 0xBB, 0x00};
+    static const uint8_t want_a[] = { 0xAA, 0xAA, 0x12, 0x34, 0x56, 0x78, 0x9A, 0xBC, 0x6A };
+    static const uint8_t want_b[] = { 0xBB, 0xBB, 0x00 };
     rig_init(&r, 6, 20, 20, 5, 3);
     r.b_drop = 0; /* the first 0xBB is lost */
     rig_send(&r, BLK, 0, 200);
@@ -305,7 +305,7 @@ static void test_lost_syn_ack(void)
 static void test_lost_answer_duplicates(void)
 {
     rig r;
-    static const uint8_t want_b[] = {0xBB, 0x00, 0xBB, 0x00};
+    static const uint8_t want_b[] = { 0xBB, 0x00, 0xBB, 0x00 };
     rig_init(&r, 6, 20, 20, 5, 3);
     r.b_drop = 1; /* the first 0x00 is lost: A resends a block B already has */
     rig_send(&r, BLK, 0, 200);
@@ -319,7 +319,7 @@ static void test_lost_answer_duplicates(void)
 static void test_garbage_before_syn(void)
 {
     rig r;
-    static const uint8_t want_b[] = {0xBB, 0x00};
+    static const uint8_t want_b[] = { 0xBB, 0x00 };
     uint16_t t;
     rig_init(&r, 6, 20, 20, 5, 3);
     /* noise on the line before A starts: B discards it */
@@ -340,7 +340,7 @@ static void test_garbage_before_syn(void)
 static void test_syn_inside_data(void)
 {
     rig r;
-    static const uint8_t blk[6] = {0xAA, 0xAA, 0x00, 0xAA, 0xFF, 0xBB};
+    static const uint8_t blk[6] = { 0xAA, 0xAA, 0x00, 0xAA, 0xFF, 0xBB };
     rig_init(&r, 6, 20, 20, 5, 3);
     rig_send(&r, blk, 0, 100);
     CHECK_EQ_INT(r.accepted, 1);
@@ -388,7 +388,7 @@ static void test_truncated_block(void)
 static void test_reboot_mid_block(void)
 {
     rig r;
-    static const uint8_t blk2[6] = {1, 2, 3, 4, 5, 6};
+    static const uint8_t blk2[6] = { 1, 2, 3, 4, 5, 6 };
     uint16_t t;
     rig_init(&r, 6, 20, 20, 5, 3);
     /* A sends 0xAA and three data bytes, then reboots */

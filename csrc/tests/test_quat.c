@@ -24,8 +24,8 @@ static double qdist(const att_real a[4], const att_real b[4])
 
 static void test_mul_conj(void)
 {
-    att_real i[4] = {0, 1, 0, 0}, j[4] = {0, 0, 1, 0}, k[4] = {0, 0, 0, 1}, r[4], c[4];
-    att_real q[4] = {0.5, 0.5, -0.5, 0.5};
+    att_real i[4] = { 0, 1, 0, 0 }, j[4] = { 0, 0, 1, 0 }, k[4] = { 0, 0, 0, 1 }, r[4], c[4];
+    att_real q[4] = { 0.5, 0.5, -0.5, 0.5 };
     att_quat_mul(i, j, r); /* i j = k */
     CHECK_CLOSE(r[0], 0, 0);
     CHECK_CLOSE(r[3], 1, 0);
@@ -43,8 +43,8 @@ static void test_mul_conj(void)
 
 static void test_normalize(void)
 {
-    att_real q[4] = {3, 0, 4, 0}, z[4] = {0, 0, 0, 0}, n[4] = {0, NAN, 0, 0}, o[4];
-    att_real tiny[4] = {(att_real)1e-30, 0, 0, 0};
+    att_real q[4] = { 3, 0, 4, 0 }, z[4] = { 0, 0, 0, 0 }, n[4] = { 0, NAN, 0, 0 }, o[4];
+    att_real tiny[4] = { (att_real)1e-30, 0, 0, 0 };
     CHECK_EQ_INT(att_quat_normalize(q, o), ATT_OK);
     CHECK_CLOSE(o[0], 0.6, TOL);
     CHECK_CLOSE(o[2], 0.8, TOL);
@@ -56,10 +56,10 @@ static void test_normalize(void)
 
 static void test_rotvec(void)
 {
-    att_real phi[3] = {0, 0, (att_real)(3.14159265358979323846 / 2)}, q[4], back[3];
-    att_real small[3] = {(att_real)1e-12, (att_real)-2e-12, (att_real)3e-12};
-    att_real big[3] = {1.0, -2.0, 2.0}; /* 3 rad */
-    att_real bad[3] = {0, INFINITY, 0};
+    att_real phi[3] = { 0, 0, (att_real)(3.14159265358979323846 / 2) }, q[4], back[3];
+    att_real small[3] = { (att_real)1e-12, (att_real)-2e-12, (att_real)3e-12 };
+    att_real big[3] = { 1.0, -2.0, 2.0 }; /* 3 rad */
+    att_real bad[3] = { 0, INFINITY, 0 };
     CHECK_EQ_INT(att_rotvec_to_quat(phi, q), ATT_OK);
     CHECK_CLOSE(q[0], sqrt(0.5), TOL);
     CHECK_CLOSE(q[3], sqrt(0.5), TOL);
@@ -76,7 +76,7 @@ static void test_rotvec(void)
     CHECK_EQ_INT(att_rotvec_to_quat(bad, q), ATT_E_NONFINITE);
     /* series/closed-form boundary at φ = 0.2 is continuous */
     {
-        att_real a[3] = {(att_real)0.19999999, 0, 0}, b[3] = {(att_real)0.20000001, 0, 0};
+        att_real a[3] = { (att_real)0.19999999, 0, 0 }, b[3] = { (att_real)0.20000001, 0, 0 };
         att_real qa[4], qb[4];
         att_rotvec_to_quat(a, qa);
         att_rotvec_to_quat(b, qb);
@@ -88,7 +88,7 @@ static void test_rotvec(void)
 static void test_dcm(void)
 {
     /* 90° about z (yaw +90°): body x (right) -> north, body y (forward) -> west */
-    att_real q[4], C[9], e[3] = {(att_real)(3.14159265358979323846 / 2), 0, 0}, q2[4], e2[3];
+    att_real q[4], C[9], e[3] = { (att_real)(3.14159265358979323846 / 2), 0, 0 }, q2[4], e2[3];
     att_real h;
     CHECK_EQ_INT(att_euler_to_quat(e, q), ATT_OK);
     CHECK_EQ_INT(att_quat_to_dcm(q, C), ATT_OK);
@@ -116,7 +116,7 @@ static void test_dcm(void)
     CHECK_CLOSE(e2[2], 3.0, 10 * TOL);
     /* 180° rotations: every Shepperd branch */
     {
-        att_real r[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+        att_real r[4][4] = { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } };
         int i;
         for (i = 0; i < 4; i++) {
             CHECK_EQ_INT(att_quat_to_dcm(r[i], C), ATT_OK);
@@ -128,14 +128,14 @@ static void test_dcm(void)
 
 static void test_gimbal(void)
 {
-    att_real e[3] = {(att_real)0.4, (att_real)(3.14159265358979323846 / 2), (att_real)0.3};
+    att_real e[3] = { (att_real)0.4, (att_real)(3.14159265358979323846 / 2), (att_real)0.3 };
     att_real C[9], e2[3], C2[9];
     int i;
     CHECK_EQ_INT(att_euler_to_dcm(e, C), ATT_OK);
     CHECK_EQ_INT(att_dcm_to_euler(C, e2), ATT_OK);
     CHECK(isfinite(e2[0]) && isfinite(e2[1]) && isfinite(e2[2]));
-    CHECK_CLOSE(e2[2], 0, 0);           /* documented answer: roll 0 */
-    CHECK_CLOSE(e2[0], 0.7, 10 * TOL);  /* yaw = ψ + γ at θ = +90° */
+    CHECK_CLOSE(e2[2], 0, 0);          /* documented answer: roll 0 */
+    CHECK_CLOSE(e2[0], 0.7, 10 * TOL); /* yaw = ψ + γ at θ = +90° */
     CHECK_CLOSE(e2[1], 3.14159265358979323846 / 2, 10 * TOL);
     CHECK_EQ_INT(att_euler_to_dcm(e2, C2), ATT_OK);
     for (i = 0; i < 9; i++) {
@@ -149,7 +149,7 @@ static void test_gimbal(void)
 
 static void test_errors_and_arrays(void)
 {
-    att_real C[2 * 9], q[2 * 4] = {1, 0, 0, 0, 0, 0, 0, 0}, e[3] = {0, NAN, 0};
+    att_real C[2 * 9], q[2 * 4] = { 1, 0, 0, 0, 0, 0, 0, 0 }, e[3] = { 0, NAN, 0 };
     size_t bad = 99;
     CHECK_EQ_INT(att_quat_to_dcm_n(q, C, 2, &bad), ATT_E_ARG);
     CHECK_EQ_INT(bad, 1);

@@ -30,9 +30,9 @@ static long expect_word(uint16_t code, const tlc2543_settings *s)
 
 static void test_self_test_and_scan(void)
 {
-    static const uint8_t xyz[3] = {TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z};
+    static const uint8_t xyz[3] = { TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z };
     uint16_t codes[3], st_codes[3];
-    double v[3] = {0.0, 2.5, 5.0};
+    double v[3] = { 0.0, 2.5, 5.0 };
     uint32_t conv0;
 
     setup(0);
@@ -61,9 +61,9 @@ static void test_self_test_and_scan(void)
 static void test_modes(void)
 {
     uint8_t len_i, lsbf, bip;
-    static const uint8_t lens[3] = {TLC2543_LEN_8, TLC2543_LEN_12, TLC2543_LEN_16};
-    static const uint8_t ch[2] = {3, 7};
-    double v[11] = {0};
+    static const uint8_t lens[3] = { TLC2543_LEN_8, TLC2543_LEN_12, TLC2543_LEN_16 };
+    static const uint8_t ch[2] = { 3, 7 };
+    double v[11] = { 0 };
     for (len_i = 0; len_i < 3; len_i++) {
         for (lsbf = 0; lsbf < 2; lsbf++) {
             for (bip = 0; bip < 2; bip++) {
@@ -92,7 +92,7 @@ static void test_modes(void)
 static void test_faults(void)
 {
     uint16_t w, codes[3];
-    tlc2543_settings s = {TLC2543_LEN_12, 0, 0, 5};
+    tlc2543_settings s = { TLC2543_LEN_12, 0, 0, 5 };
 
     setup(&s);
     model.stuck_eoc = 0;
@@ -113,8 +113,8 @@ static void test_faults(void)
 
 static void test_power_down_and_args(void)
 {
-    static const uint8_t bad[2] = {0, TLC2543_POWER_DOWN};
-    static const uint8_t one[1] = {5};
+    static const uint8_t bad[2] = { 0, TLC2543_POWER_DOWN };
+    static const uint8_t one[1] = { 5 };
     uint16_t codes[2];
     setup(0);
     CHECK_EQ_INT(tlc2543_power_down(&adc), ATT_OK);
@@ -128,7 +128,7 @@ static void test_power_down_and_args(void)
     CHECK_EQ_INT(tlc2543_scan(&adc, one, 1, codes, 15), ATT_E_ARG);
     CHECK_EQ_INT(tlc2543_scan(&adc, 0, 1, codes, 0), ATT_E_NULL);
     {
-        tlc2543_settings s = {2, 0, 0, 0}; /* length code 2 is not accepted */
+        tlc2543_settings s = { 2, 0, 0, 0 }; /* length code 2 is not accepted */
         CHECK_EQ_INT(tlc2543_init(&adc, &model.hal, &s), ATT_E_ARG);
         CHECK_EQ_INT(tlc2543_init(&adc, 0, 0), ATT_E_NULL);
     }
@@ -154,8 +154,10 @@ static void test_trace_and_violation(void)
 
 static void test_batch(void)
 {
-    static const uint8_t xyz[3] = {0, 1, 2};
-    double volts[4 * 3] = {0.0, 2.5, 5.0, -1.0, 6.0, 1.0, 0.6103515625, 2.5006103515625, 4.99, 3.3, 3.3, 3.3};
+    static const uint8_t xyz[3] = { 0, 1, 2 };
+    double volts[4 * 3] = {
+        0.0, 2.5, 5.0, -1.0, 6.0, 1.0, 0.6103515625, 2.5006103515625, 4.99, 3.3, 3.3, 3.3
+    };
     int32_t codes[4 * 3];
     size_t done = 99;
     int i;
@@ -179,15 +181,15 @@ static void test_batch(void)
  * read before it is valid" violation.
  */
 /* The broken variant: every public function renamed, custom HAL. */
-#define TLC2543_HAL_CUSTOM 1
-#define tlc2543_init broken_init
-#define tlc2543_cycle broken_cycle
-#define tlc2543_scan broken_scan
+#define TLC2543_HAL_CUSTOM      1
+#define tlc2543_init            broken_init
+#define tlc2543_cycle           broken_cycle
+#define tlc2543_scan            broken_scan
 #define tlc2543_self_test_codes broken_self_test_codes
-#define tlc2543_self_test broken_self_test
-#define tlc2543_power_down broken_power_down
-#define tlc2543_signed broken_signed
-#define tlc2543_clocks broken_clocks
+#define tlc2543_self_test       broken_self_test
+#define tlc2543_power_down      broken_power_down
+#define tlc2543_signed          broken_signed
+#define tlc2543_clocks          broken_clocks
 
 static int latched_dout;
 
@@ -197,13 +199,13 @@ static int latched_dout;
 #undef TLC2543_DOUT
 #undef TLC2543_EOC
 #undef TLC2543_DELAY_NS
-#define TLC2543_CS(d, v) ((d)->hal->set_cs((d)->hal->ctx, (v)))
-#define TLC2543_DIN(d, v) ((d)->hal->set_din((d)->hal->ctx, (v)))
-#define TLC2543_EOC(d) ((d)->hal->get_eoc((d)->hal->ctx))
+#define TLC2543_CS(d, v)        ((d)->hal->set_cs((d)->hal->ctx, (v)))
+#define TLC2543_DIN(d, v)       ((d)->hal->set_din((d)->hal->ctx, (v)))
+#define TLC2543_EOC(d)          ((d)->hal->get_eoc((d)->hal->ctx))
 #define TLC2543_DELAY_NS(d, ns) ((d)->hal->delay_ns((d)->hal->ctx, (ns)))
 /* BROKEN: DATA OUT is latched the moment the clock falls */
-#define TLC2543_CLOCK(d, v)                                                   \
-    ((d)->hal->set_clock((d)->hal->ctx, (v)),                                 \
+#define TLC2543_CLOCK(d, v)                   \
+    ((d)->hal->set_clock((d)->hal->ctx, (v)), \
      (void)((v) ? 0 : (latched_dout = (d)->hal->get_dout((d)->hal->ctx))))
 #define TLC2543_DOUT(d) (latched_dout)
 
@@ -211,7 +213,7 @@ static int latched_dout;
 
 static void test_wrong_edge_variant_is_caught(void)
 {
-    static const uint8_t xyz[3] = {0, 1, 2};
+    static const uint8_t xyz[3] = { 0, 1, 2 };
     uint16_t codes[3];
     CHECK_EQ_INT(tlc2543m_init(&model, 5.0, 0.0, 0xA5Au), ATT_OK);
     CHECK_EQ_INT(broken_init(&adc, &model.hal, 0), ATT_OK);

@@ -19,7 +19,7 @@
 
 int main(int argc, char **argv)
 {
-    static const char *names[] = {"rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4"};
+    static const char *names[] = { "rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4" };
     att_real table[TABLE][3], q[4];
     att_integ s;
     unsigned long n, i, updates = 0;

@@ -34,7 +34,11 @@
 
 #include "attitude/attitude.h"
 
-enum { MAX_REC = 2048, MAX_VALS = MAX_REC * 9, MAX_OUT = MAX_REC * 9 };
+enum {
+    MAX_REC = 2048,
+    MAX_VALS = MAX_REC * 9,
+    MAX_OUT = MAX_REC * 9
+};
 
 static att_real in_buf[MAX_VALS];
 static att_real in_buf2[MAX_VALS];
@@ -110,27 +114,24 @@ static const struct {
     size_t in, out;
     map_fn fn;
 } maps[] = {
-    {"quat_normalize", 4, 4, att_quat_normalize_n},
-    {"rotvec_to_quat", 3, 4, att_rotvec_to_quat_n},
-    {"quat_to_rotvec", 4, 3, att_quat_to_rotvec_n},
-    {"quat_to_dcm", 4, 9, att_quat_to_dcm_n},
-    {"dcm_to_quat", 9, 4, att_dcm_to_quat_n},
-    {"dcm_to_euler", 9, 3, att_dcm_to_euler_n},
-    {"euler_to_dcm", 3, 9, att_euler_to_dcm_n},
-    {"quat_to_euler", 4, 3, att_quat_to_euler_n},
-    {"euler_to_quat", 3, 4, att_euler_to_quat_n},
-    {"quat_heading", 4, 1, att_quat_heading_n},
-    {"dcm_heading", 9, 1, att_dcm_heading_n},
+    { "quat_normalize", 4, 4, att_quat_normalize_n }, { "rotvec_to_quat", 3, 4, att_rotvec_to_quat_n },
+    { "quat_to_rotvec", 4, 3, att_quat_to_rotvec_n }, { "quat_to_dcm", 4, 9, att_quat_to_dcm_n },
+    { "dcm_to_quat", 9, 4, att_dcm_to_quat_n },       { "dcm_to_euler", 9, 3, att_dcm_to_euler_n },
+    { "euler_to_dcm", 3, 9, att_euler_to_dcm_n },     { "quat_to_euler", 4, 3, att_quat_to_euler_n },
+    { "euler_to_quat", 3, 4, att_euler_to_quat_n },   { "quat_heading", 4, 1, att_quat_heading_n },
+    { "dcm_heading", 9, 1, att_dcm_heading_n },
 };
 
 static const struct {
     const char *name;
     att_method m;
 } methods[] = {
-    {"rv1", ATT_METHOD_RV1}, {"rv2", ATT_METHOD_RV2}, {"rv3", ATT_METHOD_RV3},
-    {"rv3-coning", ATT_METHOD_RV3_CONING}, {"rv3-reuse", ATT_METHOD_RV3_REUSE},
+    { "rv1", ATT_METHOD_RV1 },
+    { "rv2", ATT_METHOD_RV2 },
+    { "rv3", ATT_METHOD_RV3 },
+    { "rv3-coning", ATT_METHOD_RV3_CONING },
+    { "rv3-reuse", ATT_METHOD_RV3_REUSE },
 };
-
 
 static void result(const char *id, int status, long err, size_t nout)
 {
@@ -191,12 +192,13 @@ static int run_link(const char *id, int tx, size_t n)
         if (byte == -2 && tx)
             row(i, 0, att_link_sender_start(&s, block, tick));
         else if (byte >= 0)
-            row(i, 0, tx ? att_link_sender_sink(&s, (uint8_t)byte, tick)
-                         : att_link_receiver_sink(&r, (uint8_t)byte, tick));
+            row(i, 0,
+                tx ? att_link_sender_sink(&s, (uint8_t)byte, tick)
+                   : att_link_receiver_sink(&r, (uint8_t)byte, tick));
         for (guard = 0; guard < 2 * ATT_LINK_BLOCK_MAX + 8; guard++) {
             uint8_t out = 0;
-            att_link_result res = tx ? att_link_sender_poll(&s, tick, &out)
-                                     : att_link_receiver_poll(&r, tick, &out);
+            att_link_result res =
+                tx ? att_link_sender_poll(&s, tick, &out) : att_link_receiver_poll(&r, tick, &out);
             row(i, 1, res);
             if (res == ATT_LINK_SEND)
                 row(i, 2, out);
@@ -207,15 +209,23 @@ static int run_link(const char *id, int tx, size_t n)
     if (tx) {
         const att_link_sender_stats *t = &s.stats;
         long sv[6];
-        sv[0] = t->blocks_sent; sv[1] = t->blocks_accepted; sv[2] = t->naks;
-        sv[3] = t->timeouts; sv[4] = t->gave_up; sv[5] = t->bytes_discarded;
+        sv[0] = t->blocks_sent;
+        sv[1] = t->blocks_accepted;
+        sv[2] = t->naks;
+        sv[3] = t->timeouts;
+        sv[4] = t->gave_up;
+        sv[5] = t->bytes_discarded;
         for (k = 0; k < 6; k++)
             row(n, 3, sv[k]);
     } else {
         const att_link_receiver_stats *t = &r.stats;
         long sv[6];
-        sv[0] = (long)t->syns; sv[1] = (long)t->blocks_accepted; sv[2] = (long)t->naks;
-        sv[3] = (long)t->timeouts; sv[4] = (long)t->resyncs; sv[5] = (long)t->bytes_discarded;
+        sv[0] = (long)t->syns;
+        sv[1] = (long)t->blocks_accepted;
+        sv[2] = (long)t->naks;
+        sv[3] = (long)t->timeouts;
+        sv[4] = (long)t->resyncs;
+        sv[5] = (long)t->bytes_discarded;
         for (k = 0; k < 6; k++)
             row(n, 3, sv[k]);
     }

@@ -27,33 +27,33 @@
 #ifndef FW_TLC_HAL_SIM_H
 #define FW_TLC_HAL_SIM_H
 
-__sbit __at(0xC0) fwm_cs_pin;      /* CS as last driven (reset: 1) */
-__sbit __at(0xC1) fwm_clk_pin;     /* I/O CLOCK as last driven */
-__sbit __at(0xC2) fwm_din_pin;     /* DATA INPUT as last driven */
-__sbit __at(0xC3) fwm_t;           /* DATA OUT bit being returned */
-__sbit __at(0xC4) fwm_bad_count;   /* a cycle without exactly 12 clocks */
-__sbit __at(0xC5) fwm_bad_format;  /* a format other than 12-bit MSB-first unipolar */
-__sbit __at(0xC6) fwm_bad_cs;      /* CS rose with the clock high */
-__sbit __at(0xC7) fwm_bad_abort;   /* a cycle ended before its conversion did */
-__sfr __at(0xC1) fwm_nclk;         /* clocks (DATA OUT reads) in this cycle */
-__sfr __at(0xC2) fwm_in;           /* input byte shifted in */
-__sfr16 __at(0xC8C3) fwm_word;     /* result being shifted out, code << 4 */
-__sbit __at(0xCF) fwm_msb;         /* its bit 15 (SFR 0xC8 is bit-addressable) */
-__sfr __at(0xC5) fwm_eoc_wait;     /* EOC reads that still return low */
-__sfr __at(0xC6) fwm_a;            /* address of the cycle being ended */
-__sfr16 __at(0xAAA9) fwm_vx;       /* inputs AIN0..AIN2 now, code << 4 */
+__sbit __at(0xC0) fwm_cs_pin;     /* CS as last driven (reset: 1) */
+__sbit __at(0xC1) fwm_clk_pin;    /* I/O CLOCK as last driven */
+__sbit __at(0xC2) fwm_din_pin;    /* DATA INPUT as last driven */
+__sbit __at(0xC3) fwm_t;          /* DATA OUT bit being returned */
+__sbit __at(0xC4) fwm_bad_count;  /* a cycle without exactly 12 clocks */
+__sbit __at(0xC5) fwm_bad_format; /* a format other than 12-bit MSB-first unipolar */
+__sbit __at(0xC6) fwm_bad_cs;     /* CS rose with the clock high */
+__sbit __at(0xC7) fwm_bad_abort;  /* a cycle ended before its conversion did */
+__sfr __at(0xC1) fwm_nclk;        /* clocks (DATA OUT reads) in this cycle */
+__sfr __at(0xC2) fwm_in;          /* input byte shifted in */
+__sfr16 __at(0xC8C3) fwm_word;    /* result being shifted out, code << 4 */
+__sbit __at(0xCF) fwm_msb;        /* its bit 15 (SFR 0xC8 is bit-addressable) */
+__sfr __at(0xC5) fwm_eoc_wait;    /* EOC reads that still return low */
+__sfr __at(0xC6) fwm_a;           /* address of the cycle being ended */
+__sfr16 __at(0xAAA9) fwm_vx;      /* inputs AIN0..AIN2 now, code << 4 */
 __sfr16 __at(0xACAB) fwm_vy;
 __sfr16 __at(0xAEAD) fwm_vz;
 
-#define TLC2543_PIN_CS fwm_cs_pin
+#define TLC2543_PIN_CS    fwm_cs_pin
 #define TLC2543_PIN_CLOCK fwm_clk_pin
-#define TLC2543_PIN_DIN fwm_din_pin
+#define TLC2543_PIN_DIN   fwm_din_pin
 
 /* One DATA OUT read = one clock: shift DATA INPUT in (first 8 clocks),
  * count, and return the next bit of the previous result, MSB first. */
-#define FWM_DOUT_READ                                                          \
-    ((fwm_nclk < 8u ? (fwm_in = (unsigned char)((fwm_in << 1) | fwm_din_pin)) : 0), \
-     fwm_nclk++, fwm_t = fwm_msb, fwm_word <<= 1)
+#define FWM_DOUT_READ                                                                           \
+    ((fwm_nclk < 8u ? (fwm_in = (unsigned char)((fwm_in << 1) | fwm_din_pin)) : 0), fwm_nclk++, \
+     fwm_t = fwm_msb, fwm_word <<= 1)
 #if defined(FW_SIM_DOUT_STUCK)
 /* fault: DATA OUT tied to the level in this cell (set by fw_sim_model_init;
  * a cell rather than a constant, so the compiler keeps the driver's code) */
@@ -66,8 +66,7 @@ __sfr __at(0xBF) fwm_stuck_dout;
 /* End of an I/O cycle (first EOC read with CS high, tlc_model.c): checks
  * it, converts; returns the EOC level (1 if no conversion: power-down). */
 unsigned char fwm_end_cycle(void);
-#define TLC2543_PIN_EOC                                                        \
-    ((fwm_cs_pin && fwm_nclk != 0u) ? fwm_end_cycle()                          \
-                                     : (fwm_eoc_wait != 0u ? (fwm_eoc_wait--, 0) : 1))
+#define TLC2543_PIN_EOC \
+    ((fwm_cs_pin && fwm_nclk != 0u) ? fwm_end_cycle() : (fwm_eoc_wait != 0u ? (fwm_eoc_wait--, 0) : 1))
 
 #endif /* FW_TLC_HAL_SIM_H */

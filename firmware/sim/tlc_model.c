@@ -31,45 +31,41 @@ extern uint16_t fw_ticks; /* firmware's Timer 0 tick counter (main.c) */
 
 /* Gyro signals (see above). */
 #ifndef FW_SIM_X_OFF
-#define FW_SIM_X_OFF 32768u
-#define FW_SIM_X_SH 1
-#define FW_SIM_X_PH 0
+#define FW_SIM_X_OFF  32768u
+#define FW_SIM_X_SH   1
+#define FW_SIM_X_PH   0
 #define FW_SIM_X_STEP 3
 #endif
 #ifndef FW_SIM_Y_OFF
-#define FW_SIM_Y_OFF 24576u
-#define FW_SIM_Y_SH 2
-#define FW_SIM_Y_PH 64
+#define FW_SIM_Y_OFF  24576u
+#define FW_SIM_Y_SH   2
+#define FW_SIM_Y_PH   64
 #define FW_SIM_Y_STEP 5
 #endif
 #ifndef FW_SIM_Z_OFF
-#define FW_SIM_Z_OFF 40960u
-#define FW_SIM_Z_SH 3
-#define FW_SIM_Z_PH 128
+#define FW_SIM_Z_OFF  40960u
+#define FW_SIM_Z_SH   3
+#define FW_SIM_Z_PH   128
 #define FW_SIM_Z_STEP 7
 #endif
 
 static const int16_t quarter_sine[65] = {
-    0, 804, 1608, 2410, 3212, 4011, 4808, 5602,
-    6393, 7179, 7962, 8739, 9512, 10278, 11039, 11793,
-    12539, 13279, 14010, 14732, 15446, 16151, 16846, 17530,
-    18204, 18868, 19519, 20159, 20787, 21403, 22005, 22594,
-    23170, 23731, 24279, 24811, 25329, 25832, 26319, 26790,
-    27245, 27683, 28105, 28510, 28898, 29268, 29621, 29956,
-    30273, 30571, 30852, 31113, 31356, 31580, 31785, 31971,
-    32137, 32285, 32412, 32521, 32609, 32678, 32728, 32757,
-    32767,
+    0,     804,   1608,  2410,  3212,  4011,  4808,  5602,  6393,  7179,  7962,  8739,  9512,
+    10278, 11039, 11793, 12539, 13279, 14010, 14732, 15446, 16151, 16846, 17530, 18204, 18868,
+    19519, 20159, 20787, 21403, 22005, 22594, 23170, 23731, 24279, 24811, 25329, 25832, 26319,
+    26790, 27245, 27683, 28105, 28510, 28898, 29268, 29621, 29956, 30273, 30571, 30852, 31113,
+    31356, 31580, 31785, 31971, 32137, 32285, 32412, 32521, 32609, 32678, 32728, 32757, 32767,
 };
 
-static const uint16_t gyro_off[3] = {FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF};
-static const uint8_t gyro_sh[3] = {FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH};
-static const uint8_t gyro_step[3] = {FW_SIM_X_STEP, FW_SIM_Y_STEP, FW_SIM_Z_STEP};
-static const uint8_t gyro_phase[3] = {FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH};
+static const uint16_t gyro_off[3] = { FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF };
+static const uint8_t gyro_sh[3] = { FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH };
+static const uint8_t gyro_step[3] = { FW_SIM_X_STEP, FW_SIM_Y_STEP, FW_SIM_Z_STEP };
+static const uint8_t gyro_phase[3] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH };
 
 /* Model state beyond tlc_hal_sim.h's cells: SFR cells too, no RAM. */
-__sfr __at(0xBD) m_started;       /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
-__sfr __at(0xC7) m_k;             /* sampling periods since the first step (mod 256) */
-__sfr16 __at(0xCAC9) m_bound;     /* fw_ticks at which m_k next increments */
+__sfr __at(0xBD) m_started;         /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
+__sfr __at(0xC7) m_k;               /* sampling periods since the first step (mod 256) */
+__sfr16 __at(0xCAC9) m_bound;       /* fw_ticks at which m_k next increments */
 __sfr16 __at(0xCCCB) m_conversions; /* gyro input evaluations so far */
 
 void fw_sim_model_init(void)

@@ -16,6 +16,7 @@ void main(void)
     s51_report_cycles("empty");
 
     S51_CYCLES_BEGIN();
+    /* clang-format off */
     __asm
         nop
         nop
@@ -28,17 +29,20 @@ void main(void)
         nop
         nop
     __endasm;
+    /* clang-format on */
     S51_CYCLES_END();
     s51_report_cycles("ten_nops");
 
     /* NOP = 1, DJNZ = 2 cycles: 100 iterations = 300 cycles + MOV (1). */
     S51_CYCLES_BEGIN();
+    /* clang-format off */
     __asm
         mov r7,#100
     00001$:
         nop
         djnz r7,00001$
     __endasm;
+    /* clang-format on */
     S51_CYCLES_END();
     s51_report_cycles("nop_djnz100");
 

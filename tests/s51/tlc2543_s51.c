@@ -15,7 +15,7 @@
 #include "attitude/tlc2543.h"
 
 static tlc2543 adc;
-static const uint8_t xyz[3] = {TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z};
+static const uint8_t xyz[3] = { TLC2543_CH_X, TLC2543_CH_Y, TLC2543_CH_Z };
 
 static void check(unsigned char ok, const char *what)
 {
@@ -111,7 +111,10 @@ void main(void)
     /* DATA OUT all ones: the self-test must fail on the mid-scale code */
     check(tlc2543_self_test(&adc) == TLC2543_E_SELFTEST_MID, "self-test detects stuck DOUT");
 
-    s.length = TLC2543_LEN_8; s.lsb_first = 0; s.bipolar = 0; s.eoc_polls = 0;
+    s.length = TLC2543_LEN_8;
+    s.lsb_first = 0;
+    s.bipolar = 0;
+    s.eoc_polls = 0;
     check(tlc2543_init(&adc, 0, &s) == ATT_OK, "init8");
     S51_CYCLES_BEGIN();
     st = tlc2543_cycle(&adc, TLC2543_CH_X, &w);
@@ -119,7 +122,8 @@ void main(void)
     s51_report_cycles("cycle8");
     check(st == ATT_OK && w == 0xFFu, "cycle8");
 
-    s.length = TLC2543_LEN_16; s.lsb_first = 1;
+    s.length = TLC2543_LEN_16;
+    s.lsb_first = 1;
     check(tlc2543_init(&adc, 0, &s) == ATT_OK, "init16");
     S51_CYCLES_BEGIN();
     st = tlc2543_cycle(&adc, TLC2543_CH_X, &w);

@@ -52,6 +52,26 @@ def lint(c):
             if shutil.which(cc):
                 for d in ("", "-DATT_REAL_F32"):
                     c.run(f"{cc} {strict} {d} {srcs}")
+        format(c, check=True)
+
+
+C_FORMAT_GLOBS = ("csrc/**/*.[ch]", "firmware/**/*.[ch]", "bench/*.c", "tests/*.c", "tests/s51/*.c",
+                  "toolchain/*.[ch]")
+
+
+def _c_format_files() -> list[str]:
+    files: set[Path] = set()
+    for g in C_FORMAT_GLOBS:
+        files.update(ROOT.glob(g))
+    return [str(p.relative_to(ROOT)) for p in sorted(files)]
+
+
+@task(help={"check": "only report files that differ from .clang-format (exit 1 if any)"})
+def format(c, check=False):
+    """Apply .clang-format to every C source and header (csrc/, firmware/, C tests and benches)."""
+    mode = "--dry-run --Werror" if check else "-i"
+    with c.cd(str(ROOT)):
+        c.run(f"clang-format {mode} " + " ".join(_c_format_files()))
 
 
 @task

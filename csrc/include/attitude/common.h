@@ -37,13 +37,13 @@ typedef double att_real;
  * defines its own codes inside its range. */
 typedef enum {
     ATT_OK = 0,
-    ATT_E_NULL = -1,       /* a required pointer argument is NULL */
-    ATT_E_ARG = -2,        /* an argument is out of its documented domain */
-    ATT_E_NONFINITE = -3,  /* NaN or Inf in an input */
-    ATT_E_RANGE = -4,      /* value outside the representable range */
-    ATT_E_STATE = -5,      /* call not valid in the current state */
-    ATT_E_TIMEOUT = -6,    /* a bounded wait expired */
-    ATT_E_BUFFER = -7      /* caller buffer too small */
+    ATT_E_NULL = -1,      /* a required pointer argument is NULL */
+    ATT_E_ARG = -2,       /* an argument is out of its documented domain */
+    ATT_E_NONFINITE = -3, /* NaN or Inf in an input */
+    ATT_E_RANGE = -4,     /* value outside the representable range */
+    ATT_E_STATE = -5,     /* call not valid in the current state */
+    ATT_E_TIMEOUT = -6,   /* a bounded wait expired */
+    ATT_E_BUFFER = -7     /* caller buffer too small */
 } att_status;
 
 /* Short English description of a status code (static storage). */

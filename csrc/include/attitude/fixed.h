@@ -56,12 +56,12 @@ typedef int32_t att_q28; /* Q4.28 */
 
 /* Constants (enums, so that Python sees them too). */
 enum {
-    ATT_FX_Q30_ONE = 1073741824,    /* 1.0 in Q2.30 */
-    ATT_FX_Q28_ONE = 268435456,     /* 1.0 in Q4.28 */
-    ATT_FX_DTHETA_MAX = 429496730,  /* 0.4 rad in Q2.30: largest |Δθ| component accepted */
-    ATT_FX_QUAT_MAX = 1342177280,   /* 1.25 in Q2.30: largest |component| of an input
+    ATT_FX_Q30_ONE = 1073741824,   /* 1.0 in Q2.30 */
+    ATT_FX_Q28_ONE = 268435456,    /* 1.0 in Q4.28 */
+    ATT_FX_DTHETA_MAX = 429496730, /* 0.4 rad in Q2.30: largest |Δθ| component accepted */
+    ATT_FX_QUAT_MAX = 1342177280,  /* 1.25 in Q2.30: largest |component| of an input
                                        quaternion (keeps 4-term 64-bit sums exact) */
-    ATT_FX_GIMBAL_Q30 = 16          /* 2^-26 in Q2.30: cos θ below this = gimbal lock */
+    ATT_FX_GIMBAL_Q30 = 16         /* 2^-26 in Q2.30: cos θ below this = gimbal lock */
 };
 
 /* Methods: the same numbers as att_method of attitude/integrator.h. */
@@ -84,27 +84,27 @@ enum {
 
 /* att_fx_integ_update() results. */
 enum {
-    ATT_FX_PENDING = 0,    /* increment buffered, no new attitude yet */
-    ATT_FX_UPDATED = 1     /* a new attitude was written */
+    ATT_FX_PENDING = 0, /* increment buffered, no new attitude yet */
+    ATT_FX_UPDATED = 1  /* a new attitude was written */
 };
 
 /* Caller-owned integrator state (55 bytes on the 8051). Treat as opaque. */
 typedef struct {
-    att_q30 q[4];          /* attitude quaternion, Q2.30, |q| = 1 within ±4 LSB */
-    att_q30 buf[9];        /* 3 increments (3 values each): rv2/rv3: those of the unfinished
+    att_q30 q[4];   /* attitude quaternion, Q2.30, |q| = 1 within ±4 LSB */
+    att_q30 buf[9]; /* 3 increments (3 values each): rv2/rv3: those of the unfinished
                               update, oldest first (the last one is scratch); rv3-reuse:
                               the two previous increments, increment `old` the older;
                               Q2.30 rad */
-    uint8_t method;        /* att_fx_method */
-    uint8_t nbuf;          /* valid entries of buf */
-    uint8_t old;           /* rv3-reuse: index of the older increment (0 or 1) */
+    uint8_t method; /* att_fx_method */
+    uint8_t nbuf;   /* valid entries of buf */
+    uint8_t old;    /* rv3-reuse: index of the older increment (0 or 1) */
 } att_fx_integ;
 
 /* ADC-code → increment converter (per axis), set up by att_fx_adc_init. */
 typedef struct {
-    int32_t zero_q8[3];    /* zero-rate code, Q24.8 (code × 256) */
-    int32_t gain[3];       /* gain mantissa in [2^30, 2^31) */
-    uint8_t shift[3];      /* Δθ(Q2.30) = round((code·256 − zero_q8) · gain / 2^shift) */
+    int32_t zero_q8[3]; /* zero-rate code, Q24.8 (code × 256) */
+    int32_t gain[3];    /* gain mantissa in [2^30, 2^31) */
+    uint8_t shift[3];   /* Δθ(Q2.30) = round((code·256 − zero_q8) · gain / 2^shift) */
 } att_fx_adc;
 
 /* ---- primitives ------------------------------------------------------ */
@@ -172,8 +172,8 @@ size_t att_fx_integ_outputs(const att_fx_integ *s, size_t n);
  * *n_out their number. All increments are checked first: on
  * ATT_FX_E_RANGE the state is unchanged, *err_index = first bad sample,
  * *n_out = 0. n_out, err_index may be NULL. */
-att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n,
-                              att_q30 *q_out, size_t *n_out, size_t *err_index);
+att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n, att_q30 *q_out, size_t *n_out,
+                              size_t *err_index);
 
 /* ---- attitude outputs ------------------------------------------------ */
 
@@ -210,8 +210,8 @@ att_q28 att_fx_atan2(int32_t y, int32_t x);
  * 31-bit mantissa and shift (relative error ≤ 2^-31). ATT_E_ARG for a
  * zero scale/period; ATT_FX_E_RANGE if the gain is too large (> 2^8
  * rad per code) or too small (< 2^-40 rad per code). */
-att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3],
-                           const uint32_t scale_q32[3], uint32_t period_ns);
+att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3], const uint32_t scale_q32[3],
+                           uint32_t period_ns);
 
 /* Δθ_i = (code_i − zero_i) · scale_i · period, Q2.30 rad, rounded to
  * nearest (one rounding of an exact 64-bit product). |Δθ_i| >

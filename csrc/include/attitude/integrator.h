@@ -41,37 +41,48 @@ typedef enum {
  * its second update (one previous increment) uses Φ = Δθ2 + (1/12) Δθ1×Δθ2
  * and its first update Φ = Δθ1. */
 enum {
-    ATT_RV2_K_NUM = 2, ATT_RV2_DEN = 3,
-    ATT_RV3_K12_NUM = 57, ATT_RV3_K13_NUM = 33, ATT_RV3_K23_NUM = 57, ATT_RV3_DEN = 80,
-    ATT_RV3C_K12_NUM = 27, ATT_RV3C_K13_NUM = 18, ATT_RV3C_K23_NUM = 27, ATT_RV3C_DEN = 40,
-    ATT_RV3R_K12_NUM = 1, ATT_RV3R_K13_NUM = -31, ATT_RV3R_K23_NUM = 121, ATT_RV3R_DEN = 720,
-    ATT_RV3R_START_K_NUM = 1, ATT_RV3R_START_DEN = 12
+    ATT_RV2_K_NUM = 2,
+    ATT_RV2_DEN = 3,
+    ATT_RV3_K12_NUM = 57,
+    ATT_RV3_K13_NUM = 33,
+    ATT_RV3_K23_NUM = 57,
+    ATT_RV3_DEN = 80,
+    ATT_RV3C_K12_NUM = 27,
+    ATT_RV3C_K13_NUM = 18,
+    ATT_RV3C_K23_NUM = 27,
+    ATT_RV3C_DEN = 40,
+    ATT_RV3R_K12_NUM = 1,
+    ATT_RV3R_K13_NUM = -31,
+    ATT_RV3R_K23_NUM = 121,
+    ATT_RV3R_DEN = 720,
+    ATT_RV3R_START_K_NUM = 1,
+    ATT_RV3R_START_DEN = 12
 };
 
 /* Renormalization period (updates) and update() results. */
 enum {
     ATT_INTEG_RENORM_PERIOD = 16,
-    ATT_INTEG_PENDING = 0,  /* increment buffered, no new attitude yet */
-    ATT_INTEG_UPDATED = 1   /* a new attitude was written to q_out */
+    ATT_INTEG_PENDING = 0, /* increment buffered, no new attitude yet */
+    ATT_INTEG_UPDATED = 1  /* a new attitude was written to q_out */
 };
 
 /* Integrator status codes (range -20..-39). */
 enum {
-    ATT_E_INTEG_METHOD = -20,   /* unknown method, or a call not valid for this method */
-    ATT_E_INTEG_DIVERGED = -21  /* finite input but a non-finite result (increment too large) */
+    ATT_E_INTEG_METHOD = -20,  /* unknown method, or a call not valid for this method */
+    ATT_E_INTEG_DIVERGED = -21 /* finite input but a non-finite result (increment too large) */
 };
 
 /* Caller-owned state. Treat as opaque; read the attitude with
  * att_integ_attitude(). */
 typedef struct {
-    att_real q[4];        /* current attitude Q (unit, renormalized periodically) */
-    att_real buf[2][3];   /* rv2/rv3: increments of the unfinished update; rv3-reuse:
+    att_real q[4];           /* current attitude Q (unit, renormalized periodically) */
+    att_real buf[2][3];      /* rv2/rv3: increments of the unfinished update; rv3-reuse:
                              the two previous increments (buf[1] newest); rk4: the
                              rate at the start of the step (buf[0]) and the midpoint
                              rate (buf[1]) */
-    att_real k[3];        /* k12, k13, k23 of the method (or k of rv2 in k[0]) */
-    int method;           /* att_method */
-    int nbuf;             /* number of valid entries of buf */
+    att_real k[3];           /* k12, k13, k23 of the method (or k of rv2 in k[0]) */
+    int method;              /* att_method */
+    int nbuf;                /* number of valid entries of buf */
     unsigned int since_norm; /* updates since the last renormalization */
     unsigned long updates;   /* attitude updates since init/reset (wraps) */
 } att_integ;
@@ -111,15 +122,15 @@ int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att
  * the index of the offending increment (the first non-finite one, or the
  * last one of the diverged update) and *n_out is 0. n_out and err_index
  * may be NULL. */
-att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out,
-                           size_t *n_out, size_t *err_index);
+att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out, size_t *n_out,
+                           size_t *err_index);
 
 /* n rate samples (n×3 values, rk4 only), exactly as n
  * att_integ_update_rate() calls; h holds n_h step sizes: n_h == 1 uses
  * h[0] for every update, otherwise h[j] is the step of the j-th update
  * completed in this call (n_h must be ≥ att_integ_outputs(s, n)). Errors
  * as att_integ_batch (ATT_E_ARG: bad h or n_h, err_index = the update). */
-att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h,
-                               size_t n_h, att_real *q_out, size_t *n_out, size_t *err_index);
+att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h, size_t n_h,
+                               att_real *q_out, size_t *n_out, size_t *err_index);
 
 #endif /* ATTITUDE_INTEGRATOR_H */

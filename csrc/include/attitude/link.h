@@ -67,7 +67,7 @@ typedef enum {
     ATT_LINK_TIMEOUT = 8,   /* poll: A: no 0xBB or no answer in time, will retry or give up /
                                B: gap inside a block too long, partial block dropped */
     ATT_LINK_GAVE_UP = 9,   /* poll: A: max_attempts used, block dropped, now idle */
-    ATT_LINK_E_NULL = -60,   /* a required pointer is NULL */
+    ATT_LINK_E_NULL = -60,  /* a required pointer is NULL */
     ATT_LINK_E_CONFIG = -61, /* configuration out of range */
     ATT_LINK_E_BUSY = -62,   /* sender: start while a block is still in progress */
     ATT_LINK_E_STATE = -63   /* internal state corrupted (struct overwritten?) */
@@ -99,10 +99,10 @@ typedef struct {
     att_link_sender_config cfg;
     att_link_sender_stats stats;
     const uint8_t ATT_LINK_MEM *block; /* caller's block (cfg.block_size bytes) */
-    uint16_t t0;        /* tick at which the running timer started */
-    uint8_t state;      /* private state (enum in link_sender.c) */
-    uint8_t index;      /* next data byte to send */
-    uint8_t attempts;   /* attempts started for the current block */
+    uint16_t t0;                       /* tick at which the running timer started */
+    uint8_t state;                     /* private state (enum in link_sender.c) */
+    uint8_t index;                     /* next data byte to send */
+    uint8_t attempts;                  /* attempts started for the current block */
 } att_link_sender;
 
 /* Defaults for 1 ms ticks at 9600 baud: N = block_size, syn and answer
@@ -162,13 +162,13 @@ typedef struct {
 typedef struct {
     att_link_receiver_config cfg;
     att_link_receiver_stats stats;
-    uint8_t *block;      /* caller's buffer, cfg.block_size bytes */
-    uint16_t t_last;     /* tick of the last byte received (or 0xBB handed out) in a block */
-    uint8_t state;       /* private state (enum in link_receiver.c) */
-    uint8_t index;       /* data bytes stored so far */
-    uint8_t sum;         /* running sum of the data bytes mod 256 */
-    uint8_t out_byte;    /* byte waiting to be handed out by poll */
-    uint8_t flags;       /* private flags (pending output, pending timeout, discarded) */
+    uint8_t *block;   /* caller's buffer, cfg.block_size bytes */
+    uint16_t t_last;  /* tick of the last byte received (or 0xBB handed out) in a block */
+    uint8_t state;    /* private state (enum in link_receiver.c) */
+    uint8_t index;    /* data bytes stored so far */
+    uint8_t sum;      /* running sum of the data bytes mod 256 */
+    uint8_t out_byte; /* byte waiting to be handed out by poll */
+    uint8_t flags;    /* private flags (pending output, pending timeout, discarded) */
 } att_link_receiver;
 
 /* Defaults for 1 ms ticks at 9600 baud: N = block_size, gap 20 ms. */

@@ -75,8 +75,7 @@ att_status att_quat_heading(const att_real q[4], att_real *heading);
 att_status att_dcm_heading(const att_real C[9], att_real *heading);
 
 /* Array forms: n records back to back (see the header comment). */
-att_status att_quat_mul_n(const att_real *a, const att_real *b, att_real *out, size_t n,
-                          size_t *err_index);
+att_status att_quat_mul_n(const att_real *a, const att_real *b, att_real *out, size_t n, size_t *err_index);
 att_status att_quat_normalize_n(const att_real *q, att_real *out, size_t n, size_t *err_index);
 att_status att_rotvec_to_quat_n(const att_real *phi, att_real *q, size_t n, size_t *err_index);
 att_status att_quat_to_rotvec_n(const att_real *q, att_real *phi, size_t n, size_t *err_index);

@@ -46,23 +46,23 @@
 
 /* Input byte fields and addresses (datasheet "input data byte"). */
 enum {
-    TLC2543_CH_X = 0,         /* board wiring: gyro X on AIN0 */
-    TLC2543_CH_Y = 1,         /* gyro Y on AIN1 */
-    TLC2543_CH_Z = 2,         /* gyro Z on AIN2 */
-    TLC2543_AIN_COUNT = 11,   /* analog inputs AIN0..AIN10 */
-    TLC2543_TEST_MID = 11,    /* test input (Vref+ + Vref-)/2 -> 0x800 */
-    TLC2543_TEST_REFM = 12,   /* test input Vref- -> 0x000 */
-    TLC2543_TEST_REFP = 13,   /* test input Vref+ -> 0xFFF */
-    TLC2543_POWER_DOWN = 14,  /* software power-down address */
-    TLC2543_NO_RESULT = 0xF0  /* tlc2543.pending >= this: output register
+    TLC2543_CH_X = 0,        /* board wiring: gyro X on AIN0 */
+    TLC2543_CH_Y = 1,        /* gyro Y on AIN1 */
+    TLC2543_CH_Z = 2,        /* gyro Z on AIN2 */
+    TLC2543_AIN_COUNT = 11,  /* analog inputs AIN0..AIN10 */
+    TLC2543_TEST_MID = 11,   /* test input (Vref+ + Vref-)/2 -> 0x800 */
+    TLC2543_TEST_REFM = 12,  /* test input Vref- -> 0x000 */
+    TLC2543_TEST_REFP = 13,  /* test input Vref+ -> 0xFFF */
+    TLC2543_POWER_DOWN = 14, /* software power-down address */
+    TLC2543_NO_RESULT = 0xF0 /* tlc2543.pending >= this: output register
                                  undefined (address 15 is never sent) */
 };
 
 /* Output data length field (D3-D2 of the input byte). */
 enum {
-    TLC2543_LEN_12 = 0,  /* 12 clocks (D3-D2 = 00 or 10) */
-    TLC2543_LEN_8 = 1,   /* 8 clocks: the 8 MSBs */
-    TLC2543_LEN_16 = 3   /* 16 clocks: result followed by four 0 bits */
+    TLC2543_LEN_12 = 0, /* 12 clocks (D3-D2 = 00 or 10) */
+    TLC2543_LEN_8 = 1,  /* 8 clocks: the 8 MSBs */
+    TLC2543_LEN_16 = 3  /* 16 clocks: result followed by four 0 bits */
 };
 
 /* Status codes of this module (range -40..-59 of common.h). */
@@ -75,10 +75,14 @@ enum {
 
 /* Self-test tolerance in 12-bit LSB (see docs/tlc2543.md: datasheet total
  * unadjusted error +-1 LSB, plus 1 LSB for noise on the reference). */
-enum { TLC2543_SELFTEST_TOL = 2 };
+enum {
+    TLC2543_SELFTEST_TOL = 2
+};
 
 /* Default bound of the EOC wait when settings->eoc_polls is 0. */
-enum { TLC2543_EOC_POLLS_DEFAULT = 40 };
+enum {
+    TLC2543_EOC_POLLS_DEFAULT = 40
+};
 
 /* Settings (Fusion style). NULL settings = 12-bit, MSB first, unipolar. */
 typedef struct {
@@ -105,7 +109,8 @@ typedef struct {
 
 /* Initialise the state (no pin activity). `hal` is required on the host and
  * ignored on the 8051; `settings` may be NULL. ATT_E_ARG on a bad field. */
-int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal, const tlc2543_settings *settings) TLC2543_COLD;
+int tlc2543_init(tlc2543 TLC2543_DATA *dev, const tlc2543_hal *hal,
+                 const tlc2543_settings *settings) TLC2543_COLD;
 
 /* One I/O cycle: send `address` (0..14) with the configured mode and read
  * the word clocked out (the conversion requested by the previous cycle;
@@ -121,8 +126,8 @@ int tlc2543_cycle(tlc2543 TLC2543_DATA *dev, uint8_t address, uint16_t TLC2543_D
  * n cycles (its first result is already converted); the first cycle is
  * skipped whenever the pending conversion is channels[0] in the configured
  * mode. n = 1..255. On error, codes already read are kept. */
-int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n,
-                 uint16_t TLC2543_DATA *codes, uint8_t next);
+int tlc2543_scan(tlc2543 TLC2543_DATA *dev, const uint8_t *channels, uint8_t n, uint16_t TLC2543_DATA *codes,
+                 uint8_t next);
 
 /* Convert the three internal test voltages (12-bit, MSB first, unipolar)
  * and check them against 0x800 / 0x000 / 0xFFF within TLC2543_SELFTEST_TOL.

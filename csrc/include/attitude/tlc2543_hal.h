@@ -27,13 +27,13 @@
 
 /* Host HAL: pin callbacks on a caller-owned context. Levels are 0/1. */
 typedef struct tlc2543_hal {
-    void *ctx;                                  /* passed to every callback */
-    void (*set_cs)(void *ctx, int level);       /* CS (active low) */
-    void (*set_clock)(void *ctx, int level);    /* I/O CLOCK */
-    void (*set_din)(void *ctx, int level);      /* DATA INPUT, to the ADC */
-    int (*get_dout)(void *ctx);                 /* DATA OUT, from the ADC */
-    int (*get_eoc)(void *ctx);                  /* EOC (high = conversion done) */
-    void (*delay_ns)(void *ctx, uint32_t ns);   /* wait at least ns nanoseconds */
+    void *ctx;                                /* passed to every callback */
+    void (*set_cs)(void *ctx, int level);     /* CS (active low) */
+    void (*set_clock)(void *ctx, int level);  /* I/O CLOCK */
+    void (*set_din)(void *ctx, int level);    /* DATA INPUT, to the ADC */
+    int (*get_dout)(void *ctx);               /* DATA OUT, from the ADC */
+    int (*get_eoc)(void *ctx);                /* EOC (high = conversion done) */
+    void (*delay_ns)(void *ctx, uint32_t ns); /* wait at least ns nanoseconds */
 } tlc2543_hal;
 
 #ifndef ATT_CDEF
@@ -56,11 +56,11 @@ typedef struct tlc2543_hal {
 #ifndef TLC2543_PIN_CS
 #define TLC2543_PIN_CS P1_4
 #endif
-#define TLC2543_CS(d, v) (TLC2543_PIN_CS = (v))
-#define TLC2543_CLOCK(d, v) (TLC2543_PIN_CLOCK = (v))
-#define TLC2543_DIN(d, v) (TLC2543_PIN_DIN = (v))
-#define TLC2543_DOUT(d) (TLC2543_PIN_DOUT)
-#define TLC2543_EOC(d) (TLC2543_PIN_EOC)
+#define TLC2543_CS(d, v)        (TLC2543_PIN_CS = (v))
+#define TLC2543_CLOCK(d, v)     (TLC2543_PIN_CLOCK = (v))
+#define TLC2543_DIN(d, v)       (TLC2543_PIN_DIN = (v))
+#define TLC2543_DOUT(d)         (TLC2543_PIN_DOUT)
+#define TLC2543_EOC(d)          (TLC2543_PIN_EOC)
 #define TLC2543_DELAY_NS(d, ns) ((void)0)
 /* The input byte and the received byte share one shift register: the
  * bit-addressable B register. Clock k sends B.k and then overwrites it with
@@ -77,35 +77,40 @@ __sbit __at(0xF5) TLC2543_B5;
 __sbit __at(0xF6) TLC2543_B6;
 __sbit __at(0xF7) TLC2543_B7;
 #define TLC2543_SR_LOAD(sr, byte) (B = (byte))
-#define TLC2543_SR_BIT(sr, k) (TLC2543_B##k)
-#define TLC2543_SR_PUT(sr, k, v) (TLC2543_B##k = (v))
-#define TLC2543_SR_GET(sr) (B)
-#define TLC2543_SR_SHL4(sr) (B = (uint8_t)(B << 4))
+#define TLC2543_SR_BIT(sr, k)     (TLC2543_B##k)
+#define TLC2543_SR_PUT(sr, k, v)  (TLC2543_B##k = (v))
+#define TLC2543_SR_GET(sr)        (B)
+#define TLC2543_SR_SHL4(sr)       (B = (uint8_t)(B << 4))
 /* Store a 16-bit word from its two bytes (SDCC's mcs51 port is little
  * endian): two MOV @R0 instead of building the word in registers. */
-#define TLC2543_STORE_WORD(p, whi, wlo) \
-    do { uint8_t __data *q_ = (uint8_t __data *)(p); *q_ = (wlo); q_++; *q_ = (whi); } while (0)
+#define TLC2543_STORE_WORD(p, whi, wlo)             \
+    do {                                            \
+        uint8_t __data *q_ = (uint8_t __data *)(p); \
+        *q_ = (wlo);                                \
+        q_++;                                       \
+        *q_ = (whi);                                \
+    } while (0)
 /* Driver state and result words live in internal RAM (small model). */
 #define TLC2543_DATA __data
 /* Cold functions keep their parameters and locals on the stack (only while
  * they run) instead of in static internal RAM: the AT89S51 has 128 bytes. */
 #define TLC2543_COLD __reentrant
 #elif !defined(TLC2543_HAL_CUSTOM)
-#define TLC2543_CS(d, v) ((d)->hal->set_cs((d)->hal->ctx, (v)))
-#define TLC2543_CLOCK(d, v) ((d)->hal->set_clock((d)->hal->ctx, (v)))
-#define TLC2543_DIN(d, v) ((d)->hal->set_din((d)->hal->ctx, (v)))
-#define TLC2543_DOUT(d) ((d)->hal->get_dout((d)->hal->ctx))
-#define TLC2543_EOC(d) ((d)->hal->get_eoc((d)->hal->ctx))
+#define TLC2543_CS(d, v)        ((d)->hal->set_cs((d)->hal->ctx, (v)))
+#define TLC2543_CLOCK(d, v)     ((d)->hal->set_clock((d)->hal->ctx, (v)))
+#define TLC2543_DIN(d, v)       ((d)->hal->set_din((d)->hal->ctx, (v)))
+#define TLC2543_DOUT(d)         ((d)->hal->get_dout((d)->hal->ctx))
+#define TLC2543_EOC(d)          ((d)->hal->get_eoc((d)->hal->ctx))
 #define TLC2543_DELAY_NS(d, ns) ((d)->hal->delay_ns((d)->hal->ctx, (ns)))
 #endif
 /* Defaults (host, and custom HALs that do not define them). */
 /* Shift register of one byte in a local variable `sr`. */
 #ifndef TLC2543_SR_LOAD
 #define TLC2543_SR_LOAD(sr, byte) ((sr) = (uint8_t)(byte))
-#define TLC2543_SR_BIT(sr, k) (((sr) >> (k)) & 1u)
+#define TLC2543_SR_BIT(sr, k)     (((sr) >> (k)) & 1u)
 #define TLC2543_SR_PUT(sr, k, v) \
-    ((sr) = (uint8_t)(((sr) & (uint8_t)~(1u << (k))) | ((v) ? (1u << (k)) : 0u)))
-#define TLC2543_SR_GET(sr) (sr)
+    ((sr) = (uint8_t)(((sr) & (uint8_t) ~(1u << (k))) | ((v) ? (1u << (k)) : 0u)))
+#define TLC2543_SR_GET(sr)  (sr)
 #define TLC2543_SR_SHL4(sr) ((sr) = (uint8_t)((sr) << 4))
 #endif
 #ifndef TLC2543_STORE_WORD
