@@ -211,7 +211,7 @@ def errors(q_est: ArrayLike, q_ref: ArrayLike, movement: ArrayLike | None = None
     total, heading, incl = error_angles(q_est, q_ref)
     m = np.ones(total.shape, bool) if movement is None else np.asarray(movement, bool).ravel()
     if m.shape != total.shape:
-        raise InvalidArgument(f"movement must have {total.shape[0]} entries, got {m.shape[0]}")
+        raise InvalidArgument(f"movement must have {len(total)} entries, got {m.size}")
     ok = m & np.isfinite(total) & np.isfinite(heading) & np.isfinite(incl)
     k = int(ok.sum())
     if k == 0:

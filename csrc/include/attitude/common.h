@@ -34,8 +34,12 @@ typedef double att_real;
  * -100..-119, aiding solvers (alignment, TRIAD, Gauss-Newton, magnetometer
  * calibration) -120..-139, attitude filter -140..-159, wavelet denoiser
  * -160..-179, AD7927 -180..-199, link v2 -200..-219. Each module's header
- * defines its own codes inside its range. */
-typedef enum {
+ * defines its own codes inside its range.
+ *
+ * `att_status` is an int, not the enum type: with short enums (the
+ * bare-metal ARM EABI, SDCC) an enum whose values fit in a byte is one byte
+ * wide, and the module codes below -128 would not survive the conversion. */
+enum {
     ATT_OK = 0,
     ATT_E_NULL = -1,      /* a required pointer argument is NULL */
     ATT_E_ARG = -2,       /* an argument is out of its documented domain */
@@ -44,7 +48,8 @@ typedef enum {
     ATT_E_STATE = -5,     /* call not valid in the current state */
     ATT_E_TIMEOUT = -6,   /* a bounded wait expired */
     ATT_E_BUFFER = -7     /* caller buffer too small */
-} att_status;
+};
+typedef int att_status;
 
 /* Short English description of a status code (static storage). */
 const char *att_status_str(int status);
