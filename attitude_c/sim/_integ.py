@@ -12,11 +12,11 @@ import numpy as np
 
 from ..errors import InvalidArgument
 
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
 PRECISIONS = ("f64", "f32", "fixed")
 
 # increments consumed per update
-_PER_UPDATE = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rk4": 1}
+_PER_UPDATE = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1, "rk4": 1}
 
 
 def check_method(method: str) -> None:

@@ -131,6 +131,7 @@ static const struct {
     { "rv3", ATT_METHOD_RV3 },
     { "rv3-coning", ATT_METHOD_RV3_CONING },
     { "rv3-reuse", ATT_METHOD_RV3_REUSE },
+    { "rv3-reuse-poly", ATT_METHOD_RV3_REUSE_POLY },
 };
 
 static void result(const char *id, int status, long err, size_t nout)
