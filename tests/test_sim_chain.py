@@ -67,10 +67,12 @@ def test_methods_rank_as_coning_theory_predicts() -> None:
 
 def test_error_orders_on_the_paper_motion() -> None:
     """Halving h on the paper's motion: rv1's error falls ~4× (second order),
-    the multi-sample methods' ~16× (fourth order). Bounds leave ±25 % for
-    the higher-order terms at h = 0.08 s (Ωh ≈ 0.15)."""
+    the multi-sample methods' ~16× (fourth order), the reuse forms' ~8× (third
+    order: they extrapolate the newest interval's correction from the past
+    increments; docs/integrator.md, sec. 3.3). Bounds leave ±25 % for the
+    higher-order terms at h = 0.08 s (Ωh ≈ 0.15)."""
     tr = PaperTrajectory()
-    for m, order in (("rv1", 2), ("rv2", 4), ("rv3", 4)):
+    for m, order in (("rv1", 2), ("rv2", 4), ("rv3", 4), ("rv3-reuse", 3), ("rv3-reuse-poly", 3)):
         ratio = _drift(m, tr, 0.08, 30.0) / _drift(m, tr, 0.04, 30.0)
         assert 0.75 * 2**order < ratio < 1.25 * 2**order, (m, ratio)
 
