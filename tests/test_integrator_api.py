@@ -164,6 +164,11 @@ def test_methods_constant() -> None:
         assert {m: ac.method_code(m, lib) for m in ac.METHODS} == codes
     with pytest.raises(InvalidArgument, match="method"):
         ac.method_code("rv3-reuse-old")
+    # the simulator and the simulate command offer exactly these methods
+    from attitude_c.cli import simulate
+    from attitude_c.sim import _integ
+
+    assert _integ.METHODS == simulate._METHODS == ac.METHODS
 
 
 def test_demo_command(capsys: pytest.CaptureFixture[str]) -> None:
