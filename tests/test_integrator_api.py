@@ -160,8 +160,11 @@ def test_methods_constant() -> None:
     assert codes == {"rv1": 0, "rv2": 1, "rv3": 2, "rv3-coning": 3, "rv3-reuse": 4, "rk4": 5,
                      "rv3-reuse-poly": 6}
     for prec in ("f64", "f32"):
-        _, lib = ffi_lib(prec)
+        ffi, lib = ffi_lib(prec)
         assert {m: ac.method_code(m, lib) for m in ac.METHODS} == codes
+        # ... and the library's own names (att_integ_method_name) are these
+        assert {m: ffi.string(lib.att_integ_method_name(c)).decode() for m, c in codes.items()} \
+            == {m: m for m in codes}
     with pytest.raises(InvalidArgument, match="method"):
         ac.method_code("rv3-reuse-old")
     # the simulator and the simulate command offer exactly these methods

@@ -10,6 +10,35 @@ static int method_valid(int m)
     return m >= 0 && m < (int)ATT_METHOD_COUNT;
 }
 
+/* indexed by att_method */
+static const char *const method_names[ATT_METHOD_COUNT] = { "rv1",       "rv2", "rv3",           "rv3-coning",
+                                                            "rv3-reuse", "rk4", "rv3-reuse-poly" };
+
+const char *att_integ_method_name(att_method method)
+{
+    return method_valid((int)method) ? method_names[method] : NULL;
+}
+
+att_status att_integ_method_from_name(const char *name, att_method *method)
+{
+    int m;
+    if (name == NULL || method == NULL) {
+        return ATT_E_NULL;
+    }
+    for (m = 0; m < (int)ATT_METHOD_COUNT; m++) {
+        const char *a = name, *b = method_names[m];
+        while (*a != '\0' && *a == *b) {
+            a++;
+            b++;
+        }
+        if (*a == *b) {
+            *method = (att_method)m;
+            return ATT_OK;
+        }
+    }
+    return (att_status)ATT_E_INTEG_METHOD;
+}
+
 static int is_reuse(int m)
 {
     return m == ATT_METHOD_RV3_REUSE || m == ATT_METHOD_RV3_REUSE_POLY;

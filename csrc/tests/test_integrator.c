@@ -272,6 +272,27 @@ static void test_long_run(void)
 #endif
 }
 
+static void test_method_names(void)
+{
+    att_method m, back = ATT_METHOD_RV1;
+    for (m = ATT_METHOD_RV1; m < ATT_METHOD_COUNT; m = (att_method)(m + 1)) {
+        const char *name = att_integ_method_name(m);
+        CHECK(name != NULL);
+        CHECK_EQ_INT(att_integ_method_from_name(name, &back), ATT_OK);
+        CHECK_EQ_INT(back, m);
+    }
+    CHECK(strcmp(att_integ_method_name(ATT_METHOD_RV3_REUSE_POLY), "rv3-reuse-poly") == 0);
+    CHECK(att_integ_method_name(ATT_METHOD_COUNT) == NULL);
+    CHECK(att_integ_method_name((att_method)-1) == NULL);
+    back = ATT_METHOD_RV2;
+    CHECK_EQ_INT(att_integ_method_from_name("rv3-reuse-", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(att_integ_method_from_name("rv3-reus", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(att_integ_method_from_name("", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(back, ATT_METHOD_RV2);
+    CHECK_EQ_INT(att_integ_method_from_name(NULL, &back), ATT_E_NULL);
+    CHECK_EQ_INT(att_integ_method_from_name("rv1", NULL), ATT_E_NULL);
+}
+
 int main(void)
 {
     test_constant_rate();
@@ -279,5 +300,6 @@ int main(void)
     test_bad_input();
     test_rk4();
     test_long_run();
+    test_method_names();
     return ATT_TEST_REPORT();
 }

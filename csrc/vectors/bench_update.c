@@ -19,32 +19,13 @@
 
 int main(int argc, char **argv)
 {
-    static const struct {
-        const char *name;
-        att_method m;
-    } methods[] = {
-        { "rv1", ATT_METHOD_RV1 },
-        { "rv2", ATT_METHOD_RV2 },
-        { "rv3", ATT_METHOD_RV3 },
-        { "rv3-coning", ATT_METHOD_RV3_CONING },
-        { "rv3-reuse", ATT_METHOD_RV3_REUSE },
-        { "rv3-reuse-poly", ATT_METHOD_RV3_REUSE_POLY },
-        { "rk4", ATT_METHOD_RK4 },
-    };
     att_real table[TABLE][3], q[4];
     att_integ s;
     unsigned long n, i, updates = 0;
-    size_t k;
     att_method m;
     int rc;
-    if (argc != 3)
+    if (argc != 3 || att_integ_method_from_name(argv[1], &m) != ATT_OK)
         return 2;
-    for (k = 0; k < sizeof methods / sizeof methods[0]; k++)
-        if (strcmp(argv[1], methods[k].name) == 0)
-            break;
-    if (k == sizeof methods / sizeof methods[0])
-        return 2;
-    m = methods[k].m;
     n = strtoul(argv[2], NULL, 10);
     for (i = 0; i < TABLE; i++) { /* ~1 rad/s at 100 Hz, varying direction */
         table[i][0] = (att_real)(0.010 + 0.001 * (double)i);

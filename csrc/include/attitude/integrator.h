@@ -99,6 +99,16 @@ typedef struct {
     unsigned long updates;   /* attitude updates since init/reset (wraps) */
 } att_integ;
 
+/* Canonical name of a method ("rv1", "rv2", "rv3", "rv3-coning",
+ * "rv3-reuse", "rk4", "rv3-reuse-poly": the names of attitude_c and
+ * attitude-rx --method), or NULL for a value outside att_method. */
+const char *att_integ_method_name(att_method method);
+
+/* The method whose att_integ_method_name() is `name` (exact match) into
+ * *method: ATT_OK, ATT_E_NULL, or ATT_E_INTEG_METHOD (unknown name,
+ * *method untouched). */
+att_status att_integ_method_from_name(const char *name, att_method *method);
+
 /* Initialize for `method` with attitude q0 (NULL = identity; normalized
  * here; ATT_E_ARG if zero, ATT_E_NONFINITE if NaN/Inf). */
 att_status att_integ_init(att_integ *s, att_method method, const att_real q0[4]);
