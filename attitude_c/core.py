@@ -36,6 +36,7 @@ __all__ = [
     "heading",
     "integrate",
     "integrate_rates",
+    "method_code",
     "quat_conj",
     "quat_multiply",
     "quat_normalize",
@@ -45,12 +46,14 @@ __all__ = [
     "rotvec_to_quat",
 ]
 
-#: Integration methods, in the order of the C enum ``att_method``.
-METHODS: tuple[str, ...] = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+#: Integration methods. The C enum value of each is the library's
+#: ``ATT_METHOD_<NAME>`` constant (see :func:`method_code`), never a position here.
+METHODS: tuple[str, ...] = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
 #: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
-INCREMENT_METHODS: tuple[str, ...] = METHODS[:5]
+INCREMENT_METHODS: tuple[str, ...] = tuple(m for m in METHODS if m != "rk4")
 #: Increments consumed per attitude update, per method.
-FRAME: dict[str, int] = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1}
+FRAME: dict[str, int] = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1,
+                         "rv3-reuse-poly": 1}
 #: Numeric precisions: the two float builds and the fixed-point port.
 PRECISIONS: tuple[str, ...] = ("f64", "f32", "fixed")
 
@@ -85,6 +88,15 @@ def _check_method(method: Any, allowed: tuple[str, ...] = METHODS) -> str:
     if method not in allowed:
         raise InvalidArgument(f"method must be one of {allowed!r}, got {method!r}")
     return method
+
+
+def method_code(method: str, lib: Any = None) -> int:
+    """The ``att_method`` value of ``method`` ("rv3-reuse" → ``lib.ATT_METHOD_RV3_REUSE``),
+    read from the compiled library (``lib``: the f64 one by default)."""
+    _check_method(method)
+    if lib is None:
+        lib = ffi_lib("f64")[1]
+    return int(getattr(lib, "ATT_METHOD_" + method.upper().replace("-", "_")))
 
 
 def _as_real(x: ArrayLike, name: str) -> NDArray[Any]:
@@ -317,7 +329,7 @@ class Integrator:
         if q is not None:
             qc = _to_c(q.reshape(1, 4), self.precision, "q0")
             qp = _ptr(self._ffi, qc)
-        st = self._lib.att_integ_init(self._state, METHODS.index(self.method), qp)
+        st = self._lib.att_integ_init(self._state, method_code(self.method, self._lib), qp)
         if st == self._lib.ATT_E_ARG:
             raise InvalidArgument("q0 is the zero quaternion (it has no attitude)")
         _raise(st, "q0")

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
+from .core import INCREMENT_METHODS
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = [
@@ -56,8 +57,10 @@ DTHETA_MAX = 429496730 / Q30_ONE
 _DTHETA_MAX_Q30 = 429496730
 _QUAT_MAX_Q30 = 1342177280
 
-#: Method name → att_fx_method value (same numbers as the float integrator).
-METHODS = {"rv1": 0, "rv2": 1, "rv3": 2, "rv3-coning": 3, "rv3-reuse": 4}
+#: Methods with a fixed-point port: every increment method of the float
+#: integrator (the att_fx_method value of each is lib.ATT_FX_<NAME>, equal to
+#: its att_method value).
+METHODS: tuple[str, ...] = INCREMENT_METHODS
 
 _FX_STATUS = {
     -80: (RangeError, "value outside its fixed-point format's range"),
@@ -117,12 +120,10 @@ def from_q28(q: ArrayLike) -> NDArray[np.float64]:
 def _method(method: str) -> int:
     if not isinstance(method, str):
         raise InvalidType(f"method: expected a string, got {type(method).__name__}")
-    try:
-        return METHODS[method]
-    except KeyError:
+    if method not in METHODS:
         raise InvalidArgument(
-            f"method: {method!r} is not available in fixed point; choose one of {sorted(METHODS)}"
-        ) from None
+            f"method: {method!r} is not available in fixed point; choose one of {sorted(METHODS)}")
+    return int(getattr(_lib()[1], "ATT_FX_" + method.upper().replace("-", "_")))
 
 
 def _dtheta_q30(dtheta: ArrayLike, name: str = "dtheta") -> NDArray[np.int32]:
@@ -182,7 +183,7 @@ def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = Non
     """Integrate body-frame angle increments (rad, shape (N, 3)) in fixed point.
 
     Same contract as the float builds: returns the attitude quaternion after
-    each update as an (M, 4) float64 array (M = N for rv1/rv3-reuse, N // 2
+    each update as an (M, 4) float64 array (M = N for rv1 and the reuse forms, N // 2
     for rv2, N // 3 for rv3/rv3-coning). Increments are rounded to Q2.30
     (|Δθ| ≤ :data:`DTHETA_MAX` per component, else :class:`RangeError`
     naming the sample); ``q0`` (default identity) is normalized in float,
@@ -248,7 +249,7 @@ def _ptr(ffi: Any, a: NDArray[Any], i: int, width: int, ctype: str = "int32_t *"
 
 def rotation_vector(dtheta: ArrayLike, method: str = "rv3") -> NDArray[np.float64]:
     """Φ of one update from the increments of that update (shape (n, 3), oldest
-    first; n = 1 rv1, 2 rv2, 3 rv3/rv3-coning, 1–3 rv3-reuse)."""
+    first; n = 1 rv1, 2 rv2, 3 rv3/rv3-coning, 1–3 rv3-reuse/rv3-reuse-poly)."""
     ffi, lib = _lib()
     m = _method(method)
     d = _dtheta_q30(dtheta)

@@ -10,9 +10,12 @@ exists:
   4×4 matrix (the C library uses Shepperd's pivoting);
 * Euler → matrix as the product of the three elementary rotations;
 * q(Φ) through ``numpy.sinc`` (the C library uses a series below 0.2 rad);
-* the coning-correction coefficients of rv2, rv3 and rv3-reuse are
-  *derived* here at import time, in exact rational arithmetic, from the
+* the coning-correction coefficients are *derived* here at import time, in
+  exact rational arithmetic: rv2, rv3 and rv3-reuse-poly from the
   polynomial angular-rate models (Miller 1983), see :func:`fit_coefficients`;
+  rv3-coning, rv3-reuse and the reuse start-up from the classical-coning
+  error series (Ignagni 1990), see :func:`coning_optimal` and
+  :func:`coning_drift_series`, which also gives every method's drift;
 * the integrator composes the update quaternions with an associative
   (parallel-prefix) product instead of a sequential loop; RK4 is the
   textbook k1…k4 scheme applied to the quaternion ODE.
@@ -24,14 +27,24 @@ counterpart and returns float64.
 from __future__ import annotations
 
 from fractions import Fraction
+from math import factorial
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "COEFFICIENTS",
+    "CONING_FORMS",
     "GIMBAL_COS",
     "METHODS",
+    "coning_attitude",
+    "coning_drift",
+    "coning_drift_leading",
+    "coning_drift_series",
+    "coning_increments",
+    "coning_leading_term",
+    "coning_optimal",
+    "coning_rates",
     "dcm_to_euler",
     "dcm_to_quat",
     "euler_to_dcm",
@@ -52,7 +65,7 @@ __all__ = [
 
 F = NDArray[np.float64]
 
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
 
 #: Gimbal-lock threshold on cos θ (docs/integrator.md): sqrt(eps) of the build.
 GIMBAL_COS = {"f64": 2.0 ** -26, "f32": 2.0 ** -12}
@@ -114,26 +127,256 @@ def fit_coefficients(intervals: list[tuple[int, int]], target: tuple[int, int]) 
     return dict(zip(pairs, sol))
 
 
+# ---------------------------------------------------------------------------
+# classical coning: the error series of every method (exact)
+# ---------------------------------------------------------------------------
+#
+# Classical coning (docs/integrator.md, sec. 5): attitude
+# q(t) = [cos β/2, 0, sin β/2 cos Ωt, sin β/2 sin Ωt], body rate
+# ω = [−2Ω sin²(β/2), −Ω sin β sin Ωt, Ω sin β cos Ωt]. To second order in β,
+# whatever the phase:
+#
+# * the cone-axis (x) component of Δθ_i × Δθ_j, increments over intervals of
+#   length T that are d = j − i intervals apart, is 2 sin²β (1 − cos λ) sin(dλ),
+#   λ = ΩT (direct integration);
+# * the true rotation vector over an update of length h = mT holds, beside
+#   ∫ω_x dt (which ΣΔθ reproduces exactly), the coning term
+#   ½ sin²β (mλ − sin mλ) (Bortz's second-order term ½ ∫ α × ω dt).
+#
+# A method Φ = ΣΔθ + Σ k_ij Δθ_i × Δθ_j therefore errs about the cone axis by
+#     e = [Σ_d c_d · 2(1 − cos λ) sin(dλ) − ½(mλ − sin mλ)] · sin²β
+# per update, c_d the sum of its coefficients at distance d, and drifts at
+# e / h: ε / (Ω sin²β) = e / (mλ sin²β). Every function below works on the
+# Taylor series of these expressions in λ with exact rational coefficients.
+
+_NSER = 16  #: Taylor coefficients kept (λ^0 … λ^15)
+
+def _ser_trig(k: int, cosine: bool) -> list[Fraction]:
+    """Taylor coefficients of sin(kλ) (cosine: cos(kλ)) in λ."""
+    out = [Fraction(0)] * _NSER
+    for p in range(_NSER):
+        if (p % 2 == 0) == cosine:
+            out[p] = Fraction((-1) ** (p // 2) * k ** p, factorial(p))
+    return out
+
+
+def _ser_mul(a: list[Fraction], b: list[Fraction]) -> list[Fraction]:
+    out = [Fraction(0)] * _NSER
+    for i, x in enumerate(a):
+        if x:
+            for j in range(_NSER - i):
+                out[i + j] += x * b[j]
+    return out
+
+
+def _ser_add(*terms: tuple[Fraction | int, list[Fraction]]) -> list[Fraction]:
+    out = [Fraction(0)] * _NSER
+    for c, ser in terms:
+        for i in range(_NSER):
+            out[i] += c * ser[i]
+    return out
+
+
+_LAM = [Fraction(0), Fraction(1)] + [Fraction(0)] * (_NSER - 2)
+
+
+def _cross_x(d: int) -> list[Fraction]:
+    """(Δθ_i × Δθ_{i+d})_x / sin²β = 2(1 − cos λ) sin(dλ)."""
+    one_minus_cos = _ser_add((-2, _ser_trig(1, True)))
+    one_minus_cos[0] += 2
+    return _ser_mul(one_minus_cos, _ser_trig(d, False))
+
+
+def _true_coning(m: int) -> list[Fraction]:
+    """True cone-axis coning term over h = mT, / sin²β: ½(mλ − sin mλ)."""
+    return _ser_add((Fraction(m, 2), _LAM), (Fraction(-1, 2), _ser_trig(m, False)))
+
+
+def _error_series(m: int, c: dict[int, Fraction]) -> list[Fraction]:
+    """Cone-axis error per update / sin²β of a form with distance sums c."""
+    return _ser_add(*[(cd, _cross_x(d)) for d, cd in c.items()], (-1, _true_coning(m)))
+
+
+def _ser_inv(a: list[Fraction]) -> list[Fraction]:
+    """1 / a for a series with a[0] ≠ 0."""
+    out = [Fraction(0)] * _NSER
+    out[0] = 1 / a[0]
+    for n in range(1, _NSER):
+        out[n] = -sum(a[k] * out[n - k] for k in range(1, n + 1)) / a[0]
+    return out
+
+
+def _rk4_drift_series() -> list[Fraction]:
+    """RK4 from rate rows every T (rows t, t+h/2, t+h; h = 2T, μ = Ωh = 2λ):
+    cone-axis drift rate / (Ω sin²β), two parts.
+
+    1. The cone-axis part of the step. With a, b, c = ½ω at t, t+h/2, t+h
+       (pure quaternions) the step is 1 + h/6 (K1 + 2K2 + 2K3 + K4),
+       K1 = a, K2 = b + h/2 a⊗b, K3 = b + h/2 b⊗b + h²/4 a⊗b⊗b,
+       K4 = c + h b⊗c + h²/2 b⊗b⊗c + h³/4 a⊗b⊗b⊗c. ω_x is O(β²) and ω_y, ω_z
+       are O(β), so to O(β²) the x-part of the step's vector is
+       h/6 (a + 4b + c)_x + h²/6 (a × b + b × c)_x = ½ω_x h +
+       h²/24 ((ω_0 × ω_m)_x + (ω_m × ω_1)_x), with (ω(t1) × ω(t2))_x =
+       Ω² sin²β sin Ω(t2 − t1); the rotation vector of the (normalized)
+       step is twice its vector part to O(β²). Hence Φ_x − ∫ω_x =
+       (μ²/6) sin(μ/2) sin²β, against the true ½(μ − sin μ) sin²β.
+    2. The y, z part of the step is Simpson's rule on ω_y, ω_z, which for
+       a sinusoid of phase advance μ per step is the exact increment times
+       κ = μ(2 + cos(μ/2)) / (6 sin(μ/2)) (a pure scale factor, no phase
+       error): δ_yz = (κ − 1) ∫ω_yz. It enters the navigation frame as
+       C(t+h) δ_yz (the step's error is a body-frame rotation at its end;
+       the right Jacobian adds nothing at O(β²) since δ_yz ∥ Φ_yz), whose
+       cone-axis component is (κ − 1) sin²β sin μ: the body y-z rate seen
+       in the navigation frame has the constant cone-axis component
+       Ω sin²β (ω_n = Ω sin β w(t) + 2Ω sin²(β/2) e_x), and carrying
+       ω_yz(s) to the end of the step adds ∫(φ × ω)_x = sin²β (sin μ − μ).
+       The increment methods have no such term (their ΣΔθ is exact).
+    """
+    lam2 = _ser_mul(_LAM, _LAM)
+    e = _ser_add((Fraction(4, 6), _ser_mul(lam2, _ser_trig(1, False))), (-1, _true_coning(2)))
+    per_time = [x / 2 for x in e[1:]] + [Fraction(0)]  # e / (2λ)
+    sinc = _ser_trig(1, False)[1:] + [Fraction(0)]     # sin λ / λ
+    two_plus_cos = _ser_add((Fraction(1, 3), _ser_trig(1, True)))
+    two_plus_cos[0] += Fraction(2, 3)                    # (2 + cos λ) / 3
+    kappa = _ser_mul(two_plus_cos, _ser_inv(sinc))
+    kappa[0] -= 1
+    sinc2 = [x / 2 for x in _ser_trig(2, False)[1:]] + [Fraction(0)]  # sin 2λ / 2λ
+    # the sinc series are known to λ^(_NSER − 2) only: so is the result
+    return _ser_add((1, per_time), (1, _ser_mul(kappa, sinc2)))[: _NSER - 2]
+
+
+def coning_optimal(m: int, distances: tuple[int, ...]) -> dict[int, Fraction]:
+    """Distance sums c_d of the coning-optimal algorithm (Ignagni 1990).
+
+    The algorithm updates over h = mT and corrects with cross products of
+    increments d ∈ ``distances`` intervals apart; the c_d are chosen so that
+    the lowest len(distances) non-zero orders of its classical-coning error
+    (λ³, λ⁵, …: the error is odd in λ) vanish. E.g. ``coning_optimal(3, (1, 2))``
+    → {1: 27/20, 2: 9/20} (rv3-coning), ``coning_optimal(1, (1, 2))`` →
+    {1: 7/60, 2: −1/60} (rv3-reuse), ``coning_optimal(1, (1,))`` → {1: 1/12}.
+    """
+    n = len(distances)
+    powers = [3 + 2 * i for i in range(n)]
+    cols = [_cross_x(d) for d in distances]
+    rhs = _true_coning(m)
+    sol = _solve([[col[p] for col in cols] for p in powers], [rhs[p] for p in powers])
+    return dict(zip(distances, sol))
+
+
 def _derive() -> dict[str, tuple[Fraction, Fraction, Fraction]]:
     rv2 = fit_coefficients([(0, 1), (1, 2)], (0, 2))
     rv3 = fit_coefficients([(0, 1), (1, 2), (2, 3)], (0, 3))
-    reuse = fit_coefficients([(-2, -1), (-1, 0), (0, 1)], (0, 1))
-    reuse_start = fit_coefficients([(-1, 0), (0, 1)], (0, 1))
+    # the newest interval's quadratic-rate fit from it and the two before it
+    poly = fit_coefficients([(-2, -1), (-1, 0), (0, 1)], (0, 1))
+    coning3 = coning_optimal(3, (1, 2))
+    reuse = coning_optimal(1, (1, 2))
+    start = coning_optimal(1, (1,))
     z = Fraction(0)
     return {
         "rv1": (z, z, z),
         "rv2": (rv2[(0, 1)], z, z),
         "rv3": (rv3[(0, 1)], rv3[(0, 2)], rv3[(1, 2)]),
-        # Ignagni (1990): the coefficients that minimize the classical-coning
-        # drift of the three-sample form (not a polynomial fit).
-        "rv3-coning": (Fraction(27, 40), Fraction(9, 20), Fraction(27, 40)),
-        "rv3-reuse": (reuse[(0, 1)], reuse[(0, 2)], reuse[(1, 2)]),
-        "rv3-reuse-start": (reuse_start[(0, 1)], z, z),
+        # Ignagni's coning-optimal three-sample algorithm, in eq. (5)'s shape
+        # k12 = k23 (k13 Δθ1×Δθ3 + k23 Δθ2×(Δθ3 − Δθ1)): 27/40, 9/20, 27/40
+        "rv3-coning": (coning3[1] / 2, coning3[2], coning3[1] / 2),
+        # update every sample: Φk = Δθk + a Δθk−1×Δθk + b Δθk−2×Δθk
+        # (Δθ1 = Δθk−2, Δθ2 = Δθk−1, Δθ3 = Δθk): k12 = 0, k13 = b, k23 = a
+        "rv3-reuse": (z, reuse[2], reuse[1]),
+        "rv3-reuse-poly": (poly[(0, 1)], poly[(0, 2)], poly[(1, 2)]),
+        # second update of both reuse forms (one previous increment):
+        # Φ = Δθ2 + k Δθ1×Δθ2, coning-optimal k = 1/12 (= the linear-rate fit)
+        "rv3-reuse-start": (start[1], z, z),
     }
 
 
 #: (k12, k13, k23) per method, exact fractions (rv2: k12 only).
 COEFFICIENTS: dict[str, tuple[Fraction, Fraction, Fraction]] = _derive()
+
+#: Increments consumed per update (h = FRAME · T).
+FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
+
+#: Per increment method: (m, {d: c_d}), the update length in increments and
+#: the sum of its cross-product coefficients at each distance d (what
+#: classical coning sees of it): c_1 = k12 + k23, c_2 = k13.
+CONING_FORMS: dict[str, tuple[int, dict[int, Fraction]]] = {
+    m: (FRAME[m], {d: c for d, c in ((1, COEFFICIENTS[m][0] + COEFFICIENTS[m][2]),
+                                     (2, COEFFICIENTS[m][1])) if c != 0})
+    for m in FRAME
+}
+
+
+def coning_attitude(beta: float, omega: float, t: ArrayLike) -> F:
+    """Classical coning, exact attitude (…, 4):
+    q(t) = [cos β/2, 0, sin β/2 cos Ωt, sin β/2 sin Ωt]."""
+    tt = np.asarray(t, dtype=np.float64)
+    c, s = np.cos(beta / 2), np.sin(beta / 2)
+    return np.stack([np.full_like(tt, c), np.zeros_like(tt), s * np.cos(omega * tt),
+                     s * np.sin(omega * tt)], axis=-1)
+
+
+def coning_rates(beta: float, omega: float, t: ArrayLike) -> F:
+    """Body rate (…, 3) of :func:`coning_attitude` (from q' = ½ q ⊗ [0, ω]):
+    ω = [−2Ω sin²(β/2), −Ω sin β sin Ωt, Ω sin β cos Ωt]."""
+    tt = np.asarray(t, dtype=np.float64)
+    return np.stack([np.full_like(tt, -2 * omega * np.sin(beta / 2) ** 2),
+                     -omega * np.sin(beta) * np.sin(omega * tt),
+                     omega * np.sin(beta) * np.cos(omega * tt)], axis=-1)
+
+
+def coning_increments(beta: float, omega: float, T: float, n: int) -> tuple[F, F]:
+    """Exact increments ∫ω dt of :func:`coning_rates` over [kT, (k+1)T],
+    k = 0 … n−1, (n, 3), and the times kT, k = 0 … n, (n + 1,)."""
+    t = np.arange(n + 1) * T
+    d = np.stack([np.full(n, -2 * omega * np.sin(beta / 2) ** 2 * T),
+                  np.sin(beta) * np.diff(np.cos(omega * t)),
+                  np.sin(beta) * np.diff(np.sin(omega * t))], axis=-1)
+    return np.asarray(d, dtype=np.float64), np.asarray(t, dtype=np.float64)
+
+
+def coning_drift_series(method: str) -> list[Fraction]:
+    """Taylor coefficients in λ = ΩT of ``method``'s classical-coning drift
+    rate about the cone axis, in units of Ω sin²β (exact; second order in β).
+
+    T is the sample interval: the increment interval, or for ``rk4`` the
+    spacing of its rate rows (h = 2T). Entry p is the coefficient of λ^p
+    (every entry returned is exact). E.g. rv1 → −λ²/12 + λ⁴/240 − …
+    """
+    if method == "rk4":
+        return _rk4_drift_series()
+    m, c = CONING_FORMS[method]
+    e = _error_series(m, c)
+    if e[0] != 0:
+        raise AssertionError("coning error series must vanish at λ = 0")
+    return [x / m for x in e[1:]]  # e / (mλ)
+
+
+def coning_leading_term(method: str) -> tuple[Fraction, int]:
+    """(k, p): the leading term k λ^p of :func:`coning_drift_series`."""
+    ser = coning_drift_series(method)
+    p = next(i for i, x in enumerate(ser) if x != 0)
+    return ser[p], p
+
+
+def coning_drift_leading(method: str, beta: float, omega: float, T: float) -> float:
+    """Leading-term drift rate (rad/s) about the cone axis: k λ^p Ω sin²β."""
+    k, p = coning_leading_term(method)
+    return float(k) * (omega * T) ** p * omega * np.sin(beta) ** 2
+
+
+def coning_drift(method: str, beta: float, omega: float, T: float) -> float:
+    """Drift rate (rad/s) about the cone axis to second order in β, all
+    orders in λ = ΩT (the closed forms behind :func:`coning_drift_series`)."""
+    lam = omega * T
+    s2 = np.sin(beta) ** 2
+    cross = lambda d: 2 * (1 - np.cos(lam)) * np.sin(d * lam)
+    true = lambda m: 0.5 * (m * lam - np.sin(m * lam))
+    if method == "rk4":  # see _rk4_drift_series: step's cone-axis part + Simpson scale error
+        e = (2 * lam) ** 2 / 6 * np.sin(lam) - true(2)
+        kappa = lam * (2 + np.cos(lam)) / (3 * np.sin(lam)) - 1
+        return float(e * s2 / (2 * T) + kappa * np.sin(2 * lam) * s2 / (2 * T))
+    m, c = CONING_FORMS[method]
+    e = sum(float(cd) * cross(d) for d, cd in c.items()) - true(m)
+    return float(e * s2 / (m * T))
 
 
 # ---------------------------------------------------------------------------
@@ -278,19 +521,16 @@ def quat_to_rotvec(q: ArrayLike) -> F:
 # integrator
 # ---------------------------------------------------------------------------
 
-FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1}
-
-
 def rotation_vectors(dtheta: ArrayLike, method: str) -> F:
     """Φ of every update of ``method`` (M, 3) from increments (N, 3)."""
     d = np.asarray(dtheta, dtype=np.float64).reshape(-1, 3)
     k = [float(x) for x in COEFFICIENTS[method]]
-    if method == "rv3-reuse":
+    if method in ("rv3-reuse", "rv3-reuse-poly"):
         z = np.zeros((2, 3))
         pad = np.concatenate([z, d])
         a, b, c = pad[:-2], pad[1:-1], d  # Δθ_{k−2}, Δθ_{k−1}, Δθ_k (zeros before the start)
         phi = c + k[0] * np.cross(a, b) + k[1] * np.cross(a, c) + k[2] * np.cross(b, c)
-        if len(d) >= 2:  # second update: one previous increment, linear-rate fit
+        if len(d) >= 2:  # second update: one previous increment, coning-optimal 1/12
             ks = float(COEFFICIENTS["rv3-reuse-start"][0])
             phi[1] = d[1] + ks * np.cross(d[0], d[1])
         return phi

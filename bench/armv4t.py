@@ -18,14 +18,14 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from attitude_c.core import FRAME, METHODS
 from toolchain import targets as T
 from toolchain.qemu_count import per_iteration
 
 TITLE = "ARMv4T (ARM920T) integrator cost and attitude-rx load"
 
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
 #: increments (rate samples for rk4) consumed per attitude update
-PER_UPDATE = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rk4": 2}
+PER_UPDATE = {**FRAME, "rk4": 2}
 CLOCK_HZ = 400e6
 #: assumed cycles per instruction of the ARM920T on this code (1-cycle ALU
 #: and cached loads, 3-cycle taken branches, 2-4 cycle multiplies; soft-float

@@ -1,6 +1,6 @@
-"""Fixed-point core: ARMv4T instructions per rv3 / rv3-reuse update (fixed vs
-float vs double), 8051 machine cycles per rv3 update and flash bytes of rv3
-alone, and the long-run accuracy against float64.
+"""Fixed-point core: ARMv4T instructions per rv3 / rv3-reuse / rv3-reuse-poly
+update (fixed vs float vs double), 8051 machine cycles per update and flash
+bytes of each update kernel alone, and the long-run accuracy against float64.
 
 ARMv4T: bench/fixed_ops.c built for armv4t-bare (arm-none-eabi-gcc -O2
 -marm -mcpu=arm920t -mfloat-abi=soft, newlib) and run under
@@ -8,11 +8,13 @@ ARMv4T: bench/fixed_ops.c built for armv4t-bare (arm-none-eabi-gcc -O2
 instruction is a ``Trace`` line (toolchain/qemu_count.py) and the per-update
 figure is the difference between K and 2K updates, so start-up cancels.
 
-8051: tests/s51/fixed_rv3.c in s51 on the C51 core (AT89S51 configuration
-of toolchain/mcs51.toml: small model, 128 B internal RAM, no external RAM,
-4 KB code), Timer 0 + overflow interrupt around one update; sizes from
-SDCC's .sym area tables, from two linked images (with and without the
-call) and from the linker's internal RAM map (free stack).
+8051: tests/s51/fixed_kernel.c (att_fx_update_rv3, att_fx_update_reuse) in
+s51 on the C51 core (AT89S51 configuration of toolchain/mcs51.toml: small
+model, 128 B internal RAM, no external RAM, 4 KB code), built and run by
+tests/test_fixed_targets.py's s51_kernel_run, Timer 0 + overflow interrupt
+around one update; sizes from SDCC's .sym area tables, from two linked
+images (with and without the call) and from the linker's internal RAM map
+(free stack).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import re
 import sys
 import tempfile
 from pathlib import Path
+from typing import Callable
 
 ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
@@ -35,11 +38,20 @@ ARM_ROWS = [
     ("fixed rv3, att_fx_integ_update (3 calls)", "fx-rv3", "f64", 3),
     ("float rv3, att_integ_update (3 calls)", "fl-rv3", "f32", 3),
     ("double rv3, att_integ_update (3 calls)", "fl-rv3", "f64", 3),
+    ("fixed rv3-reuse, att_fx_update_reuse (sliding window, one call per increment)",
+     "fx-reuse-kernel", "f64", 1),
     ("fixed rv3-reuse, att_fx_integ_batch", "fx-reuse-batch", "f64", 1),
     ("fixed rv3-reuse, att_fx_integ_update", "fx-reuse", "f64", 1),
     ("float rv3-reuse, att_integ_update", "fl-reuse", "f32", 1),
     ("double rv3-reuse, att_integ_update", "fl-reuse", "f64", 1),
+    ("fixed rv3-reuse-poly, att_fx_update_reuse", "fx-reuse-poly-kernel", "f64", 1),
+    ("fixed rv3-reuse-poly, att_fx_integ_batch", "fx-reuse-poly-batch", "f64", 1),
+    ("fixed rv3-reuse-poly, att_fx_integ_update", "fx-reuse-poly", "f64", 1),
+    ("float rv3-reuse-poly, att_integ_update", "fl-reuse-poly", "f32", 1),
+    ("double rv3-reuse-poly, att_integ_update", "fl-reuse-poly", "f64", 1),
 ]
+#: the 8051 update kernels (tests/test_fixed_targets.py KERNELS)
+KERNELS = ("rv3", "rv3-reuse", "rv3-reuse-poly")
 
 
 def _arm(quick: bool, tmp: Path) -> tuple[list[tuple[str, float]], float]:
@@ -70,48 +82,47 @@ def _rom(mem: Path) -> int:
     return int(m.group(1)) if m else -1
 
 
-def _s51(tmp: Path) -> dict[str, object]:
+def _s51(tmp: Path) -> dict[str, dict[str, object]]:
     import subprocess
 
-    from toolchain import s51
     from toolchain import targets as T
 
     sys.path.insert(0, str(ROOT / "tests"))
-    from test_fixed_targets import write_rv3_header  # type: ignore
+    from test_fixed_targets import KERNELS as DEFS  # type: ignore
+    from test_fixed_targets import s51_kernel_run  # type: ignore
 
-    out: dict[str, object] = {}
-    ihx = s51.build([ROOT / "tests" / "s51" / "fixed_rv3.c"], tmp / "s51" / "rv3",
-                    lib_sources=[ROOT / "csrc" / "src" / "fixed_rv.c"],
-                    defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"],
-                    include_dirs=[write_rv3_header(tmp / "s51" / "inc", 6)])
-    res = s51.run(ihx, timeout=120)
-    out["cycles"] = {k: int(v) for k, v in re.findall(r"^CYC (\w+) (\d+)$", res.output, re.MULTILINE)}
-    m = re.search(r"Stack starts at: 0x([0-9a-fA-F]+) .* with (\d+) bytes available",
-                  ihx.with_suffix(".mem").read_text())
-    out["stack_free"] = int(m.group(2)) if m else -1
-    out["rom_test"] = _rom(ihx.with_suffix(".mem"))
-    # flash of rv3 alone: one image calling att_fx_update_rv3, one not (the
-    # AT89S51 flags of the firmware; link-only sizes, not run)
-    src = tmp / "sz"
-    src.mkdir(parents=True, exist_ok=True)
-    for name, body in (("with", "att_fx_update_rv3(q, d);"), ("without", "q[0] ^= d[0];")):
-        (src / f"{name}.c").write_text(
-            '#include "attitude/fixed.h"\n'
-            "static att_q30 q[4];\nstatic __code const att_q30 d[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};\n"
-            f"void main(void) {{ {body} for (;;) {{ }} }}\n")
     t = T.load("mcs51")
-    for name in ("with", "without"):
-        libs = [ROOT / "csrc" / "src" / "fixed_rv.c"] if name == "with" else []
-        try:
-            ihx2 = t.build_program([src / f"{name}.c", *libs], src / name,
-                                   defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"], with_lib=False)
-            out[f"rom_{name}"] = _rom(ihx2.with_suffix(".mem"))
-        except subprocess.CalledProcessError as exc:  # does not link
-            out[f"rom_{name}"] = None
-            out[f"err_{name}"] = " ".join(
-                ln.strip() for ln in (exc.stdout + exc.stderr).splitlines() if "Error" in ln)
-        if name == "with":
-            out["rel"] = _area_sizes(src / f"{name}.objs" / "fixed_rv.sym")
+    out: dict[str, dict[str, object]] = {}
+    for method in KERNELS:
+        k: dict[str, object] = {}
+        res, sym = s51_kernel_run(tmp / "s51", method)
+        k["cycles"] = {c: int(v) for c, v in re.findall(r"^CYC (\w+) (\d+)$", res.output, re.MULTILINE)}
+        mem = sym.parent.parent / (sym.parent.name[: -len(".objs")] + ".mem")
+        m = re.search(r"Stack starts at: 0x([0-9a-fA-F]+) .* with (\d+) bytes available", mem.read_text())
+        k["stack_free"] = int(m.group(2)) if m else -1
+        k["rom_test"] = _rom(mem)
+        # flash of the kernel alone: one image calling it, one not (the
+        # AT89S51 flags of the firmware; link-only sizes, not run)
+        define, call = DEFS[method]
+        src = tmp / "sz" / method
+        src.mkdir(parents=True, exist_ok=True)
+        for name, body in (("with", call + ";"), ("without", "q[0] ^= d[0];")):
+            (src / f"{name}.c").write_text(
+                '#include "attitude/fixed.h"\n'
+                "static att_q30 q[4];\nstatic __code const att_q30 d[9] = {1, 2, 3, 4, 5, 6, 7, 8, 9};\n"
+                f"void main(void) {{ {body} for (;;) {{ }} }}\n")
+            libs = [ROOT / "csrc" / "src" / "fixed_rv.c"] if name == "with" else []
+            try:
+                ihx2 = t.build_program([src / f"{name}.c", *libs], src / name,
+                                       defines=["ATT_REAL_F32", define], with_lib=False)
+                k[f"rom_{name}"] = _rom(ihx2.with_suffix(".mem"))
+            except subprocess.CalledProcessError as exc:  # does not link
+                k[f"rom_{name}"] = None
+                k[f"err_{name}"] = " ".join(
+                    ln.strip() for ln in (exc.stdout + exc.stderr).splitlines() if "Error" in ln)
+            if name == "with":
+                k["rel"] = _area_sizes(src / f"{name}.objs" / "fixed_rv.sym")
+        out[method] = k
     return out
 
 
@@ -162,34 +173,48 @@ def run(quick: bool) -> str:
             "rad, 4 at 0.43 rad)."),
             "",
         ]
-        s = _s51(tmp)
-        cyc = s["cycles"]
-        rel = s["rel"]
-        alone = ((s["rom_with"] or 0) - (s["rom_without"] or 0)) if s["rom_with"] else None
+        s51 = _s51(tmp)
         lines += [
             "### 8051 (SDCC 4.2, s51 -t C51: AT89S51, 128 B RAM, 4 KB flash)",
             "",
-            "| figure | value |",
-            "| --- | ---: |",
-            (f"| machine cycles per rv3 update, increments ≈ ±4.9e-4 rad (series degree 1) | "
-            f"{cyc.get('small', -1):,} |"),
-            (f"| machine cycles per rv3 update, increments ±0.25 rad (series degree ≤ 4) | "
-            f"{cyc.get('big', -1):,} |"),
-            (f"| time per rv3 update at 11.0592 MHz (12 clocks per cycle), small increments | "
-            f"{cyc.get('small', 0) * 12 / 11.0592e6 * 1e3:.1f} ms |"),
-            (f"| code of rv3 alone: fixed_rv.rel (ATT_FX_RV3_ONLY; CSEG + CONST) | "
-            f"{rel.get('CSEG', 0) + rel.get('CONST', 0):,} bytes |"),
-            ("| flash of rv3 alone (image with the call − image without, SDCC library "
-             "routines included) | "
-             + (f"{alone:,} bytes |" if alone is not None else f"does not link: {s.get('err_with')} |")),
-            (f"| static RAM of fixed_rv.rel (DSEG + OSEG) | "
-            f"{rel.get('DSEG', 0) + rel.get('OSEG', 0)} bytes |"),
-            (f"| test program on the AT89S51 (tests/s51/fixed_rv3.c + s51_sif.c + rv3): flash, "
-            f"free stack | {s['rom_test']:,} bytes, {s['stack_free']} bytes |"),
+            "| figure | " + " | ".join(KERNELS) + " |",
+            "| --- |" + " ---: |" * len(KERNELS),
+        ]
+
+        def row(label: str, fmt: Callable[[dict[str, object]], str]) -> str:
+            return f"| {label} | " + " | ".join(fmt(s51[m]) for m in KERNELS) + " |"
+
+        def cyc(k: dict[str, object], which: str) -> int:
+            return int(k["cycles"].get(which, -1))  # type: ignore[union-attr]
+
+        def alone(k: dict[str, object]) -> str:
+            if not k["rom_with"]:
+                return f"does not link: {k.get('err_with')}"
+            return f"{int(k['rom_with']) - int(k['rom_without'] or 0):,} bytes"  # type: ignore[arg-type]
+
+        def rel(k: dict[str, object], *areas: str) -> int:
+            return sum(int(k["rel"].get(a, 0)) for a in areas)  # type: ignore[union-attr]
+
+        lines += [
+            row("machine cycles per update, increments ≈ ±4.9e-4 rad (series degree 1)",
+                lambda k: f"{cyc(k, 'small'):,}"),
+            row("machine cycles per update, increments ±0.25 rad (series degree ≤ 4)",
+                lambda k: f"{cyc(k, 'big'):,}"),
+            row("time per update at 11.0592 MHz (12 clocks per cycle), small increments",
+                lambda k: f"{cyc(k, 'small') * 12 / 11.0592e6 * 1e3:.1f} ms"),
+            row("increments per update", lambda k: "3" if k is s51["rv3"] else "1"),
+            row("code of the kernel alone: fixed_rv.rel (ATT_FX_RV3_ONLY / ATT_FX_REUSE_ONLY; CSEG + CONST)",
+                lambda k: f"{rel(k, 'CSEG', 'CONST'):,} bytes"),
+            row("flash of the kernel alone (image with the call − image without, SDCC library "
+                "routines included)", alone),
+            row("static RAM of fixed_rv.rel (DSEG + OSEG)", lambda k: f"{rel(k, 'DSEG', 'OSEG')} bytes"),
+            row("test program on the AT89S51 (tests/s51/fixed_kernel.c + s51_sif.c + kernel): flash, "
+                "free stack", lambda k: f"{k['rom_test']:,} bytes, {k['stack_free']} bytes"),
             "",
-            ("The update links and runs in the AT89S51 configuration (small model, 128 bytes "
-            "of internal RAM, no external RAM, 4 KB code) on s51's C51 core, bit-identical to "
-            "the host (tests/test_fixed_targets.py)."),
+            ("Each kernel links and runs in the AT89S51 configuration (small model, 128 bytes "
+             "of internal RAM, no external RAM, 4 KB code) on s51's C51 core, bit-identical to "
+             "the host (tests/test_fixed_targets.py). The reuse forms update at every increment: "
+             "per increment they cost about 2.5× rv3."),
             "",
         ]
     acc = _accuracy(quick)

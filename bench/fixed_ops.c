@@ -7,12 +7,15 @@
  *   MODE: fx-rv3        K rv3 updates, fixed point, integrator API (3 increments each)
  *         fx-rv3-kernel K calls of att_fx_update_rv3 (9 increments each)
  *         fx-reuse      K rv3-reuse updates, fixed point (1 increment each)
+ *         fx-reuse-poly K rv3-reuse-poly updates, fixed point
+ *         fx-reuse-kernel, fx-reuse-poly-kernel
+ *                       K calls of att_fx_update_reuse (a sliding window of 9 increments)
  *         fx-rv3-batch  K rv3 updates through att_fx_integ_batch (64 updates per call)
- *         loop-kernel   the fx-rv3-kernel loop calling an empty function instead
+ *         fx-loop-kernel  the fx-rv3-kernel loop calling an empty function instead
  *                       (the driver's own share of the fx-rv3-kernel figure)
- *         fx-reuse-batch  the same for rv3-reuse
+ *         fx-reuse-batch, fx-reuse-poly-batch  the same for the reuse forms
  *         fl-rv3        K rv3 updates, att_real build (float or double), 3 increments each
- *         fl-reuse      K rv3-reuse updates, att_real build
+ *         fl-reuse, fl-reuse-poly  K updates of a reuse form, att_real build
  * The increments cycle through a table of 64 made once at start-up
  * (about 1 rad/s at 1 kHz: 1e-3 rad per increment).
  */
@@ -60,25 +63,48 @@ int main(int argc, char **argv)
     if (mode[0] == 'f' && mode[1] == 'x') {
         att_fx_integ s;
         att_q30 q[4] = { ATT_FX_Q30_ONE, 0, 0, 0 };
-        int reuse = (strcmp(mode, "fx-reuse") == 0);
+        /* the reuse form of the mode, if any */
+        att_fx_method rm = strncmp(mode, "fx-reuse-poly", 13) == 0 ? ATT_FX_RV3_REUSE_POLY : ATT_FX_RV3_REUSE;
+        int reuse = (strcmp(mode, "fx-reuse") == 0) || (strcmp(mode, "fx-reuse-poly") == 0);
         int kernel = (strcmp(mode, "fx-rv3-kernel") == 0) || (strcmp(mode, "fx-loop-kernel") == 0);
         int empty = (strcmp(mode, "fx-loop-kernel") == 0);
-        if (strcmp(mode, "fx-rv3-batch") == 0 || strcmp(mode, "fx-reuse-batch") == 0) {
+        size_t len = strlen(mode);
+        if (len > 6 && strcmp(mode + len - 6, "-batch") == 0) {
             static att_q30 big[192][3];
             static att_q30 qo[192][4];
-            size_t no, per = (mode[3] == 'r' && mode[4] == 'e') ? 64u : 192u;
+            size_t no, per = (strncmp(mode, "fx-reuse", 8) == 0) ? 64u : 192u;
             for (i = 0; i < 192; ++i) {
                 big[i][0] = tab_fx[i & (NTAB - 1)][0];
                 big[i][1] = tab_fx[i & (NTAB - 1)][1];
                 big[i][2] = tab_fx[i & (NTAB - 1)][2];
             }
-            att_fx_integ_init(&s, per == 64u ? ATT_FX_RV3_REUSE : ATT_FX_RV3, 0);
+            att_fx_integ_init(&s, per == 64u ? rm : ATT_FX_RV3, 0);
             for (i = 0; i < n; i += 64) {
                 if (att_fx_integ_batch(&s, &big[0][0], per, &qo[0][0], &no, 0) != ATT_OK) {
                     return 1;
                 }
             }
             return 0;
+        }
+        if (len > 7 && strcmp(mode + len - 7, "-kernel") == 0 && strncmp(mode, "fx-reuse", 8) == 0) {
+            att_q30 d[9];
+            int k;
+            for (k = 0; k < 6; ++k) {
+                d[3 + k] = tab_fx[k / 3][k % 3];
+            }
+            for (i = 0; i < n; ++i) {
+                const att_q30 *e = tab_fx[(i + 2) & (NTAB - 1)];
+                for (k = 0; k < 6; ++k) {
+                    d[k] = d[k + 3];
+                }
+                d[6] = e[0];
+                d[7] = e[1];
+                d[8] = e[2];
+                if (att_fx_update_reuse(q, d, rm) != ATT_OK) {
+                    return 1;
+                }
+            }
+            return q[0] == 0 ? 3 : 0;
         }
         if (kernel) {
             att_q30 d[9];
@@ -99,7 +125,7 @@ int main(int argc, char **argv)
             }
             return q[0] == 0 ? 3 : 0;
         }
-        att_fx_integ_init(&s, reuse ? ATT_FX_RV3_REUSE : ATT_FX_RV3, 0);
+        att_fx_integ_init(&s, reuse ? rm : ATT_FX_RV3, 0);
         for (i = 0; i < n; ++i) {
             if (reuse) {
                 if (att_fx_integ_update(&s, tab_fx[i & (NTAB - 1)], q) < 0) {
@@ -118,8 +144,12 @@ int main(int argc, char **argv)
     } else {
         att_integ s;
         att_real q[4];
-        int reuse = (strcmp(mode, "fl-reuse") == 0);
-        att_integ_init(&s, reuse ? ATT_METHOD_RV3_REUSE : ATT_METHOD_RV3, 0);
+        int reuse = (strncmp(mode, "fl-reuse", 8) == 0);
+        att_integ_init(
+            &s,
+            reuse ? (strcmp(mode, "fl-reuse-poly") == 0 ? ATT_METHOD_RV3_REUSE_POLY : ATT_METHOD_RV3_REUSE)
+                  : ATT_METHOD_RV3,
+            0);
         for (i = 0; i < n; ++i) {
             if (reuse) {
                 if (att_integ_update(&s, tab_fl[i & (NTAB - 1)], q) < 0) {

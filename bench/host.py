@@ -10,9 +10,12 @@ from typing import Any, Callable
 
 import numpy as np
 
+from attitude_c import core
+
 TITLE = "Host integrator throughput (C batch call vs NumPy, Python loops, imufusion)"
 
-FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rk4": 2}
+#: samples per update (rk4: two rate rows per step)
+FRAME = {**core.FRAME, "rk4": 2}
 
 
 def _best(fn: Callable[[], Any], repeat: int) -> float:
@@ -32,7 +35,7 @@ def _increments(n: int) -> np.ndarray:
 
 def c_batch_rate(method: str, precision: str, n: int, repeat: int) -> float:
     """Attitude updates per second of one raw C batch call over n samples."""
-    from attitude_c import METHODS
+    from attitude_c import method_code
     from attitude_c._lib import ffi_lib
 
     ffi, lib = ffi_lib(precision)
@@ -48,7 +51,7 @@ def c_batch_rate(method: str, precision: str, n: int, repeat: int) -> float:
     ph = ffi.cast("att_real *", ffi.from_buffer(h))
 
     def run() -> None:
-        lib.att_integ_init(s, METHODS.index(method), ffi.NULL)
+        lib.att_integ_init(s, method_code(method, lib), ffi.NULL)
         if method == "rk4":
             st = lib.att_integ_rk4_batch(s, px, n, ph, 1, po, nout, err)
         else:
@@ -124,7 +127,7 @@ def run(quick: bool = False) -> str:
         npy = numpy_rate(m, n // 10, max(1, repeat // 2))
         loop = python_loop_rate(m, n_loop)
         rates[m, "f64"], rates[m, "numpy"], rates[m, "loop"] = f64, npy, loop
-        gyro = f64 * FRAME[m] if m != "rk4" else f64 * 2
+        gyro = f64 * FRAME[m]
         rows.append(f"| {m} | {_fmt(f64)} | {_fmt(gyro)} | {_fmt(f32)} | {_fmt(npy)} | "
                     f"{f64 / npy:.0f}× | {_fmt(loop)} |")
     fus = imufusion_rate(n_loop)

@@ -60,7 +60,7 @@ def run(quick: bool = False) -> str:
         t = (np.arange(1, m + 1) * k_per - 1 + offset) * h
         return float(np.max(quat_angle_between(tr.quat(t), q)))
 
-    per = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1}
+    per = attitude_c.core.FRAME
     inc_peer = inc_all[:n_peer]
     precs = ["f64", "f32"]
     try:

@@ -73,12 +73,39 @@ int main(void)
     }
     printf("rv3_kernel %08lx\n", (unsigned long)h);
 
+    /* kernel: 200 updates of each reuse form over a sliding window */
+    for (m = (int)ATT_FX_RV3_REUSE; m <= (int)ATT_FX_RV3_REUSE_POLY; m += 2) {
+        att_q30 w[9];
+        hash_reset();
+        q[0] = ATT_FX_Q30_ONE;
+        q[1] = q[2] = q[3] = 0;
+        for (i = 0; i < 9; ++i) {
+            w[i] = inc(12);
+        }
+        for (i = 0; i < 200; ++i) {
+            int k, sc = 12 + (i % 17);
+            for (k = 0; k < 6; ++k) {
+                w[k] = w[k + 3];
+            }
+            for (k = 6; k < 9; ++k) {
+                w[k] = inc(sc);
+            }
+            st = att_fx_update_reuse(q, w, (att_fx_method)m);
+            hash32(st);
+            hashn(q, 4);
+        }
+        printf("reuse_kernel_%d %08lx\n", m, (unsigned long)h);
+    }
+
     /* integrator, every method, batch + streaming */
     for (i = 0; i < 600 * 3; ++i) {
         dd[i] = inc(10 + (i / 3) % 19);
     }
-    for (m = 0; m <= 4; ++m) {
+    for (m = 0; m <= (int)ATT_FX_RV3_REUSE_POLY; ++m) {
         att_fx_integ s;
+        if (m == 5) {
+            continue; /* rk4: no fixed-point port */
+        }
         hash_reset();
         a[0] = 300000000L;
         a[1] = -200000000L;

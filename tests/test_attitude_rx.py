@@ -415,3 +415,19 @@ def test_rx_errors_and_exit_codes(rx_builds, tmp_path: Path) -> None:
     else:
         rc, err = run("--port", str(node))
     assert rc == 77 and "Permission denied" in err
+
+
+def test_rx_accepts_every_method_name(rx_builds, tmp_path: Path) -> None:
+    """Every integrator method of the library (attitude_c.METHODS, rv3-reuse-poly
+    included) is a valid --method: the run gets past its configuration to the
+    port (exit 66, no such port), and the error for an unknown name lists them."""
+    import attitude_c
+
+    for m in attitude_c.METHODS:
+        p = subprocess.run([*rx_builds["host"], "--port", str(tmp_path / "nope"), "--method", m],
+                           capture_output=True, timeout=20, check=False)
+        assert p.returncode == 66, (m, p.stderr)
+    p = subprocess.run([*rx_builds["host"], "--port", str(tmp_path / "nope"), "--method", "rv9"],
+                       capture_output=True, timeout=20, check=False)
+    assert p.returncode == 78
+    assert all(m in p.stderr.decode() for m in attitude_c.METHODS)

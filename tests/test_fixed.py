@@ -170,7 +170,18 @@ def test_adc_converter() -> None:
 
 # -- integrator --------------------------------------------------------------
 
-METHODS = ["rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse"]
+METHODS = list(fx.METHODS)
+
+
+def test_fixed_methods_are_the_increment_methods() -> None:
+    """Every increment method has a fixed-point port, under the C enum's number."""
+    from attitude_c._lib import ffi_lib
+
+    _, lib = ffi_lib("f64")
+    assert fx.METHODS == core.INCREMENT_METHODS
+    for m in fx.METHODS:
+        name = m.upper().replace("-", "_")
+        assert getattr(lib, f"ATT_FX_{name}") == getattr(lib, f"ATT_METHOD_{name}")
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -309,11 +320,35 @@ def test_long_run_rv3(motion: str) -> None:
     assert norm_err.max() <= 4 * LSB
 
 
-def test_long_run_reuse_random() -> None:
+@pytest.mark.parametrize("method", ["rv3-reuse", "rv3-reuse-poly"])
+def test_long_run_reuse_random(method: str) -> None:
     n = 1_000_000
     d = quantize(random_motion(n))
-    qf = fx.integrate(d, "rv3-reuse")
-    q64 = core.integrate(d, "rv3-reuse", precision="f64")
+    qf = fx.integrate(d, method)
+    q64 = core.integrate(d, method, precision="f64")
     for k in (100_000, n):
         ef = float(angle_error(q64[k - 1], qf[k - 1]))
         assert ef <= 3 * noise_limit(k), (k, ef)
+
+
+@pytest.mark.parametrize("method", ["rv3-reuse", "rv3-reuse-poly"])
+def test_reuse_kernel_is_the_integrators_update(method: str) -> None:
+    """att_fx_update_reuse (the 8051 kernel's API) makes, bit for bit, the
+    update the streaming integrator makes from the third increment on."""
+    from attitude_c._lib import ffi_lib
+
+    ffi, lib = ffi_lib("f64")
+    rng = np.random.default_rng(9)
+    d = fx.to_q30(np.clip(rng.normal(size=(60, 3)) * rng.choice([1e-4, 1e-2, 0.2], size=(60, 1)), -0.39, 0.39))
+    want = fx.integrate_q30(d, method)
+    m = getattr(lib, "ATT_FX_" + method.upper().replace("-", "_"))
+    q = ffi.new("int32_t[4]", [int(v) for v in want[1]])
+    for k in range(2, len(d)):
+        assert lib.att_fx_update_reuse(q, ffi.new("int32_t[9]", [int(v) for v in d[k - 2:k + 1].ravel()]),
+                                       m) == 0
+        assert list(q) == [int(v) for v in want[k]], k
+    assert lib.att_fx_update_reuse(q, ffi.new("int32_t[9]"), lib.ATT_FX_RV3) == lib.ATT_FX_E_METHOD
+    big = ffi.new("int32_t[9]", [0, 0, 0, 0, lib.ATT_FX_DTHETA_MAX + 1, 0, 0, 0, 0])
+    before = list(q)
+    assert lib.att_fx_update_reuse(q, big, m) == lib.ATT_FX_E_RANGE
+    assert list(q) == before

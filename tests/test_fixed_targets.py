@@ -9,7 +9,8 @@ everywhere.
   ARMv4T Linux (both under qemu-arm, the bare one on the ti925t ARMv4T core)
   must print exactly the same lines;
 * every fixed*.c compiles warning-free with SDCC for the 8051;
-* the rv3 update runs in s51 and matches the host bit for bit.
+* the rv3 and reuse-form update kernels run in s51 and match the host bit
+  for bit.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from __future__ import annotations
 import re
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 from conftest import ROOT, require_target
@@ -71,7 +73,9 @@ def test_halves_and_compact_builds_match_host(host_vectors: str, build_root: Pat
         exe = t.build_program([VECTORS], build_root / "fxv" / name, lib_sources=LIB_SOURCES,
                               defines=defs)
         assert t.run([exe]).stdout.decode() == host_vectors, name
-    assert len(host_vectors.splitlines()) == 8
+    names = [ln.split()[0] for ln in host_vectors.splitlines()]
+    assert names == ["rv3_kernel", "reuse_kernel_4", "reuse_kernel_6",
+                     *(f"integ_{m}" for m in (0, 1, 2, 3, 4, 6)), "primitives", "adc"]
 
 
 @pytest.mark.parametrize("target", ["armv4t-bare", "armv4t"])
@@ -107,49 +111,83 @@ def rv3_increments(n: int) -> list[list[int]]:
     return out
 
 
-def write_rv3_header(directory: Path, n: int) -> Path:
-    """fixed_rv3_inc.h for tests/s51/fixed_rv3.c: the increments in 8051 code memory."""
+#: the 8051 kernels: method → (define leaving it alone in fixed_rv.c, its call)
+KERNELS = {
+    "rv3": ("ATT_FX_RV3_ONLY", "att_fx_update_rv3(q, d)"),
+    "rv3-reuse": ("ATT_FX_REUSE_ONLY", "att_fx_update_reuse(q, d, ATT_FX_RV3_REUSE)"),
+    "rv3-reuse-poly": ("ATT_FX_REUSE_ONLY", "att_fx_update_reuse(q, d, ATT_FX_RV3_REUSE_POLY)"),
+}
+#: what docs/fixed-point.md promises for fixed_rv.rel on the AT89S51: code
+#: (CSEG + CONST) and static RAM (DSEG + OSEG) bytes when written (rv3 2,560
+#: and 64, reuse 2,635 and 65), with room for compiler noise only
+KERNEL_SIZES = {"ATT_FX_RV3_ONLY": (2600, 64), "ATT_FX_REUSE_ONLY": (2680, 65)}
+#: updates run per kernel: the last n of rv3_increments(6), so the two timed
+#: ones (small, big) are the same rows for every kernel; the reuse test
+#: program holds only 4 rows (its kernel is larger: 4 KB of flash)
+KERNEL_UPDATES = {"rv3": 6, "rv3-reuse": 4, "rv3-reuse-poly": 4}
+
+
+def kernel_rows(n: int) -> list[list[int]]:
+    return rv3_increments(6)[6 - n:]
+
+
+def write_kernel_header(directory: Path, n: int, method: str = "rv3") -> Path:
+    """fixed_kernel_inc.h for tests/s51/fixed_kernel.c: the increments in 8051
+    code memory (one row of three increments per update) and the kernel call."""
     directory.mkdir(parents=True, exist_ok=True)
-    rows = ",\n".join("    {" + ", ".join(f"{v}L" for v in d) + "}" for d in rv3_increments(n))
-    path = directory / "fixed_rv3_inc.h"
-    path.write_text(f"#define NUPD {n}\nstatic __code const att_q30 fx_inc[NUPD][9] = {{\n"
-                    f"{rows}\n}};\n")
+    rows = ",\n".join("    {" + ", ".join(f"{v}L" for v in d) + "}" for d in kernel_rows(n))
+    path = directory / "fixed_kernel_inc.h"
+    path.write_text(f"#define NUPD {n}\n#define FX_UPDATE(q, d) {KERNELS[method][1]}\n"
+                    f"static __code const att_q30 fx_inc[NUPD][9] = {{\n{rows}\n}};\n")
     return directory
 
 
-def _replay_rv3(n: int) -> list[str]:
-    """The updates of tests/s51/fixed_rv3.c (same increments), through the host build."""
+def _replay(n: int, method: str) -> list[str]:
+    """The updates of tests/s51/fixed_kernel.c (same increments), through the host build."""
     from attitude_c._lib import ffi_lib
 
     ffi, lib = ffi_lib("f64")
     q = ffi.new("int32_t[4]", [1 << 30, 0, 0, 0])
     lines = []
-    for d in rv3_increments(n):
-        assert lib.att_fx_update_rv3(q, ffi.new("int32_t[9]", d)) == 0
+    for d in kernel_rows(n):
+        dd = ffi.new("int32_t[9]", d)
+        if method == "rv3":
+            st = lib.att_fx_update_rv3(q, dd)
+        else:
+            st = lib.att_fx_update_reuse(q, dd, getattr(lib, "ATT_FX_" + method.upper().replace("-", "_")))
+        assert st == 0
         lines.append(" ".join("%08X" % (v & 0xFFFFFFFF) for v in q))
     return lines
 
 
-def test_rv3_on_8051_matches_host(build_root: Path) -> None:
-    require_target("mcs51")
+def s51_kernel_run(out: Path, method: str) -> tuple[Any, Path]:
+    """Build tests/s51/fixed_kernel.c for ``method`` with the AT89S51 flags
+    and run it in s51; returns the result and the build's .sym of fixed_rv."""
     from toolchain import s51
 
+    only, _ = KERNELS[method]
+    n = KERNEL_UPDATES[method]
+    name = method.replace("-", "_")
+    ihx = s51.build([ROOT / "tests" / "s51" / "fixed_kernel.c"], out / name,
+                    lib_sources=[SRC / "fixed_rv.c"], defines=["ATT_REAL_F32", only],
+                    include_dirs=[write_kernel_header(out / f"inc_{name}", n, method)])
+    return s51.run(ihx, timeout=120), out / f"{name}.objs" / "fixed_rv.sym"
+
+
+@pytest.mark.parametrize("method", list(KERNELS))
+def test_kernel_on_8051_matches_host(method: str, build_root: Path) -> None:
+    require_target("mcs51")
     # AT89S51 configuration of toolchain/mcs51.toml (small model, 128 B IRAM, no
     # XRAM, 4 KB code) on s51's C51 core: it links and runs, bit-identical
-    out = build_root / "s51fx"
-    ihx = s51.build([ROOT / "tests" / "s51" / "fixed_rv3.c"], out / "rv3",
-                    lib_sources=[SRC / "fixed_rv.c"], defines=["ATT_REAL_F32", "ATT_FX_RV3_ONLY"],
-                    include_dirs=[write_rv3_header(out / "inc", 6)])
-    res = s51.run(ihx, timeout=120)
+    res, sym = s51_kernel_run(build_root / "s51fx", method)
     assert res.exit_code == 0
     got = [ln for ln in res.lines if not ln.startswith(("CYC", "EXIT"))]
-    assert got == _replay_rv3(6)
+    assert got == _replay(KERNEL_UPDATES[method], method)
     cyc = dict(re.findall(r"^CYC (\w+) (\d+)$", res.output, re.MULTILINE))
     assert set(cyc) == {"small", "big"}
-    # the sizes docs/fixed-point.md promises for the AT89S51 (2,544 B of code and
-    # 64 B of static RAM when written; the bounds leave room for compiler noise only)
-    sym = (out / "rv3.objs" / "fixed_rv.sym").read_text()
     area = {m.group(1): int(m.group(2), 16)
-            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", sym, re.MULTILINE)}
-    assert area["CSEG"] + area["CONST"] <= 2600, area
-    assert area["DSEG"] + area.get("OSEG", 0) <= 64, area
+            for m in re.finditer(r"^\s+\w+\s+(\w+)\s+size\s+([0-9A-Fa-f]+)", sym.read_text(),
+                                 re.MULTILINE)}
+    code, ram = KERNEL_SIZES[KERNELS[method][0]]
+    assert area["CSEG"] + area["CONST"] <= code, area
+    assert area["DSEG"] + area.get("OSEG", 0) <= ram, area

@@ -148,12 +148,30 @@ def test_fixed_precision_dispatch(monkeypatch: pytest.MonkeyPatch) -> None:
 
 
 def test_methods_constant() -> None:
-    assert ac.METHODS == ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+    assert ac.METHODS == ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
+    assert ac.INCREMENT_METHODS == tuple(m for m in ac.METHODS if m != "rk4")
     from attitude_c._lib import ffi_lib
 
+    # every name has its own enum value, the values cover att_method exactly,
+    # and the numbers of the methods that existed before stay as they were (ABI)
     _, lib = ffi_lib("f64")
-    assert [getattr(lib, f"ATT_METHOD_{m.upper().replace('-', '_')}") for m in ac.METHODS] \
-        == list(range(6))
+    codes = {m: ac.method_code(m) for m in ac.METHODS}
+    assert sorted(codes.values()) == list(range(lib.ATT_METHOD_COUNT))
+    assert codes == {"rv1": 0, "rv2": 1, "rv3": 2, "rv3-coning": 3, "rv3-reuse": 4, "rk4": 5,
+                     "rv3-reuse-poly": 6}
+    for prec in ("f64", "f32"):
+        ffi, lib = ffi_lib(prec)
+        assert {m: ac.method_code(m, lib) for m in ac.METHODS} == codes
+        # ... and the library's own names (att_integ_method_name) are these
+        assert {m: ffi.string(lib.att_integ_method_name(c)).decode() for m, c in codes.items()} \
+            == {m: m for m in codes}
+    with pytest.raises(InvalidArgument, match="method"):
+        ac.method_code("rv3-reuse-old")
+    # the simulator and the simulate command offer exactly these methods
+    from attitude_c.cli import simulate
+    from attitude_c.sim import _integ
+
+    assert _integ.METHODS == simulate._METHODS == ac.METHODS
 
 
 def test_demo_command(capsys: pytest.CaptureFixture[str]) -> None:

@@ -42,7 +42,7 @@ EPS32 = 2.0 ** -24
 #: float64 unit roundoff (2^-53).
 EPS64 = 2.0 ** -53
 
-INCREMENT_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse")
+INCREMENT_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly")
 
 
 @dataclass

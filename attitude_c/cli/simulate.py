@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
 
 
 def _positive(kind: str) -> Callable[[str], float]:

@@ -10,13 +10,10 @@ from typing import Callable
 
 import numpy as np
 
+from ..core import FRAME, METHODS
 from ..errors import InvalidArgument
 
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
 PRECISIONS = ("f64", "f32", "fixed")
-
-# increments consumed per update
-_PER_UPDATE = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rk4": 1}
 
 
 def check_method(method: str) -> None:
@@ -75,7 +72,7 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.
         q = np.asarray(q, dtype=float)
         last = 2 * np.arange(1, len(q) + 1)
         return q, last, 0.5
-    k = _PER_UPDATE[method]
+    k = FRAME[method]  # increments consumed per update
     n_use = (n // k) * k
     if n_use == 0:
         return empty

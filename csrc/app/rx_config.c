@@ -19,6 +19,7 @@ static const struct {
     { "rv3", ATT_METHOD_RV3 },
     { "rv3-coning", ATT_METHOD_RV3_CONING },
     { "rv3-reuse", ATT_METHOD_RV3_REUSE },
+    { "rv3-reuse-poly", ATT_METHOD_RV3_REUSE_POLY },
     { "rk4", ATT_METHOD_RK4 },
 };
 
@@ -214,7 +215,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
                 break;
         if (i == sizeof methods / sizeof methods[0])
             return fail(msg, len, RX_EXIT_CONFIG,
-                        "method: unknown '%s' (rv1, rv2, rv3, rv3-coning, rv3-reuse, rk4)", value);
+                        "method: unknown '%s' (rv1, rv2, rv3, rv3-coning, rv3-reuse, rv3-reuse-poly, rk4)",
+                        value);
         c->method = methods[i].method;
     } else if (strcmp(name, "format") == 0) {
         if (strcmp(value, "csv") == 0)
@@ -397,7 +399,7 @@ void rx_usage(const char *prog, void *stream)
             "  --gyro-zero CODE[,C,C]   ADC code at zero rate, default 2048\n"
             "  --gyro-scale K[,K,K]     rad/s per code, default 7.6699e-4 (90 deg/s per 2048 codes)\n"
             "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
-            "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rk4, default rv3\n"
+            "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4, default rv3\n"
             "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
             "  --block-size N           link block bytes (multiple of 6), default 6\n"
             "  --queue N                samples the inter-thread queue holds, default 256\n"

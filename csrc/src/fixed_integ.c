@@ -9,53 +9,9 @@
 #include "fixed_prim.h"
 
 /*
- * rv3-reuse, two previous increments (d1 older, d2, d3 newest):
- *   Φ = d3 + p × d2 + u × d3,  p = (1/720) d1,  u = −(31/720) d1 + (121/720) d2
- * p rounded to Q2.30 (shift 30), u one rounding of an exact two-term
- * Q4.60 sum; per component the four cross terms accumulated exactly and
- * rounded once (shift 30), the integer d3 added. |Φ_i| ≤ 0.4 + 0.02 < 2.
- */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint32_t t,
-                       att_q30 phi[3])
-{
-    int32_t p0, p1, p2, u0, u1, u2;
-    fx_acc acc;
-    p0 = fx_mul(ATT_FX_K_RV3R_12, d1[0], 30);
-    p1 = fx_mul(ATT_FX_K_RV3R_12, d1[1], 30);
-    p2 = fx_mul(ATT_FX_K_RV3R_12, d1[2], 30);
-#define FX_U(u, i)                         \
-    fx_zero(&acc);                         \
-    fx_mac(&acc, ATT_FX_K_RV3R_13, d1[i]); \
-    fx_mac(&acc, ATT_FX_K_RV3R_23, d2[i]); \
-    u = fx_round(&acc, 30)
-    FX_U(u0, 0);
-    FX_U(u1, 1);
-    FX_U(u2, 2);
-#undef FX_U
-    fx_init_u(&acc, FX_DITHER30(t, 1u));
-    fx_mac(&acc, p1, d2[2]);
-    fx_mac(&acc, -p2, d2[1]);
-    fx_mac(&acc, u1, d3[2]);
-    fx_mac(&acc, -u2, d3[1]);
-    phi[0] = d3[0] + fx_floor(&acc, 30);
-    fx_init_u(&acc, FX_DITHER30(t, 11u));
-    fx_mac(&acc, p2, d2[0]);
-    fx_mac(&acc, -p0, d2[2]);
-    fx_mac(&acc, u2, d3[0]);
-    fx_mac(&acc, -u0, d3[2]);
-    phi[1] = d3[1] + fx_floor(&acc, 30);
-    fx_init_u(&acc, FX_DITHER30(t, 22u));
-    fx_mac(&acc, p0, d2[1]);
-    fx_mac(&acc, -p1, d2[0]);
-    fx_mac(&acc, u0, d3[1]);
-    fx_mac(&acc, -u1, d3[0]);
-    phi[2] = d3[2] + fx_floor(&acc, 30);
-}
-
-/*
  * Two-increment forms: Φ = s·(a + b) ... precisely
  *   rv2:            Φ = a + b + (2/3 a) × b
- *   rv3-reuse n=2:  Φ = b + (1/12 a) × b
+ *   reuse n=2:      Φ = b + (1/12 a) × b
  * k·a rounded to Q2.30; cross terms exact in Q4.60, rounded once; integer
  * sum added. |Φ_i| ≤ 0.8 + 2/3·2·0.16 < 1.1.
  */
@@ -81,12 +37,23 @@ static void fx_phi2(const att_q30 a[3], const att_q30 b[3], int32_t k, uint8_t w
     phi[2] = b[2] + (with_a ? a[2] : 0) + fx_floor(&acc, 30);
 }
 
+/* the fixed-point methods: 0..4 and 6 (5 is rk4, not ported) */
+static uint8_t fx_method_ok(att_fx_method m)
+{
+    return (unsigned int)m <= (unsigned int)ATT_FX_RV3_REUSE || m == ATT_FX_RV3_REUSE_POLY;
+}
+
+static uint8_t fx_is_reuse(uint8_t m)
+{
+    return m == (uint8_t)ATT_FX_RV3_REUSE || m == (uint8_t)ATT_FX_RV3_REUSE_POLY;
+}
+
 att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30 phi[3])
 {
     if (d == 0 || phi == 0) {
         return ATT_E_NULL;
     }
-    if ((unsigned int)method > (unsigned int)ATT_FX_RV3_REUSE) {
+    if (!fx_method_ok(method)) {
         return (att_status)ATT_FX_E_METHOD;
     }
     if (n < 1u || n > 3u || (method == ATT_FX_RV1 && n != 1u) || (method == ATT_FX_RV2 && n != 2u)
@@ -106,7 +73,7 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
     case ATT_FX_RV2:
         fx_phi2(d, d + 3, ATT_FX_K_RV2, 1, 0, phi);
         break;
-    default: /* rv1, rv3-reuse */
+    default: /* rv1, reuse forms */
         if (n == 1u) {
             phi[0] = d[0];
             phi[1] = d[1];
@@ -114,7 +81,7 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
         } else if (n == 2u) {
             fx_phi2(d, d + 3, ATT_FX_K_RV3R_START, 0, 0, phi);
         } else {
-            att_fx_phi_reuse_(d, d + 3, d + 6, 0, phi);
+            att_fx_phi_reuse_(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, 0, phi);
         }
         break;
     }
@@ -128,7 +95,7 @@ att_status att_fx_integ_init(att_fx_integ *s, att_fx_method method, const att_q3
     if (s == 0) {
         return ATT_E_NULL;
     }
-    if ((unsigned int)method > (unsigned int)ATT_FX_RV3_REUSE) {
+    if (!fx_method_ok(method)) {
         return (att_status)ATT_FX_E_METHOD;
     }
     if (q0 == 0) {
@@ -190,10 +157,11 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
         } else {
             att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
         }
-    } else if (m == ATT_FX_RV3_REUSE) {
+    } else if (fx_is_reuse(m)) {
         t = fx_dither_seed(s->q);
         if (s->nbuf == 2u) {
-            att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta, t, phi);
+            att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta,
+                              m == (uint8_t)ATT_FX_RV3_REUSE_POLY, t, phi);
         } else if (s->nbuf == 1u) {
             fx_phi2(s->buf, dtheta, ATT_FX_K_RV3R_START, 0, t, phi);
         } else {
@@ -217,7 +185,7 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
     if (st != ATT_OK) {
         return st;
     }
-    if (m == ATT_FX_RV3_REUSE) {
+    if (fx_is_reuse(m)) {
         if (s->nbuf < 2u) {
             fx_copy3(s->buf + 3u * s->nbuf, dtheta);
             s->nbuf++;
@@ -276,7 +244,7 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n, 
     }
     for (i = 0; i < n;) {
         /* fast paths (same arithmetic as att_fx_integ_update, no copies):
-         * a whole rv3 frame straight from the caller's array, and rv3-reuse
+         * a whole rv3 frame straight from the caller's array, and the reuse forms
          * with its two previous increments also in the array */
         if (s->nbuf == 0u && i + 3u <= n && (s->method == ATT_FX_RV3 || s->method == ATT_FX_RV3_CONING)) {
             att_q30 phi[3];
@@ -288,10 +256,11 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n, 
             }
             r = att_fx_apply_(s->q, phi, t);
             i += 3u;
-        } else if (s->method == ATT_FX_RV3_REUSE && i >= 2u) {
+        } else if (fx_is_reuse(s->method) && i >= 2u) {
             att_q30 phi[3];
             uint32_t t = fx_dither_seed(s->q);
-            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i, t, phi);
+            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i,
+                              s->method == (uint8_t)ATT_FX_RV3_REUSE_POLY, t, phi);
             r = att_fx_apply_(s->q, phi, t);
             if (r == ATT_OK && i + 1u == n) { /* leave the history in the state */
                 fx_copy3(s->buf, dtheta + 3u * (i - 1u));

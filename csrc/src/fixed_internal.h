@@ -13,9 +13,11 @@
 #define ATT_FX_K_RV3_23     765041050L   /* 57/80 (= k12) */
 #define ATT_FX_K_RV3C_13    483183821L   /* 9/20 */
 #define ATT_FX_K_RV3C_23    724775731L   /* 27/40 (= k12) */
-#define ATT_FX_K_RV3R_12    1491308L     /* 1/720 */
-#define ATT_FX_K_RV3R_13    (-46230551L) /* -31/720 */
-#define ATT_FX_K_RV3R_23    180448279L   /* 121/720 */
+#define ATT_FX_K_RV3R_13    (-17895697L) /* -1/60 */
+#define ATT_FX_K_RV3R_23    125269879L   /* 7/60 */
+#define ATT_FX_K_RV3RP_12   1491308L     /* 1/720 */
+#define ATT_FX_K_RV3RP_13   (-46230551L) /* -31/720 */
+#define ATT_FX_K_RV3RP_23   180448279L   /* 121/720 */
 #define ATT_FX_K_RV3R_START 89478485L    /* 1/12 */
 
 /*
@@ -59,10 +61,11 @@ int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n);
  * (three-sample form with k12 = k23), inputs checked by the caller. */
 void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3]);
 
-/* rv3-reuse with two previous increments: Φ = d3 + (k12 d1) × d2 +
- * (k13 d1 + k23 d2) × d3, inputs checked by the caller. */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint32_t t,
-                       att_q30 phi[3]);
+/* Reuse forms with two previous increments: Φ = d3 + (k13 d1 + k23 d2) × d3,
+ * plus (k12 d1) × d2 for the polynomial form (poly != 0); inputs checked by
+ * the caller. */
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+                       uint32_t t, att_q30 phi[3]);
 
 /* c = cos(φ/2), s = sin(φ/2)/(φ/2) (Q2.30) for Φ with |Φ|² ≤ 9.6. */
 void att_fx_cs_(const att_q30 phi[3], int32_t *c, int32_t *s);

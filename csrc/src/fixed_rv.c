@@ -1,8 +1,10 @@
 /*
  * libattitude fixed point: the update kernel (rotation vector → quaternion,
- * quaternion product with folded renormalization, the rv3 rotation vector).
- * This file alone is what an rv3 update needs (its 8051 flash size is the
- * "rv3 alone" figure of docs/fixed-point.md). Integer-only.
+ * quaternion product with folded renormalization, the rotation vectors of
+ * rv3 and of the reuse forms). This file alone is what an rv3 update or a
+ * reuse-form update needs (its 8051 flash size with -DATT_FX_RV3_ONLY is
+ * the "rv3 alone" figure of docs/fixed-point.md, with -DATT_FX_REUSE_ONLY
+ * the "reuse alone" one). Integer-only.
  */
 #include "attitude/fixed.h"
 
@@ -26,7 +28,13 @@ static const int32_t fx_cs_k[2][8] = {
  * series converges faster). Degree 7 covers v ≤ 1.2 (φ ≤ 3.1). */
 static const int32_t fx_deg_vmax[6] = { 28378L, 2349547L, 24989211L, 113507487L, 331839229L, 747556367L };
 
-#if !(defined(ATT_FX_RV3_ONLY) && (defined(__SDCC) || defined(ATT_FX_COMPACT)))
+/* -DATT_FX_RV3_ONLY / -DATT_FX_REUSE_ONLY: in the compact build, leave only
+ * att_fx_update_rv3 / att_fx_update_reuse (the 8051 flash figures) */
+#if (defined(__SDCC) || defined(ATT_FX_COMPACT)) && (defined(ATT_FX_RV3_ONLY) || defined(ATT_FX_REUSE_ONLY))
+#define FX_KERNEL_ONLY 1
+#endif
+
+#ifndef FX_KERNEL_ONLY
 uint32_t att_fx_dither_seed_(const att_q30 q[4])
 {
     uint32_t x = (uint32_t)q[0] ^ (uint32_t)q[1] ^ (uint32_t)q[2] ^ (uint32_t)q[3];
@@ -249,11 +257,28 @@ static void fxa_dither(uint8_t k)
     }
 }
 
-/* cross-product index pairs: component i uses j = (i+1)%3, k = (i+2)%3 */
+/* cross-product index pairs: component i uses j = (i+1)%3, k = (i+2)%3;
+ * fx_jk and fx_phid repeat from index 4 (fxc_phi_reuse's poly pass) */
+#ifdef ATT_FX_RV3_ONLY
 static const uint8_t fx_jk[4] = { 1, 2, 0, 1 };
-static const uint8_t fx_rot[6] = { 1, 11, 22, 6, 17, 27 };
 static const uint8_t fx_phid[3] = { 6, 2, 5 };
+#else
+static const uint8_t fx_jk[8] = { 1, 2, 0, 1, 1, 2, 0, 1 };
+static const uint8_t fx_phid[7] = { 6, 2, 5, 0, 6, 2, 5 };
+#endif
+static const uint8_t fx_rot[6] = { 1, 11, 22, 6, 17, 27 };
 
+/* End of component fx_i of a Φ routine, the integer sum of its increments
+ * in R7: Φ_i = floor(fxa / 2^30) + R7 into register fx_phid[fx_i] (6, 2,
+ * 5: the ones free at that point of both routines). */
+static void fxc_phi_out(void)
+{
+    fx_j = fx_phid[fx_i];
+    fxa_out((uint8_t)(fx_j | FX_SH30));
+    fxr[fx_j].u += fxr[FX_R7].u;
+}
+
+#ifndef ATT_FX_REUSE_ONLY
 /*
  * Φ of the increments at fx_dp into fxr[0..2], coefficients k13, k23 in
  * fxr[6], fxr[5] on entry. Registers: a = k13 Δθ1 in R0..R2, b = k23 Δθ2
@@ -286,16 +311,14 @@ static void fxc_phi_rv3(void)
         fx_ld7(fx_i);
         fx_ld7((uint8_t)((3u + fx_i) | FX_ADD));
         fx_ld7((uint8_t)((6u + fx_i) | FX_ADD));
-        fx_j = fx_phid[fx_i];
-        fxa_out((uint8_t)(fx_j | FX_SH30));
-        fxr[fx_j].u += fxr[FX_R7].u;
+        fxc_phi_out();
     }
     fxr[0].u = fxr[6].u;
     fxr[1].u = fxr[2].u;
     fxr[2].u = fxr[5].u;
 }
 
-#ifndef ATT_FX_RV3_ONLY /* -DATT_FX_RV3_ONLY: att_fx_update_rv3 alone (8051 flash) */
+#ifndef FX_KERNEL_ONLY
 void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
 {
     fx_dp = d;
@@ -303,6 +326,89 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
     fxr[6].s = k13;
     fxr[5].s = k23;
     fxc_phi_rv3();
+    phi[0] = fxr[0].s;
+    phi[1] = fxr[1].s;
+    phi[2] = fxr[2].s;
+}
+#endif
+#endif /* !ATT_FX_REUSE_ONLY */
+
+#ifndef ATT_FX_RV3_ONLY
+/*
+ * Φ of a reuse form from d = [Δθ1, Δθ2, Δθ3] at fx_dp (Δθ3 the newest) into
+ * fxr[0..2]: Φ = Δθ3 + u × Δθ3 (+ p × Δθ2 with poly), u = k13 Δθ1 + k23 Δθ2
+ * (one rounding of the exact two-term sum), p = k12 Δθ1 (the arithmetic of
+ * the fast att_fx_phi_reuse_). Registers: k13, k23 in R6, R2; p to R3..R5
+ * (poly only); u to R0..R2 (u2 over k23 once its sum is formed); operand
+ * in R7; Φ_0 goes to R6, Φ_1 over u2 (component 2 uses u0, u1, p0, p1
+ * only), Φ_2 over R5. The form is kept in fx_k (0 or 4) until the
+ * component loop and there in bit 2 of its index fx_i (0..2 or 4..6; the
+ * index tables repeat), so it needs no byte of RAM of its own (the
+ * update's static RAM is at the AT89S51's limit). Subtracted products use
+ * a negated increment.
+ */
+static void fxc_phi_reuse(uint8_t poly)
+{
+    if (poly) {
+        fx_k = 4;
+        fxr[6].s = ATT_FX_K_RV3RP_13;
+        fxr[2].s = ATT_FX_K_RV3RP_23;
+    } else {
+        fx_k = 0;
+        fxr[6].s = ATT_FX_K_RV3R_13;
+        fxr[2].s = ATT_FX_K_RV3R_23;
+    }
+    if (fx_k) {
+        for (fx_i = 3; fx_i < 6u; ++fx_i) {
+            fxr[fx_i].s = ATT_FX_K_RV3RP_12;
+            fx_ld7((uint8_t)(fx_i - 3u));
+            fxa_mul30(fx_i);
+        }
+    }
+    for (fx_i = 0; fx_i < 3u; ++fx_i) {
+        fxa_set(0x20000000ul); /* round to nearest: + 2^29, then floor */
+        fx_ld7(fx_i);
+        fxa_mac(FX_M(6, FX_R7));
+        fx_ld7((uint8_t)(3u + fx_i));
+        fxa_mac(FX_M(2, FX_R7));
+        fxa_out((uint8_t)(fx_i | FX_SH30));
+    }
+    for (fx_i = fx_k; (uint8_t)(fx_i & 3u) != 3u; ++fx_i) {
+        fx_j = fx_jk[fx_i];
+        fx_k = fx_jk[fx_i + 1u];
+        fxa_dither(fx_rot[(uint8_t)(fx_i & 3u)]);
+        fx_ld7((uint8_t)(6u + fx_k));
+        fxa_mac(FX_M(fx_j, FX_R7)); /* u_j Δθ3_k */
+        fx_ld7((uint8_t)((6u + fx_j) | FX_NEGL));
+        fxa_mac(FX_M(fx_k, FX_R7)); /* − u_k Δθ3_j */
+        if (fx_i & 4u) {
+            fx_ld7((uint8_t)(3u + fx_k));
+            fxa_mac(FX_M(3u + fx_j, FX_R7)); /* p_j Δθ2_k */
+            fx_ld7((uint8_t)((3u + fx_j) | FX_NEGL));
+            fxa_mac(FX_M(3u + fx_k, FX_R7)); /* − p_k Δθ2_j */
+        }
+        fx_ld7((uint8_t)(6u + (uint8_t)(fx_i & 3u)));
+        fxc_phi_out();
+    }
+    fxr[0].u = fxr[6].u;
+    fxr[1].u = fxr[2].u;
+    fxr[2].u = fxr[5].u;
+}
+#endif
+
+#ifndef FX_KERNEL_ONLY
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+                       uint32_t t, att_q30 phi[3])
+{
+    att_q30 w[9]; /* the three increments in one array for fx_ld7 */
+    for (fx_i = 0; fx_i < 3u; ++fx_i) {
+        w[fx_i] = d1[fx_i];
+        w[3u + fx_i] = d2[fx_i];
+        w[6u + fx_i] = d3[fx_i];
+    }
+    fx_dp = w;
+    fx_t = t;
+    fxc_phi_reuse(poly);
     phi[0] = fxr[0].s;
     phi[1] = fxr[1].s;
     phi[2] = fxr[2].s;
@@ -348,7 +454,7 @@ static void fxc_cs(void)
     } while (n != 0u);
 }
 
-#ifndef ATT_FX_RV3_ONLY
+#ifndef FX_KERNEL_ONLY
 void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
     fxr[0].s = phi[0];
@@ -428,7 +534,7 @@ static att_status fxc_apply(void)
     return ATT_OK;
 }
 
-#ifndef ATT_FX_RV3_ONLY
+#ifndef FX_KERNEL_ONLY
 att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 {
     fxr[0].s = phi[0];
@@ -458,10 +564,10 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
 }
 #endif
 
-att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
+/* Checks Q at fx_qp and the 9 increments at fx_dp: ATT_E_NULL or
+ * ATT_FX_E_RANGE (|Δθ| > 0.4), else ATT_OK with the dither seed in fx_t */
+static att_status fxc_begin(void)
 {
-    fx_qp = q;
-    fx_dp = d;
     if (fx_qp == 0 || fx_dp == 0) {
         return ATT_E_NULL;
     }
@@ -472,11 +578,43 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
         }
     }
     fxc_seed();
+    return ATT_OK;
+}
+
+#ifndef ATT_FX_REUSE_ONLY
+att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
+{
+    att_status st;
+    fx_qp = q;
+    fx_dp = d;
+    st = fxc_begin();
+    if (st != ATT_OK) {
+        return st;
+    }
     fxr[6].s = ATT_FX_K_RV3_13;
     fxr[5].s = ATT_FX_K_RV3_23;
     fxc_phi_rv3();
     return fxc_apply();
 }
+#endif
+
+#ifndef ATT_FX_RV3_ONLY
+att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method method)
+{
+    att_status st;
+    if (method != ATT_FX_RV3_REUSE && method != ATT_FX_RV3_REUSE_POLY) {
+        return (att_status)ATT_FX_E_METHOD;
+    }
+    fx_qp = q;
+    fx_dp = d;
+    st = fxc_begin();
+    if (st != ATT_OK) {
+        return st;
+    }
+    fxc_phi_reuse(method == ATT_FX_RV3_REUSE_POLY);
+    return fxc_apply();
+}
+#endif
 
 #else /* fast build: unrolled, 64-bit or halves primitive from fixed_prim.h */
 
@@ -529,6 +667,58 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
     fx_mac(&acc, b0, w1);
     fx_mac(&acc, -b1, w0);
     phi[2] = d[2] + d[5] + e2 + fx_floor(&acc, 30);
+}
+
+/*
+ * Reuse forms, two previous increments (d1 older, d2, d3 newest):
+ *   Φ = d3 + u × d3 (+ p × d2),  u = k13 d1 + k23 d2,  p = k12 d1
+ *   rv3-reuse:      k13 = −1/60, k23 = 7/60 (k12 = 0: no p term)
+ *   rv3-reuse-poly: k12 = 1/720, k13 = −31/720, k23 = 121/720
+ * u one rounding of an exact two-term Q4.60 sum, p rounded to Q2.30 (shift
+ * 30); per component the cross terms accumulated exactly and rounded once
+ * (shift 30, dithered), the integer d3 added. With |Δθ| ≤ 0.4:
+ * rv3-reuse |u_i| ≤ (8/60)·0.4, |Φ_i| ≤ 0.4 + 2·0.053·0.4 < 0.45;
+ * poly |u_i| ≤ (152/720)·0.4, |Φ_i| ≤ 0.4 + 2·(0.084 + 0.0006)·0.4 < 0.47.
+ */
+void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+                       uint32_t t, att_q30 phi[3])
+{
+    int32_t p0 = 0, p1 = 0, p2 = 0, u0, u1, u2, k13, k23;
+    fx_acc acc;
+    if (poly) {
+        p0 = fx_mul(ATT_FX_K_RV3RP_12, d1[0], 30);
+        p1 = fx_mul(ATT_FX_K_RV3RP_12, d1[1], 30);
+        p2 = fx_mul(ATT_FX_K_RV3RP_12, d1[2], 30);
+        k13 = ATT_FX_K_RV3RP_13;
+        k23 = ATT_FX_K_RV3RP_23;
+    } else {
+        k13 = ATT_FX_K_RV3R_13;
+        k23 = ATT_FX_K_RV3R_23;
+    }
+#define FX_U(u, i)            \
+    fx_zero(&acc);            \
+    fx_mac(&acc, k13, d1[i]); \
+    fx_mac(&acc, k23, d2[i]); \
+    u = fx_round(&acc, 30)
+    FX_U(u0, 0);
+    FX_U(u1, 1);
+    FX_U(u2, 2);
+#undef FX_U
+    /* component i (j, k the next two, cyclic); the p × d2 terms are exact
+     * zeros for rv3-reuse (p = 0): skipped. Unrolled (a loop costs ARM ~20 %) */
+#define FX_PHI(i, j, k, uj, uk, pj, pk, ROT) \
+    fx_init_u(&acc, FX_DITHER30(t, ROT));    \
+    fx_mac(&acc, uj, d3[k]);                 \
+    fx_mac(&acc, -(uk), d3[j]);              \
+    if (poly) {                              \
+        fx_mac(&acc, pj, d2[k]);             \
+        fx_mac(&acc, -(pk), d2[j]);          \
+    }                                        \
+    phi[i] = d3[i] + fx_floor(&acc, 30)
+    FX_PHI(0, 1, 2, u1, u2, p1, p2, 1u);
+    FX_PHI(1, 2, 0, u2, u0, p2, p0, 11u);
+    FX_PHI(2, 0, 1, u0, u1, p0, p1, 22u);
+#undef FX_PHI
 }
 
 /*
@@ -686,6 +876,24 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
     }
     t = fx_dither_seed(q);
     att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
+    return att_fx_apply_(q, phi, t);
+}
+
+att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method method)
+{
+    att_q30 phi[3];
+    uint32_t t;
+    if (method != ATT_FX_RV3_REUSE && method != ATT_FX_RV3_REUSE_POLY) {
+        return (att_status)ATT_FX_E_METHOD;
+    }
+    if (q == 0 || d == 0) {
+        return ATT_E_NULL;
+    }
+    if (!att_fx_dtheta_ok_(d, 9u)) {
+        return (att_status)ATT_FX_E_RANGE;
+    }
+    t = fx_dither_seed(q);
+    att_fx_phi_reuse_(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, t, phi);
     return att_fx_apply_(q, phi, t);
 }
 

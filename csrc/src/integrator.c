@@ -10,6 +10,40 @@ static int method_valid(int m)
     return m >= 0 && m < (int)ATT_METHOD_COUNT;
 }
 
+/* indexed by att_method */
+static const char *const method_names[ATT_METHOD_COUNT] = { "rv1",       "rv2", "rv3",           "rv3-coning",
+                                                            "rv3-reuse", "rk4", "rv3-reuse-poly" };
+
+const char *att_integ_method_name(att_method method)
+{
+    return method_valid((int)method) ? method_names[method] : NULL;
+}
+
+att_status att_integ_method_from_name(const char *name, att_method *method)
+{
+    int m;
+    if (name == NULL || method == NULL) {
+        return ATT_E_NULL;
+    }
+    for (m = 0; m < (int)ATT_METHOD_COUNT; m++) {
+        const char *a = name, *b = method_names[m];
+        while (*a != '\0' && *a == *b) {
+            a++;
+            b++;
+        }
+        if (*a == *b) {
+            *method = (att_method)m;
+            return ATT_OK;
+        }
+    }
+    return (att_status)ATT_E_INTEG_METHOD;
+}
+
+static int is_reuse(int m)
+{
+    return m == ATT_METHOD_RV3_REUSE || m == ATT_METHOD_RV3_REUSE_POLY;
+}
+
 static void set_coeffs(att_integ *s)
 {
     att_real k12 = ATT_R(0.0), k13 = ATT_R(0.0), k23 = ATT_R(0.0);
@@ -31,6 +65,11 @@ static void set_coeffs(att_integ *s)
         k12 = ATT_R(ATT_RV3R_K12_NUM) / ATT_R(ATT_RV3R_DEN);
         k13 = ATT_R(ATT_RV3R_K13_NUM) / ATT_R(ATT_RV3R_DEN);
         k23 = ATT_R(ATT_RV3R_K23_NUM) / ATT_R(ATT_RV3R_DEN);
+        break;
+    case ATT_METHOD_RV3_REUSE_POLY:
+        k12 = ATT_R(ATT_RV3RP_K12_NUM) / ATT_R(ATT_RV3RP_DEN);
+        k13 = ATT_R(ATT_RV3RP_K13_NUM) / ATT_R(ATT_RV3RP_DEN);
+        k23 = ATT_R(ATT_RV3RP_K23_NUM) / ATT_R(ATT_RV3RP_DEN);
         break;
     default:
         break;
@@ -162,6 +201,25 @@ static int commit(att_integ *s, const att_real q[4], unsigned int sn, att_real q
     return ATT_INTEG_UPDATED;
 }
 
+/* Φ of the reuse forms from the two previous increments a (older), b and
+ * the newest c: Φ = c + (k13 a + k23 b) × c, plus k12 a × b for the
+ * polynomial form (rv3-reuse has k12 = 0: one cross product). One
+ * function for the streaming and the batch path, so both round alike. */
+static inline void reuse_phi(int method, const att_real k[3], const att_real a[3], const att_real b[3],
+                             const att_real c[3], att_real phi[3])
+{
+    att_real u[3];
+    u[0] = k[1] * a[0] + k[2] * b[0];
+    u[1] = k[1] * a[1] + k[2] * b[1];
+    u[2] = k[1] * a[2] + k[2] * b[2];
+    phi[0] = c[0] + (u[1] * c[2] - u[2] * c[1]);
+    phi[1] = c[1] + (u[2] * c[0] - u[0] * c[2]);
+    phi[2] = c[2] + (u[0] * c[1] - u[1] * c[0]);
+    if (method == ATT_METHOD_RV3_REUSE_POLY) {
+        att__cross_acc(phi, k[0], a, b);
+    }
+}
+
 int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4])
 {
     att_real phi[3], q[4];
@@ -207,12 +265,11 @@ int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4])
         att__cross_acc(phi, s->k[2], s->buf[1], dtheta);
         break;
     case ATT_METHOD_RV3_REUSE:
+    case ATT_METHOD_RV3_REUSE_POLY:
         if (s->nbuf == 1) {
             att__cross_acc(phi, ATT_R(ATT_RV3R_START_K_NUM) / ATT_R(ATT_RV3R_START_DEN), s->buf[1], dtheta);
         } else if (s->nbuf >= 2) {
-            att__cross_acc(phi, s->k[0], s->buf[0], s->buf[1]);
-            att__cross_acc(phi, s->k[1], s->buf[0], dtheta);
-            att__cross_acc(phi, s->k[2], s->buf[1], dtheta);
+            reuse_phi(s->method, s->k, s->buf[0], s->buf[1], dtheta, phi);
         }
         break;
     default: /* rv1 */
@@ -227,7 +284,7 @@ int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4])
     if (r < 0) {
         return r;
     }
-    if (s->method == ATT_METHOD_RV3_REUSE) {
+    if (is_reuse(s->method)) {
         copy3(s->buf[0], s->buf[1]);
         copy3(s->buf[1], dtheta);
         if (s->nbuf < 2) {
@@ -416,12 +473,12 @@ static size_t frames_fast(att_integ *s, const att_real *dth, size_t i0, size_t n
     return (size_t)m * nframes;
 }
 
-/* rv3-reuse fast loop: history already full (nbuf == 2). */
+/* Reuse-form fast loop: history already full (nbuf == 2). */
 static size_t reuse_fast(att_integ *s, const att_real *dth, size_t i0, size_t n, att_real *q_out,
                          size_t *nout, att_status *st, size_t *err_index)
 {
     att_real q[4], phi[3], a[3], b[3];
-    const att_real k12 = s->k[0], k13 = s->k[1], k23 = s->k[2];
+    const int method = s->method;
     unsigned int sn = s->since_norm;
     size_t j, no = *nout;
     int i;
@@ -433,12 +490,7 @@ static size_t reuse_fast(att_integ *s, const att_real *dth, size_t i0, size_t n,
     for (j = 0; j < n; j++) {
         const att_real *c = dth + 3 * (i0 + j);
         att_real *o = q_out + 4 * no;
-        phi[0] = c[0] + k12 * (a[1] * b[2] - a[2] * b[1]) + k13 * (a[1] * c[2] - a[2] * c[1])
-                 + k23 * (b[1] * c[2] - b[2] * c[1]);
-        phi[1] = c[1] + k12 * (a[2] * b[0] - a[0] * b[2]) + k13 * (a[2] * c[0] - a[0] * c[2])
-                 + k23 * (b[2] * c[0] - b[0] * c[2]);
-        phi[2] = c[2] + k12 * (a[0] * b[1] - a[1] * b[0]) + k13 * (a[0] * c[1] - a[1] * c[0])
-                 + k23 * (b[0] * c[1] - b[1] * c[0]);
+        reuse_phi(method, s->k, a, b, c, phi);
         step_q(q, phi, &sn);
         if (!att__finite4(q)) {
             *st = att__finite3(c) ? (att_status)ATT_E_INTEG_DIVERGED : ATT_E_NONFINITE;
@@ -502,7 +554,7 @@ att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_r
         m = 1;
         break;
     }
-    if (s->method == ATT_METHOD_RV3_REUSE) {
+    if (is_reuse(s->method)) {
         /* start-up (fewer than two previous increments) one by one */
         while (i < n && s->nbuf < 2 && st == ATT_OK) {
             st = feed_single(s, dtheta, i, i + 1, q_out, &nout, &bad);

@@ -45,8 +45,11 @@ static void test_constant_rate(void)
     double q[4];
     int m, k;
     fill_constant(w, dt);
-    for (m = 0; m < ATT_METHOD_RK4; m++) {
+    for (m = 0; m < ATT_METHOD_COUNT; m++) {
         int per = (m == ATT_METHOD_RV2) ? 2 : (m == ATT_METHOD_RV3 || m == ATT_METHOD_RV3_CONING) ? 3 : 1;
+        if (m == ATT_METHOD_RK4) {
+            continue; /* rates, not increments: tested below */
+        }
         CHECK_EQ_INT(att_integ_init(&s, (att_method)m, NULL), ATT_OK);
         CHECK_EQ_INT(att_integ_outputs(&s, N), N / per);
         CHECK_EQ_INT(att_integ_batch(&s, dth, N, out, &nout, &err), ATT_OK);
@@ -66,7 +69,10 @@ static void test_batch_equals_stream(void)
     for (i = 0; i < N * 3; i++) { /* a wobbly, non-constant motion */
         dth[i] = (att_real)(0.01 * sin(0.37 * (double)i) + 0.002 * (double)(i % 3));
     }
-    for (m = 0; m < ATT_METHOD_RK4; m++) {
+    for (m = 0; m < ATT_METHOD_COUNT; m++) {
+        if (m == ATT_METHOD_RK4) {
+            continue; /* rates, not increments: tested below */
+        }
         att_integ_init(&a, (att_method)m, NULL);
         att_integ_init(&b, (att_method)m, NULL);
         /* batch in uneven chunks */
@@ -266,6 +272,27 @@ static void test_long_run(void)
 #endif
 }
 
+static void test_method_names(void)
+{
+    att_method m, back = ATT_METHOD_RV1;
+    for (m = ATT_METHOD_RV1; m < ATT_METHOD_COUNT; m = (att_method)(m + 1)) {
+        const char *name = att_integ_method_name(m);
+        CHECK(name != NULL);
+        CHECK_EQ_INT(att_integ_method_from_name(name, &back), ATT_OK);
+        CHECK_EQ_INT(back, m);
+    }
+    CHECK(strcmp(att_integ_method_name(ATT_METHOD_RV3_REUSE_POLY), "rv3-reuse-poly") == 0);
+    CHECK(att_integ_method_name(ATT_METHOD_COUNT) == NULL);
+    CHECK(att_integ_method_name((att_method)-1) == NULL);
+    back = ATT_METHOD_RV2;
+    CHECK_EQ_INT(att_integ_method_from_name("rv3-reuse-", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(att_integ_method_from_name("rv3-reus", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(att_integ_method_from_name("", &back), ATT_E_INTEG_METHOD);
+    CHECK_EQ_INT(back, ATT_METHOD_RV2);
+    CHECK_EQ_INT(att_integ_method_from_name(NULL, &back), ATT_E_NULL);
+    CHECK_EQ_INT(att_integ_method_from_name("rv1", NULL), ATT_E_NULL);
+}
+
 int main(void)
 {
     test_constant_rate();
@@ -273,5 +300,6 @@ int main(void)
     test_bad_input();
     test_rk4();
     test_long_run();
+    test_method_names();
     return ATT_TEST_REPORT();
 }

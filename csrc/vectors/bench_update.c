@@ -7,7 +7,7 @@
  * the cost of one update (start-up cancels out). The increments come from a
  * small precomputed table, so the per-sample overhead is a few loads.
  *
- *   bench_update METHOD N     METHOD = rv1|rv2|rv3|rv3-coning|rv3-reuse|rk4
+ *   bench_update METHOD N     METHOD = rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,17 +19,12 @@
 
 int main(int argc, char **argv)
 {
-    static const char *names[] = { "rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4" };
     att_real table[TABLE][3], q[4];
     att_integ s;
     unsigned long n, i, updates = 0;
-    int m, rc;
-    if (argc != 3)
-        return 2;
-    for (m = 0; m < 6; m++)
-        if (strcmp(argv[1], names[m]) == 0)
-            break;
-    if (m == 6)
+    att_method m;
+    int rc;
+    if (argc != 3 || att_integ_method_from_name(argv[1], &m) != ATT_OK)
         return 2;
     n = strtoul(argv[2], NULL, 10);
     for (i = 0; i < TABLE; i++) { /* ~1 rad/s at 100 Hz, varying direction */
@@ -37,7 +32,7 @@ int main(int argc, char **argv)
         table[i][1] = (att_real)(-0.007 + 0.0005 * (double)i);
         table[i][2] = (att_real)(0.004 - 0.0003 * (double)i);
     }
-    if (att_integ_init(&s, (att_method)m, NULL) != ATT_OK)
+    if (att_integ_init(&s, m, NULL) != ATT_OK)
         return 3;
     for (i = 0; i < n; i++) {
         if (m == ATT_METHOD_RK4)

@@ -122,17 +122,6 @@ static const struct {
     { "dcm_heading", 9, 1, att_dcm_heading_n },
 };
 
-static const struct {
-    const char *name;
-    att_method m;
-} methods[] = {
-    { "rv1", ATT_METHOD_RV1 },
-    { "rv2", ATT_METHOD_RV2 },
-    { "rv3", ATT_METHOD_RV3 },
-    { "rv3-coning", ATT_METHOD_RV3_CONING },
-    { "rv3-reuse", ATT_METHOD_RV3_REUSE },
-};
-
 static void result(const char *id, int status, long err, size_t nout)
 {
     printf("= %s %d %ld %lu\n", id, status, err, (unsigned long)nout);
@@ -296,14 +285,8 @@ static int run_case(const char *id, const char *fn, size_t n)
             if (read_values(&h, 1) != 0)
                 return -1;
         } else {
-            if (token(mname, sizeof mname) != 0)
+            if (token(mname, sizeof mname) != 0 || att_integ_method_from_name(mname, &m) != ATT_OK)
                 return -1;
-            for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
-                if (strcmp(mname, methods[i].name) == 0)
-                    break;
-            if (i == sizeof methods / sizeof methods[0])
-                return -1;
-            m = methods[i].m;
         }
         if (read_values(q0, 4) != 0 || read_values(in_buf, 3 * n) != 0)
             return -1;

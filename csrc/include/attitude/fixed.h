@@ -64,15 +64,19 @@ enum {
     ATT_FX_GIMBAL_Q30 = 16         /* 2^-26 in Q2.30: cos θ below this = gimbal lock */
 };
 
-/* Methods: the same numbers as att_method of attitude/integrator.h. */
+/* Methods: the same numbers as att_method of attitude/integrator.h (5,
+ * rk4, has no fixed-point port). */
 typedef enum {
-    ATT_FX_RV1 = 0,        /* Φ = Δθ, one update per increment */
-    ATT_FX_RV2 = 1,        /* Φ = Δθ1 + Δθ2 + (2/3) Δθ1×Δθ2, one update per 2 increments */
-    ATT_FX_RV3 = 2,        /* paper eq. (5), 33/80 and 57/80, one update per 3 increments */
-    ATT_FX_RV3_CONING = 3, /* 9/20 and 27/40 (Ignagni), one update per 3 increments */
-    ATT_FX_RV3_REUSE = 4   /* one update per increment: Φ = Δθ3 + (1/720) Δθ1×Δθ2
-                              − (31/720) Δθ1×Δθ3 + (121/720) Δθ2×Δθ3 (Δθ3 newest);
-                              2nd update Φ = Δθ2 + (1/12) Δθ1×Δθ2, 1st Φ = Δθ1 */
+    ATT_FX_RV1 = 0,           /* Φ = Δθ, one update per increment */
+    ATT_FX_RV2 = 1,           /* Φ = Δθ1 + Δθ2 + (2/3) Δθ1×Δθ2, one update per 2 increments */
+    ATT_FX_RV3 = 2,           /* paper eq. (5), 33/80 and 57/80, one update per 3 increments */
+    ATT_FX_RV3_CONING = 3,    /* 9/20 and 27/40 (Ignagni), one update per 3 increments */
+    ATT_FX_RV3_REUSE = 4,     /* one update per increment, coning-optimal: Φ = Δθ3 +
+                                  (7/60) Δθ2×Δθ3 − (1/60) Δθ1×Δθ3 (Δθ3 newest) */
+    ATT_FX_RV3_REUSE_POLY = 6 /* one update per increment: Φ = Δθ3 + (1/720) Δθ1×Δθ2
+                                  − (31/720) Δθ1×Δθ3 + (121/720) Δθ2×Δθ3.
+                                  Both reuse forms: 2nd update Φ = Δθ2 + (1/12) Δθ1×Δθ2,
+                                  1st Φ = Δθ1 */
 } att_fx_method;
 
 /* Fixed-point status codes (range -80..-99). */
@@ -92,12 +96,12 @@ enum {
 typedef struct {
     att_q30 q[4];   /* attitude quaternion, Q2.30, |q| = 1 within ±4 LSB */
     att_q30 buf[9]; /* 3 increments (3 values each): rv2/rv3: those of the unfinished
-                              update, oldest first (the last one is scratch); rv3-reuse:
+                              update, oldest first (the last one is scratch); reuse forms:
                               the two previous increments, increment `old` the older;
                               Q2.30 rad */
     uint8_t method; /* att_fx_method */
     uint8_t nbuf;   /* valid entries of buf */
-    uint8_t old;    /* rv3-reuse: index of the older increment (0 or 1) */
+    uint8_t old;    /* reuse forms: index of the older increment (0 or 1) */
 } att_fx_integ;
 
 /* ADC-code → increment converter (per axis), set up by att_fx_adc_init. */
@@ -136,8 +140,8 @@ att_status att_fx_rotvec_to_quat(const att_q30 phi[3], att_q30 q[4]);
  * products accumulated exactly in 64 bits (the coefficient first
  * multiplied into the older increment, rounded to Q2.30), one rounding
  * per component. d holds n×3 values oldest first: n = 1 (rv1), 2 (rv2),
- * 3 (rv3 / rv3-coning), and for rv3-reuse n = 1, 2 or 3 (start-up forms
- * included). */
+ * 3 (rv3 / rv3-coning), and for the reuse forms n = 1, 2 or 3 (start-up
+ * forms included). */
 att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30 phi[3]);
 
 /* One rv3 update Q ← Q ⊗ q(Φ) with Φ of eq. (5) from d = [Δθ1, Δθ2, Δθ3]
@@ -150,6 +154,18 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
  * (AT89S51: 2.5 KB code, 64 bytes of static RAM, d may be in code memory);
  * -DATT_FX_RV3_ONLY leaves only this update in fixed_rv.c. */
 att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9]);
+
+/* One update of a reuse form (method ATT_FX_RV3_REUSE or
+ * ATT_FX_RV3_REUSE_POLY, else ATT_FX_E_METHOD) from d = [Δθk−2, Δθk−1,
+ * Δθk] (9 values, Q2.30, oldest first; each |Δθ_i| ≤ ATT_FX_DTHETA_MAX
+ * else ATT_FX_E_RANGE, Q untouched): Q ← Q ⊗ q(Φ) with the method's Φ,
+ * bit for bit the update att_fx_integ_update makes from the third
+ * increment on (the caller keeps the three-increment window; the first two
+ * updates after a start need the start-up forms of att_fx_integ_update).
+ * Q as for att_fx_update_rv3. On the
+ * 8051 the compact, non-reentrant build (-DATT_FX_REUSE_ONLY leaves only
+ * this update in fixed_rv.c). */
+att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method method);
 
 /* The same update for any method from its Φ (Q2.30 rad, |Φ|² ≤ 9.6). */
 att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3]);

@@ -22,24 +22,32 @@
 
 #include "attitude/common.h"
 
-/* Integration methods. */
+/* Integration methods. The numbers are part of the ABI (Python, the
+ * fixed-point port and attitude-rx map names to them): new methods are
+ * appended. */
 typedef enum {
-    ATT_METHOD_RV1 = 0,        /* Φ = Δθ; one update per increment */
-    ATT_METHOD_RV2 = 1,        /* two-sample: one update per 2 increments */
-    ATT_METHOD_RV3 = 2,        /* paper eq. (5), 33/80 and 57/80: one update per 3 increments */
-    ATT_METHOD_RV3_CONING = 3, /* 9/20 and 27/40 (Ignagni): one update per 3 increments */
-    ATT_METHOD_RV3_REUSE = 4,  /* one update per increment, correction from the newest
-                                  increment and the two before it (sec. 1.2 done right) */
-    ATT_METHOD_RK4 = 5,        /* RK4 from rates at t, t+h/2, t+h (att_integ_update_rate) */
-    ATT_METHOD_COUNT = 6
+    ATT_METHOD_RV1 = 0,            /* Φ = Δθ; one update per increment */
+    ATT_METHOD_RV2 = 1,            /* two-sample: one update per 2 increments */
+    ATT_METHOD_RV3 = 2,            /* paper eq. (5), 33/80 and 57/80: one update per 3 increments */
+    ATT_METHOD_RV3_CONING = 3,     /* 9/20 and 27/40 (Ignagni): one update per 3 increments */
+    ATT_METHOD_RV3_REUSE = 4,      /* paper sec. 1.2: one update per increment, coning-optimal
+                                  correction from the newest increment and the two before
+                                  it: Φk = Δθk + (7/60) Δθk−1×Δθk − (1/60) Δθk−2×Δθk */
+    ATT_METHOD_RK4 = 5,            /* RK4 from rates at t, t+h/2, t+h (att_integ_update_rate) */
+    ATT_METHOD_RV3_REUSE_POLY = 6, /* one update per increment, the newest interval's
+                                      quadratic-rate fit from the same three increments
+                                      (1/720, −31/720, 121/720); under coning ~70× the
+                                      drift of rv3-reuse (docs/integrator.md) */
+    ATT_METHOD_COUNT = 7
 } att_method;
 
 /* Method coefficients as exact fractions k = NUM / DEN (for fixed-point
  * ports). rv2: Φ = Δθ1 + Δθ2 + k Δθ1×Δθ2. Three-sample forms: k12, k13,
- * k23 of the general form above. rv3-reuse (newest increment Δθ3, the two
- * previous Δθ1, Δθ2): Φ = Δθ3 + k12 Δθ1×Δθ2 + k13 Δθ1×Δθ3 + k23 Δθ2×Δθ3;
- * its second update (one previous increment) uses Φ = Δθ2 + (1/12) Δθ1×Δθ2
- * and its first update Φ = Δθ1. */
+ * k23 of the general form above. Reuse forms (newest increment Δθ3, the
+ * two previous Δθ1, Δθ2): Φ = Δθ3 + k12 Δθ1×Δθ2 + k13 Δθ1×Δθ3 +
+ * k23 Δθ2×Δθ3 (rv3-reuse: k12 = 0); the second update after init/reset
+ * (one previous increment) uses Φ = Δθ2 + (1/12) Δθ1×Δθ2 and the first
+ * Φ = Δθ1, in both reuse forms. Derived in attitude_c/reference.py. */
 enum {
     ATT_RV2_K_NUM = 2,
     ATT_RV2_DEN = 3,
@@ -51,10 +59,14 @@ enum {
     ATT_RV3C_K13_NUM = 18,
     ATT_RV3C_K23_NUM = 27,
     ATT_RV3C_DEN = 40,
-    ATT_RV3R_K12_NUM = 1,
-    ATT_RV3R_K13_NUM = -31,
-    ATT_RV3R_K23_NUM = 121,
-    ATT_RV3R_DEN = 720,
+    ATT_RV3R_K12_NUM = 0,
+    ATT_RV3R_K13_NUM = -1,
+    ATT_RV3R_K23_NUM = 7,
+    ATT_RV3R_DEN = 60,
+    ATT_RV3RP_K12_NUM = 1,
+    ATT_RV3RP_K13_NUM = -31,
+    ATT_RV3RP_K23_NUM = 121,
+    ATT_RV3RP_DEN = 720,
     ATT_RV3R_START_K_NUM = 1,
     ATT_RV3R_START_DEN = 12
 };
@@ -76,7 +88,7 @@ enum {
  * att_integ_attitude(). */
 typedef struct {
     att_real q[4];           /* current attitude Q (unit, renormalized periodically) */
-    att_real buf[2][3];      /* rv2/rv3: increments of the unfinished update; rv3-reuse:
+    att_real buf[2][3];      /* rv2/rv3: increments of the unfinished update; reuse forms:
                              the two previous increments (buf[1] newest); rk4: the
                              rate at the start of the step (buf[0]) and the midpoint
                              rate (buf[1]) */
@@ -86,6 +98,16 @@ typedef struct {
     unsigned int since_norm; /* updates since the last renormalization */
     unsigned long updates;   /* attitude updates since init/reset (wraps) */
 } att_integ;
+
+/* Canonical name of a method ("rv1", "rv2", "rv3", "rv3-coning",
+ * "rv3-reuse", "rk4", "rv3-reuse-poly": the names of attitude_c and
+ * attitude-rx --method), or NULL for a value outside att_method. */
+const char *att_integ_method_name(att_method method);
+
+/* The method whose att_integ_method_name() is `name` (exact match) into
+ * *method: ATT_OK, ATT_E_NULL, or ATT_E_INTEG_METHOD (unknown name,
+ * *method untouched). */
+att_status att_integ_method_from_name(const char *name, att_method *method);
 
 /* Initialize for `method` with attitude q0 (NULL = identity; normalized
  * here; ATT_E_ARG if zero, ATT_E_NONFINITE if NaN/Inf). */

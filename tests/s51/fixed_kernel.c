@@ -1,12 +1,13 @@
 /*
- * 8051 run of the fixed-point rv3 update (tests/test_fixed_targets.py).
+ * 8051 run of a fixed-point update kernel (tests/test_fixed_targets.py):
+ * att_fx_update_rv3, or att_fx_update_reuse for one of the reuse forms.
  *
- * K = NUPD updates Q ← Q ⊗ q(Φ_rv3) from the increments of the generated
- * header fixed_rv3_inc.h (tests/test_fixed_targets.py writes it from a
- * 32-bit LCG and replays the same increments on the host, comparing every
- * quaternion bit for bit). Prints one line per update: the four Q2.30
+ * K = NUPD updates Q ← Q ⊗ q(Φ) from the increments of the generated
+ * header fixed_kernel_inc.h (tests/test_fixed_targets.py writes it from a
+ * 32-bit LCG, with FX_UPDATE naming the kernel, and replays the same
+ * increments on the host, comparing every quaternion bit for bit). Prints one line per update: the four Q2.30
  * components as 8 hex digits. The last two updates are timed in machine
- * cycles with Timer 0 plus an overflow interrupt (the ~20 cycles of each
+ * cycles with Timer 0 plus an overflow interrupt (the few cycles of each
  * ISR entry are inside the count: < 0.1 %), one with small increments
  * (≈ ±4.9e-4 rad: the degree-1 series) and one with large ones (±0.25 rad:
  * up to degree 4).
@@ -21,13 +22,21 @@
 #include "attitude/fixed.h"
 #include "s51_sif.h"
 
-#include "fixed_rv3_inc.h" /* NUPD, fx_inc[NUPD][9] (generated) */
+#include "fixed_kernel_inc.h" /* NUPD, fx_inc[NUPD][9], FX_UPDATE (generated) */
 
 static volatile unsigned char ovf;
 
-void t0_isr(void) __interrupt(1)
+/* Timer 0 overflow: ovf++ with no register saved, so the interrupt takes
+ * only its return address (2 bytes) from the update's stack — the reuse
+ * kernel leaves 13 bytes of stack, its deepest call chain needs 10. */
+void t0_isr(void) __interrupt(1) __naked
 {
-    ovf++;
+    /* clang-format off */
+    __asm
+        inc _ovf
+        reti
+    __endasm;
+    /* clang-format on */
 }
 
 static void put32(int32_t v)
@@ -60,7 +69,7 @@ void main(void)
             EA = 1;
             TR0 = 1;
         }
-        st = att_fx_update_rv3(q, fx_inc[k]);
+        st = FX_UPDATE(q, fx_inc[k]);
         if (k >= NUPD - 2) {
             TR0 = 0;
             EA = 0;
