@@ -35,6 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from attitude_c.errors import BlockFormatError
+from attitude_c.link import block
+
 ROOT = Path(__file__).resolve().parents[1]
 FW_DIR = ROOT / "firmware"
 CSRC = ROOT / "csrc"
@@ -46,16 +49,15 @@ MACHINE_HZ = XTAL_HZ // 12          #: machine cycles per second (12-clock core)
 TICK_HZ = MACHINE_HZ // 256         #: Timer 0 ticks per second (3600)
 FLASH_SIZE = 4096
 IRAM_SIZE = 128
-BLOCK_SIZE = 6
+#: Link block size N the firmware sends: one record of the block format (attitude/block.h).
+BLOCK_SIZE = block.fmt().size
 #: UART rates Timer 1 in mode 2 makes exactly from 11.0592 MHz (SMOD 0 or 1).
 BAUD_RATES = (1200, 2400, 4800, 9600, 14400, 19200, 28800, 57600)
 #: Bytes on the wire per delivered block: 0xAA, 0xBB, N data, checksum, answer.
 WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
 
-REPORT_MARK = 0xFE
-REPORT_KINDS = {0: "boot", 1: "selftest", 2: "gave_up", 3: "overrun", 4: "adc_error"}
-
-SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c"]
+SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
+           CSRC / "src" / "block.c"]
 SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
 
 
@@ -202,7 +204,9 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
     ``sim_blocks`` accepted blocks, 0 = never) or ``bench`` (production pins,
     self-test skipped because s51's port pins read 1, cycle counters).
-    ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck``.
+    ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck`` (every
+    conversion), ``adc_error_at=K`` (EOC stuck in the scan of sample K only, 0 <= K < 256: one
+    ADC_ERROR report in that sample's place, then sampling goes on).
     """
     if kind not in ("production", "sim", "bench"):
         raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
@@ -227,8 +231,13 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if kind == "sim":
         defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
         for f in faults:
+            name, _, arg = f.partition("=")
+            if name == "adc_error_at" and arg.isdigit() and int(arg) < 256:
+                defines.append(f"FW_SIM_EOC_STUCK_AT={int(arg)}")
+                continue
             if f not in fault_defs:
-                raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)}")
+                raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)} and adc_error_at=K "
+                                 f"(0 <= K < 256)")
             defines.append(fault_defs[f])
         extra.append(f"-Wp-include,{SIM_HAL_HEADER}")
         sources.insert(1, FW_DIR / "sim" / "tlc_model.c")
@@ -273,65 +282,58 @@ class Sample:
 
 @dataclass
 class Report:
-    kind: str
-    raw: bytes
+    """A report record (attitude/block.h) as libattitude's decoder read it."""
+
+    record: block.Record
+
+    @property
+    def kind(self) -> str:
+        return self.record.kind
+
+    @property
+    def raw(self) -> bytes:
+        return self.record.raw
 
     @property
     def first(self) -> int:
-        return (self.raw[2] << 8) | self.raw[3]
+        return self.record.first
 
     @property
     def count(self) -> int:
-        return (self.raw[4] << 8) | self.raw[5]
+        return self.record.count
 
     @property
     def status(self) -> int:
         """Self-test / ADC error status (negative att_status)."""
-        b = self.raw[2] if self.kind == "selftest" else self.raw[4]
-        return b - 256 if b >= 128 else b
+        return self.record.status
 
     @property
     def bad_code(self) -> int:
-        return (self.raw[3] << 8) | self.raw[4]
+        return self.record.bad_code
 
     @property
     def attempt(self) -> int:
-        return self.raw[5]
+        return self.record.attempt
 
 
 def decode_stream(blocks: Iterable[bytes]) -> list[Sample | Report]:
-    """Number the samples of a block stream (firmware/report.h).
+    """Number the samples of a block stream with libattitude's decoder and
+    sequence tracker (attitude/block.h, through ``attitude_c.link.block``).
 
-    Samples are counted from 0; a gave_up / overrun / adc_error report says
-    which samples will never come, and must start exactly at the next number.
+    Samples are counted from 0 after BOOT; a gave_up / overrun / adc_error
+    report says which samples will never come, and must start exactly at
+    the next number. Any record that breaks the format, or a loss report
+    that disagrees with the count, raises :class:`FirmwareError`.
     """
-    out: list[Sample | Report] = []
-    seq = 0
+    blocks = [bytes(b) for b in blocks]
     for b in blocks:
         if len(b) != BLOCK_SIZE:
             raise FirmwareError(f"block of {len(b)} bytes, expected {BLOCK_SIZE}: {b.hex()}")
-        if b[0] == REPORT_MARK:
-            kind = REPORT_KINDS.get(b[1])
-            if kind is None:
-                raise FirmwareError(f"unknown report kind in {b.hex()}")
-            r = Report(kind, bytes(b))
-            out.append(r)
-            if kind == "boot":
-                seq = 0
-            elif kind in ("gave_up", "overrun"):
-                if r.first != seq & 0xFFFF:
-                    raise FirmwareError(f"{kind} report for sample {r.first}, expected {seq}")
-                seq += r.count
-            elif kind == "adc_error":
-                if r.first != seq & 0xFFFF:
-                    raise FirmwareError(f"adc_error report for sample {r.first}, expected {seq}")
-                seq += 1
-            continue
-        if b[0] > 0x0F or b[2] > 0x0F or b[4] > 0x0F:
-            raise FirmwareError(f"not a sample block (code > 4095): {b.hex()}")
-        out.append(Sample(seq, ((b[0] << 8) | b[1], (b[2] << 8) | b[3], (b[4] << 8) | b[5])))
-        seq += 1
-    return out
+    try:
+        numbered = block.number_stream(blocks)
+    except BlockFormatError as exc:
+        raise FirmwareError(str(exc)) from exc
+    return [Sample(span.first, rec.codes) if rec.kind == "sample" else Report(rec) for rec, span in numbered]
 
 
 # -- host end of the link -----------------------------------------------------

@@ -203,5 +203,5 @@ def test_decode_stream_numbers_samples_across_loss_reports() -> None:
     assert [x.seq for x in out if isinstance(x, tool.Sample)] == [0, 1, 5]
     with pytest.raises(tool.FirmwareError, match="expected 2"):
         tool.decode_stream([boot, s(1), s(2), bytes([0xFE, 2, 0, 7, 0, 1])])
-    with pytest.raises(tool.FirmwareError, match="code > 4095"):
+    with pytest.raises(tool.FirmwareError, match="sample code above 4095"):
         tool.decode_stream([bytes([0x10, 0, 0, 0, 0, 0])])
