@@ -78,6 +78,15 @@ def test_production_image_fits_the_at89s51(out: Path, baud: int) -> None:
     assert img.stack_free >= 15 + STACK_MARGIN
 
 
+def test_sim_image_that_never_stops_compiles(out: Path) -> None:
+    """sim_blocks=0 is documented as "run until the simulator is stopped"."""
+    require_target("mcs51")
+    img = tool.build(out, kind="sim", sim_blocks=0, name="fw_forever")
+    assert img.ihx.exists()
+    with pytest.raises(ValueError, match="adc_error_at=K"):
+        tool.build(out, kind="sim", faults=["adc_error_at=300"], name="fw_bad_fault")
+
+
 def test_build_fails_when_the_image_does_not_fit(out: Path) -> None:
     require_target("mcs51")
     with pytest.raises(tool.FirmwareTooBig, match="does not fit"):
@@ -179,6 +188,23 @@ def test_selftest_failure_is_reported_over_the_link(out: Path, fault: str, statu
     for attempt, rep in enumerate(stream[1:], start=1):
         assert (rep.status, rep.bad_code, rep.attempt) == (status, code, attempt)
     assert res.stats["samples"] >= 2  # no sampling: seq counts the failed attempts
+
+
+def test_adc_error_is_reported_in_the_lost_samples_place(out: Path) -> None:
+    """A scan that fails once (EOC stuck, sim fault adc_error_at=K) becomes an ADC_ERROR
+    report for exactly that sample; the numbering and the samples after it are intact."""
+    _need()
+    cfg = tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
+    img = tool.build(out, cfg, kind="sim", sim_blocks=12, faults=["adc_error_at=5"], name="fw_adc_error")
+    res = tool.run(img, tool.LinkHost(), timeout=60)
+    stream = res.stream  # decode_stream checks the report's sample number against the count
+    errs = [x for x in stream if isinstance(x, tool.Report) and x.kind == "adc_error"]
+    assert len(errs) == 1 and errs[0].status == -40  # TLC2543_E_EOC_TIMEOUT
+    lost = errs[0].first
+    assert lost >= 5  # sample 5, or the first one scanned after it (an overrun in between)
+    samples = _samples(stream)
+    assert lost not in {s.seq for s in samples} and max(s.seq for s in samples) > lost
+    _assert_match_model(samples)
 
 
 def test_fastest_baud_57600(out: Path) -> None:
