@@ -457,7 +457,9 @@ class LinkHost:
 # -- simulation -------------------------------------------------------------
 
 @dataclass
-class SimResult:
+class SimOutput:
+    """What one s51 run of a sim/bench image produced (whatever was on the host end)."""
+
     output: str                     #: text the firmware wrote through the simulator interface
     console: str                    #: s51 console (state command output included)
     stats: dict[str, int]           #: the firmware's STATS line
@@ -465,7 +467,11 @@ class SimResult:
     max_sp: int                     #: highest stack pointer s51 saw
     sim_seconds: float              #: simulated time
     wall_seconds: float
-    host: LinkHost
+
+
+@dataclass
+class SimResult(SimOutput):
+    host: LinkHost = None  # type: ignore[assignment]
 
     @property
     def stream(self) -> list[Sample | Report]:
@@ -492,6 +498,99 @@ def _parse_kv(line_tag: str, text: str) -> dict[str, int]:
     return {k: int(v, 16) for k, v in re.findall(r"(\w+)=([0-9A-F]+)", m.group(1))}
 
 
+class Session:
+    """A socat pty pair with s51 on one end (``with Session(image) as s:``).
+
+    ``s.port`` is the host end (a pty path): give it to whatever plays the
+    Linux computer (:class:`LinkHost` through :func:`run`, or a program such
+    as ``attitude-rx``) *before* ``s.run()`` starts the firmware, so that its
+    BOOT report finds a listener. Every process is killed on exit.
+    """
+
+    def __init__(self, image: Image, timeout: float = 60.0) -> None:
+        if image.kind == "production":
+            raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
+        for tool in ("s51", "socat"):
+            if shutil.which(tool) is None:
+                raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
+        self.image = image
+        self.timeout = timeout
+        self._tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
+        self._dev_fw = self._tmp / "uart_fw"
+        self.port = self._tmp / "uart_host"
+        self._socat: subprocess.Popen[bytes] | None = None
+        self._s51: subprocess.Popen[bytes] | None = None
+        self._t0 = time.monotonic()
+
+    def __enter__(self) -> Session:
+        try:
+            self._socat = subprocess.Popen(
+                ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                start_new_session=True)
+            while not (self._dev_fw.exists() and self.port.exists()):
+                if self._socat.poll() is not None:
+                    err = self._socat.stderr.read().decode() if self._socat.stderr else ""
+                    raise FirmwareError(f"socat failed: {err}")
+                if time.monotonic() - self._t0 > 10:
+                    raise SimTimeout("socat did not create the pty pair within 10 s")
+                time.sleep(0.01)
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        _kill_group(self._s51)
+        _kill_group(self._socat)
+        shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def run(self, pump: Any = None, describe: Any = None) -> SimOutput:
+        """Start s51 and wait until the firmware stops itself (``pump()``, if given, is
+        called in the loop: the host end's work); raise :class:`SimTimeout` after the
+        session's timeout (``describe()`` adds the host end's view to the message) and
+        :class:`FirmwareError` if the program did not stop through ``s51_exit`` with
+        code 0 (e.g. the device model detected a protocol violation)."""
+        sif_out = self._tmp / "sif.out"
+        cmds = self._tmp / "cmds"
+        cmds.write_text(f'file "{self.image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
+        t_start = time.monotonic()
+        self._s51 = s51 = subprocess.Popen(
+            ["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}", "-s", str(self._dev_fw),
+             "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            start_new_session=True, cwd=self._tmp)
+        deadline = time.monotonic() + self.timeout
+        while s51.poll() is None:
+            if time.monotonic() > deadline:
+                _kill_group(s51)
+                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+                raise SimTimeout(f"s51 did not stop within {self.timeout} s; firmware output so far:\n"
+                                 + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
+                                 + "\ns51 console (end):\n" + con[-3000:]
+                                 + (f"\nhost: {describe()}" if describe is not None else ""))
+            if pump is not None:
+                pump()
+            else:
+                time.sleep(0.02)
+        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
+        wall = time.monotonic() - t_start
+        m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
+        if m is None or int(m.group(1)) != 0:
+            raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\n"
+                                f"console:\n{console[-2000:]}")
+        sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
+        clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
+        if sp is None or clk is None:
+            raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
+        return SimOutput(output=output, console=console, stats=_parse_kv("STATS", output),
+                         bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
+                         sim_seconds=float(clk.group(1)), wall_seconds=wall)
+
+
 def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) -> SimResult:
     """Run a sim/bench image in ``s51 -t C51`` with its UART on a pty pair and ``host`` on the other end.
 
@@ -502,71 +601,24 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
     :class:`FirmwareError` if the program did not stop through ``s51_exit``
     with code 0 (e.g. the device model detected a protocol violation).
     """
-    if image.kind == "production":
-        raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
-    for tool in ("s51", "socat"):
-        if shutil.which(tool) is None:
-            raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
     import serial  # pyserial
 
     host = host or LinkHost()
-    tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
-    dev_fw, dev_host = tmp / "uart_fw", tmp / "uart_host"
-    sif_out = tmp / "sif.out"
-    cmds = tmp / "cmds"
-    cmds.write_text(f'file "{image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
-    socat = s51 = None
-    port = None
-    t_start = time.monotonic()
-    console = ""
-    try:
-        socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={dev_fw}", f"pty,raw,echo=0,link={dev_host}"],
-                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                 stderr=subprocess.PIPE, start_new_session=True)
-        while not (dev_fw.exists() and dev_host.exists()):
-            if socat.poll() is not None:
-                raise FirmwareError(f"socat failed: {socat.stderr.read().decode() if socat.stderr else ''}")
-            if time.monotonic() - t_start > 10:
-                raise SimTimeout("socat did not create the pty pair within 10 s")
-            time.sleep(0.01)
-        port = serial.Serial(str(dev_host), image.config.baud, timeout=0.01)
-        s51 = subprocess.Popen(["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
-                                "-s", str(dev_fw), "-C", str(cmds)],
-                               stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               start_new_session=True, cwd=tmp)
-        deadline = time.monotonic() + timeout
-        while s51.poll() is None:
-            if time.monotonic() > deadline:
-                _kill_group(s51)
-                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
-                raise SimTimeout(f"s51 did not stop within {timeout} s; firmware output so far:\n"
-                                 + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
-                                 + "\ns51 console (end):\n" + con[-3000:]
-                                 + f"\nhost: {len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
-                                 f"receiver {host.stats()}")
+    with Session(image, timeout) as sess:
+        port = serial.Serial(str(sess.port), image.config.baud, timeout=0.01)
+
+        def pump() -> None:
             data = port.read(max(1, port.in_waiting))
-            if data:
-                reply = host.receive(data)
-            else:
-                reply = host._poll(host.tick())
+            reply = host.receive(data) if data else host._poll(host.tick())
             if reply:
                 port.write(reply)
-        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
-    finally:
-        if port is not None:
+
+        def describe() -> str:
+            return (f"{len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
+                    f"receiver {host.stats()}")
+
+        try:
+            out = sess.run(pump, describe)
+        finally:
             port.close()
-        _kill_group(s51)
-        _kill_group(socat)
-        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
-        shutil.rmtree(tmp, ignore_errors=True)
-    wall = time.monotonic() - t_start
-    m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
-    if m is None or int(m.group(1)) != 0:
-        raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\nconsole:\n{console[-2000:]}")
-    sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
-    clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
-    if sp is None or clk is None:
-        raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
-    return SimResult(output=output, console=console, stats=_parse_kv("STATS", output),
-                     bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
-                     sim_seconds=float(clk.group(1)), wall_seconds=wall, host=host)
+    return SimResult(**vars(out), host=host)
