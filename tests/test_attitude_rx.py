@@ -352,7 +352,7 @@ def test_rx_reports_are_logged_and_losses_held_not_integrated(rx_builds) -> None
     # (what is sent, sample number it stands for or None); numbers 0..23
     stream: list[tuple[bytes, str]] = [
         (block.encode_boot(72, 9600), "boot"),
-        *[(_block(codes[k]), "s") for k in range(0, 6)],
+        *[(_block(codes[k]), "s") for k in range(6)],
         (block.encode_loss("gave_up", 6, 1), "loss"),
         *[(_block(codes[k]), "s") for k in (7, 8)],
         (block.encode_loss("overrun", 9, 3), "loss"),            # 9, 10, 11

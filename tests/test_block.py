@@ -120,7 +120,7 @@ def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
 
 
 def test_number_stream_accounts_for_every_sample() -> None:
-    s = lambda a: block.encode_sample([a, a, a])  # noqa: E731
+    s = lambda a: block.encode_sample([a, a, a])
     boot = block.encode_boot(72, 9600)
     out = block.number_stream([boot, s(1), s(2), block.encode_loss("overrun", 2, 3), s(3),
                                block.encode_adc_error(6, -40), s(4)])
@@ -161,7 +161,7 @@ def test_block_sources_compile_for_the_8051_and_the_encoders_stay_small(tmp_path
                               capture_output=True, text=True, timeout=120, check=False)
         assert proc.returncode == 0 and "warning" not in (proc.stdout + proc.stderr).lower(), proc.stderr
         text = rel.read_text()
-        segs[src] = {k: int(v, 16) for k, v in re.findall(r"^A (CSEG|DSEG|OSEG) size ([0-9A-F]+)", text, re.M)}
+        segs[src] = {k: int(v, 16) for k, v in re.findall(r"^A (CSEG|DSEG|OSEG) size ([0-9A-F]+)", text, re.MULTILINE)}
     enc = segs["block.c"]
     assert enc["DSEG"] == 0, enc
     assert enc["OSEG"] <= 8, enc

@@ -26,9 +26,23 @@ Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error"]
 LossKind = Literal["gave_up", "overrun"]
 Bytes = Union[bytes, bytearray, memoryview]
 
-__all__ = ["Kind", "LossKind", "Format", "Record", "Span", "SeqTracker", "decode", "try_decode",
-           "encode_sample", "encode_boot", "encode_selftest", "encode_loss", "encode_adc_error",
-           "number_stream", "fmt"]
+__all__ = [
+    "Format",
+    "Kind",
+    "LossKind",
+    "Record",
+    "SeqTracker",
+    "Span",
+    "decode",
+    "encode_adc_error",
+    "encode_boot",
+    "encode_loss",
+    "encode_sample",
+    "encode_selftest",
+    "fmt",
+    "number_stream",
+    "try_decode",
+]
 
 
 @dataclass(frozen=True)
