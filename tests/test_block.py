@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import subprocess
+import time
 from pathlib import Path
 
 import pytest
@@ -181,3 +182,45 @@ def test_the_format_is_written_down_once() -> None:
             if pat.search(code) and "/*" not in code and "//" not in code and not code.lstrip().startswith("*"):
                 hits.append(f"{f.relative_to(ROOT)}:{n}: {line.strip()}")
     assert not hits, "\n".join(hits)
+
+
+# -- attitude link-rx --decode -------------------------------------------------------
+
+def test_link_rx_decode_prints_numbered_records(capsys: pytest.CaptureFixture[str]) -> None:
+    """`attitude link-rx --decode` decodes with the same C decoder and tracker."""
+    import json
+    import threading
+
+    from attitude_c.cli import main
+    from attitude_c.link.transport import PtyPair, open_port, run_sender
+
+    stream = [block.encode_boot(72, 9600), block.encode_sample([1, 2, 3]),
+              block.encode_loss("overrun", 1, 2), block.encode_sample([4, 5, 6]),
+              bytes([0x10, 0, 0, 0, 0, 0]), bytes.fromhex("fe0900000000"),
+              block.encode_loss("gave_up", 7, 1)]
+    with PtyPair() as (p0, p1):
+        def send() -> None:
+            time.sleep(0.3)  # link-rx opens its port first
+            pa = open_port(p0)
+            try:
+                run_sender(pa, stream, syn_timeout_ms=1000, answer_timeout_ms=1000)
+            finally:
+                pa.close()
+
+        th = threading.Thread(target=send, daemon=True)
+        th.start()
+        rc = main(["link-rx", "--port", p1, "--decode", "--count", str(len(stream)), "--duration", "30",
+                   "--gap-timeout-ms", "400"])
+        th.join(timeout=30)
+    assert rc == 0
+    recs = [json.loads(ln) for ln in capsys.readouterr().out.splitlines()]
+    assert recs == [
+        {"report": "BOOT", "version": 1, "period_ticks": 72, "period_s": 0.02, "baud": 9600},
+        {"n": 0, "codes": [1, 2, 3]},
+        {"report": "OVERRUN", "first": 1, "count": 2, "slip": 0},
+        {"n": 3, "codes": [4, 5, 6]},
+        {"n": 4, "codes": [4096, 0, 0], "error": "sample code above 4095"},
+        {"error": "unknown report kind", "raw": "fe0900000000"},
+        {"report": "GAVE_UP", "first": 5, "count": 3, "slip": 2},
+    ]
+    assert main(["link-rx", "--port", "loop://", "--decode", "--block-size", "8"]) == 2
