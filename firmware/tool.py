@@ -280,40 +280,9 @@ class Sample:
     codes: tuple[int, int, int]
 
 
-@dataclass
-class Report:
-    """A report record (attitude/block.h) as libattitude's decoder read it."""
-
-    record: block.Record
-
-    @property
-    def kind(self) -> str:
-        return self.record.kind
-
-    @property
-    def raw(self) -> bytes:
-        return self.record.raw
-
-    @property
-    def first(self) -> int:
-        return self.record.first
-
-    @property
-    def count(self) -> int:
-        return self.record.count
-
-    @property
-    def status(self) -> int:
-        """Self-test / ADC error status (negative att_status)."""
-        return self.record.status
-
-    @property
-    def bad_code(self) -> int:
-        return self.record.bad_code
-
-    @property
-    def attempt(self) -> int:
-        return self.record.attempt
+#: A report record as libattitude's decoder read it (kind, raw, first, count, status,
+#: bad_code, attempt, period_ticks, baud, ...): attitude_c.link.block.Record.
+Report = block.Record
 
 
 def decode_stream(blocks: Iterable[bytes]) -> list[Sample | Report]:
@@ -333,7 +302,7 @@ def decode_stream(blocks: Iterable[bytes]) -> list[Sample | Report]:
         numbered = block.number_stream(blocks)
     except BlockFormatError as exc:
         raise FirmwareError(str(exc)) from exc
-    return [Sample(span.first, rec.codes) if rec.kind == "sample" else Report(rec) for rec, span in numbered]
+    return [Sample(span.first, rec.codes) if rec.kind == "sample" else rec for rec, span in numbered]
 
 
 # -- host end of the link -----------------------------------------------------

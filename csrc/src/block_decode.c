@@ -4,6 +4,8 @@
  * apart from the encoders of block.c so that the firmware does not link
  * it. Portable C99 (SDCC compiles it too).
  */
+#include <string.h>
+
 #include "attitude/block.h"
 
 static uint16_t be16(const uint8_t *p)
@@ -24,17 +26,7 @@ int att_block_decode(const uint8_t *raw, att_block *out)
     if (raw == NULL || out == NULL) {
         return ATT_E_NULL;
     }
-    for (i = 0; i < 3u; i++) {
-        out->code[i] = 0;
-    }
-    out->first = 0;
-    out->count = 0;
-    out->period_ticks = 0;
-    out->bad_code = 0;
-    out->version = 0;
-    out->baud_div = 0;
-    out->attempt = 0;
-    out->status = 0;
+    memset(out, 0, sizeof *out); /* the fields a kind does not use are 0 */
     if (raw[0] != (uint8_t)ATT_BLOCK_MARK) {
         out->kind = (uint16_t)ATT_BLOCK_SAMPLE;
         for (i = 0; i < 3u; i++) {
