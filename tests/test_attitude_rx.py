@@ -403,7 +403,7 @@ def test_rx_reports_are_logged_and_losses_held_not_integrated(rx_builds) -> None
     assert (st["boot"], st["gave_up"], st["overrun"], st["adc_error"], st["selftest"]) == (1, 2, 1, 1, 1)
     assert st["block_errors"] == 1 and st["seq_errors"] == 1 and st["updates"] == 24
     assert "BOOT: block format 1, sample period 72 ticks = 0.02 s, 9600 baud" in err
-    assert "OVERRUN: 3 samples lost at sample 9" in err and "holding the last rate over 3 samples" in err
+    assert "OVERRUN: 3 samples lost at sample 9" in err and "samples 9..11 missing (OVERRUN): holding the last rate over 3 sample periods" in err
     assert "sample 15 rejected: code out of 0..4095" in err
     assert "vanished unreported" in err
 

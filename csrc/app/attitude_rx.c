@@ -328,16 +328,21 @@ static void integrate(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], c
 static void hold(rx_app *app, rx_att *a, uint32_t first, uint32_t n, const char *why)
 {
     uint32_t k;
+    char which[48];
+    if (n == 1u)
+        snprintf(which, sizeof which, "sample %lu", (unsigned long)first);
+    else
+        snprintf(which, sizeof which, "samples %lu..%lu", (unsigned long)first,
+                 (unsigned long)(first + n - 1u));
     app->missing += n;
     if (!a->have_rate) {
-        fprintf(stderr,
-                "attitude-rx: samples %lu..%lu missing (%s) before the first sample: no rate to hold\n",
-                (unsigned long)first, (unsigned long)(first + n - 1u), why);
+        fprintf(stderr, "attitude-rx: %s missing (%s) before the first sample: no rate to hold\n", which,
+                why);
         app->t += (double)n * app->period;
         return;
     }
-    fprintf(stderr, "attitude-rx: samples %lu..%lu missing (%s): holding the last rate over %lu sample%s\n",
-            (unsigned long)first, (unsigned long)(first + n - 1u), why, (unsigned long)n, n == 1u ? "" : "s");
+    fprintf(stderr, "attitude-rx: %s missing (%s): holding the last rate over %lu sample period%s\n", which,
+            why, (unsigned long)n, n == 1u ? "" : "s");
     for (k = 0; k < n && !finished(app); k++) {
         app->held++;
         integrate(app, a, first + k, a->rate, a->code);
