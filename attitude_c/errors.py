@@ -47,6 +47,19 @@ class LinkError(AttitudeError, OSError):
     """The serial link failed (port missing, dead line, gave up)."""
 
 
+class BlockFormatError(InvalidArgument):
+    """A record breaks the block format (csrc/include/attitude/block.h).
+
+    ``status`` is the C status (``lib.ATT_BLOCK_E_*``), ``index`` the
+    position of the record in its stream when known.
+    """
+
+    def __init__(self, message: str, status: int, index: int | None = None) -> None:
+        super().__init__(message)
+        self.status = status
+        self.index = index
+
+
 # C status codes of csrc/include/attitude/common.h (generic range).
 _GENERIC = {
     -1: (InvalidArgument, "NULL pointer argument"),

@@ -5,7 +5,8 @@
  * handshake protocol (link sender A of libattitude).
  *
  * Built with SDCC for the 8051 small model from the library's own sources,
- * unchanged: csrc/src/tlc2543.c (ADC driver) and csrc/src/link_sender.c.
+ * unchanged: csrc/src/tlc2543.c (ADC driver), csrc/src/link_sender.c and
+ * csrc/src/block.c (the block format's encoders, attitude/block.h).
  * See docs/firmware.md for the wiring, the block formats and the build.
  *
  *   Timer 0  mode 1, free-running: TH0 advances every 256 machine cycles
@@ -25,16 +26,20 @@
  * Blocks wait in a two-slot FIFO (one being sent, one being filled: all the
  * RAM allows next to the driver and the link sender). Every sample that cannot be
  * delivered is replaced by a report block at its place in the stream
- * (report.h), so the receiver always knows which sample is which.
+ * (attitude/block.h), so the receiver always knows which sample is which.
  *
  * Integer arithmetic only, no dynamic memory, no __xdata.
  */
 #include <8051.h>
 
+#include "attitude/block.h"
 #include "attitude/link.h"
 #include "attitude/tlc2543.h"
 #include "config.h"
-#include "report.h"
+
+/* BOOT announces the period in ticks of 1/ATT_BLOCK_TICK_HZ s: the
+ * firmware's tick must be that unit (it is at 11.0592 MHz). */
+typedef char fw_tick_is_the_boot_period_unit[(FW_TICK_HZ == (long)ATT_BLOCK_TICK_HZ) ? 1 : -1];
 
 #if defined(FW_SIM)
 /* Simulation image: text output and stop through the uCsim simulator
@@ -110,7 +115,7 @@ static void timer0_init(void)
 
 /* Everything in internal RAM (the small model's default space): __data
  * pointers are one byte and need no library call. */
-static uint8_t queue[2][FW_BLOCK_SIZE];
+static uint8_t queue[2][ATT_BLOCK_SIZE];
 static __bit q_head;       /* slot of the oldest block (the one being sent) */
 static __bit q_any;        /* at least one block queued */
 static __bit q_full;       /* both slots used */
@@ -120,28 +125,12 @@ static uint16_t slot_seq0; /* number of the sample in slot 0 / 1 */
 static uint16_t slot_seq1;
 static uint16_t ovr_count; /* samples lost to a full queue, not yet reported:
                               always the newest ones, seq - ovr_count .. seq - 1 */
-static uint8_t __data *wp; /* the block being written (put_word appends) */
+static uint8_t __data *wp; /* the block being written */
 static uint8_t txb;        /* byte handed out by the link sender (its out pointer is __data) */
 
 extern att_link_sender fw_tx; /* link_state.c */
 #define tx fw_tx
 static tlc2543 adc;
-
-/* Append w big-endian at wp. */
-static void put_word(uint16_t w)
-{
-    wp[0] = (uint8_t)(w >> 8);
-    wp[1] = (uint8_t)w;
-    wp += 2;
-}
-
-/* Start a report block at wp: marker and kind (two put_word follow). */
-static void put_report_head(uint8_t kind)
-{
-    wp[0] = (uint8_t)FW_REPORT_MARK;
-    wp[1] = kind;
-    wp += 2;
-}
 
 /* Claim the free slot at the tail (wp points to it); 0 if the queue is full. */
 static uint8_t q_push(void)
@@ -175,9 +164,7 @@ static void q_unpush(void)
 static void flush_overrun(void)
 {
     if (!q_any && q_push()) {
-        put_report_head((uint8_t)FW_REPORT_OVERRUN);
-        put_word((uint16_t)(seq - ovr_count));
-        put_word(ovr_count);
+        (void)att_block_encode_loss(wp, (uint8_t)ATT_BLOCK_OVERRUN, (uint16_t)(seq - ovr_count), ovr_count);
         ovr_count = 0;
     }
 }
@@ -209,19 +196,16 @@ static uint8_t sample_slot(void)
     return 1;
 }
 
-/* The scan into the slot at wp returned st: store the codes big-endian
- * (they are little-endian words in the slot), or an ADC_ERROR report. */
+/* The scan into the slot at wp returned st: the sample record (the
+ * codes, native words in the slot, encoded in place), or an ADC_ERROR
+ * report when the scan (or the encoding: a code above 4095) failed. */
 static void sample_store(int st)
 {
-    uint8_t t;
-    if (st != ATT_OK) {
-        put_report_head((uint8_t)FW_REPORT_ADC_ERROR);
-        put_word(seq);
-        put_word((uint16_t)((uint16_t)(uint8_t)st << 8));
-        return;
+    if (st == ATT_OK) {
+        st = att_block_encode_sample(wp, (const uint16_t __data *)wp);
     }
-    for (t = 0; t < 3u; t++) {
-        put_word(*(uint16_t __data *)wp);
+    if (st != ATT_OK) {
+        (void)att_block_encode_adc_error(wp, seq, (int8_t)st);
     }
 }
 
@@ -240,9 +224,7 @@ static uint8_t self_test_done(int st)
         if (i < 3u) {
             bad = ((uint16_t __data *)wp)[i];
         }
-        put_report_head((uint8_t)FW_REPORT_SELFTEST);
-        put_word((uint16_t)(((uint16_t)(uint8_t)st << 8) | (uint8_t)(bad >> 8)));
-        put_word((uint16_t)(((uint16_t)(uint8_t)bad << 8) | (uint8_t)seq)); /* attempt, mod 256 */
+        (void)att_block_encode_selftest(wp, (int8_t)st, bad, (uint8_t)seq); /* attempt, mod 256 */
         P3_5 = 0;                                                           /* fault LED on */
 #if defined(FW_BENCH)
         /* s51's port pins read 1: the test fails, but it ran (its stack
@@ -422,7 +404,7 @@ static void sim_finish(void)
 /* The head block was accepted by the receiver: drop it from the queue. */
 static void block_accepted(void)
 {
-    if (queue[q_head][0] != (uint8_t)FW_REPORT_MARK) {
+    if (queue[q_head][0] != (uint8_t)ATT_BLOCK_MARK) {
         P3_5 = 1; /* a sample went through: fault LED off */
     }
     q_head = !q_head;
@@ -436,9 +418,11 @@ static void block_accepted(void)
     bench_blocks++;
 #endif
 #if defined(FW_SIM)
-    if ((uint16_t)FW_SIM_BLOCKS != 0u && ++sim_accepted >= (uint16_t)FW_SIM_BLOCKS) {
+#if FW_SIM_BLOCKS != 0
+    if (++sim_accepted >= (uint16_t)FW_SIM_BLOCKS) {
         sim_finish();
     }
+#endif
 #endif
 }
 
@@ -448,17 +432,15 @@ static void block_given_up(void)
 {
     P3_5 = 0; /* fault LED on */
     wp = queue[q_head];
-    if (wp[0] != (uint8_t)FW_REPORT_MARK) {
-        put_report_head((uint8_t)FW_REPORT_GAVE_UP);
-        put_word(q_head ? slot_seq1 : slot_seq0);
-        put_word(1u);
+    if (wp[0] != (uint8_t)ATT_BLOCK_MARK) {
+        (void)att_block_encode_loss(wp, (uint8_t)ATT_BLOCK_GAVE_UP, q_head ? slot_seq1 : slot_seq0, 1u);
     }
 }
 
 /* ---- main ------------------------------------------------------------ */
 
-static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS, FW_BLOCK_SIZE,
-                                                 FW_MAX_ATTEMPTS };
+static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS,
+                                                 ATT_BLOCK_SIZE, FW_MAX_ATTEMPTS };
 
 /* main's state is static: no local lives across a call, so main pushes
  * nothing on the stack around the deep calls (the scan). */
@@ -484,9 +466,7 @@ void main(void)
 #endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push();                 /* the queue is empty: BOOT report first */
-    put_report_head((uint8_t)FW_REPORT_BOOT);
-    put_word((uint16_t)(((uint16_t)FW_VERSION << 8) | (uint8_t)(FW_PERIOD_TICKS >> 8)));
-    put_word((uint16_t)(((uint16_t)(uint8_t)FW_PERIOD_TICKS << 8) | (uint8_t)(FW_BAUD / 1200L)));
+    (void)att_block_encode_boot(wp, FW_PERIOD_TICKS, (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT));
     sampling = 0;
     next_sample = tick_now();
 

@@ -35,6 +35,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from attitude_c.errors import BlockFormatError
+from attitude_c.link import block
+
 ROOT = Path(__file__).resolve().parents[1]
 FW_DIR = ROOT / "firmware"
 CSRC = ROOT / "csrc"
@@ -46,16 +49,15 @@ MACHINE_HZ = XTAL_HZ // 12          #: machine cycles per second (12-clock core)
 TICK_HZ = MACHINE_HZ // 256         #: Timer 0 ticks per second (3600)
 FLASH_SIZE = 4096
 IRAM_SIZE = 128
-BLOCK_SIZE = 6
+#: Link block size N the firmware sends: one record of the block format (attitude/block.h).
+BLOCK_SIZE = block.fmt().size
 #: UART rates Timer 1 in mode 2 makes exactly from 11.0592 MHz (SMOD 0 or 1).
 BAUD_RATES = (1200, 2400, 4800, 9600, 14400, 19200, 28800, 57600)
 #: Bytes on the wire per delivered block: 0xAA, 0xBB, N data, checksum, answer.
 WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
 
-REPORT_MARK = 0xFE
-REPORT_KINDS = {0: "boot", 1: "selftest", 2: "gave_up", 3: "overrun", 4: "adc_error"}
-
-SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c"]
+SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
+           CSRC / "src" / "block.c"]
 SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
 
 
@@ -202,7 +204,9 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
     ``sim_blocks`` accepted blocks, 0 = never) or ``bench`` (production pins,
     self-test skipped because s51's port pins read 1, cycle counters).
-    ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck``.
+    ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck`` (every
+    conversion), ``adc_error_at=K`` (EOC stuck in the scan of sample K only, 0 <= K < 256: one
+    ADC_ERROR report in that sample's place, then sampling goes on).
     """
     if kind not in ("production", "sim", "bench"):
         raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
@@ -227,8 +231,13 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if kind == "sim":
         defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
         for f in faults:
+            name, _, arg = f.partition("=")
+            if name == "adc_error_at" and arg.isdigit() and int(arg) < 256:
+                defines.append(f"FW_SIM_EOC_STUCK_AT={int(arg)}")
+                continue
             if f not in fault_defs:
-                raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)}")
+                raise ValueError(f"unknown fault {f!r}; known: {sorted(fault_defs)} and adc_error_at=K "
+                                 f"(0 <= K < 256)")
             defines.append(fault_defs[f])
         extra.append(f"-Wp-include,{SIM_HAL_HEADER}")
         sources.insert(1, FW_DIR / "sim" / "tlc_model.c")
@@ -271,67 +280,29 @@ class Sample:
     codes: tuple[int, int, int]
 
 
-@dataclass
-class Report:
-    kind: str
-    raw: bytes
-
-    @property
-    def first(self) -> int:
-        return (self.raw[2] << 8) | self.raw[3]
-
-    @property
-    def count(self) -> int:
-        return (self.raw[4] << 8) | self.raw[5]
-
-    @property
-    def status(self) -> int:
-        """Self-test / ADC error status (negative att_status)."""
-        b = self.raw[2] if self.kind == "selftest" else self.raw[4]
-        return b - 256 if b >= 128 else b
-
-    @property
-    def bad_code(self) -> int:
-        return (self.raw[3] << 8) | self.raw[4]
-
-    @property
-    def attempt(self) -> int:
-        return self.raw[5]
+#: A report record as libattitude's decoder read it (kind, raw, first, count, status,
+#: bad_code, attempt, period_ticks, baud, ...): attitude_c.link.block.Record.
+Report = block.Record
 
 
 def decode_stream(blocks: Iterable[bytes]) -> list[Sample | Report]:
-    """Number the samples of a block stream (firmware/report.h).
+    """Number the samples of a block stream with libattitude's decoder and
+    sequence tracker (attitude/block.h, through ``attitude_c.link.block``).
 
-    Samples are counted from 0; a gave_up / overrun / adc_error report says
-    which samples will never come, and must start exactly at the next number.
+    Samples are counted from 0 after BOOT; a gave_up / overrun / adc_error
+    report says which samples will never come, and must start exactly at
+    the next number. Any record that breaks the format, or a loss report
+    that disagrees with the count, raises :class:`FirmwareError`.
     """
-    out: list[Sample | Report] = []
-    seq = 0
+    blocks = [bytes(b) for b in blocks]
     for b in blocks:
         if len(b) != BLOCK_SIZE:
             raise FirmwareError(f"block of {len(b)} bytes, expected {BLOCK_SIZE}: {b.hex()}")
-        if b[0] == REPORT_MARK:
-            kind = REPORT_KINDS.get(b[1])
-            if kind is None:
-                raise FirmwareError(f"unknown report kind in {b.hex()}")
-            r = Report(kind, bytes(b))
-            out.append(r)
-            if kind == "boot":
-                seq = 0
-            elif kind in ("gave_up", "overrun"):
-                if r.first != seq & 0xFFFF:
-                    raise FirmwareError(f"{kind} report for sample {r.first}, expected {seq}")
-                seq += r.count
-            elif kind == "adc_error":
-                if r.first != seq & 0xFFFF:
-                    raise FirmwareError(f"adc_error report for sample {r.first}, expected {seq}")
-                seq += 1
-            continue
-        if b[0] > 0x0F or b[2] > 0x0F or b[4] > 0x0F:
-            raise FirmwareError(f"not a sample block (code > 4095): {b.hex()}")
-        out.append(Sample(seq, ((b[0] << 8) | b[1], (b[2] << 8) | b[3], (b[4] << 8) | b[5])))
-        seq += 1
-    return out
+    try:
+        numbered = block.number_stream(blocks)
+    except BlockFormatError as exc:
+        raise FirmwareError(str(exc)) from exc
+    return [Sample(span.first, rec.codes) if rec.kind == "sample" else rec for rec, span in numbered]
 
 
 # -- host end of the link -----------------------------------------------------
@@ -455,7 +426,9 @@ class LinkHost:
 # -- simulation -------------------------------------------------------------
 
 @dataclass
-class SimResult:
+class SimOutput:
+    """What one s51 run of a sim/bench image produced (whatever was on the host end)."""
+
     output: str                     #: text the firmware wrote through the simulator interface
     console: str                    #: s51 console (state command output included)
     stats: dict[str, int]           #: the firmware's STATS line
@@ -463,7 +436,11 @@ class SimResult:
     max_sp: int                     #: highest stack pointer s51 saw
     sim_seconds: float              #: simulated time
     wall_seconds: float
-    host: LinkHost
+
+
+@dataclass
+class SimResult(SimOutput):
+    host: LinkHost = None  # type: ignore[assignment]
 
     @property
     def stream(self) -> list[Sample | Report]:
@@ -490,6 +467,99 @@ def _parse_kv(line_tag: str, text: str) -> dict[str, int]:
     return {k: int(v, 16) for k, v in re.findall(r"(\w+)=([0-9A-F]+)", m.group(1))}
 
 
+class Session:
+    """A socat pty pair with s51 on one end (``with Session(image) as s:``).
+
+    ``s.port`` is the host end (a pty path): give it to whatever plays the
+    Linux computer (:class:`LinkHost` through :func:`run`, or a program such
+    as ``attitude-rx``) *before* ``s.run()`` starts the firmware, so that its
+    BOOT report finds a listener. Every process is killed on exit.
+    """
+
+    def __init__(self, image: Image, timeout: float = 60.0) -> None:
+        if image.kind == "production":
+            raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
+        for tool in ("s51", "socat"):
+            if shutil.which(tool) is None:
+                raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
+        self.image = image
+        self.timeout = timeout
+        self._tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
+        self._dev_fw = self._tmp / "uart_fw"
+        self.port = self._tmp / "uart_host"
+        self._socat: subprocess.Popen[bytes] | None = None
+        self._s51: subprocess.Popen[bytes] | None = None
+        self._t0 = time.monotonic()
+
+    def __enter__(self) -> Session:
+        try:
+            self._socat = subprocess.Popen(
+                ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                start_new_session=True)
+            while not (self._dev_fw.exists() and self.port.exists()):
+                if self._socat.poll() is not None:
+                    err = self._socat.stderr.read().decode() if self._socat.stderr else ""
+                    raise FirmwareError(f"socat failed: {err}")
+                if time.monotonic() - self._t0 > 10:
+                    raise SimTimeout("socat did not create the pty pair within 10 s")
+                time.sleep(0.01)
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        _kill_group(self._s51)
+        _kill_group(self._socat)
+        shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def run(self, pump: Any = None, describe: Any = None) -> SimOutput:
+        """Start s51 and wait until the firmware stops itself (``pump()``, if given, is
+        called in the loop: the host end's work); raise :class:`SimTimeout` after the
+        session's timeout (``describe()`` adds the host end's view to the message) and
+        :class:`FirmwareError` if the program did not stop through ``s51_exit`` with
+        code 0 (e.g. the device model detected a protocol violation)."""
+        sif_out = self._tmp / "sif.out"
+        cmds = self._tmp / "cmds"
+        cmds.write_text(f'file "{self.image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
+        t_start = time.monotonic()
+        self._s51 = s51 = subprocess.Popen(
+            ["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}", "-s", str(self._dev_fw),
+             "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+            start_new_session=True, cwd=self._tmp)
+        deadline = time.monotonic() + self.timeout
+        while s51.poll() is None:
+            if time.monotonic() > deadline:
+                _kill_group(s51)
+                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+                raise SimTimeout(f"s51 did not stop within {self.timeout} s; firmware output so far:\n"
+                                 + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
+                                 + "\ns51 console (end):\n" + con[-3000:]
+                                 + (f"\nhost: {describe()}" if describe is not None else ""))
+            if pump is not None:
+                pump()
+            else:
+                time.sleep(0.02)
+        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
+        wall = time.monotonic() - t_start
+        m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
+        if m is None or int(m.group(1)) != 0:
+            raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\n"
+                                f"console:\n{console[-2000:]}")
+        sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
+        clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
+        if sp is None or clk is None:
+            raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
+        return SimOutput(output=output, console=console, stats=_parse_kv("STATS", output),
+                         bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
+                         sim_seconds=float(clk.group(1)), wall_seconds=wall)
+
+
 def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) -> SimResult:
     """Run a sim/bench image in ``s51 -t C51`` with its UART on a pty pair and ``host`` on the other end.
 
@@ -500,71 +570,24 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
     :class:`FirmwareError` if the program did not stop through ``s51_exit``
     with code 0 (e.g. the device model detected a protocol violation).
     """
-    if image.kind == "production":
-        raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
-    for tool in ("s51", "socat"):
-        if shutil.which(tool) is None:
-            raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
     import serial  # pyserial
 
     host = host or LinkHost()
-    tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
-    dev_fw, dev_host = tmp / "uart_fw", tmp / "uart_host"
-    sif_out = tmp / "sif.out"
-    cmds = tmp / "cmds"
-    cmds.write_text(f'file "{image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
-    socat = s51 = None
-    port = None
-    t_start = time.monotonic()
-    console = ""
-    try:
-        socat = subprocess.Popen(["socat", f"pty,raw,echo=0,link={dev_fw}", f"pty,raw,echo=0,link={dev_host}"],
-                                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                 stderr=subprocess.PIPE, start_new_session=True)
-        while not (dev_fw.exists() and dev_host.exists()):
-            if socat.poll() is not None:
-                raise FirmwareError(f"socat failed: {socat.stderr.read().decode() if socat.stderr else ''}")
-            if time.monotonic() - t_start > 10:
-                raise SimTimeout("socat did not create the pty pair within 10 s")
-            time.sleep(0.01)
-        port = serial.Serial(str(dev_host), image.config.baud, timeout=0.01)
-        s51 = subprocess.Popen(["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
-                                "-s", str(dev_fw), "-C", str(cmds)],
-                               stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               start_new_session=True, cwd=tmp)
-        deadline = time.monotonic() + timeout
-        while s51.poll() is None:
-            if time.monotonic() > deadline:
-                _kill_group(s51)
-                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
-                raise SimTimeout(f"s51 did not stop within {timeout} s; firmware output so far:\n"
-                                 + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
-                                 + "\ns51 console (end):\n" + con[-3000:]
-                                 + f"\nhost: {len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
-                                 f"receiver {host.stats()}")
+    with Session(image, timeout) as sess:
+        port = serial.Serial(str(sess.port), image.config.baud, timeout=0.01)
+
+        def pump() -> None:
             data = port.read(max(1, port.in_waiting))
-            if data:
-                reply = host.receive(data)
-            else:
-                reply = host._poll(host.tick())
+            reply = host.receive(data) if data else host._poll(host.tick())
             if reply:
                 port.write(reply)
-        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
-    finally:
-        if port is not None:
+
+        def describe() -> str:
+            return (f"{len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
+                    f"receiver {host.stats()}")
+
+        try:
+            out = sess.run(pump, describe)
+        finally:
             port.close()
-        _kill_group(s51)
-        _kill_group(socat)
-        output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
-        shutil.rmtree(tmp, ignore_errors=True)
-    wall = time.monotonic() - t_start
-    m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
-    if m is None or int(m.group(1)) != 0:
-        raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\nconsole:\n{console[-2000:]}")
-    sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
-    clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
-    if sp is None or clk is None:
-        raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
-    return SimResult(output=output, console=console, stats=_parse_kv("STATS", output),
-                     bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
-                     sim_seconds=float(clk.group(1)), wall_seconds=wall, host=host)
+    return SimResult(**vars(out), host=host)

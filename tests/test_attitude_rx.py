@@ -172,7 +172,7 @@ class Rx:
 def _stats(err: str) -> dict[str, int]:
     out: dict[str, int] = {}
     for line in err.splitlines():
-        if line.startswith(("attitude-rx: link:", "attitude-rx: samples:")):
+        if line.startswith(("attitude-rx: link:", "attitude-rx: samples:", "attitude-rx: reports:")):
             for kv in line.split(":", 2)[2].split():
                 k, v = kv.split("=")
                 out[k] = int(v)
@@ -189,13 +189,16 @@ def _gyro_codes(n: int, seed: int = 3) -> np.ndarray:
 
 @pytest.mark.qemu
 def test_rx_armv4t_matches_host_integrator(rx_builds) -> None:
-    """Codes -> increments -> rv3 on the emulated ARMv4T equals attitude_c.integrate on the host."""
+    """Codes -> increments -> rv3 on the emulated ARMv4T equals attitude_c.integrate on the host;
+    the sample period is the one the stream's BOOT report announces (36 ticks = 0.01 s)."""
     import attitude_c
+    from attitude_c.link import block
 
     n = 60
     codes = _gyro_codes(n)
     rx = Rx(rx_builds["armv4t"], "--method", "rv3", "--count", str(n // 3), "--gap-ms", "2000")
     feeder = Feeder(rx.master)
+    feeder.send(block.encode_boot(round(PERIOD * 3600), 9600))
     for c in codes:
         feeder.send(_block(c))
     rc, out, err = rx.finish(sig=None)
@@ -215,9 +218,10 @@ def test_rx_armv4t_matches_host_integrator(rx_builds) -> None:
     e_ref = np.degrees(attitude_c.quat_to_euler(q_ref))
     np.testing.assert_allclose(rows[:, 9:12], e_ref, atol=1e-9)
     st = _stats(err)
-    assert st["blocks_accepted"] == n and st["received"] == n and st["updates"] == n // 3
-    assert st["queue_overflows"] == 0 and st["naks"] == 0
-    assert feeder.sender.stats.blocks_accepted == n
+    assert st["blocks_accepted"] == n + 1 and st["received"] == n and st["updates"] == n // 3
+    assert st["queue_overflows"] == 0 and st["naks"] == 0 and st["boot"] == 1 and st["held"] == 0
+    assert feeder.sender.stats.blocks_accepted == n + 1
+    assert "period 36 ticks = 0.01 s" in err
 
 
 @pytest.mark.qemu
@@ -301,23 +305,157 @@ def test_rx_lossy_channel_keeps_running_and_counts_match(rx_builds) -> None:
 
 
 @pytest.mark.qemu
-def test_rx_queue_overflow_is_counted(rx_builds) -> None:
-    """A slow attitude thread and a tiny queue: samples are dropped and counted, not blocked."""
+def test_rx_queue_overflow_is_counted_and_held(rx_builds) -> None:
+    """A slow attitude thread and a tiny queue: samples are dropped and counted, not blocked;
+    the next record that gets through brings the gap, and the rate is held over it."""
     rx = Rx(rx_builds["host"], "--method", "rv1", "--no-header", "--queue", "2",
             "--consumer-delay", "0.2", "--gap-ms", "2000")
     feeder = Feeder(rx.master)
     n = 12
     for i in range(n):
         feeder.send(_block((2048 + i, 2048, 2048)))
+    time.sleep(1.0)  # the consumer (0.2 s per record) empties the 2-slot queue
+    feeder.send(_block((2100, 2048, 2048)))
+    time.sleep(0.5)
     rc, out, err = rx.finish(signal.SIGINT)
     assert rc == 0, err
     st = _stats(err)
-    assert st["received"] == n
+    assert st["received"] == n + 1
     assert st["queue_overflows"] > 0
     assert st["queue_high_water"] == 2
-    # nothing accepted is lost silently: every sample was either integrated or counted
-    assert st["integrated"] + st["queue_overflows"] == n
-    assert len(out.strip().splitlines()) == st["updates"] == st["integrated"]
+    # nothing accepted is lost silently: every sample was integrated, or counted and its period held
+    assert st["integrated"] + st["queue_overflows"] == n + 1
+    assert st["held"] == st["missing"] == st["queue_overflows"]
+    rows = [ln.split(",") for ln in out.strip().splitlines()]
+    assert len(rows) == st["updates"] == n + 1  # one rv1 update per sample period
+    assert [int(r[1]) for r in rows] == list(range(n + 1))  # the numbering has no hole
+    assert "dropped on a full queue" in err
+
+
+def _jsonl(out: str) -> list[dict]:
+    import json
+
+    return [json.loads(ln) for ln in out.strip().splitlines()]
+
+
+def test_rx_reports_are_logged_and_losses_held_not_integrated(rx_builds) -> None:
+    """The firmware's report blocks are decoded (stderr and JSONL records), never integrated;
+    the sample period comes from BOOT; every missing sample (loss reports, a code above 4095,
+    a numbering slip) is filled by holding the last rate (docs/cross-build.md)."""
+    import attitude_c
+    from attitude_c.link import block
+
+    rx = Rx(rx_builds["host"], "--method", "rv1", "--format", "jsonl", "--gap-ms", "2000")
+    feeder = Feeder(rx.master)
+    codes = _gyro_codes(24, seed=7)
+    bad = bytes([0x10, 0x00, 0x08, 0x00, 0x08, 0x00])  # X = 4096: no sample, and no report
+    # (what is sent, sample number it stands for or None); numbers 0..23
+    stream: list[tuple[bytes, str]] = [
+        (block.encode_boot(72, 9600), "boot"),
+        *[(_block(codes[k]), "s") for k in range(6)],
+        (block.encode_loss("gave_up", 6, 1), "loss"),
+        *[(_block(codes[k]), "s") for k in (7, 8)],
+        (block.encode_loss("overrun", 9, 3), "loss"),            # 9, 10, 11
+        (_block(codes[12]), "s"),
+        (block.encode_adc_error(13, -40), "loss"),
+        (_block(codes[14]), "s"),
+        (bad, "bad"),                                           # 15
+        (_block(codes[16]), "s"),
+        (block.encode_selftest(-41, 4095, 1), "selftest"),
+        (bytes([0xFE, 0x09, 0, 0, 0, 0]), "unknown"),           # no such kind: ignored, no number
+        (block.encode_loss("gave_up", 19, 1), "loss"),          # 17, 18 vanished unreported: slip 2
+        *[(_block(codes[k]), "s") for k in range(20, 24)],
+    ]
+    for raw, _ in stream:
+        feeder.send(raw)
+    feeder.drain(300)
+    rc, out, err = rx.finish(signal.SIGINT)
+    assert rc == 0, err
+    recs = _jsonl(out)
+    updates = [r for r in recs if "q" in r]
+    reports = [r for r in recs if "report" in r]
+    errors = [r for r in recs if "error" in r]
+    # one rv1 update per sample period, numbers 0..23 without a hole, t from BOOT's 20 ms
+    assert [u["n"] for u in updates] == list(range(24))
+    np.testing.assert_allclose([u["t"] for u in updates], 0.02 * np.arange(1, 25), rtol=1e-12)
+    # the policy, written out: a missing sample gets the rate of the last good one
+    held = {6: 5, 9: 8, 10: 8, 11: 8, 13: 12, 15: 14, 17: 16, 18: 16, 19: 16}
+    src = [held.get(k, k) for k in range(24)]
+    assert [u["codes"] for u in updates] == codes[src].tolist()
+    dtheta = (codes[src] - 2048.0) * SCALE * 0.02
+    np.testing.assert_allclose([u["q"] for u in updates], attitude_c.integrate(dtheta, method="rv1"),
+                               atol=1e-12)  # same f64 arithmetic as the host library: rounding only
+    assert updates[-1]["held"] == len(held)
+    assert [r["report"] for r in reports] == ["BOOT", "GAVE_UP", "OVERRUN", "ADC_ERROR", "SELFTEST", "GAVE_UP"]
+    boot = reports[0]
+    assert (boot["period_ticks"], boot["period_s"], boot["baud"], boot["version"]) == (72, 0.02, 9600, 1)
+    assert [(r["first"], r["count"], r["slip"]) for r in reports if "first" in r] == [
+        (6, 1, 0), (9, 3, 0), (13, 1, 0), (17, 3, 2)]
+    assert reports[3]["status"] == -40 and reports[4]["bad_code"] == 4095
+    assert [e["error"] for e in errors] == ["code", "kind"]
+    assert errors[0]["n"] == 15 and errors[0]["codes"] == [4096, 2048, 2048]
+    # each record sits in the stream where it arrived
+    order = [("q" if "q" in r else r.get("report") or r["error"]) for r in recs]
+    assert order.index("BOOT") == 0 and order[7] == "GAVE_UP" and order[11] == "OVERRUN"
+    st = _stats(err)
+    assert st["received"] == 16 and st["integrated"] == 15 and st["code_errors"] == 1
+    assert st["held"] == st["missing"] == len(held)
+    assert (st["boot"], st["gave_up"], st["overrun"], st["adc_error"], st["selftest"]) == (1, 2, 1, 1, 1)
+    assert st["block_errors"] == 1 and st["seq_errors"] == 1 and st["updates"] == 24
+    assert "BOOT: block format 1, sample period 72 ticks = 0.02 s, 9600 baud" in err
+    assert "OVERRUN: 3 samples lost at sample 9" in err and "samples 9..11 missing (OVERRUN): holding the last rate over 3 sample periods" in err
+    assert "sample 15 rejected: code out of 0..4095" in err
+    assert "vanished unreported" in err
+
+
+def test_rx_period_option_wins_over_boot_with_a_warning(rx_builds) -> None:
+    rx = Rx(rx_builds["host"], "--method", "rv3", "--period", "0.01", "--no-header", "--gap-ms", "2000")
+    from attitude_c.link import block
+
+    feeder = Feeder(rx.master)
+    feeder.send(block.encode_boot(72, 9600))
+    for k in range(3):
+        feeder.send(_block((2048 + 100 * k, 2048, 2048)))
+    feeder.drain(200)
+    rc, out, err = rx.finish(signal.SIGINT)
+    assert rc == 0, err
+    rows = out.strip().splitlines()
+    assert len(rows) == 1 and float(rows[0].split(",")[0]) == pytest.approx(0.03)
+    assert "warning: the board samples every 0.02 s (BOOT) but --period 0.01 s was given" in err
+
+
+def test_rx_command_line_getopt(rx_builds, tmp_path: Path) -> None:
+    """-h/--help, --version, unknown options name themselves, --name=value, config file kept."""
+    import re
+
+    exe = rx_builds["host"]
+
+    def run(*args: str) -> tuple[int, str, str]:
+        p = subprocess.run([*exe, *args], capture_output=True, timeout=20, check=False)
+        return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+    for h in ("-h", "--help"):
+        rc, out, err = run(h)
+        assert rc == 0 and out.startswith("usage:") and "--period" in out and err == ""
+    rc, out, _ = run("--version")
+    version = re.search(r'^version\s*=\s*"([^"]+)"', (Path(__file__).parents[1] / "pyproject.toml").read_text(),
+                        re.MULTILINE).group(1)
+    assert rc == 0 and out.startswith(f"attitude-rx {version} ")
+    assert run("--port", "/dev/null", "--help")[0] == 0  # help wins over the rest
+    for args, want in [(("--foo",), "unknown option --foo"),
+                       (("--port", "/dev/null", "--bogus=3"), "unknown option --bogus"),
+                       (("-x", "--port", "/dev/null"), "unknown option -x"),
+                       (("--port",), "option --port needs a value"),
+                       (("--port", "/dev/null", "--period"), "option --period needs a value"),
+                       (("--port", "/dev/null", "stray"), "unexpected argument 'stray'")]:
+        rc, out, err = run(*args)
+        assert rc == 64 and want in err and err.count("\n") == 1, (args, err)
+    cfg = tmp_path / "rx.conf"
+    cfg.write_text(f"port = {tmp_path / 'nope'}\n")
+    rc, _, err = run("--config", str(cfg))  # the file is read ...
+    assert rc == 66 and "nope" in err
+    rc, _, err = run(f"--config={cfg}", "--port=/dev/null")  # ... and the command line wins
+    assert rc == 74 and "not a serial port" in err
 
 
 def test_rx_port_vanishes_is_reported_and_retried(rx_builds, tmp_path: Path) -> None:

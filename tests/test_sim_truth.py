@@ -177,13 +177,23 @@ def test_trajectory_argument_errors() -> None:
 
 
 def test_firmware_trajectory_truth() -> None:
-    """The --firmware s51 motion: its grid truth (rv3 on closed-form increments
-    at h/64) against RK4 on the rates at 200 Hz (both ~1e-12 rad)."""
+    """The --firmware s51 motion: its closed form (no integrator) against RK4 on the
+    rates at 200 Hz (RK4's error ~(ωdt)^4/120 per step: ~1e-12 rad over 6 s), its
+    closed-form increments against the base class's Gauss-Legendre quadrature,
+    and the gyro parameters it accepts."""
     from attitude_c.sim.firmware import FirmwareTrajectory
+    from attitude_c.sim.trajectory import Trajectory
 
     tr = FirmwareTrajectory(period=0.08, rad_per_s_per_code=8.5e-4, duration=7.0)
-    q = _rk4_attitude(tr, 6.0, 0.005)
-    assert quat_angle_between(q, tr.quat(6.0)) < 1e-9
-    # between grid points quat() adds one midpoint-rate rotation vector over
-    # ≤ 3.75 ms: its O(|ω||ω̇|dt³) error is ~1e-9 rad (used for plots only)
-    assert quat_angle_between(_rk4_attitude(tr, 2.5, 0.005), tr.quat(2.5)) < 1e-8
+    assert quat_angle_between(_rk4_attitude(tr, 6.0, 0.005), tr.quat(6.0)) < 1e-9
+    assert quat_angle_between(_rk4_attitude(tr, 2.5, 0.005), tr.quat(2.5)) < 1e-9
+    np.testing.assert_allclose(tr.increments(0.3, 0.08, 50), Trajectory.increments(tr, 0.3, 0.08, 50),
+                               atol=1e-15)  # 8-node Gauss-Legendre is exact to rounding here
+    # the model's sample k is the rate at the midpoint of period k
+    k = 17
+    from firmware import tool
+
+    want = [4096 * tool.Gyro(*g).fraction(k) - 2048 for g in tr.gyros]
+    np.testing.assert_allclose(tr.omega((k + 0.5) * 0.08) / 8.5e-4, want, atol=1e-9)
+    with pytest.raises(InvalidArgument, match="quadrature pair"):
+        FirmwareTrajectory(gyros=((32768, 2, 0, 4), (32768, 2, 64, 5), (32768, 2, 128, 6)))

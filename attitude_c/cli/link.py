@@ -57,6 +57,9 @@ def register(sub: Any) -> None:
     p.add_argument("--idle-eof", type=float, default=None,
                    help="treat this many seconds without a byte as end of input")
     p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
+    p.add_argument("--decode", action="store_true",
+                   help="print each 6-byte record decoded with the block format (attitude/block.h) as a "
+                        "JSON line: samples numbered, reports, records that break the format")
     p.set_defaults(func=cmd_rx)
 
     p = sub.add_parser("link-tx", help="sender A on a serial port: blocks from stdin hex lines or test samples")
@@ -101,9 +104,46 @@ def _stop_on_signals() -> threading.Event:
     return ev
 
 
+def _block_printer() -> Any:
+    """``show(block)`` printing each record of a block as one JSON line (libattitude's
+    block decoder and sequence tracker through attitude_c.link.block)."""
+    from ..link import block
+
+    tracker = block.SeqTracker()
+    size = block.fmt().size
+
+    def show(b: bytes) -> None:
+        for k in range(0, len(b), size):
+            raw = b[k:k + size]
+            rec, st = block.try_decode(raw)
+            if rec is None or (st != 0 and rec.kind != "sample"):  # no place in the numbering
+                print(json.dumps({"error": block.fmt().errors[st], "raw": raw.hex()}), flush=True)
+                continue
+            span, _ = tracker.feed(rec)  # a slip shows in the loss report's "slip"
+            out: dict[str, Any]
+            if rec.kind == "sample":
+                out = {"n": span.first, "codes": list(rec.codes)}
+                if st != 0:
+                    out["error"] = block.fmt().errors[st]  # never a sample to integrate
+            else:
+                out = rec.as_dict()
+                if rec.is_loss:
+                    out.update(first=span.first, count=span.count, slip=span.slip)
+            print(json.dumps(out), flush=True)
+
+    return show
+
+
 def cmd_rx(args: argparse.Namespace) -> int:
     from ..link.transport import open_port, run_receiver
 
+    if args.decode:
+        from ..link import block
+
+        if args.block_size % block.fmt().size:
+            print(f"link-rx: --decode needs a block size that is a multiple of {block.fmt().size} (records "
+                  f"of the block format), got {args.block_size}", file=sys.stderr)
+            return 2
     stop = _stop_on_signals()
     try:
         port = open_port(args.port, args.baud)
@@ -113,6 +153,9 @@ def cmd_rx(args: argparse.Namespace) -> int:
 
     def show(b: bytes) -> None:
         print(_hex_block(b), flush=True)
+
+    if args.decode:
+        show = _block_printer()
 
     print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl})",
           file=sys.stderr, flush=True)

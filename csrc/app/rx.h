@@ -24,10 +24,24 @@ enum {
 };
 
 enum {
-    RX_QUEUE_MAX = 4096, /* largest --queue */
+    RX_QUEUE_MAX = 4096,    /* largest --queue */
+    RX_REPORT_RESERVE = 64, /* queue slots beyond --queue that only reports may take */
     RX_PATH_MAX = 256,
     RX_MSG_MAX = 256
 };
+
+#define RX_VERSION "0.1.0" /* the project's version (pyproject.toml; a test keeps them equal) */
+
+/* Default sample period until a BOOT report says otherwise: the firmware's
+ * default, 72 ticks of 1/3600 s (docs/firmware.md). */
+#define RX_PERIOD_DEFAULT (72.0 / 3600.0)
+
+/* What the command line asks for. */
+typedef enum {
+    RX_RUN = 0,
+    RX_HELP = 1,
+    RX_VERSION_INFO = 2
+} rx_action;
 
 typedef enum {
     RX_FORMAT_CSV = 0,
@@ -38,7 +52,8 @@ typedef enum {
 typedef struct {
     char port[RX_PATH_MAX];
     long baud;       /* bits per second */
-    double period;   /* s, gyro sample period */
+    double period;   /* s, gyro sample period (until a BOOT report announces it) */
+    int period_set;  /* --period given (command line or config file): BOOT does not override it */
     double zero[3];  /* ADC code at zero rate, per channel */
     double scale[3]; /* rad/s per code, per channel */
     int axis_src[3]; /* body axis i = sign[i] * channel axis_src[i] */
@@ -54,14 +69,17 @@ typedef struct {
     int header;            /* print the CSV header line */
 } rx_config;
 
-/* Defaults: 9600 baud, 0.01 s, zero 2048, scale = 90 deg/s per 2048 codes,
- * axes x,y,z, rv3, CSV, N = 6, queue 256, gap 20 ms. */
+/* Defaults: 9600 baud, period 0.02 s (RX_PERIOD_DEFAULT), zero 2048,
+ * scale = 90 deg/s per 2048 codes, axes x,y,z, rv3, CSV, N = 6, queue 256,
+ * gap 20 ms. */
 void rx_config_defaults(rx_config *c);
 
-/* Parse argv (and the --config file it names, whose values the command
- * line overrides). Returns 0, or an RX_EXIT_* code with a message in msg.
- * Sets *help when --help was given. */
-int rx_config_parse(rx_config *c, int argc, char **argv, int *help, char *msg, size_t msglen);
+/* Parse argv with getopt_long (and the --config files it names, whose
+ * values the command line overrides). Returns 0, or an RX_EXIT_* code with
+ * a message in msg (an unknown option names itself). Sets *action to
+ * RX_HELP for -h/--help, RX_VERSION_INFO for --version (whichever comes
+ * first; the rest of the line is then not checked). */
+int rx_config_parse(rx_config *c, int argc, char **argv, rx_action *action, char *msg, size_t msglen);
 
 /* Apply one "name value" setting (long option name without "--"). */
 int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, size_t msglen);
@@ -73,16 +91,23 @@ const char *rx_method_name(att_method m);
 
 void rx_usage(const char *prog, void *stream);
 
-/* ---- bounded sample queue (one producer, one consumer) ---- */
+/* ---- bounded record queue (one producer, one consumer) ---- */
+/* One record of an accepted block, decoded and numbered by the receiver
+ * thread (attitude/block.h), in stream order. */
 typedef struct {
-    uint16_t code[3]; /* raw ADC codes X, Y, Z as received */
-    uint32_t seq;     /* sample number since start (0-based) */
-} rx_sample;
+    att_block blk;          /* the record (a sample: blk.kind == ATT_BLOCK_SAMPLE) */
+    att_block_span span;    /* its place in the numbering (sample: span.first = its number) */
+    int status;             /* att_block_decode's status (ATT_BLOCK_E_CODE: bad sample) */
+    int seq_status;         /* att_block_seq_feed's status (ATT_BLOCK_E_SEQ: numbering slipped) */
+    uint32_t missing_first; /* samples dropped on a full queue just before this record: */
+    uint32_t missing;       /* their first number and how many (the attitude thread holds them) */
+    uint8_t raw[ATT_BLOCK_SIZE];
+} rx_item;
 
 typedef struct {
     pthread_mutex_t lock;
     pthread_cond_t nonempty;
-    rx_sample buf[RX_QUEUE_MAX];
+    rx_item buf[RX_QUEUE_MAX + RX_REPORT_RESERVE];
     unsigned cap, head, count;
     unsigned long pushed, popped, overflows;
     unsigned high_water;
@@ -91,10 +116,12 @@ typedef struct {
 
 int rx_queue_init(rx_queue *q, unsigned cap);
 void rx_queue_destroy(rx_queue *q);
-/* Non-blocking: 0 = queued, 1 = full (sample dropped, overflow counted). */
-int rx_queue_push(rx_queue *q, const rx_sample *s);
-/* Blocking until a sample or the queue is closed and empty: 0 = got one, 1 = closed. */
-int rx_queue_pop(rx_queue *q, rx_sample *s);
+/* Non-blocking: 0 = queued, 1 = full (item dropped, overflow counted).
+ * Samples fill up to cap items; reports may use RX_REPORT_RESERVE more, so
+ * a BOOT or a loss report is not lost behind a backlog of samples. */
+int rx_queue_push(rx_queue *q, const rx_item *it);
+/* Blocking until an item or the queue is closed and empty: 0 = got one, 1 = closed. */
+int rx_queue_pop(rx_queue *q, rx_item *it);
 void rx_queue_close(rx_queue *q);
 
 /* ---- serial port ---- */

@@ -1,7 +1,8 @@
-/* attitude-rx: command line and config file. */
+/* attitude-rx: command line (getopt_long) and config file. */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -37,7 +38,7 @@ void rx_config_defaults(rx_config *c)
     int i;
     memset(c, 0, sizeof *c);
     c->baud = 9600;
-    c->period = 0.01;
+    c->period = RX_PERIOD_DEFAULT;
     for (i = 0; i < 3; i++) {
         c->zero[i] = 2048.0;
         /* 90 deg/s full scale over half of a 12-bit range (CG-L53 + TLC2543) */
@@ -191,6 +192,7 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
             return fail(msg, len, RX_EXIT_CONFIG,
                         "period: '%s' must be a sample period in seconds, 0 < T <= 10", value);
         c->period = d;
+        c->period_set = 1;
     } else if (strcmp(name, "gyro-zero") == 0) {
         double v[3];
         if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > 65535 || v[1] > 65535
@@ -320,67 +322,105 @@ int rx_config_file(rx_config *c, const char *path, char *msg, size_t len)
     return 0;
 }
 
-/* Split "--name=value" / "--name value"; returns the index of the next argument. */
-static int next_opt(int argc, char **argv, int i, char *name, size_t nlen, const char **value)
+/* Long options: every setting of rx_config_set (same names as in a config
+ * file) plus the command-line-only ones. */
+enum {
+    OPT_HELP = 'h',
+    OPT_VERSION = 256,
+    OPT_CONFIG,
+    OPT_NO_HEADER,
+    OPT_SETTING
+};
+
+static const struct option long_options[] = { { "help", no_argument, NULL, OPT_HELP },
+                                              { "version", no_argument, NULL, OPT_VERSION },
+                                              { "config", required_argument, NULL, OPT_CONFIG },
+                                              { "no-header", no_argument, NULL, OPT_NO_HEADER },
+                                              { "port", required_argument, NULL, OPT_SETTING },
+                                              { "baud", required_argument, NULL, OPT_SETTING },
+                                              { "period", required_argument, NULL, OPT_SETTING },
+                                              { "gyro-zero", required_argument, NULL, OPT_SETTING },
+                                              { "gyro-scale", required_argument, NULL, OPT_SETTING },
+                                              { "axes", required_argument, NULL, OPT_SETTING },
+                                              { "method", required_argument, NULL, OPT_SETTING },
+                                              { "format", required_argument, NULL, OPT_SETTING },
+                                              { "block-size", required_argument, NULL, OPT_SETTING },
+                                              { "queue", required_argument, NULL, OPT_SETTING },
+                                              { "gap-ms", required_argument, NULL, OPT_SETTING },
+                                              { "count", required_argument, NULL, OPT_SETTING },
+                                              { "consumer-delay", required_argument, NULL, OPT_SETTING },
+                                              { "reopen-delay", required_argument, NULL, OPT_SETTING },
+                                              { "header", required_argument, NULL, OPT_SETTING },
+                                              { NULL, 0, NULL, 0 } };
+
+/* The option as the user wrote it (argv[optind - 1], without "=value"). */
+static const char *opt_text(char **argv, char *buf, size_t len)
 {
-    const char *a = argv[i] + 2;
-    const char *eq = strchr(a, '=');
-    if (eq != NULL) {
-        size_t n = (size_t)(eq - a);
-        if (n >= nlen)
-            n = nlen - 1;
-        memcpy(name, a, n);
-        name[n] = '\0';
-        *value = eq + 1;
-        return i + 1;
+    const char *a = argv[optind - 1];
+    size_t n = strcspn(a, "=");
+    if (optopt != 0 && optopt != OPT_HELP && a[0] == '-' && a[1] != '-') { /* -x, or -x inside -abx */
+        snprintf(buf, len, "-%c", optopt);
+        return buf;
     }
-    snprintf(name, nlen, "%s", a);
-    if (strcmp(name, "help") == 0 || strcmp(name, "no-header") == 0) {
-        *value = "";
-        return i + 1;
-    }
-    *value = (i + 1 < argc) ? argv[i + 1] : NULL;
-    return i + 2;
+    snprintf(buf, len, "%.*s", (int)(n < len ? n : len - 1), a);
+    return buf;
 }
 
-int rx_config_parse(rx_config *c, int argc, char **argv, int *help, char *msg, size_t len)
+/* One getopt_long pass over argv; pass 1 handles -h, --version and
+ * --config, pass 2 the settings (so the command line wins over the files). */
+static int parse_pass(rx_config *c, int argc, char **argv, int pass, rx_action *action, char *msg, size_t len)
 {
-    int i, rc;
-    char name[64];
-    const char *value;
-    *help = 0;
-    /* pass 1: --help and --config (the file first, so the command line wins) */
-    for (i = 1; i < argc;) {
-        if (strncmp(argv[i], "--", 2) != 0)
-            return fail(msg, len, RX_EXIT_USAGE, "unexpected argument '%s' (options start with --)", argv[i]);
-        i = next_opt(argc, argv, i, name, sizeof name, &value);
-        if (strcmp(name, "help") == 0) {
-            *help = 1;
-            return 0;
-        }
-        if (strcmp(name, "config") == 0) {
-            if (value == NULL)
-                return fail(msg, len, RX_EXIT_USAGE, "option --config needs a value");
-            rc = rx_config_file(c, value, msg, len);
-            if (rc != 0)
+    int ch, idx, rc;
+    char opt[64];
+    optind = 0; /* full rescan (glibc and musl) */
+    opterr = 0; /* messages are ours: one line naming the option */
+    for (;;) {
+        idx = -1;
+        optopt = 0;
+        ch = getopt_long(argc, argv, ":h", long_options, &idx);
+        if (ch == -1)
+            break;
+        switch (ch) {
+        case OPT_HELP:
+        case OPT_VERSION:
+            if (pass == 1) {
+                *action = ch == OPT_HELP ? RX_HELP : RX_VERSION_INFO;
+                return 0;
+            }
+            break;
+        case OPT_CONFIG:
+            if (pass == 1 && (rc = rx_config_file(c, optarg, msg, len)) != 0)
                 return rc;
-        }
-    }
-    /* pass 2: everything else */
-    for (i = 1; i < argc;) {
-        i = next_opt(argc, argv, i, name, sizeof name, &value);
-        if (strcmp(name, "config") == 0)
-            continue;
-        if (strcmp(name, "no-header") == 0) {
+            break;
+        case OPT_NO_HEADER:
             c->header = 0;
-            continue;
+            break;
+        case OPT_SETTING:
+            if (pass == 2 && (rc = rx_config_set(c, long_options[idx].name, optarg, msg, len)) != 0)
+                return rc;
+            break;
+        case ':':
+            return fail(msg, len, RX_EXIT_USAGE, "option %s needs a value (see --help)",
+                        opt_text(argv, opt, sizeof opt));
+        default: /* '?': unknown (or ambiguous abbreviation) */
+            return fail(msg, len, RX_EXIT_USAGE, "unknown option %s (see --help)",
+                        opt_text(argv, opt, sizeof opt));
         }
-        rc = rx_config_set(c, name, value, msg, len);
-        if (rc != 0)
-            return rc == RX_EXIT_CONFIG && strncmp(msg, "unknown setting", 15) == 0
-                       ? fail(msg, len, RX_EXIT_USAGE, "unknown option --%s (see --help)", name)
-                       : rc;
     }
+    if (optind < argc)
+        return fail(msg, len, RX_EXIT_USAGE, "unexpected argument '%s' (options start with --)",
+                    argv[optind]);
+    return 0;
+}
+
+int rx_config_parse(rx_config *c, int argc, char **argv, rx_action *action, char *msg, size_t len)
+{
+    int rc;
+    *action = RX_RUN;
+    if ((rc = parse_pass(c, argc, argv, 1, action, msg, len)) != 0 || *action != RX_RUN)
+        return rc;
+    if ((rc = parse_pass(c, argc, argv, 2, action, msg, len)) != 0)
+        return rc;
     if (c->port[0] == '\0')
         return fail(msg, len, RX_EXIT_USAGE,
                     "no serial port: give --port PATH (or port = PATH in --config FILE)");
@@ -391,23 +431,28 @@ void rx_usage(const char *prog, void *stream)
 {
     fprintf((FILE *)stream,
             "usage: %s --port PATH [options]\n"
-            "Receive gyro samples over the serial link (AA/BB handshake, checksum, 00/FF answer),\n"
-            "integrate the attitude in a second thread, print one line per attitude update.\n\n"
+            "Receive gyro samples and reports over the serial link (AA/BB handshake, checksum, 00/FF\n"
+            "answer; block format of attitude/block.h), integrate the attitude in a second thread, print\n"
+            "one line per attitude update (and, with --format jsonl, one record per report).\n\n"
             "  --port PATH              serial device (required)\n"
             "  --baud N                 line rate, default 9600 (8N1 raw)\n"
-            "  --period SECONDS         gyro sample period, default 0.01\n"
+            "  --period SECONDS         gyro sample period; default: the one the BOOT report announces\n"
+            "                           (0.02 s until one arrives); given, it wins over BOOT (warning)\n"
             "  --gyro-zero CODE[,C,C]   ADC code at zero rate, default 2048\n"
             "  --gyro-scale K[,K,K]     rad/s per code, default 7.6699e-4 (90 deg/s per 2048 codes)\n"
             "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
             "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4, default rv3\n"
             "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
             "  --block-size N           link block bytes (multiple of 6), default 6\n"
-            "  --queue N                samples the inter-thread queue holds, default 256\n"
+            "  --queue N                records the inter-thread queue holds, default 256\n"
             "  --gap-ms MS              link gap timeout inside a block, default 20\n"
-            "  --count N                stop after N output lines (default: until SIGINT/SIGTERM)\n"
+            "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
             "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
-            "  --consumer-delay SECONDS make the attitude thread sleep per sample (diagnostics)\n"
+            "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
             "  --config FILE            'name = value' lines with the names above; the command line wins\n"
+            "  -h, --help               this text;  --version: the version\n"
+            "Missing samples (loss reports, bad codes, queue overflow) are filled by holding the last\n"
+            "rate and counted (docs/cross-build.md).\n"
             "Exit codes: 0 ok, 64 usage, 66 no such port, 74 port not usable, 77 permission denied,\n"
             "78 bad configuration.\n",
             prog);

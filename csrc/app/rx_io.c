@@ -1,4 +1,4 @@
-/* attitude-rx: bounded sample queue and termios serial port setup. */
+/* attitude-rx: bounded record queue and termios serial port setup. */
 #define _DEFAULT_SOURCE 1 /* cfmakeraw */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -33,15 +33,17 @@ void rx_queue_destroy(rx_queue *q)
     pthread_mutex_destroy(&q->lock);
 }
 
-int rx_queue_push(rx_queue *q, const rx_sample *s)
+int rx_queue_push(rx_queue *q, const rx_item *it)
 {
     int full;
+    unsigned limit = q->cap + (it->blk.kind == ATT_BLOCK_SAMPLE ? 0u : (unsigned)RX_REPORT_RESERVE);
+    const unsigned size = sizeof q->buf / sizeof q->buf[0];
     pthread_mutex_lock(&q->lock);
-    full = q->count == q->cap;
+    full = q->count >= limit;
     if (full) {
         q->overflows++;
     } else {
-        q->buf[(q->head + q->count) % q->cap] = *s;
+        q->buf[(q->head + q->count) % size] = *it;
         q->count++;
         q->pushed++;
         if (q->count > q->high_water)
@@ -52,15 +54,16 @@ int rx_queue_push(rx_queue *q, const rx_sample *s)
     return full;
 }
 
-int rx_queue_pop(rx_queue *q, rx_sample *s)
+int rx_queue_pop(rx_queue *q, rx_item *it)
 {
     int closed = 0;
+    const unsigned size = sizeof q->buf / sizeof q->buf[0];
     pthread_mutex_lock(&q->lock);
     while (q->count == 0 && !q->closed)
         pthread_cond_wait(&q->nonempty, &q->lock);
     if (q->count > 0) {
-        *s = q->buf[q->head];
-        q->head = (q->head + 1) % q->cap;
+        *it = q->buf[q->head];
+        q->head = (q->head + 1) % size;
         q->count--;
         q->popped++;
     } else {

@@ -20,6 +20,10 @@
  * AIN3..AIN10 are grounded (code 0); the test inputs give 0x800, 0x000,
  * 0xFFF. FW_SIM_DOUT_STUCK=0/1 ties DATA OUT low/high, FW_SIM_EOC_STUCK
  * keeps EOC low: the faults of the self-test and EOC-timeout tests.
+ * FW_SIM_EOC_STUCK_AT=K keeps EOC low in one scan only, that of sample K
+ * (or of the first sample scanned after it; K < 256): the driver times
+ * out, the firmware sends an ADC_ERROR report in that sample's place and
+ * samples on (a deterministic loss report).
  */
 #include "attitude/tlc2543.h"
 #include "config.h"
@@ -67,6 +71,7 @@ __sfr __at(0xBD) m_started;         /* fw_sim_model_step() ran once (a byte: SFR
 __sfr __at(0xC7) m_k;               /* sampling periods since the first step (mod 256) */
 __sfr16 __at(0xCAC9) m_bound;       /* fw_ticks at which m_k next increments */
 __sfr16 __at(0xCCCB) m_conversions; /* gyro input evaluations so far */
+__sfr __at(0xAF) m_fault_done;      /* FW_SIM_EOC_STUCK_AT: the one failed scan happened */
 
 void fw_sim_model_init(void)
 {
@@ -85,6 +90,7 @@ void fw_sim_model_init(void)
     m_k = 0;
     m_bound = 0;
     m_conversions = 0;
+    m_fault_done = 0;
 #if defined(FW_SIM_DOUT_STUCK)
     fwm_stuck_dout = FW_SIM_DOUT_STUCK;
 #endif
@@ -146,6 +152,12 @@ unsigned char fwm_end_cycle(void)
     fwm_eoc_wait = 255u; /* fault: EOC stays low past the driver's bound */
 #else
     fwm_eoc_wait = FW_SIM_CONV_POLLS - 1; /* this read is the first low one */
+#if defined(FW_SIM_EOC_STUCK_AT)
+    if (m_started && !m_fault_done && m_k >= (uint8_t)FW_SIM_EOC_STUCK_AT) {
+        m_fault_done = 1;
+        fwm_eoc_wait = 255u; /* past the driver's bound: this scan times out */
+    }
+#endif
 #endif
     return 0u;
 }

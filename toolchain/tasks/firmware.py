@@ -42,7 +42,7 @@ def build(c, baud=9600, period_ticks=72, max_attempts=5, out=""):
     "samples": "samples to receive (the firmware stops after them)",
     "baud": "UART rate",
     "period_ticks": "sampling period in ticks of 1/3600 s (108 = 30 ms: no overruns against a host on a pty)",
-    "fault": "ADC model fault: dout_stuck_high, dout_stuck_low or eoc_stuck",
+    "fault": "ADC model fault: dout_stuck_high, dout_stuck_low, eoc_stuck or adc_error_at=K (one failed scan)",
     "timeout": "wall-clock limit in seconds",
     "impl": "host receiver: c (libattitude through CFFI) or python (attitude_c.link)",
 })
@@ -50,7 +50,7 @@ def sim(c, samples=20, baud=9600, period_ticks=108, fault="", timeout=120, impl=
     """Run the firmware in s51 -t C51 against the C receiver on a socat pty pair; print the samples received."""
     tool = _tool()
     cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), selftest_retry=360)
-    blocks = int(samples) + 1 if not fault else 3
+    blocks = int(samples) + 1 if not fault or fault.startswith("adc_error_at") else 3
     img = tool.build(tool.BUILD, cfg, kind="sim", sim_blocks=blocks, faults=[fault] if fault else [])
     print(img.size_report())
     res = tool.run(img, tool.LinkHost(impl), timeout=float(timeout))

@@ -10,6 +10,7 @@
 #include "attitude/quat.h"
 #include "attitude/integrator.h"
 #include "attitude/link.h"
+#include "attitude/block.h"
 #include "attitude/fixed.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

@@ -1,0 +1,326 @@
+"""The block format of the acquisition link, through the C library.
+
+A thin typed layer over ``csrc/src/block.c`` / ``block_decode.c``
+(``csrc/include/attitude/block.h`` is the format's one description): the
+constants, record kinds and every range check come from the compiled
+library (``lib.ATT_BLOCK_*``); nothing of the format is written again here.
+
+- :func:`decode` (raises :class:`~attitude_c.errors.BlockFormatError`) and
+  :func:`try_decode` (returns the C status) turn 6 bytes into a :class:`Record`;
+- ``encode_*`` build records (what the firmware sends);
+- :class:`SeqTracker` numbers the samples of a stream and places every loss
+  report (``att_block_seq_*``); :func:`number_stream` does both for a list of
+  blocks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal, Union
+
+from .._lib import ffi_lib
+from ..errors import BlockFormatError, InvalidArgument, InvalidType, raise_for_status
+
+Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error"]
+LossKind = Literal["gave_up", "overrun"]
+Bytes = Union[bytes, bytearray, memoryview]
+
+__all__ = [
+    "Format",
+    "Kind",
+    "LossKind",
+    "Record",
+    "SeqTracker",
+    "Span",
+    "decode",
+    "encode_adc_error",
+    "encode_boot",
+    "encode_loss",
+    "encode_sample",
+    "encode_selftest",
+    "fmt",
+    "number_stream",
+    "try_decode",
+]
+
+
+@dataclass(frozen=True)
+class Format:
+    """The format's constants, as compiled into the library."""
+
+    size: int          #: bytes per record
+    code_max: int      #: largest sample code
+    mark: int          #: byte 0 of a report
+    version: int       #: format version BOOT carries
+    tick_hz: int       #: BOOT period unit (ticks per second)
+    period_max: int    #: largest BOOT period (ticks)
+    baud_unit: int     #: BOOT baud_div unit
+    kinds: dict[int, Kind] = field(repr=False)  #: C kind value -> name
+    errors: dict[int, str] = field(repr=False)  #: C status -> what it means
+
+
+_fmt: Format | None = None
+
+
+def _c() -> tuple[Any, Any]:
+    return ffi_lib("f64")
+
+
+def fmt() -> Format:
+    """The block format's constants (loaded from the C library on first use)."""
+    global _fmt
+    if _fmt is None:
+        ffi, lib = _c()
+        kinds: dict[int, Kind] = {v: n[len("ATT_BLOCK_"):].lower()  # type: ignore[misc]
+                                  for v, n in ffi.typeof("att_block_kind").elements.items()}
+        errors = {lib.ATT_BLOCK_E_CODE: f"sample code above {lib.ATT_BLOCK_CODE_MAX}",
+                  lib.ATT_BLOCK_E_KIND: "unknown report kind",
+                  lib.ATT_BLOCK_E_FIELD: "report field out of range",
+                  lib.ATT_BLOCK_E_SEQ: "loss report disagrees with the sample count"}
+        _fmt = Format(size=lib.ATT_BLOCK_SIZE, code_max=lib.ATT_BLOCK_CODE_MAX, mark=lib.ATT_BLOCK_MARK,
+                      version=lib.ATT_BLOCK_VERSION, tick_hz=lib.ATT_BLOCK_TICK_HZ,
+                      period_max=lib.ATT_BLOCK_PERIOD_MAX, baud_unit=lib.ATT_BLOCK_BAUD_UNIT,
+                      kinds=kinds, errors=errors)
+    return _fmt
+
+
+def _kind_value(kind: str) -> int:
+    for v, n in fmt().kinds.items():
+        if n == kind:
+            return v
+    raise InvalidArgument(f"kind must be one of {sorted(fmt().kinds.values())}, got {kind!r}")
+
+
+@dataclass(frozen=True)
+class Record:
+    """One decoded record. Fields its kind does not use are 0."""
+
+    kind: Kind
+    raw: bytes
+    codes: tuple[int, int, int] = (0, 0, 0)  #: sample: X, Y, Z codes
+    first: int = 0         #: gave_up, overrun, adc_error: first lost sample (mod 2^16)
+    count: int = 0         #: gave_up, overrun: samples lost; adc_error: 1
+    period_ticks: int = 0  #: boot: sampling period in ticks of 1/tick_hz s
+    baud: int = 0          #: boot: line rate (baud)
+    version: int = 0       #: boot: format version
+    status: int = 0        #: selftest, adc_error: the failure's att_status
+    bad_code: int = 0      #: selftest: code read from the failed test input
+    attempt: int = 0       #: selftest: attempt number
+
+    @property
+    def is_report(self) -> bool:
+        return self.kind != "sample"
+
+    @property
+    def is_loss(self) -> bool:
+        return self.kind in ("gave_up", "overrun", "adc_error")
+
+    @property
+    def period_s(self) -> float:
+        """boot: the sampling period in seconds."""
+        return self.period_ticks / fmt().tick_hz
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: ``{"codes": [...]}`` or ``{"report": "BOOT", ...}`` (attitude-rx's fields)."""
+        if self.kind == "sample":
+            return {"codes": list(self.codes)}
+        out: dict[str, Any] = {"report": self.kind.upper()}
+        if self.kind == "boot":
+            out.update(version=self.version, period_ticks=self.period_ticks, period_s=self.period_s,
+                       baud=self.baud)
+        elif self.kind == "selftest":
+            out.update(status=self.status, bad_code=self.bad_code, attempt=self.attempt)
+        else:
+            out.update(first=self.first, count=self.count)
+            if self.kind == "adc_error":
+                out["status"] = self.status
+        return out
+
+
+def _raw(raw: Bytes, what: str) -> bytes:
+    if not isinstance(raw, (bytes, bytearray, memoryview)):
+        raise InvalidType(f"{what} must be bytes, got {type(raw).__name__}")
+    b = bytes(raw)
+    if len(b) != fmt().size:
+        raise InvalidArgument(f"{what} must have {fmt().size} bytes, got {len(b)}")
+    return b
+
+
+def _where(index: int | None) -> str:
+    return "record" if index is None else f"record {index}"
+
+
+def try_decode(raw: Bytes, index: int | None = None) -> tuple[Record | None, int]:
+    """Decode 6 bytes: ``(record, status)``, status 0 or a ``lib.ATT_BLOCK_E_*`` code.
+
+    On ``E_CODE`` the record is a sample with the codes as received (for a
+    log: never integrate them); on ``E_FIELD`` it is the report as read; on
+    ``E_KIND`` (a kind the format does not define) it is None. Only a wrong
+    size or type raises.
+    """
+    b = _raw(raw, _where(index))
+    ffi, lib = _c()
+    out = ffi.new("att_block *")
+    st = lib.att_block_decode(b, out)
+    if st < 0 and st not in fmt().errors:
+        raise_for_status(st, "att_block_decode")
+    kind = fmt().kinds.get(out.kind)
+    if kind is None:
+        return None, st
+    rec = Record(kind=kind, raw=b, codes=(out.code[0], out.code[1], out.code[2]), first=out.first,
+                 count=out.count, period_ticks=out.period_ticks, baud=out.baud_div * fmt().baud_unit,
+                 version=out.version, status=out.status, bad_code=out.bad_code, attempt=out.attempt)
+    return rec, st
+
+
+def decode(raw: Bytes, index: int | None = None) -> Record:
+    """Decode 6 bytes; a record that breaks the format raises :class:`BlockFormatError`
+    naming the record (``index``) and its bytes."""
+    rec, st = try_decode(raw, index)
+    if st != 0 or rec is None:
+        raise BlockFormatError(f"{_where(index)} {bytes(raw).hex(' ')}: {fmt().errors[st]}", st, index)
+    return rec
+
+
+def _encode(fn: str, *args: Any) -> bytes:
+    ffi, lib = _c()
+    buf = ffi.new("uint8_t[]", fmt().size)
+    st = getattr(lib, fn)(buf, *args)
+    if st != 0:
+        raise_for_status(st, fn)  # every argument was checked before: not reached
+    return bytes(ffi.buffer(buf))
+
+
+def _check(name: str, v: int, lo: int, hi: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, int):
+        try:
+            import numpy as np
+
+            if isinstance(v, np.integer):
+                v = int(v)
+            else:
+                raise TypeError
+        except TypeError:
+            raise InvalidType(f"{name} must be an integer, got {type(v).__name__}") from None
+    if not lo <= v <= hi:
+        raise InvalidArgument(f"{name} must be {lo}..{hi}, got {v}")
+    return v
+
+
+def encode_sample(codes: Sequence[int]) -> bytes:
+    """A sample record from the three codes X, Y, Z (each 0..4095)."""
+    if len(codes) != 3:
+        raise InvalidArgument(f"codes must hold 3 values (X, Y, Z), got {len(codes)}")
+    c = [_check(f"codes[{i}]", v, 0, fmt().code_max) for i, v in enumerate(codes)]
+    ffi, _ = _c()
+    return _encode("att_block_encode_sample", ffi.new("uint16_t[3]", c))
+
+
+def encode_boot(period_ticks: int, baud: int) -> bytes:
+    """BOOT: the sampling period in ticks of 1/3600 s and the line rate (a multiple of 1200)."""
+    _check("period_ticks", period_ticks, 1, fmt().period_max)
+    u = fmt().baud_unit
+    _check("baud", baud, u, 255 * u)
+    if baud % u:
+        raise InvalidArgument(f"baud must be a multiple of {u}, got {baud}")
+    return _encode("att_block_encode_boot", period_ticks, baud // u)
+
+
+def encode_selftest(status: int, bad_code: int, attempt: int) -> bytes:
+    """SELFTEST: the failed self-test's status (-128..-1), its code, the attempt (0..255)."""
+    _check("status", status, -128, -1)
+    _check("bad_code", bad_code, 0, fmt().code_max)
+    _check("attempt", attempt, 0, 255)
+    return _encode("att_block_encode_selftest", status, bad_code, attempt)
+
+
+def encode_loss(kind: LossKind, first: int, count: int) -> bytes:
+    """GAVE_UP or OVERRUN: samples first .. first + count - 1 (mod 2^16) lost."""
+    if kind not in ("gave_up", "overrun"):
+        raise InvalidArgument(f"kind must be 'gave_up' or 'overrun', got {kind!r}")
+    _check("first", first, 0, 0xFFFF)
+    _check("count", count, 1, 0xFFFF)
+    return _encode("att_block_encode_loss", _kind_value(kind), first, count)
+
+
+def encode_adc_error(first: int, status: int) -> bytes:
+    """ADC_ERROR: sample ``first`` lost to a scan that failed with ``status`` (-128..-1)."""
+    _check("first", first, 0, 0xFFFF)
+    _check("status", status, -128, -1)
+    return _encode("att_block_encode_adc_error", first, status)
+
+
+@dataclass(frozen=True)
+class Span:
+    """Where a record falls in the numbering (``att_block_span``)."""
+
+    first: int  #: sample: its number; loss report: first sample missing; boot/selftest: next number
+    count: int  #: sample: 1; loss report: samples missing here (unreported gap included); else 0
+    slip: int   #: loss report: its first minus the number expected (0 when the count agrees)
+
+
+class SeqTracker:
+    """Numbers the samples of a stream and places each loss report (``att_block_seq``)."""
+
+    def __init__(self) -> None:
+        self._ffi, self._lib = _c()
+        self._s: Any = self._ffi.new("att_block_seq *")
+        self._b: Any = self._ffi.new("att_block *")
+        self._span: Any = self._ffi.new("att_block_span *")
+        self._lib.att_block_seq_init(self._s)
+
+    @property
+    def next(self) -> int:
+        """Number of the next sample expected."""
+        return int(self._s.next)
+
+    def feed(self, rec: Record) -> tuple[Span, int]:
+        """Place ``rec`` (a sample, also one that failed ``E_CODE``, or a report):
+        ``(span, status)`` with status 0 or ``lib.ATT_BLOCK_E_SEQ`` (the numbering
+        slipped; it follows the report from now on)."""
+        lib = self._lib
+        st = lib.att_block_decode(rec.raw, self._b)
+        if rec.kind == "sample":  # a sample with a bad code still takes its number
+            self._b.kind = lib.ATT_BLOCK_SAMPLE
+        elif st < 0:
+            raise BlockFormatError(f"record {rec.raw.hex(' ')}: {fmt().errors.get(st, st)}: it has "
+                                   "no place in the numbering", st)
+        st = lib.att_block_seq_feed(self._s, self._b, self._span)
+        if st < 0 and st != lib.ATT_BLOCK_E_SEQ:
+            raise BlockFormatError(f"record {rec.raw.hex(' ')}: {fmt().errors.get(st, st)}", st)
+        return Span(int(self._span.first), int(self._span.count), int(self._span.slip)), st
+
+
+def number_stream(blocks: Iterable[Bytes], *, strict: bool = True) -> list[tuple[Record, Span]]:
+    """Decode and number a stream of records (each link block may hold several).
+
+    ``strict``: a record that breaks the format or a loss report that
+    disagrees with the count raises :class:`BlockFormatError` naming the
+    record's index; otherwise bad records are skipped (a bad-code sample
+    still takes its number) and slips are followed.
+    """
+    n = fmt().size
+    tr = SeqTracker()
+    out: list[tuple[Record, Span]] = []
+    i = 0
+    for blk in blocks:
+        b = bytes(blk)
+        if len(b) % n:
+            raise InvalidArgument(f"block {len(out)} has {len(b)} bytes, not a multiple of {n}")
+        for k in range(0, len(b), n):
+            rec, st = try_decode(b[k:k + n], i)
+            if st != 0 and (strict or rec is None or rec.kind != "sample"):
+                if strict:
+                    raise BlockFormatError(f"record {i} {b[k:k + n].hex(' ')}: {fmt().errors[st]}", st, i)
+                i += 1
+                continue
+            assert rec is not None
+            expected = tr.next
+            span, st = tr.feed(rec)
+            if st != 0 and strict:
+                raise BlockFormatError(f"record {i} {rec.raw.hex(' ')}: {fmt().errors[st]} (its first "
+                                       f"sample is {rec.first}, expected {expected & 0xFFFF})", st, i)
+            out.append((rec, span))
+            i += 1
+    return out

@@ -1,0 +1,187 @@
+/*
+ * libattitude — block format of the acquisition link: what the bytes of a
+ * link block mean (prefix att_block_). The AT89S51 firmware encodes with
+ * it, attitude-rx and the Python host ends (through the bindings) decode
+ * with it: this header is the one description of the format.
+ *
+ * Records. A link block (attitude/link.h) of N bytes carries N / 6
+ * records of ATT_BLOCK_SIZE = 6 bytes (the firmware sends N = 6: one
+ * record per block). Multi-byte fields are big-endian.
+ *
+ * Sample record: one sample of the three gyro channels,
+ *
+ *     bytes 0-1  X code   bytes 2-3  Y code   bytes 4-5  Z code
+ *
+ * each the TLC2543's 12-bit code, 0..ATT_BLOCK_CODE_MAX (4095), so byte 0
+ * is 0x00..0x0F. A record whose byte 0 is not ATT_BLOCK_MARK and that
+ * holds a code above 4095 is no sample: the decoder rejects it
+ * (ATT_BLOCK_E_CODE) and a receiver must never integrate it.
+ *
+ * Report record: byte 0 = ATT_BLOCK_MARK (0xFE, never byte 0 of a sample),
+ * byte 1 = kind, bytes 2-5 by kind (widths in bits):
+ *
+ *     kind         byte 2        bytes 3-4        byte 5        sent
+ *     0 BOOT       version (8)   period (16)      baud_div (8)  once at power-up, first
+ *     1 SELFTEST   status (8)    bad_code (16)    attempt (8)   each failed ADC self-test
+ *
+ *     kind         bytes 2-3     bytes 4-5                      sent
+ *     2 GAVE_UP    first (16)    count (16)                     the link gave up on samples
+ *     3 OVERRUN    first (16)    count (16)                     samples lost to a full queue
+ *     4 ADC_ERROR  first (16)    status (8), then 0 (8)         a scan that failed: 1 sample
+ *
+ * Fields (the decoder checks every range; a report outside them is
+ * rejected with ATT_BLOCK_E_FIELD, an unknown kind with ATT_BLOCK_E_KIND):
+ *   version   ATT_BLOCK_VERSION (1), the format this header describes; a
+ *             receiver decodes only version 1.
+ *   period    sampling period in ticks of 1/ATT_BLOCK_TICK_HZ s (1/3600 s:
+ *             Timer 0 of the AT89S51 at 11.0592 MHz), 1..ATT_BLOCK_PERIOD_MAX.
+ *             72 = 20 ms.
+ *   baud_div  line rate / ATT_BLOCK_BAUD_UNIT (1200), 1..255: 8 = 9600 baud.
+ *   status    the att_status of the failure, -128..-1: a TLC2543_E_* code
+ *             (attitude/tlc2543.h: -40 EOC timeout, -41/-42/-43 a self-test
+ *             input read wrong) or another negative library status.
+ *   bad_code  SELFTEST: the 12-bit code read from the failed test input
+ *             (0..4095; 0 when there was none, e.g. an EOC timeout).
+ *   attempt   SELFTEST: number of the self-test attempt, from 1, mod 256.
+ *   first     number of the first lost sample (mod 2^16).
+ *   count     GAVE_UP, OVERRUN: samples lost, 1..65535: first .. first +
+ *             count - 1. ADC_ERROR always loses one sample (count 1).
+ *
+ * Loss accounting by sequence number. Samples are numbered from 0, the
+ * first sample after BOOT (the self-test runs before sampling starts);
+ * sample records carry no number. Every sample that will never be sent
+ * is announced by exactly one GAVE_UP, OVERRUN or ADC_ERROR report placed
+ * in the stream where the lost samples would have been. A receiver that
+ * numbers the sample records it gets and advances by `count` at each loss
+ * report therefore knows the number (and so the time, number x period)
+ * of every sample, and how many are missing where; a loss report whose
+ * `first` disagrees with that count shows that the numbering slipped (a
+ * record lost or duplicated on the way: the link's known duplicate, a
+ * receiver started after BOOT). att_block_seq_feed keeps that count,
+ * reports a slip (ATT_BLOCK_E_SEQ) and resynchronizes on the report.
+ *
+ * Encoders (block.c) are what the firmware links: portable C99 that SDCC
+ * compiles for the AT89S51 (leaf functions, 8/16-bit arithmetic, buffers
+ * in __data memory there: ATT_LINK_MEM). The decoder and the sequence
+ * tracker (block_decode.c) are host code, kept in their own translation
+ * unit so that an 8051 image does not carry them.
+ */
+#ifndef ATTITUDE_BLOCK_H
+#define ATTITUDE_BLOCK_H
+
+#include "attitude/common.h"
+#include "attitude/link.h"
+
+/* Format constants. */
+enum {
+    ATT_BLOCK_SIZE = 6,           /* bytes of one record (= ATT_LINK_BLOCK_DEFAULT) */
+    ATT_BLOCK_CODE_MAX = 4095,    /* largest sample code (12-bit ADC) */
+    ATT_BLOCK_MARK = 0xFE,        /* byte 0 of every report record */
+    ATT_BLOCK_VERSION = 1,        /* format version carried by BOOT */
+    ATT_BLOCK_TICK_HZ = 3600,     /* BOOT period unit: ticks per second */
+    ATT_BLOCK_PERIOD_MAX = 32767, /* largest BOOT period (ticks) */
+    ATT_BLOCK_BAUD_UNIT = 1200    /* BOOT baud_div unit (baud per count) */
+};
+
+/* Record kinds: byte 1 of a report record, or ATT_BLOCK_SAMPLE. */
+typedef enum {
+    ATT_BLOCK_BOOT = 0,
+    ATT_BLOCK_SELFTEST = 1,
+    ATT_BLOCK_GAVE_UP = 2,
+    ATT_BLOCK_OVERRUN = 3,
+    ATT_BLOCK_ADC_ERROR = 4,
+    ATT_BLOCK_SAMPLE = 0x100 /* a sample record (not a byte value: never a report kind) */
+} att_block_kind;
+
+/* Status codes of this module (range -100..-119 of common.h). */
+enum {
+    ATT_BLOCK_E_CODE = -100,  /* a sample code above ATT_BLOCK_CODE_MAX */
+    ATT_BLOCK_E_KIND = -101,  /* a report kind this format does not define */
+    ATT_BLOCK_E_FIELD = -102, /* a report field outside its range (see above) */
+    ATT_BLOCK_E_SEQ = -103    /* a loss report's first disagrees with the sample count */
+};
+
+/* ------------------------------------------------------------------ */
+/* Encoders (block.c): each fills the ATT_BLOCK_SIZE bytes at blk.     */
+/* All return ATT_OK, ATT_E_NULL (blk NULL) or the code named; on an   */
+/* error blk holds unspecified bytes and must not be sent as is.       */
+/* ------------------------------------------------------------------ */
+
+/* Sample record from codes[0..2] = X, Y, Z (each 0..4095, else
+ * ATT_BLOCK_E_CODE). codes may be the same memory as blk: the firmware
+ * scans the ADC's words into the block and converts them in place. */
+int att_block_encode_sample(uint8_t ATT_LINK_MEM *blk, const uint16_t ATT_LINK_MEM *codes);
+
+/* BOOT: version ATT_BLOCK_VERSION, period_ticks 1..32767, baud_div 1..255
+ * (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_boot(uint8_t ATT_LINK_MEM *blk, uint16_t period_ticks, uint8_t baud_div);
+
+/* SELFTEST: status -128..-1, bad_code 0..4095, attempt (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_selftest(uint8_t ATT_LINK_MEM *blk, int8_t status, uint16_t bad_code, uint8_t attempt);
+
+/* GAVE_UP or OVERRUN (kind; another kind: ATT_BLOCK_E_KIND): samples
+ * first .. first + count - 1 lost, count >= 1 (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_loss(uint8_t ATT_LINK_MEM *blk, uint8_t kind, uint16_t first, uint16_t count);
+
+/* ADC_ERROR: sample `first` lost to a scan that failed with status -128..-1
+ * (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_adc_error(uint8_t ATT_LINK_MEM *blk, uint16_t first, int8_t status);
+
+/* ------------------------------------------------------------------ */
+/* Decoder (block_decode.c)                                           */
+/* ------------------------------------------------------------------ */
+
+/* One decoded record. Fields a kind does not use are 0. */
+typedef struct {
+    uint16_t code[3];      /* SAMPLE: X, Y, Z codes */
+    uint16_t first;        /* GAVE_UP, OVERRUN, ADC_ERROR: first lost sample (mod 2^16) */
+    uint16_t count;        /* GAVE_UP, OVERRUN: samples lost; ADC_ERROR: 1 */
+    uint16_t period_ticks; /* BOOT: sampling period, ticks of 1/ATT_BLOCK_TICK_HZ s */
+    uint16_t bad_code;     /* SELFTEST: code of the failed test input */
+    uint16_t kind;         /* att_block_kind, or an unknown report kind byte (ATT_BLOCK_E_KIND) */
+    uint8_t version;       /* BOOT: format version */
+    uint8_t baud_div;      /* BOOT: line rate / ATT_BLOCK_BAUD_UNIT */
+    uint8_t attempt;       /* SELFTEST: attempt number (from 1, mod 256) */
+    int8_t status;         /* SELFTEST, ADC_ERROR: the failure's att_status */
+} att_block;
+
+/* Decode the ATT_BLOCK_SIZE bytes at raw into *out. Returns ATT_OK,
+ * ATT_E_NULL, ATT_BLOCK_E_CODE (out->kind = ATT_BLOCK_SAMPLE and the codes
+ * as received, for the caller's log: never integrate them),
+ * ATT_BLOCK_E_KIND (out->kind = the unknown kind byte) or
+ * ATT_BLOCK_E_FIELD (a report field out of range, a BOOT of another
+ * version; out->kind = the report's kind). */
+int att_block_decode(const uint8_t *raw, att_block *out);
+
+/* Sequence tracker: numbers the samples of a record stream. */
+typedef struct {
+    uint32_t next;  /* number of the next sample expected (since the last BOOT; not wrapped) */
+    uint8_t synced; /* the numbering was fixed by a BOOT or a loss report */
+} att_block_seq;
+
+/* Where one record falls in the numbering. */
+typedef struct {
+    uint32_t first; /* SAMPLE: its number; loss report: first sample lost;
+                       BOOT, SELFTEST: the number the next sample will have */
+    uint32_t count; /* SAMPLE: 1; loss report: samples missing here (its count,
+                       plus an unreported gap when slip > 0); BOOT, SELFTEST: 0 */
+    int32_t slip;   /* loss report: its first minus the number expected, -32768..32767:
+                       > 0 samples vanished without a report (they are included in
+                       first/count), < 0 that many records were numbered twice;
+                       0 otherwise */
+} att_block_span;
+
+/* Start unsynced: samples are numbered from 0 until a BOOT (numbering
+ * restarts at 0) or a loss report (its first and count are adopted as
+ * they are, no slip) fixes the numbering. */
+void att_block_seq_init(att_block_seq *s);
+
+/* Place the decoded record b (also a SAMPLE that failed with
+ * ATT_BLOCK_E_CODE: it still took a number) and advance. Returns ATT_OK,
+ * ATT_E_NULL, ATT_BLOCK_E_KIND (b->kind unknown: nothing changes),
+ * ATT_BLOCK_E_FIELD (a loss report with count 0: nothing changes) or
+ * ATT_BLOCK_E_SEQ (synced, and a loss report disagrees with the count:
+ * *span says how; the numbering follows the report from now on). */
+int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span);
+
+#endif /* ATTITUDE_BLOCK_H */

@@ -1,0 +1,305 @@
+/*
+ * Tests of the block format (attitude/block.h): encoders against the bytes
+ * the header specifies, the decoder's range checks, round trips, and the
+ * sequence tracker's loss accounting (slips both ways, late join, BOOT).
+ */
+#include <string.h>
+
+#include "attitude/attitude.h"
+#include "att_test.h"
+
+static int bytes_eq(const uint8_t *a, const uint8_t *b)
+{
+    return memcmp(a, b, ATT_BLOCK_SIZE) == 0;
+}
+
+static void test_encoders_write_the_specified_bytes(void)
+{
+    uint8_t b[ATT_BLOCK_SIZE];
+    uint16_t codes[3] = { 0x123, 0xFFF, 0 };
+    static const uint8_t sample[6] = { 0x01, 0x23, 0x0F, 0xFF, 0x00, 0x00 };
+    static const uint8_t boot[6] = { 0xFE, 0x00, 0x01, 0x00, 0x48, 0x08 }; /* 72 ticks, 9600 baud */
+    static const uint8_t self[6] = { 0xFE, 0x01, 0xD7, 0x0F, 0xFF, 0x03 }; /* -41, 0xFFF, attempt 3 */
+    static const uint8_t gave[6] = { 0xFE, 0x02, 0x12, 0x34, 0x00, 0x01 };
+    static const uint8_t over[6] = { 0xFE, 0x03, 0xFF, 0xFE, 0x01, 0x00 };
+    static const uint8_t adc[6] = { 0xFE, 0x04, 0x00, 0x07, 0xD8, 0x00 }; /* sample 7, -40 */
+
+    CHECK_EQ_INT(att_block_encode_sample(b, codes), ATT_OK);
+    CHECK(bytes_eq(b, sample));
+    CHECK_EQ_INT(att_block_encode_boot(b, 72, 8), ATT_OK);
+    CHECK(bytes_eq(b, boot));
+    CHECK_EQ_INT(att_block_encode_selftest(b, -41, 0xFFF, 3), ATT_OK);
+    CHECK(bytes_eq(b, self));
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_GAVE_UP, 0x1234, 1), ATT_OK);
+    CHECK(bytes_eq(b, gave));
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_OVERRUN, 0xFFFE, 256), ATT_OK);
+    CHECK(bytes_eq(b, over));
+    CHECK_EQ_INT(att_block_encode_adc_error(b, 7, -40), ATT_OK);
+    CHECK(bytes_eq(b, adc));
+}
+
+static void test_sample_encodes_in_place(void)
+{
+    /* the firmware scans native words into the block and converts them there */
+    union {
+        uint16_t w[3];
+        uint8_t b[ATT_BLOCK_SIZE];
+    } u;
+    static const uint8_t want[6] = { 0x0A, 0xBC, 0x00, 0x01, 0x08, 0x00 };
+    u.w[0] = 0xABC;
+    u.w[1] = 1;
+    u.w[2] = 0x800;
+    CHECK_EQ_INT(att_block_encode_sample(u.b, u.w), ATT_OK);
+    CHECK(bytes_eq(u.b, want));
+}
+
+static void test_encoders_reject_out_of_range(void)
+{
+    uint8_t b[ATT_BLOCK_SIZE];
+    uint16_t codes[3] = { 0, 4096, 0 };
+    CHECK_EQ_INT(att_block_encode_sample(b, codes), ATT_BLOCK_E_CODE);
+    codes[1] = 0xFE00; /* would read as a report */
+    CHECK_EQ_INT(att_block_encode_sample(b, codes), ATT_BLOCK_E_CODE);
+    CHECK_EQ_INT(att_block_encode_sample(NULL, codes), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_encode_sample(b, NULL), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_encode_boot(b, 0, 8), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_boot(b, 32768, 8), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_boot(b, 32767, 8), ATT_OK);
+    CHECK_EQ_INT(att_block_encode_boot(b, 1, 0), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_boot(NULL, 72, 8), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_encode_selftest(b, 0, 0, 1), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_selftest(b, -1, 4096, 1), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_selftest(NULL, -1, 0, 1), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_ADC_ERROR, 0, 1), ATT_BLOCK_E_KIND);
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_BOOT, 0, 1), ATT_BLOCK_E_KIND);
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_OVERRUN, 0, 0), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_loss(NULL, ATT_BLOCK_OVERRUN, 0, 1), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_encode_adc_error(b, 0, 0), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_adc_error(NULL, 0, -40), ATT_E_NULL);
+}
+
+static void test_decoder_reads_every_kind(void)
+{
+    att_block d;
+    static const uint8_t sample[6] = { 0x0F, 0xFF, 0x00, 0x00, 0x08, 0x01 };
+    static const uint8_t boot[6] = { 0xFE, 0x00, 0x01, 0x00, 0xD8, 0x30 };
+    static const uint8_t self[6] = { 0xFE, 0x01, 0xD8, 0x00, 0x00, 0xFF };
+    static const uint8_t over[6] = { 0xFE, 0x03, 0x00, 0x02, 0x00, 0x03 };
+    static const uint8_t adc[6] = { 0xFE, 0x04, 0xFF, 0xFF, 0x9C, 0x00 };
+
+    CHECK_EQ_INT(att_block_decode(sample, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_SAMPLE);
+    CHECK_EQ_INT(d.code[0], 4095);
+    CHECK_EQ_INT(d.code[1], 0);
+    CHECK_EQ_INT(d.code[2], 0x801);
+    CHECK_EQ_INT(att_block_decode(boot, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_BOOT);
+    CHECK_EQ_INT(d.version, 1);
+    CHECK_EQ_INT(d.period_ticks, 216);
+    CHECK_EQ_INT(d.baud_div, 48); /* 57600 baud */
+    CHECK_EQ_INT(d.code[0], 0);   /* fields of other kinds are 0 */
+    CHECK_EQ_INT(att_block_decode(self, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_SELFTEST);
+    CHECK_EQ_INT(d.status, -40);
+    CHECK_EQ_INT(d.bad_code, 0);
+    CHECK_EQ_INT(d.attempt, 255);
+    CHECK_EQ_INT(att_block_decode(over, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_OVERRUN);
+    CHECK_EQ_INT(d.first, 2);
+    CHECK_EQ_INT(d.count, 3);
+    CHECK_EQ_INT(att_block_decode(adc, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_ADC_ERROR);
+    CHECK_EQ_INT(d.first, 65535);
+    CHECK_EQ_INT(d.count, 1);
+    CHECK_EQ_INT(d.status, -100);
+}
+
+static void test_decoder_rejects(void)
+{
+    att_block d;
+    uint8_t r[6] = { 0x10, 0x00, 0x00, 0x00, 0x00, 0x00 };
+    unsigned v;
+    CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_CODE);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_SAMPLE); /* the codes are kept for a log */
+    CHECK_EQ_INT(d.code[0], 4096);
+    /* every first word: 0..4095 is a sample, 0xFExx a report, the rest a bad code */
+    r[0] = r[1] = 0;
+    for (v = 0; v <= 0xFFFFu; v++) {
+        int st;
+        r[4] = (uint8_t)(v >> 8);
+        r[5] = (uint8_t)v;
+        st = att_block_decode(r, &d);
+        if (st != (v <= 4095u ? ATT_OK : ATT_BLOCK_E_CODE)) {
+            CHECK_EQ_INT(v, -1);
+            break;
+        }
+    }
+    CHECK_EQ_INT(v, 0x10000L);
+    r[0] = 0xFE;
+    r[1] = 5; /* no such kind */
+    CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
+    CHECK_EQ_INT(d.kind, 5);
+    r[1] = 0xFF;
+    CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
+    CHECK(d.kind != ATT_BLOCK_SAMPLE);
+    {
+        static const uint8_t bad[][6] = {
+            { 0xFE, 0x00, 0x02, 0x00, 0x48, 0x08 }, /* BOOT of another format version */
+            { 0xFE, 0x00, 0x01, 0x00, 0x00, 0x08 }, /* period 0 */
+            { 0xFE, 0x00, 0x01, 0x80, 0x00, 0x08 }, /* period 32768 */
+            { 0xFE, 0x00, 0x01, 0x00, 0x48, 0x00 }, /* baud 0 */
+            { 0xFE, 0x01, 0x00, 0x00, 0x00, 0x01 }, /* self-test status 0 */
+            { 0xFE, 0x01, 0xD7, 0x10, 0x00, 0x01 }, /* bad code 4096 */
+            { 0xFE, 0x02, 0x00, 0x05, 0x00, 0x00 }, /* gave up on 0 samples */
+            { 0xFE, 0x03, 0x00, 0x05, 0x00, 0x00 }, /* overrun of 0 samples */
+            { 0xFE, 0x04, 0x00, 0x05, 0x05, 0x00 }, /* ADC error status 5 */
+            { 0xFE, 0x04, 0x00, 0x05, 0xD8, 0x01 }, /* ADC error, last byte not 0 */
+        };
+        size_t i;
+        for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+            CHECK_EQ_INT(att_block_decode(bad[i], &d), ATT_BLOCK_E_FIELD);
+            CHECK_EQ_INT(d.kind, bad[i][1]);
+        }
+    }
+    CHECK_EQ_INT(att_block_decode(NULL, &d), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_decode(r, NULL), ATT_E_NULL);
+}
+
+static void test_round_trips(void)
+{
+    uint8_t b[ATT_BLOCK_SIZE];
+    att_block d;
+    uint16_t c[3];
+    unsigned v;
+    int s;
+    for (v = 0; v <= 4095u; v += 13u) {
+        c[0] = (uint16_t)v;
+        c[1] = (uint16_t)(4095u - v);
+        c[2] = (uint16_t)((v * 7u) & 4095u);
+        CHECK_EQ_INT(att_block_encode_sample(b, c), ATT_OK);
+        CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+        CHECK(d.kind == ATT_BLOCK_SAMPLE && d.code[0] == c[0] && d.code[1] == c[1] && d.code[2] == c[2]);
+    }
+    for (s = -128; s <= -1; s++) {
+        CHECK_EQ_INT(att_block_encode_adc_error(b, (uint16_t)(s + 200), (int8_t)s), ATT_OK);
+        CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+        CHECK(d.kind == ATT_BLOCK_ADC_ERROR && d.status == s && d.first == s + 200 && d.count == 1);
+        CHECK_EQ_INT(att_block_encode_selftest(b, (int8_t)s, 4095, (uint8_t)-s), ATT_OK);
+        CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+        CHECK(d.kind == ATT_BLOCK_SELFTEST && d.status == s && d.bad_code == 4095 && d.attempt == -s);
+    }
+    CHECK_EQ_INT(att_block_encode_boot(b, 32767, 255), ATT_OK);
+    CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+    CHECK(d.kind == ATT_BLOCK_BOOT && d.period_ticks == 32767 && d.baud_div == 255 && d.version == 1);
+    CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_GAVE_UP, 65535, 65535), ATT_OK);
+    CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+    CHECK(d.kind == ATT_BLOCK_GAVE_UP && d.first == 65535 && d.count == 65535);
+}
+
+/* Feed one record (bytes) to the tracker. */
+static int feed(att_block_seq *t, const uint8_t *raw, att_block_span *sp)
+{
+    att_block d;
+    (void)att_block_decode(raw, &d);
+    return att_block_seq_feed(t, &d, sp);
+}
+
+static void test_tracker_numbers_across_losses(void)
+{
+    att_block_seq t;
+    att_block_span sp;
+    uint8_t boot[6], smp[6], loss[6];
+    uint16_t c[3] = { 1, 2, 3 };
+    int i;
+    att_block_seq_init(&t);
+    att_block_encode_boot(boot, 72, 8);
+    att_block_encode_sample(smp, c);
+    CHECK_EQ_INT(feed(&t, boot, &sp), ATT_OK);
+    CHECK(sp.first == 0 && sp.count == 0 && sp.slip == 0);
+    for (i = 0; i < 3; i++) {
+        CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+        CHECK(sp.first == (uint32_t)i && sp.count == 1);
+    }
+    att_block_encode_loss(loss, ATT_BLOCK_OVERRUN, 3, 4); /* 3..6 lost */
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_OK);
+    CHECK(sp.first == 3 && sp.count == 4 && sp.slip == 0);
+    att_block_encode_adc_error(loss, 7, -40);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_OK);
+    CHECK(sp.first == 7 && sp.count == 1);
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK_EQ_INT(sp.first, 8);
+    /* a gap nobody reported (a whole block lost): the loss report shows it */
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK); /* 9 */
+    att_block_encode_loss(loss, ATT_BLOCK_GAVE_UP, 12, 1);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_BLOCK_E_SEQ);
+    CHECK(sp.first == 10 && sp.count == 3 && sp.slip == 2); /* 10, 11 unreported + 12 */
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK_EQ_INT(sp.first, 13);
+    /* a duplicate (B's 0x00 lost, A resent): numbered one too many */
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK); /* 14, in truth a copy of 13 */
+    att_block_encode_loss(loss, ATT_BLOCK_GAVE_UP, 14, 1);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_BLOCK_E_SEQ);
+    CHECK(sp.first == 14 && sp.count == 1 && sp.slip == -1);
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK_EQ_INT(sp.first, 15);
+    /* a reboot restarts the numbering */
+    CHECK_EQ_INT(feed(&t, boot, &sp), ATT_OK);
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK_EQ_INT(sp.first, 0);
+}
+
+static void test_tracker_wraps_and_late_join(void)
+{
+    att_block_seq t;
+    att_block_span sp;
+    att_block d;
+    uint8_t smp[6], loss[6];
+    uint16_t c[3] = { 1, 2, 3 };
+    uint32_t i;
+    att_block_encode_sample(smp, c);
+    /* joined after BOOT: the first loss report's numbering is adopted */
+    att_block_seq_init(&t);
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK_EQ_INT(sp.first, 0);
+    att_block_encode_loss(loss, ATT_BLOCK_OVERRUN, 40000, 2);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_OK);
+    CHECK(sp.first == 40000 && sp.count == 2 && sp.slip == 0);
+    CHECK_EQ_INT(t.next, 40002);
+    /* report numbers wrap at 2^16; the tracker's do not */
+    for (i = 40002; i < 70000u; i++) {
+        (void)feed(&t, smp, &sp);
+    }
+    att_block_encode_loss(loss, ATT_BLOCK_GAVE_UP, (uint16_t)70000u, 1);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_OK);
+    CHECK(sp.first == 70000u && sp.count == 1 && sp.slip == 0);
+    /* SELFTEST takes no number, an unknown kind or a count of 0 changes nothing */
+    d.kind = 7;
+    CHECK_EQ_INT(att_block_seq_feed(&t, &d, &sp), ATT_BLOCK_E_KIND);
+    (void)att_block_decode(loss, &d);
+    d.count = 0;
+    CHECK_EQ_INT(att_block_seq_feed(&t, &d, &sp), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(t.next, 70001u);
+    att_block_encode_selftest(loss, -41, 0, 1);
+    CHECK_EQ_INT(feed(&t, loss, &sp), ATT_OK);
+    CHECK(sp.count == 0 && t.next == 70001u);
+    /* a sample with a bad code still takes its number */
+    smp[0] = 0x10;
+    CHECK_EQ_INT(feed(&t, smp, &sp), ATT_OK);
+    CHECK(sp.first == 70001u && sp.count == 1);
+    CHECK_EQ_INT(att_block_seq_feed(NULL, &d, &sp), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_seq_feed(&t, NULL, &sp), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_seq_feed(&t, &d, NULL), ATT_E_NULL);
+}
+
+int main(void)
+{
+    test_encoders_write_the_specified_bytes();
+    test_sample_encodes_in_place();
+    test_encoders_reject_out_of_range();
+    test_decoder_reads_every_kind();
+    test_decoder_rejects();
+    test_round_trips();
+    test_tracker_numbers_across_losses();
+    test_tracker_wraps_and_late_join();
+    return ATT_TEST_REPORT();
+}
