@@ -122,3 +122,44 @@ def test_budget_cli(tmp_path, capsys) -> None:
     import matplotlib.image as mpimg
 
     assert mpimg.imread(out / "budget.png").shape[0] > 200
+
+
+def _table_summary(heading_max_abs: float, pitch_max_abs: float) -> dict:
+    from attitude_c.sim import PAPER_MAXIMA
+
+    err = {k: {"max": 0.0, "min": 0.0, "rms": 0.0, "max_abs": 0.0}
+           for k in ("heading", "pitch", "roll", "attitude_angle")}
+    err["heading"].update(max=heading_max_abs, max_abs=heading_max_abs)
+    err["pitch"].update(max=pitch_max_abs, max_abs=pitch_max_abs)
+    return {
+        "parameters": {"trajectory": {"trajectory": "paper"}, "method": "rk4", "precision": "f64",
+                       "sensors": "full", "gyro": {"name": "cg-l53"}, "period_s": 0.08,
+                       "duration_s": 60.0, "seed": 0},
+        "errors_rad": err,
+        "paper_maxima_rad": {"heading": PAPER_MAXIMA["heading"][1], "pitch": PAPER_MAXIMA["pitch"][1]},
+        "times_better_than_paper": {"heading": PAPER_MAXIMA["heading"][1] / heading_max_abs,
+                                    "pitch": PAPER_MAXIMA["pitch"][1] / pitch_max_abs},
+        "link": {}, "updates": 250,
+    }
+
+
+def test_table_prints_the_true_ratio_below_one_when_worse() -> None:
+    """A run worse than the paper (heading 0.87 rad against 0.12; pitch 0.25
+    against 0.15) shows ratios below 1, truncated, never rounded up to 1."""
+    from attitude_c.sim.report import format_table
+
+    text = format_table(_table_summary(0.87, 0.25))
+    rows = {ln.split()[0]: ln.split() for ln in text.splitlines() if ln.startswith(("heading", "pitch"))}
+    assert rows["heading"][-1] == "0.13"  # 0.12 / 0.87 = 0.1379...
+    assert rows["pitch"][-1] == "0.6"  # 0.15 / 0.25
+    assert "larger than the paper's maximum" in text
+
+
+@pytest.mark.parametrize("ratio, shown", [
+    (0.996, "0.99"), (0.999999, "0.99"), (0.138, "0.13"), (0.6, "0.6"), (0.00123, "0.0012"),
+    (3e-5, "3.0e-05"), (1.0, "1"), (3.46, "3.4"), (9.99, "9.9"), (212.9, "212"), (float("inf"), "inf"),
+])
+def test_ratio_is_truncated_never_rounded_up(ratio, shown) -> None:
+    from attitude_c.sim.report import format_ratio
+
+    assert format_ratio(ratio) == shown
