@@ -163,3 +163,45 @@ def test_ratio_is_truncated_never_rounded_up(ratio, shown) -> None:
     from attitude_c.sim.report import format_ratio
 
     assert format_ratio(ratio) == shown
+
+
+def _short_csv(tmp_path: Path) -> Path:
+    """A 10 s trajectory file (rows every 0.02 s)."""
+    t = np.arange(0, 10.0001, 0.02)
+    e = np.column_stack([20 * np.sin(t), 10 * np.sin(0.7 * t), 15 * np.cos(0.5 * t)])
+    p = tmp_path / "short.csv"
+    np.savetxt(p, np.column_stack([t, e]), delimiter=",", header="time,yaw_deg,pitch_deg,roll_deg",
+               comments="", fmt="%.12g")
+    return p
+
+
+def test_csv_file_alone_runs_the_files_span(tmp_path) -> None:
+    """`--trajectory-file` alone means `--trajectory csv`, and the duration is
+    the file's span (10 s), not the 60 s default held at the last row."""
+    out = tmp_path / "o"
+    assert main(["simulate", "--trajectory-file", str(_short_csv(tmp_path)), "--sensors", "ideal",
+                 "--no-plots", "--no-progress", "--out", str(out)]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["parameters"]["trajectory"]["trajectory"] == "csv"
+    assert s["parameters"]["duration_s"] == pytest.approx(10.0)
+    assert s["updates"] == 41  # rv3: one update per 3 samples of 0.08 s in 10 s (125 samples)
+
+
+def test_csv_shorter_than_an_explicit_duration_is_an_error(tmp_path, capsys) -> None:
+    p = _short_csv(tmp_path)
+    rc = main(["simulate", "--trajectory-file", str(p), "--duration", "60", "--no-progress",
+               "--out", str(tmp_path / "x")])
+    err = capsys.readouterr().err
+    assert rc == 2
+    assert "--duration 60 s is longer than the trajectory file" in err and "10 s" in err
+    assert not (tmp_path / "x").exists()
+    # the library refuses the same run
+    from attitude_c.errors import InvalidArgument
+    from attitude_c.sim import SimConfig, make_trajectory, simulate
+
+    with pytest.raises(InvalidArgument, match="longer than the trajectory's data"):
+        simulate(SimConfig(trajectory=make_trajectory("csv", path=p), duration=10.5, sensors="ideal",
+                           link="none"))
+    # an explicit paper trajectory with a file is still a contradiction
+    rc = main(["simulate", "--trajectory", "paper", "--trajectory-file", str(p), "--no-progress"])
+    assert rc == 2 and "only used with --trajectory csv" in capsys.readouterr().err

@@ -81,6 +81,10 @@ class SimConfig:
         if self.duration < self.period:
             raise InvalidArgument(f"duration ({self.duration} s) must be at least one period "
                                   f"({self.period} s)")
+        span = getattr(self.trajectory, "span", None)  # a trajectory from data ends somewhere
+        if span is not None and self.duration > span * (1 + 1e-9):
+            raise InvalidArgument(f"duration ({self.duration:g} s) is longer than the trajectory's data "
+                                  f"({span:g} s): the run would hold the last attitude, not measure")
         if self.duration / self.period > 2_000_000:
             raise InvalidArgument("duration/period above 2e6 samples: choose a shorter run")
         if self.sensors not in SENSOR_MODES:

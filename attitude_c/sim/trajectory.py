@@ -270,7 +270,9 @@ class CsvTrajectory(Trajectory):
     seconds. Between two rows the attitude moves at the constant body rate
     that takes one row to the next (spherical linear interpolation), so the
     truth, the body rates and the increments are exactly consistent. Before
-    the first row the body is at rest; after the last it stays still.
+    the first row the body is at rest (the static calibration); a run may
+    not go past the last row (``SimConfig.validate`` checks the duration
+    against :attr:`span`).
     """
 
     def __init__(self, path: str | Path) -> None:
@@ -343,6 +345,11 @@ class CsvTrajectory(Trajectory):
         self.rates = rv / dt[:, None]  # body rate of each segment
         # cumulative integral of ω at the rows (piecewise linear in between)
         self._cum = np.vstack([np.zeros(3), np.cumsum(rv, axis=0)])
+
+    @property
+    def span(self) -> float:
+        """Seconds the file covers (first to last row): the longest run it can drive."""
+        return self.t_end - self.t_start
 
     def _seg(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         tc = np.clip(t, self.t[0], self.t[-1])
