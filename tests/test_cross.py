@@ -4,12 +4,11 @@ Makefile, the CMake toolchain file and the qemu instruction counter."""
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, require_target, require_tools
+from conftest import ROOT, clean_copy, require_target, require_tools
 
 from toolchain import armv4t_check
 from toolchain.tasks.cross import cross_build_target
@@ -157,15 +156,8 @@ def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
 # -- plain Makefile and CMake -----------------------------------------------
 
 def _clean_copy(tmp_path: Path) -> Path:
-    """The tracked sources only (what a fresh clone has), so no stale build output is reused."""
-    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "Makefile", "CMakeLists.txt",
-                            "cmake", "csrc", "pyproject.toml"], cwd=ROOT, check=True,
-                           capture_output=True, text=True).stdout.split()
-    dst = tmp_path / "src"
-    for f in files:
-        (dst / f).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(ROOT / f, dst / f)
-    return dst
+    """The C build files and sources only (what a fresh clone has)."""
+    return clean_copy(tmp_path / "src", "Makefile", "CMakeLists.txt", "cmake", "csrc", "pyproject.toml")
 
 
 @pytest.mark.qemu
