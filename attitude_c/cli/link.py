@@ -250,7 +250,7 @@ def cmd_test(args: argparse.Namespace) -> int:
 
     try:
         dead = [tuple(float(x) for x in _pair(d, "--dead")) for d in args.dead]
-        reboots = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
+        reboots: list[Any] = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
         chan = ChannelConfig(ber=args.ber, drop=args.drop, insert=args.insert, duplicate=args.duplicate,
                              dead=dead, seed=args.seed)  # type: ignore[arg-type]
         blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),

@@ -11,7 +11,9 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
+from ..core import METHODS as _METHODS
+from ..sim.trajectory import TRAJECTORIES
+
 #: Simulated time when --duration is not given (and the trajectory is not a file).
 DEFAULT_DURATION_S = 60.0
 
@@ -100,7 +102,7 @@ def register(subparsers: Any) -> None:
     )
     g = p.add_argument_group("scenario")
     g.add_argument("--trajectory", default=argparse.SUPPRESS,
-                   choices=("paper", "coning", "static", "constant-rate", "csv"),
+                   choices=TRAJECTORIES,
                    help="reference motion (default: paper, or csv when --trajectory-file is given; "
                    "csv needs --trajectory-file)")
     g.add_argument("--trajectory-file", metavar="CSV", default=None,

@@ -31,7 +31,7 @@ from typing import Any, Callable, Literal
 import serial
 
 from ..errors import InvalidArgument, LinkError
-from .cends import make_receiver, make_sender
+from .cends import Impl, make_receiver, make_sender
 from .protocol import (
     BLOCK_DEFAULT,
     DEFAULT_ANSWER_TIMEOUT_MS,
@@ -345,7 +345,7 @@ class ReceiverReport:
     error: str | None = None
 
 
-def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
+def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT,
                  gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: int | None = None,
                  duration: float | None = None, on_block: Callable[[bytes], None] | None = None,
                  stop: threading.Event | None = None, eof_after: float | None = None,
@@ -400,7 +400,7 @@ def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
     return rep
 
 
-def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
+def run_sender(port: Any, blocks: Iterable[bytes], *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT,
                syn_timeout_ms: int = DEFAULT_SYN_TIMEOUT_MS,
                answer_timeout_ms: int = DEFAULT_ANSWER_TIMEOUT_MS,
                max_attempts: int = DEFAULT_MAX_ATTEMPTS,

@@ -10,10 +10,8 @@ from typing import Callable
 
 import numpy as np
 
+from ..core import METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
-
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rk4")
-PRECISIONS = ("f64", "f32", "fixed")
 
 # increments consumed per update
 _PER_UPDATE = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rk4": 1}
@@ -29,7 +27,7 @@ def check_precision(precision: str) -> None:
         raise InvalidArgument(f"precision must be one of {PRECISIONS}, got {precision!r}")
 
 
-def precision_available(precision: str) -> bool:
+def precision_available(precision: Precision) -> bool:
     """Whether the installed core supports ``precision`` (fixed lands later)."""
     import attitude_c
 
@@ -40,8 +38,8 @@ def precision_available(precision: str) -> bool:
     return True
 
 
-def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.ndarray],
-                   precision: str, h: float) -> tuple[np.ndarray, np.ndarray, float]:
+def run_integrator(dtheta: np.ndarray, method: Method, q0_at: Callable[[float], np.ndarray],
+                   precision: Precision, h: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Integrate increments (n, 3) of period h.
 
     ``q0_at(offset)`` gives the initial attitude ``offset`` periods after the
@@ -80,7 +78,7 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.
     if n_use == 0:
         return empty
     q = np.asarray(attitude_c.integrate(dtheta[:n_use], method=method, q0=q0_at(0.0),
-                                        precision=precision), dtype=float)
+                                        precision=precision), dtype=np.float64)
     m = len(q)
     if m * k == n_use:
         last = np.arange(1, m + 1) * k - 1

@@ -9,11 +9,12 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Literal, get_args
 
 import numpy as np
 
 from .. import __version__
+from ..core import Method, Precision
 from ..errors import InvalidArgument
 from . import _integ
 from ._rot import quat_angle_between, quat_to_euler, wrap_angle
@@ -36,7 +37,8 @@ __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult",
 # The paper's reported error extremes at a 0.08 s period (sec. 4, Fig. 8), rad.
 PAPER_MAXIMA = {"heading": (-0.05, 0.12), "pitch": (-0.10, 0.15)}
 
-SENSOR_MODES = ("ideal", "quantized", "full")
+SensorMode = Literal["ideal", "quantized", "full"]
+SENSOR_MODES: tuple[SensorMode, ...] = get_args(SensorMode)
 
 Progress = Callable[[str, int, int], None]
 
@@ -57,15 +59,15 @@ class SimConfig:
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
     duration: float = 60.0
     period: float = 0.08
-    method: str = "rv3"
-    precision: str = "f64"
-    sensors: str = "full"
+    method: Method = "rv3"
+    precision: Precision = "f64"
+    sensors: SensorMode = "full"
     gyro: GyroModel = field(default_factory=lambda: gyro_preset("cg-l53"))
     conditioning: Conditioning = field(default_factory=Conditioning)
     adc: AdcModel = field(default_factory=AdcModel)
     board: Board = field(default_factory=Board)
     calibration_s: float = 60.0
-    link: str = "c"
+    link: Literal["c", "none"] = "c"
     ber: float = 0.0
     link_attempts: int = 5
     seed: int = 0

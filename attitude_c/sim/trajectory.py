@@ -21,7 +21,7 @@ import csv
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -382,10 +382,11 @@ class CsvTrajectory(Trajectory):
                 "t_start": self.t_start, "t_end": self.t_end}
 
 
-TRAJECTORIES = ("paper", "coning", "static", "constant-rate", "csv")
+TrajectoryKind = Literal["paper", "coning", "static", "constant-rate", "csv"]
+TRAJECTORIES: tuple[TrajectoryKind, ...] = get_args(TrajectoryKind)
 
 
-def make_trajectory(kind: str, **kw: Any) -> Trajectory:
+def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
     """Build a trajectory by name (``paper``, ``coning``, ``static``,
     ``constant-rate``, ``csv`` with ``path=``)."""
     if kind == "paper":
