@@ -91,6 +91,7 @@ def test_sdist_wheel_fresh_venv_smoke(tmp_path: Path) -> None:
     for m in ("attitude_c.core", "attitude_c.cli.simulate", "attitude_c.link.transport",
               "attitude_c.sim.chain", "attitude_c.tlc2543.model", "attitude_c.reference"):
         assert m in out["modules"]
+    assert out["f32_dtype"] == "float32"
 
     run = work / "run"
     proc = _run([env_dir / "bin" / "attitude", "simulate", "--duration", "5", "--no-progress", "--out", run],
