@@ -45,6 +45,7 @@ class Target:
     os: str
     cc: str
     ar: str
+    #: Every flag of the project's own compiles: ``strict_cflags + target_cflags``.
     cflags: list[str]
     ldflags: list[str] = field(default_factory=list)
     libs: list[str] = field(default_factory=list)
@@ -61,6 +62,11 @@ class Target:
     pic_flags: list[str] = field(default_factory=lambda: ["-fPIC"])
     #: Post-build checks by name (e.g. "armv4t": toolchain/armv4t_check.py).
     checks: list[str] = field(default_factory=list)
+    #: The target itself (TOML ``cflags``: architecture, ABI, optimization): what
+    #: ``make TARGET=NAME`` and cmake/NAME-toolchain.cmake pass too.
+    target_cflags: list[str] = field(default_factory=list)
+    #: The project's compile policy (TOML ``strict_cflags``: -std, warnings, -Werror).
+    strict_cflags: list[str] = field(default_factory=list)
 
     def library_sources(self) -> list[Path]:
         """The library sources this target builds (sorted, de-duplicated)."""
@@ -167,9 +173,11 @@ def load(name: str) -> Target:
         raise ValueError(f"unknown target {name!r}; known targets: {', '.join(names())}")
     d = tomllib.loads(path.read_text())
     cc = os.environ.get(f"ATT_CC_{name.upper().replace('-', '_')}", d["cc"])
+    strict, target = list(d.get("strict_cflags", [])), list(d.get("cflags", []))
     return Target(
         name=d["name"], kind=d["kind"], os=d["os"], cc=cc, ar=d["ar"],
-        cflags=list(d.get("cflags", [])), ldflags=list(d.get("ldflags", [])),
+        cflags=strict + target, target_cflags=target, strict_cflags=strict,
+        ldflags=list(d.get("ldflags", [])),
         libs=list(d.get("libs", [])), run_cmd=list(d.get("run", [])),
         apt=list(d.get("apt", [])), objdump=d.get("objdump"),
         lib_source_globs=list(d.get("lib_sources", ["csrc/src/*.c"])),

@@ -14,7 +14,9 @@ Produces in ``build/NAME/``:
   object (toolchain/armv4t_check.py); the build fails on a violation.
 
 The build is done from Python (not by calling make) so that every
-target, including SDCC, uses exactly the flags of its TOML file.
+target, including SDCC, uses exactly the flags of its TOML file;
+``make TARGET=NAME`` and cmake/NAME-toolchain.cmake use the same ones
+(generated from the TOML files by toolchain/buildfiles.py).
 """
 
 from __future__ import annotations
