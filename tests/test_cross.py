@@ -1,5 +1,5 @@
-"""Cross builds: invoke cross-build, the ARMv4T instruction check, the plain
-Makefile, the CMake toolchain file and the qemu instruction counter."""
+"""Cross builds: invoke cross-build, the ARMv4T instruction check and the qemu
+instruction counter (make and CMake: tests/test_consumer.py, test_buildfiles.py)."""
 
 from __future__ import annotations
 
@@ -8,29 +8,14 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from conftest import ROOT, clean_copy, require_target, require_tools
+from conftest import ROOT, require_target, require_tools
 
 from toolchain import armv4t_check
 from toolchain.tasks.cross import cross_build_target
 
-# A small user program: what a mini2440 application does with the library.
-EXAMPLE_C = r"""
-#include <stdio.h>
-#include "attitude/attitude.h"
-int main(void)
-{
-    const att_real d[9] = {0, 0, 0.01, 0, 0, 0.01, 0, 0, 0.01}; /* 0.03 rad about z */
-    att_real q[4];
-    att_integ s;
-    size_t n = 0;
-    if (att_integ_init(&s, ATT_METHOD_RV3, NULL) != ATT_OK
-        || att_integ_batch(&s, d, 3, q, &n, NULL) != ATT_OK || n != 1)
-        return 1;
-    printf("att_real=%d ok=%s q=%.6f %.6f\n", att_real_size(), att_status_str(ATT_OK),
-           (double)q[0], (double)q[3]);
-    return 0;
-}
-"""
+# A small user program: what a mini2440 application does with the library (the
+# consumer project's, tests/consumer/main.c).
+EXAMPLE_C = (ROOT / "tests" / "consumer" / "main.c").read_text()
 # q = [cos(0.015), 0, 0, sin(0.015)] to 6 decimals (the same in float and double)
 Q_TEXT = "q=0.999888 0.014999"
 
@@ -153,56 +138,8 @@ def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
         == f"att_real=4 ok=ok {Q_TEXT}"
 
 
-# -- plain Makefile and CMake -----------------------------------------------
-
-def _clean_copy(tmp_path: Path) -> Path:
-    """The C build files and sources only (what a fresh clone has)."""
-    return clean_copy(tmp_path / "src", "Makefile", "CMakeLists.txt", "cmake", "csrc", "pyproject.toml")
-
-
-@pytest.mark.qemu
-def test_makefile_cross_compile_install_and_link(tmp_path: Path) -> None:
-    """make CROSS_COMPILE=arm-linux-gnueabi- from a clean tree; make install; an example links."""
-    t = require_target("armv4t")
-    require_tools("make", "pkg-config", apt="make pkg-config")
-    src = _clean_copy(tmp_path)
-    arch = "-march=armv4t -mtune=arm920t -marm -mfloat-abi=soft"
-    subprocess.run(["make", "-j2", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}"],
-                   cwd=src, check=True, capture_output=True)
-    root = tmp_path / "rootfs"
-    subprocess.run(["make", "install", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}",
-                    "PREFIX=/usr", f"DESTDIR={root}"], cwd=src, check=True, capture_output=True)
-    lib = root / "usr" / "lib"
-    for name in ("libattitude.a", "libattitude.so", "libattitude.so.0", "pkgconfig/attitude.pc"):
-        assert (lib / name).exists(), name
-    assert (root / "usr" / "include" / "attitude" / "attitude.h").exists()
-    assert "prefix=/usr" in (lib / "pkgconfig" / "attitude.pc").read_text()
-    assert armv4t_check.check_objects([lib / "libattitude.a"], objdump=t.objdump) == []
-    if any((ROOT / "csrc" / "app").glob("*.c")):
-        assert (root / "usr" / "bin" / "attitude-rx").exists()
-    env = dict(os.environ, PKG_CONFIG_PATH="", PKG_CONFIG_LIBDIR=str(lib / "pkgconfig"),
-               PKG_CONFIG_SYSROOT_DIR=str(root))
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "--static", "attitude"], env=env,
-                           check=True, capture_output=True, text=True).stdout.split()
-    ex = tmp_path / "example.c"
-    ex.write_text(EXAMPLE_C)
-    exe = tmp_path / "example"
-    subprocess.run(["arm-linux-gnueabi-gcc", *arch.split(), str(ex), "-o", str(exe), "-static", *flags],
-                   check=True, capture_output=True)
-    assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
-
-
-def test_cmake_armv4t_toolchain(tmp_path: Path) -> None:
-    """CMake with cmake/armv4t-toolchain.cmake builds an ARMv4T-clean libattitude.a."""
-    t = require_target("armv4t")
-    require_tools("cmake", "make", apt="cmake make")
-    bdir = tmp_path / "cmake"
-    subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir),
-                    f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'armv4t-toolchain.cmake'}"],
-                   check=True, capture_output=True)
-    subprocess.run(["cmake", "--build", str(bdir), "-j2"], check=True, capture_output=True)
-    assert armv4t_check.check_objects([bdir / "libattitude.a"], objdump=t.objdump) == []
-    assert (bdir / "libattitude.so").exists()
+# -- plain Makefile and CMake: tests/test_consumer.py (installs, consumer project) and
+# tests/test_buildfiles.py (the same target flags on every path).
 
 
 # -- qemu instruction counter ----------------------------------------------

@@ -104,7 +104,7 @@ def lint(c):
 
 
 C_FORMAT_GLOBS = ("csrc/**/*.[ch]", "firmware/**/*.[ch]", "bench/*.c", "tests/*.c", "tests/s51/*.c",
-                  "toolchain/*.[ch]")
+                  "tests/consumer/*.c", "toolchain/*.[ch]")
 
 
 def _c_format_files() -> list[str]:
