@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from ..errors import AttitudeError
+from .simulate import _nonneg
 
 
 def _hex_block(b: bytes) -> str:
@@ -53,16 +54,6 @@ EXIT_INTERRUPTED = 130  # SIGINT / SIGTERM with a block in progress
 WAIT_NOTE_S = 5.0
 
 
-def _wait_seconds(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not math.isfinite(v) or v < 0:
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text!r}")
-    return v
-
-
 def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", required=True, help="device or pyserial URL (/dev/ttyS1, socket://host:port, ...)")
     p.add_argument("--baud", type=int, default=9600, help="line rate (default 9600, 8N1)")
@@ -87,7 +78,7 @@ def register(sub: Any) -> None:
     p.add_argument("--syn-timeout-ms", type=int, default=50)
     p.add_argument("--answer-timeout-ms", type=int, default=50)
     p.add_argument("--max-attempts", type=int, default=5)
-    p.add_argument("--wait", type=_wait_seconds, default=None, metavar="S",
+    p.add_argument("--wait", type=_nonneg("--wait"), default=None, metavar="S",
                    help="wait at most S seconds for the receiver's first handshake (default: for ever, "
                    f"with a message every {WAIT_NOTE_S:g} s; 0: no wait)")
     p.add_argument("--on-give-up", choices=("fail", "skip"), default="fail",
