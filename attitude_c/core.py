@@ -391,21 +391,25 @@ class Integrator:
         a, lead = _shaped(x, "dtheta", (3,), "3-vector per sample")
         return self._update_increments(a, lead)
 
-    def _update_increments(self, a: NDArray[Any], lead: tuple[int, ...]) -> FloatArray:
+    def _update_increments(self, a: NDArray[Any], lead: tuple[int, ...],
+                           out: NDArray[Any] | None = None) -> FloatArray:
         """``att_integ_batch`` on records ``a`` (n, 3) of any real dtype."""
-        return self._batch(a, lead, "dtheta", None)
+        return self._batch(a, lead, "dtheta", None, out)
 
     def _batch(self, a: NDArray[Any], lead: tuple[int, ...], name: str,
-               h: NDArray[Any] | None) -> FloatArray:
+               h: NDArray[Any] | None, out: NDArray[Any] | None = None) -> FloatArray:
         """One batch call (``att_integ_rk4_batch`` when step sizes ``h`` are
         given). The C call checks every sample (NaN/Inf, divergence) and
         leaves the state as it was on error, so the data get no second pass
-        here: only the conversion to the build's dtype when they have another."""
+        here: only the conversion to the build's dtype when they have another.
+        ``out``: a buffer already checked by :func:`_check_out` for exactly
+        ``self.outputs(n)`` records; it is filled and returned itself."""
         with np.errstate(over="ignore"):  # finite float64 -> inf float32: found below
             c = np.ascontiguousarray(a, dtype=self._dtype)
         n = c.shape[0]
-        m = self.outputs(n)
-        out = np.empty((max(m, 1), 4), dtype=self._dtype)
+        given = out is not None
+        if out is None:
+            out = np.empty((max(self.outputs(n), 1), 4), dtype=self._dtype)
         if n:
             ffi, lib = self._ffi, self._lib
             nout = ffi.new("size_t *")
@@ -423,7 +427,9 @@ class Integrator:
                     raise _nonfinite(name, i, lead)
                 _raise(st, name, i)
             m = int(nout[0])
-        return out[:m]
+        else:
+            m = 0
+        return out if given else out[:m]
 
     def _update_one(self, x: NDArray[Any]) -> FloatArray:
         """Fast path for one float increment (3,): no array conversions; the C
@@ -442,7 +448,8 @@ class Integrator:
         _raise(r, "dtheta", 0)
         raise AssertionError("unreachable")  # pragma: no cover
 
-    def _update_rates(self, a: NDArray[Any], lead: tuple[int, ...], dt: ArrayLike | None) -> FloatArray:
+    def _update_rates(self, a: NDArray[Any], lead: tuple[int, ...], dt: ArrayLike | None,
+                      out: NDArray[Any] | None = None) -> FloatArray:
         n = a.shape[0]
         if dt is None:
             raise InvalidArgument("dt is required with method 'rk4' (sampling interval, s)")
@@ -455,7 +462,8 @@ class Integrator:
                 raise InvalidArgument(f"dt must be > 0: dt[0] = {d1[0]!r}")
             if not len(self._pending_dt) or (self._pending_dt == d1[0]).all():
                 # one spacing throughout: every step is h = 2 dt, one value for the C call
-                q = self._batch(a, lead, "omega", _to_c((2 * d1).reshape(1, 1), self.precision, "dt")[0])
+                q = self._batch(a, lead, "omega", _to_c((2 * d1).reshape(1, 1), self.precision, "dt")[0],
+                                out)
                 self._pending_dt = np.full(self.pending, d1[0])
                 return q
             d = np.full(n, d1[0])
@@ -472,7 +480,7 @@ class Integrator:
         alld = np.concatenate([self._pending_dt, d])
         h = alld[0: 2 * m: 2] + alld[1: 2 * m: 2] if m else np.ones(1)
         hc = _to_c(h.reshape(-1, 1), self.precision, "dt").reshape(-1)
-        q = self._batch(a, lead, "omega", hc)
+        q = self._batch(a, lead, "omega", hc, out)
         nb = self.pending
         self._pending_dt = alld[len(alld) - nb:] if nb else np.empty(0)
         return q
@@ -492,8 +500,38 @@ def _fixedpoint() -> Any:
     return fixedpoint
 
 
+def _n_outputs(method: str, n: int) -> int:
+    """Attitude updates that n samples complete from a fresh state (C count)."""
+    ffi, lib = ffi_lib("f64")
+    s = ffi.new("att_integ *")
+    lib.att_integ_init(s, METHODS.index(method), ffi.NULL)
+    return int(lib.att_integ_outputs(s, n))
+
+
+def _check_out(out: Any, m: int, precision: str, source: NDArray[Any], source_name: str) -> NDArray[Any]:
+    """Validate a caller's ``out`` buffer: an ndarray of shape (m, 4), the
+    precision's dtype, C-contiguous, writeable, not sharing memory with the
+    input. Checked before any computation, so a bad ``out`` changes nothing."""
+    dtype = np.dtype(np.float64 if precision == "fixed" else _DTYPES[precision])
+    if not isinstance(out, np.ndarray):
+        raise InvalidType(f"out must be a numpy.ndarray, got {type(out).__name__}")
+    if out.dtype != dtype:
+        raise InvalidType(f"out must have dtype {dtype.name} for precision={precision!r}, "
+                          f"got {out.dtype}")
+    if out.shape != (m, 4):
+        raise InvalidArgument(f"out must have shape ({m}, 4) (one quaternion per attitude "
+                              f"update), got {out.shape}")
+    if not out.flags.c_contiguous:
+        raise InvalidArgument("out must be C-contiguous (np.empty((M, 4)), not a strided view)")
+    if not out.flags.writeable:
+        raise InvalidArgument("out is read-only")
+    if np.may_share_memory(out, source):
+        raise InvalidArgument(f"out must not share memory with {source_name}")
+    return out
+
+
 def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = None,
-              precision: Precision = "f64") -> FloatArray:
+              precision: Precision = "f64", out: NDArray[Any] | None = None) -> FloatArray:
     """Integrate body angle increments Δθ (N, 3) (rad) from attitude q0.
 
     Returns the quaternion after each attitude update, (M, 4): float64, or
@@ -503,6 +541,14 @@ def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = 
     Integrator to stream). ``precision`` is "f64", "f32" or "fixed" (float64
     results). NaN/Inf raise NonFiniteError naming the first bad sample
     (checked once, by the C call).
+
+    ``out``: optional preallocated result array, a C-contiguous ndarray of
+    shape (M, 4) and the result's dtype (float64, float32 for "f32"), not
+    overlapping ``dtheta``; it is filled and returned (no allocation: reuse
+    one buffer across calls). A wrong ``out`` raises InvalidType (type,
+    dtype) or InvalidArgument (shape, layout, read-only, overlap) before any
+    work; after an error raised by the integration itself (NaN/Inf,
+    divergence) its content is unspecified.
     """
     precision = _check_precision(precision, allow_fixed=True)
     method = _check_method(method, INCREMENT_METHODS + ("rk4",))
@@ -516,20 +562,30 @@ def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = 
                               f"per update, got {a.shape[0]}")
     q = _check_q0(q0)
     if precision == "fixed":
-        out = _fixedpoint().integrate(_records(a, "dtheta", (3,), "angle increment"), method, q)
-        return np.asarray(out, dtype=np.float64)
-    return Integrator(method, q, precision)._update_increments(a, lead)
+        if out is not None:
+            _check_out(out, _n_outputs(method, a.shape[0]), precision, a, "dtheta")
+        res = _fixedpoint().integrate(_records(a, "dtheta", (3,), "angle increment"), method, q)
+        if out is None:
+            return np.asarray(res, dtype=np.float64)
+        out[...] = res
+        return out
+    it = Integrator(method, q, precision)
+    if out is not None:
+        _check_out(out, it.outputs(a.shape[0]), precision, a, "dtheta")
+    return it._update_increments(a, lead, out)
 
 
 def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "rk4",
-                    q0: ArrayLike | None = None, precision: Precision = "f64") -> FloatArray:
+                    q0: ArrayLike | None = None, precision: Precision = "f64",
+                    out: NDArray[Any] | None = None) -> FloatArray:
     """Integrate body rates ω (N, 3) (rad/s) sampled every ``dt`` s.
 
     ``dt``: scalar or one value per row (dt[i] = time from row i to row i+1).
     ``rk4``: rows are at t, t+h/2, t+h, t+3h/2, … (each step end is the
     next step's start), h = dt[2k] + dt[2k+1]; returns (N − 1) // 2
     attitudes. Increment methods: Δθ_i = ω_i · dt_i (ω_i the mean rate of
-    interval i), then as :func:`integrate`.
+    interval i), then as :func:`integrate`. ``out``: as in :func:`integrate`
+    (shape (M, 4), not overlapping ``omega``).
     """
     precision = _check_precision(precision, allow_fixed=True)
     method = _check_method(method)
@@ -550,7 +606,9 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "r
             raise NonFiniteError("dt holds NaN or Inf", index=_first_bad(np.isfinite(d)))
         if not (d > 0).all():
             raise InvalidArgument("dt must be > 0")
-        return integrate(a * d[:, None], method, q, precision)
+        if out is not None and np.may_share_memory(out, omega):
+            raise InvalidArgument("out must not share memory with omega")
+        return integrate(a * d[:, None], method, q, precision, out)
     if a.shape[0] < 3:
         raise InvalidArgument(f"method 'rk4' needs at least 3 rate rows (t, t+h/2, t+h), "
                               f"got {a.shape[0]}")
@@ -558,5 +616,14 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "r
         fx = _fixedpoint()
         if not hasattr(fx, "integrate_rates"):
             raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
-        return np.asarray(fx.integrate_rates(a, dt, method, q), dtype=np.float64)
-    return Integrator("rk4", q, precision)._update_rates(a, lead, dt)
+        if out is not None:
+            _check_out(out, _n_outputs("rk4", a.shape[0]), precision, a, "omega")
+        res = fx.integrate_rates(a, dt, method, q)
+        if out is None:
+            return np.asarray(res, dtype=np.float64)
+        out[...] = res
+        return out
+    it = Integrator("rk4", q, precision)
+    if out is not None:
+        _check_out(out, it.outputs(a.shape[0]), precision, a, "omega")
+    return it._update_rates(a, lead, dt, out)
