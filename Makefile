@@ -17,7 +17,10 @@
 # LDFLAGS, TARGET_CFLAGS (architecture flags; set by TARGET), PREFIX,
 # DESTDIR, LIBDIR, INCLUDEDIR, BINDIR, PKGCONFIGDIR, BUILDDIR, PRECISION
 # (f64|f32), STATIC_APP (1 = link attitude-rx statically, 0 = against
-# libattitude.so), SHARED (0 = no .so), APP (0 = no attitude-rx).
+# libattitude.so), SHARED (0 = no .so), APP (0 = no attitude-rx),
+# SHARED_LDFLAGS, SHARED_LIBGCC, SHARED_LIBS (the link of libattitude.so; set
+# by TARGET: armv4t links the ARMv4T libgcc.a of arm-none-eabi-gcc and only
+# -lm -lc, see docs/cross-build.md).
 #
 # Products (in $(BUILDDIR), default build/make, or build/make-NAME with
 # TARGET=NAME): libattitude.a (libattitude.lib with SDCC),
@@ -44,6 +47,9 @@ SHARED        ?= $(ATT_TARGET_SHARED_$(TARGET))
 APP           ?= $(ATT_TARGET_APP_$(TARGET))
 APP_LIBS      := $(ATT_TARGET_APP_LIBS_$(TARGET))
 LIB_GLOBS     := $(ATT_TARGET_SOURCES_$(TARGET))
+SHARED_LDFLAGS ?= $(ATT_TARGET_SHARED_LDFLAGS_$(TARGET))
+SHARED_LIBGCC_CMD := $(ATT_TARGET_SHARED_LIBGCC_$(TARGET))
+SHARED_LIBS   ?= $(ATT_TARGET_SHARED_LIBS_$(TARGET))
 BUILDDIR      ?= build/make-$(TARGET)
 CFLAGS        ?=
 ifeq ($(origin CC),default)
@@ -60,6 +66,9 @@ TARGET_LDFLAGS :=
 TARGET_LIBS   := -lm
 APP_LIBS      := -pthread
 LIB_GLOBS     := csrc/src/*.c
+SHARED_LDFLAGS ?=
+SHARED_LIBGCC_CMD :=
+SHARED_LIBS   ?= $(TARGET_LIBS)
 CFLAGS        ?= -O2
 ifeq ($(origin CC),default)
 CC := $(CROSS_COMPILE)gcc
@@ -81,6 +90,14 @@ STATIC_APP   ?= 1
 SHARED       ?= 1
 APP          ?= 1
 LDFLAGS      ?=
+
+# libattitude.so of a target that links its own libgcc (armv4t: the ARMv4T one
+# of arm-none-eabi-gcc, not the armel compiler's ARMv5TE runtime).
+ifeq ($(SHARED),1)
+ifneq ($(SHARED_LIBGCC_CMD),)
+SHARED_LIBGCC ?= $(shell $(SHARED_LIBGCC_CMD) 2>/dev/null)
+endif
+endif
 
 ifeq ($(KIND),sdcc)
 # SDCC has no double (it would silently be float): always the float build.
@@ -134,7 +151,8 @@ all: $(ALL)
 # into an object or a link; it is rewritten only when that text changes, so
 # objects rebuild exactly when the compiler or a flag changed.
 STAMP_TEXT := $(CC) $(shell $(CC) --version 2>/dev/null | head -n 1) | $(ATT_CFLAGS) $(TARGET_CFLAGS) \
-  $(CPPFLAGS) $(CFLAGS) | $(TARGET_LDFLAGS) $(LDFLAGS) $(TARGET_LIBS) | $(AR) | $(STATIC_APP)
+  $(CPPFLAGS) $(CFLAGS) | $(TARGET_LDFLAGS) $(LDFLAGS) $(TARGET_LIBS) | $(AR) | $(STATIC_APP) \
+  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS)
 $(STAMP): FORCE
 	@mkdir -p $(@D)
 	@if [ "$$(cat $@ 2>/dev/null)" != '$(subst ','\'',$(STAMP_TEXT))' ]; then \
@@ -157,7 +175,10 @@ $(STATIC_LIB): $(LIB_OBJS)
 	$(AR) rcs $@ $^
 
 $(SHARED_REAL): $(PIC_OBJS)
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) -shared -Wl,-soname,libattitude.so.$(SOVERSION) $^ -o $@ $(TARGET_LIBS)
+ifeq ($(origin SHARED_LIBGCC),file)
+	@test -f '$(SHARED_LIBGCC)' || { echo 'libattitude.so (TARGET=$(TARGET)) links the libgcc.a that `$(SHARED_LIBGCC_CMD)` prints: install that compiler, or pass SHARED_LIBGCC=/path/to/libgcc.a, or SHARED=0' >&2; exit 1; }
+endif
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) $(SHARED_LDFLAGS) -shared -Wl,-soname,libattitude.so.$(SOVERSION) $^ -o $@ $(SHARED_LIBGCC) $(SHARED_LIBS)
 
 $(BUILDDIR)/libattitude.so: $(SHARED_REAL)
 	ln -sf libattitude.so.$(VERSION) $(BUILDDIR)/libattitude.so.$(SOVERSION)

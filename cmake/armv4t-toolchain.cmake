@@ -28,6 +28,12 @@ set(CMAKE_C_FLAGS_INIT "-O2 -march=armv4t -mtune=arm920t -marm -mfloat-abi=soft"
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-static")
 set(CMAKE_SHARED_LINKER_FLAGS_INIT "")
 
+# How libattitude.so is linked (toolchain/<name>.toml shared_*): read by the
+# library's CMakeLists.txt for that one target, not applied to other targets.
+set(ATT_SHARED_LINK_OPTIONS "-nostdlib;-Wl,--no-undefined;-Wl,-z,noexecstack")
+set(ATT_SHARED_LIBGCC_CMD "arm-none-eabi-gcc;-marm;-mcpu=arm920t;-mfloat-abi=soft;-print-libgcc-file-name")
+set(ATT_SHARED_LIBS "-lm;-lc")
+
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)

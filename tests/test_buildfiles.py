@@ -97,3 +97,30 @@ def test_every_build_path_compiles_with_the_toml_flags(name: str, tmp_path: Path
         assert Path(cmd[0]).name == t.cc, (path, cmd)
         assert _target_flags(cmd) == t.target_cflags, (path, cmd)
         assert _defines(cmd) == _defines(cmds["invoke"]), (path, cmd)
+
+
+def test_every_build_path_links_the_shared_library_alike(tmp_path: Path) -> None:
+    """armv4t's libattitude.so: invoke, `make TARGET=armv4t` and CMake with
+    cmake/armv4t-toolchain.cmake link it with the TOML's shared_ldflags and end
+    the link line with the same libraries (the ARMv4T libgcc.a, -lm, -lc)."""
+    from toolchain.tasks.cross import shared_link_cmd
+
+    t = require_target("armv4t")
+    require_tools("make", "cmake", apt="make cmake")
+    tail = t.shared_link_libs()
+    assert Path(tail[0]).name == "libgcc.a" and tail[1:] == ["-lm", "-lc"]
+    mk = subprocess.run(["make", "-n", "TARGET=armv4t", f"BUILDDIR={tmp_path / 'mk'}"], cwd=ROOT,
+                        env=_clean_env(), capture_output=True, text=True, check=True).stdout
+    bdir = tmp_path / "cmake"
+    subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir), "-DATT_BUILD_APP=OFF",
+                    f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'armv4t-toolchain.cmake'}"],
+                   env=_clean_env(), capture_output=True, text=True, check=True)
+    cmds = {
+        "invoke": shared_link_cmd(t, [Path("common.o")], Path("libattitude.so.0")),
+        "make": shlex.split(next(ln for ln in mk.splitlines() if " -shared " in ln)),
+        "cmake": shlex.split((bdir / "CMakeFiles/attitude_shared.dir/link.txt").read_text()),
+    }
+    for path, cmd in cmds.items():
+        assert Path(cmd[0]).name == t.cc, (path, cmd)
+        assert cmd[-len(tail):] == tail, (path, cmd)
+        assert all(f in cmd for f in t.shared_ldflags) and "-static" not in cmd, (path, cmd)

@@ -2,9 +2,19 @@
 a staged root (`DESTDIR=... --prefix /usr`), then a separate consumer
 project (tests/consumer/, outside the library's tree) built against the
 installed copy through pkg-config and through CMake's find_package, on the
-host and for armv4t (run under qemu-arm). The installed armv4t library
-passes the ARMv4T instruction check whichever way it was built (invoke:
-tests/test_cross.py::test_cross_build_armv4t).
+host and for armv4t (run under qemu-arm). The installed armv4t library,
+libattitude.a and libattitude.so, passes the ARMv4T instruction check
+whichever way it was built (invoke: tests/test_cross.py::test_cross_build_armv4t).
+
+What the armv4t checks cover: toolchain/armv4t_check.py reads every
+instruction of the installed libattitude.a and libattitude.so (our code, the
+ARMv4T libgcc helpers linked into the .so, its PLT stubs). A consumer linked
+against the .so runs under qemu-arm with the Debian armel loader, libc and
+libm (`-L` their sysroot): that proves the .so loads, resolves and computes
+right; it runs on qemu's default CPU, not the ARMv4T model (ti925t), because
+that loader and libc are ARMv5TE (SIGILL in the loader there): on the board
+they are the board's own, not ours. The statically linked consumers run the
+library's code alike.
 
 Each build starts from a copy of the tracked sources (no stale objects)."""
 
@@ -73,6 +83,31 @@ def _cmake_consumer(tmp_path: Path, root: Path, *options: str) -> tuple[Path, st
     return bdir / "consumer", out
 
 
+def _armel_prefix(t) -> Path:
+    """The armel sysroot holding the dynamic loader (for qemu-arm -L)."""
+    out = subprocess.run([t.cc, "-print-file-name=ld-linux.so.3"], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    loader = Path(out)
+    assert loader.is_absolute() and loader.exists(), f"{t.cc} knows no ld-linux.so.3 ({out!r})"
+    return loader.resolve().parent.parent
+
+
+def _check_armv4t_install(t, root: Path, tmp_path: Path) -> None:
+    """The installed libattitude.a and libattitude.so are ARMv4T clean; the
+    .so needs only libm and libc; a consumer linked against it (pkg-config,
+    no -static) runs under qemu-arm with the armel loader (module docstring)."""
+    lib = root / "usr/lib"
+    so = (lib / "libattitude.so").resolve()
+    assert armv4t_check.check_objects([lib / "libattitude.a", so], objdump=t.objdump) == []
+    dyn = _run([t.tool("readelf"), "-dW", so])
+    assert sorted(ln.split("[")[1].rstrip("]") for ln in dyn.splitlines() if "(NEEDED)" in ln) \
+        == ["libc.so.6", "libm.so.6"], dyn
+    exe = _pkg_config_consumer(tmp_path / "dyn", root, t.cc, t.target_cflags, [f"-Wl,-rpath,{lib}"])
+    assert "libattitude.so.0" in _run([t.tool("readelf"), "-dW", exe])
+    res = t.run([exe], timeout=60, extra_run_args=["-L", str(_armel_prefix(t))])
+    assert res.stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
+
+
 def _check_pc(root: Path, f32: bool) -> None:
     pc = (root / "usr/lib/pkgconfig/attitude.pc").read_text()
     assert pc.startswith("prefix=/usr\n"), pc  # the install prefix, not the configure-time /usr/local
@@ -102,15 +137,15 @@ def test_cmake_host_float_build_package_and_pkg_config(tmp_path: Path) -> None:
 
 @pytest.mark.qemu
 def test_cmake_armv4t_package_find_package_and_pkg_config(tmp_path: Path) -> None:
-    """armv4t with cmake/armv4t-toolchain.cmake: the installed libattitude.a is
-    ARMv4T clean; the consumer, cross-built through find_package (with the
-    same toolchain file) and through pkg-config, runs under qemu-arm."""
+    """armv4t with cmake/armv4t-toolchain.cmake: the installed libattitude.a
+    and libattitude.so are ARMv4T clean; the consumer, cross-built through
+    find_package (with the same toolchain file) and through pkg-config,
+    static and against the .so, runs under qemu-arm."""
     t = require_target("armv4t")
     root = _cmake_install(tmp_path, "armv4t-toolchain.cmake")
-    lib = root / "usr/lib"
     _check_pc(root, f32=False)
-    assert armv4t_check.check_objects([lib / "libattitude.a"], objdump=t.objdump) == []
-    assert (lib / "libattitude.so").exists() and (root / "usr/bin/attitude-rx").exists()
+    assert (root / "usr/bin/attitude-rx").exists()
+    _check_armv4t_install(t, root, tmp_path)
     exe, _ = _cmake_consumer(tmp_path, root, f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake/armv4t-toolchain.cmake'}",
                              f"-DCMAKE_FIND_ROOT_PATH={root}", "-DCMAKE_PREFIX_PATH=/usr")
     assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
@@ -121,8 +156,9 @@ def test_cmake_armv4t_package_find_package_and_pkg_config(tmp_path: Path) -> Non
 @pytest.mark.qemu
 def test_make_armv4t_preset_install_and_pkg_config(tmp_path: Path) -> None:
     """The README's line: `make TARGET=armv4t PREFIX=/usr DESTDIR=... install`
-    from a clean tree; the installed library is ARMv4T clean and a consumer
-    built through pkg-config runs under qemu-arm."""
+    from a clean tree; the installed libraries (.a and .so) are ARMv4T clean
+    and a consumer built through pkg-config, static and against the .so, runs
+    under qemu-arm."""
     t = require_target("armv4t")
     require_tools("make", apt="make")
     assert "make TARGET=armv4t PREFIX=/usr DESTDIR=" in (ROOT / "README.md").read_text()
@@ -133,7 +169,7 @@ def test_make_armv4t_preset_install_and_pkg_config(tmp_path: Path) -> None:
         assert (lib / name).exists(), name
     assert (root / "usr/include/attitude/attitude.h").exists() and (root / "usr/bin/attitude-rx").exists()
     _check_pc(root, f32=False)
-    assert armv4t_check.check_objects([lib / "libattitude.a"], objdump=t.objdump) == []
+    _check_armv4t_install(t, root, tmp_path)
     exe = _pkg_config_consumer(tmp_path, root, t.cc, t.target_cflags, t.ldflags)
     assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 

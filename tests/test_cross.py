@@ -68,6 +68,48 @@ def test_armv4t_check_rejects_interworking_and_vfp(tmp_path: Path) -> None:
     assert "FPU" in reasons and "BLX" in reasons
 
 
+SHARED_C = r"""
+#include <math.h>
+double norm(double x, double y) { return sqrt(x * x + y * y) / (x + 1.0); }
+unsigned part(unsigned a, unsigned b) { return a / b; }
+"""
+
+
+def test_armv4t_shared_object_needs_the_armv4t_libgcc(tmp_path: Path) -> None:
+    """A shared object of ARMv4T code linked the armel compiler's default way
+    pulls its ARMv5TE runtime (soft-float/division helpers with clz and
+    pc-loading returns, crti.o) and fails the check; linked as the armv4t
+    target says (toolchain/armv4t.toml: the ARMv4T libgcc.a of
+    arm-none-eabi-gcc, -nostdlib, then -lm -lc) it passes, its PLT stubs
+    included."""
+    t = require_target("armv4t")
+    src = tmp_path / "shared.c"
+    src.write_text(SHARED_C)
+    obj = _cc(t, src, tmp_path / "shared.o", "-march=armv4t", "-fPIC")
+    default = tmp_path / "default.so"
+    subprocess.run([t.cc, *t.target_cflags, "-shared", str(obj), "-o", str(default), "-lm"], check=True,
+                   capture_output=True)
+    vs = armv4t_check.check_objects([default], objdump=t.objdump)
+    assert any(v.insn.startswith("clz") for v in vs) and any("v5TE" in v.reason for v in vs), vs
+    v4t = tmp_path / "v4t.so"
+    subprocess.run([t.cc, *t.target_cflags, "-shared", str(obj), "-o", str(v4t), *t.shared_ldflags,
+                    *t.shared_link_libs()], check=True, capture_output=True)
+    plt = subprocess.run([t.objdump, "-d", str(v4t)], check=True, capture_output=True, text=True).stdout
+    assert "<sqrt@plt>:" in plt  # a PLT stub is there, and accepted
+    assert armv4t_check.check_objects([v4t], objdump=t.objdump) == []
+
+
+def test_armv4t_check_accepts_only_the_linkers_plt_stubs() -> None:
+    """Only GNU ld's PLT pc loads, and only inside .plt / NAME@plt, are accepted."""
+    text = ("00000400 <.plt>:\n 400:\tstr\tlr, [sp, #-4]!\n 404:\tldr\tlr, [pc, #4]\n"
+            " 408:\tadd\tlr, pc, lr\n 40c:\tldr\tpc, [lr, #8]!\n 410:\t.word\t0x00010bf0\n"
+            "00000414 <sqrt@plt>:\n 414:\tadd\tip, pc, #0, 12\n 418:\tadd\tip, ip, #16, 20\n"
+            " 41c:\tldr\tpc, [ip, #3052]!\n 420:\tpop\t{r4, pc}\n"
+            "00000424 <f>:\n 424:\tldr\tpc, [ip, #8]!\n 428:\tbx\tlr\n")
+    vs = armv4t_check.check_disassembly(text, "x.so")
+    assert [(v.function, v.address) for v in vs] == [("sqrt@plt", "0x420"), ("f", "0x424")], vs
+
+
 def test_armv4t_check_cli_exit_status(tmp_path: Path) -> None:
     t = require_target("armv4t")
     src = tmp_path / "snippet.c"
@@ -107,7 +149,9 @@ def test_cross_build_armv4t(tmp_path: Path) -> None:
     if any((ROOT / "csrc" / "app").glob("*.c")):
         assert (out / "attitude-rx").exists()
     exe = _example_against(t, out, tmp_path)
-    assert armv4t_check.check_objects([out / "libattitude.a"], objdump=t.objdump) == []
+    # the .so too: linked against the ARMv4T libgcc, not the armel compiler's (toolchain/armv4t.toml)
+    assert armv4t_check.check_objects([out / "libattitude.a", (out / "libattitude.so").resolve()],
+                                      objdump=t.objdump) == []
     res = t.run([exe], timeout=60)
     assert res.stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 

@@ -16,7 +16,9 @@ optimization, instrumentation) go unchanged into every path; the TOML
 ``strict_cflags`` (-std, warnings, -Werror) stay with the project's own
 builds: make and CMake add their own ``-std=c99 -Wall -Wextra -Wpedantic``.
 The TOML ``ldflags`` link programs (``-static``, ``--specs=...``); the
-shared library gets them without those program-only flags.
+shared library gets them without those program-only flags, plus the TOML
+``shared_ldflags``, the libgcc.a that ``shared_libgcc`` prints and
+``shared_libs`` (armv4t: an ARMv4T runtime instead of the compiler's own).
 ``tests/test_buildfiles.py`` checks that these files are current and that
 invoke, make and CMake compile with the same target flags.
 """
@@ -104,6 +106,9 @@ def make_fragment() -> str:
             "APP": "1" if t.app else "0",
             "APP_LIBS": " ".join(t.app_libs),
             "SOURCES": " ".join(t.lib_source_globs),
+            "SHARED_LDFLAGS": " ".join(t.shared_ldflags),
+            "SHARED_LIBGCC": " ".join(t.shared_libgcc),
+            "SHARED_LIBS": " ".join(t.shared_libs),
         }
         lines += [f"ATT_TARGET_{k}_{name} := {val}".rstrip() for k, val in v.items()]
     return "\n".join(lines) + "\n"
@@ -154,6 +159,13 @@ def cmake_toolchain(t: T.Target) -> str:
             f'set(CMAKE_C_FLAGS_INIT "{q(t.target_cflags)}")',
             f'set(CMAKE_EXE_LINKER_FLAGS_INIT "{q(t.ldflags)}")',
             f'set(CMAKE_SHARED_LINKER_FLAGS_INIT "{q(shared_ldflags(t))}")']
+    if t.shared_ldflags or t.shared_libgcc or t.shared_libs != t.libs:
+        out += ["",
+                "# How libattitude.so is linked (toolchain/<name>.toml shared_*): read by the",
+                "# library's CMakeLists.txt for that one target, not applied to other targets.",
+                f'set(ATT_SHARED_LINK_OPTIONS "{";".join(t.shared_ldflags)}")',
+                f'set(ATT_SHARED_LIBGCC_CMD "{";".join(t.shared_libgcc)}")',
+                f'set(ATT_SHARED_LIBS "{";".join(t.shared_libs)}")']
     opts = []
     if not t.shared:
         opts.append('set(ATT_BUILD_SHARED OFF CACHE BOOL "build libattitude.so as well as libattitude.a")')

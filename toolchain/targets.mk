@@ -17,6 +17,9 @@ ATT_TARGET_SHARED_aarch64 := 1
 ATT_TARGET_APP_aarch64 := 1
 ATT_TARGET_APP_LIBS_aarch64 := -pthread
 ATT_TARGET_SOURCES_aarch64 := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_aarch64 :=
+ATT_TARGET_SHARED_LIBGCC_aarch64 :=
+ATT_TARGET_SHARED_LIBS_aarch64 := -lm
 
 # Embedded Linux on the ARM920T (S3C2440, mini2440): ARMv4T, no FPU.
 # The Debian armel libc is built for ARMv5, so programs run under plain qemu-arm.
@@ -33,6 +36,9 @@ ATT_TARGET_SHARED_armv4t := 1
 ATT_TARGET_APP_armv4t := 1
 ATT_TARGET_APP_LIBS_armv4t := -pthread
 ATT_TARGET_SOURCES_armv4t := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_armv4t := -nostdlib -Wl,--no-undefined -Wl,-z,noexecstack
+ATT_TARGET_SHARED_LIBGCC_armv4t := arm-none-eabi-gcc -marm -mcpu=arm920t -mfloat-abi=soft -print-libgcc-file-name
+ATT_TARGET_SHARED_LIBS_armv4t := -lm -lc
 
 # The same ARM920T core without an OS: newlib + semihosting, run on qemu's
 # ti925t model (an ARMv4T core), so every instruction executed is ARMv4T.
@@ -49,6 +55,9 @@ ATT_TARGET_SHARED_armv4t-bare := 0
 ATT_TARGET_APP_armv4t-bare := 0
 ATT_TARGET_APP_LIBS_armv4t-bare :=
 ATT_TARGET_SOURCES_armv4t-bare := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_armv4t-bare :=
+ATT_TARGET_SHARED_LIBGCC_armv4t-bare :=
+ATT_TARGET_SHARED_LIBS_armv4t-bare := -lm
 
 # Embedded Linux on ARMv7-A with VFP (e.g. Cortex-A8/A9 boards).
 ATT_TARGET_KIND_armv7hf := gcc
@@ -64,6 +73,9 @@ ATT_TARGET_SHARED_armv7hf := 1
 ATT_TARGET_APP_armv7hf := 1
 ATT_TARGET_APP_LIBS_armv7hf := -pthread
 ATT_TARGET_SOURCES_armv7hf := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_armv7hf :=
+ATT_TARGET_SHARED_LIBGCC_armv7hf :=
+ATT_TARGET_SHARED_LIBS_armv7hf := -lm
 
 # Native build for tests on the development machine.
 ATT_TARGET_KIND_host := gcc
@@ -79,6 +91,9 @@ ATT_TARGET_SHARED_host := 1
 ATT_TARGET_APP_host := 1
 ATT_TARGET_APP_LIBS_host := -pthread
 ATT_TARGET_SOURCES_host := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_host :=
+ATT_TARGET_SHARED_LIBGCC_host :=
+ATT_TARGET_SHARED_LIBS_host := -lm
 
 # Host build with AddressSanitizer + UndefinedBehaviorSanitizer (C test programs).
 ATT_TARGET_KIND_host-asan := gcc
@@ -94,6 +109,9 @@ ATT_TARGET_SHARED_host-asan := 0
 ATT_TARGET_APP_host-asan := 0
 ATT_TARGET_APP_LIBS_host-asan :=
 ATT_TARGET_SOURCES_host-asan := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_host-asan :=
+ATT_TARGET_SHARED_LIBGCC_host-asan :=
+ATT_TARGET_SHARED_LIBS_host-asan := -lm
 
 # Host build with clang, sanitizers on (proves the sources are clean under a second compiler).
 ATT_TARGET_KIND_host-clang := gcc
@@ -109,6 +127,9 @@ ATT_TARGET_SHARED_host-clang := 0
 ATT_TARGET_APP_host-clang := 0
 ATT_TARGET_APP_LIBS_host-clang :=
 ATT_TARGET_SOURCES_host-clang := csrc/src/*.c
+ATT_TARGET_SHARED_LDFLAGS_host-clang :=
+ATT_TARGET_SHARED_LIBGCC_host-clang :=
+ATT_TARGET_SHARED_LIBS_host-clang := -lm
 
 # AT89S51: 8051 core, 4 KB flash, 128 bytes of RAM, no external RAM.
 # Only the parts of the library meant for the 8051 are built here
@@ -126,3 +147,6 @@ ATT_TARGET_SHARED_mcs51 := 0
 ATT_TARGET_APP_mcs51 := 0
 ATT_TARGET_APP_LIBS_mcs51 :=
 ATT_TARGET_SOURCES_mcs51 := csrc/src/common.c csrc/src/tlc2543*.c csrc/src/link_tx*.c csrc/src/link_sender*.c csrc/src/linka*.c csrc/src/fixed*.c csrc/src/fix_*.c
+ATT_TARGET_SHARED_LDFLAGS_mcs51 :=
+ATT_TARGET_SHARED_LIBGCC_mcs51 :=
+ATT_TARGET_SHARED_LIBS_mcs51 :=

@@ -60,6 +60,13 @@ class Target:
     app: bool = False             # the attitude-rx program (needs POSIX threads and termios)
     app_libs: list[str] = field(default_factory=list)
     pic_flags: list[str] = field(default_factory=lambda: ["-fPIC"])
+    #: How libattitude.so is linked (TOML ``shared_ldflags``, ``shared_libgcc``,
+    #: ``shared_libs``): extra link flags; a command printing the path of a
+    #: libgcc.a to link instead of the compiler's own runtime (empty: the
+    #: compiler's); the libraries after it (default: ``libs``).
+    shared_ldflags: list[str] = field(default_factory=list)
+    shared_libgcc: list[str] = field(default_factory=list)
+    shared_libs: list[str] = field(default_factory=list)
     #: Post-build checks by name (e.g. "armv4t": toolchain/armv4t_check.py).
     checks: list[str] = field(default_factory=list)
     #: The target itself (TOML ``cflags``: architecture, ABI, optimization): what
@@ -81,11 +88,28 @@ class Target:
             return self.ar[: -len("ar")] + name
         return name
 
+    def shared_link_libs(self) -> list[str]:
+        """What follows the objects on the link line of libattitude.so: the
+        libgcc.a that ``shared_libgcc`` prints (if any), then ``shared_libs``."""
+        if not self.shared_libgcc:
+            return list(self.shared_libs)
+        if shutil.which(self.shared_libgcc[0]) is None:
+            raise ToolchainMissing(f"target {self.name}: libattitude.so links the libgcc of "
+                                   f"{self.shared_libgcc[0]}, which is not found; {self.install_hint()}")
+        proc = subprocess.run(self.shared_libgcc, capture_output=True, text=True, check=False)
+        path = proc.stdout.strip()
+        if proc.returncode != 0 or not Path(path).is_file():
+            raise ToolchainMissing(f"target {self.name}: {' '.join(self.shared_libgcc)} gave no libgcc.a "
+                                   f"({proc.stderr.strip() or path!r})")
+        return [path, *self.shared_libs]
+
     # -- availability -----------------------------------------------------
     def tools(self) -> list[str]:
         tools = [self.cc, self.ar]
         if self.run_cmd:
             tools.append(self.run_cmd[0])
+        if self.shared_libgcc:
+            tools.append(self.shared_libgcc[0])
         return tools
 
     def missing_tools(self) -> list[str]:
@@ -184,4 +208,7 @@ def load(name: str) -> Target:
         shared=bool(d.get("shared", False)), app=bool(d.get("app", False)),
         app_libs=list(d.get("app_libs", [])), pic_flags=list(d.get("pic_flags", ["-fPIC"])),
         checks=list(d.get("checks", [])),
+        shared_ldflags=list(d.get("shared_ldflags", [])),
+        shared_libgcc=list(d.get("shared_libgcc", [])),
+        shared_libs=list(d.get("shared_libs", d.get("libs", []))),
     )
