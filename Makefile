@@ -28,8 +28,10 @@
 # A stamp of the compiler and every flag makes objects rebuild when either
 # changes (another TARGET, CFLAGS or compiler in the same BUILDDIR).
 
-VERSION      := 0.1.0
-SOVERSION    := 0
+# The version's one source: csrc/include/attitude/version.h (`make version` prints it).
+att_version_part = $(shell sed -n 's/^ *ATT_VERSION_$(1) = \([0-9][0-9]*\).*/\1/p' csrc/include/attitude/version.h)
+VERSION      := $(call att_version_part,MAJOR).$(call att_version_part,MINOR).$(call att_version_part,PATCH)
+SOVERSION    := $(call att_version_part,SO)
 
 TARGET ?=
 ifneq ($(TARGET),)
@@ -144,8 +146,11 @@ ifneq ($(APP_SRCS),)
 ALL += $(APP_EXE)
 endif
 
-.PHONY: all install uninstall clean FORCE
+.PHONY: all install uninstall clean version FORCE
 all: $(ALL)
+
+version:
+	@echo $(VERSION)
 
 # The stamp holds the compiler (name and version) and every flag that goes
 # into an object or a link; it is rewritten only when that text changes, so

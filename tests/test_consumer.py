@@ -28,6 +28,7 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, clean_copy, require_target, require_tools
 
+from attitude_c._build import version as attitude_version
 from toolchain import armv4t_check
 
 CONSUMER = ROOT / "tests" / "consumer"
@@ -124,15 +125,17 @@ def test_cmake_host_float_build_package_and_pkg_config(tmp_path: Path) -> None:
     for f in ("attitudeConfig.cmake", "attitudeConfigVersion.cmake", "attitudeTargets.cmake"):
         assert (root / "usr/lib/cmake/attitude" / f).exists(), f
     exe, log = _cmake_consumer(tmp_path, root, f"-DCMAKE_PREFIX_PATH={root / 'usr'}")
-    assert "libattitude 0.1.0, precision f32" in log
+    v = attitude_version.read()
+    want = f"{v['MAJOR']}.{v['MINOR']}.{v['PATCH']}"
+    assert f"libattitude {want}, precision f32" in log
     assert _run([exe]).strip() == f"att_real=4 ok=ok {Q_TEXT}"
     exe = _pkg_config_consumer(tmp_path, root, t.cc, t.target_cflags, [])
     out = _run([exe], env=_env(LD_LIBRARY_PATH=str(root / "usr/lib")))  # -lattitude: the .so here
     assert out.strip() == f"att_real=4 ok=ok {Q_TEXT}"
-    proc = subprocess.run(["cmake", "-S", str(CONSUMER), "-B", str(tmp_path / "v"), "-DATT_WANT_VERSION=0.2",
+    proc = subprocess.run(["cmake", "-S", str(CONSUMER), "-B", str(tmp_path / "v"), f"-DATT_WANT_VERSION={v['MAJOR']}.{v['MINOR'] + 1}",
                            f"-DCMAKE_PREFIX_PATH={root / 'usr'}"], env=_env(), capture_output=True, text=True,
                           check=False)
-    assert proc.returncode != 0 and "0.1.0" in proc.stderr
+    assert proc.returncode != 0 and want in proc.stderr
 
 
 @pytest.mark.qemu

@@ -13,7 +13,6 @@ from typing import Any, Callable, Literal, get_args
 
 import numpy as np
 
-from .. import __version__
 from ..core import Method, Precision
 from ..errors import InvalidArgument
 from . import _integ
@@ -33,6 +32,14 @@ from .sensors import (
 from .trajectory import PaperTrajectory, Trajectory
 
 __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "acquire", "simulate"]
+
+
+def _package_version() -> str:
+    """attitude_c.__version__ (read at use: the package resolves it lazily)."""
+    import attitude_c
+
+    return attitude_c.__version__
+
 
 # The paper's reported error extremes at a 0.08 s period (sec. 4, Fig. 8), rad.
 PAPER_MAXIMA = {"heading": (-0.05, 0.12), "pitch": (-0.10, 0.15)}
@@ -307,7 +314,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     err = wrap_angle(e_est - e_true)
     err_angle = quat_angle_between(q_true, q_est) if len(q_est) else np.zeros(0)
     summary: dict[str, Any] = {
-        "attitude_c_version": __version__,
+        "attitude_c_version": _package_version(),
         "parameters": cfg.params(),
         "updates": len(t_out),
         "samples": int(n),

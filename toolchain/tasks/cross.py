@@ -23,7 +23,6 @@ target, including SDCC, uses exactly the flags of its TOML file;
 from __future__ import annotations
 
 import os
-import re
 import shutil
 import subprocess
 from collections.abc import Sequence
@@ -31,17 +30,19 @@ from pathlib import Path
 
 from invoke import task
 
+from attitude_c._build import version as _version
 from toolchain import targets as T
 from toolchain.buildfiles import shared_ldflags
 
 ROOT = T.ROOT
 APP_DIR = ROOT / "csrc" / "app"
-SOVERSION = "0"
+#: N of the soname libattitude.so.N (csrc/include/attitude/version.h).
+SOVERSION = str(_version.read()["SO"])
 
 
 def version() -> str:
-    m = re.search(r'^version\s*=\s*"([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.MULTILINE)
-    return m.group(1) if m else "0.0.0"
+    """MAJOR.MINOR.PATCH from csrc/include/attitude/version.h, the one source."""
+    return _version.version()
 
 
 def _run(cmd: Sequence[str], verbose: bool) -> None:
