@@ -1,29 +1,83 @@
 # libattitude: plain Makefile for users who build with Buildroot, Yocto or
-# their own Makefiles (the project's own tasks use `invoke cross-build`).
+# their own Makefiles (needs only GNU make and a C compiler).
 #
-#   make                                         # native build
-#   make CROSS_COMPILE=arm-linux-gnueabi- \
-#        TARGET_CFLAGS="-march=armv4t -mtune=arm920t -marm -mfloat-abi=soft"   # mini2440
-#   make install PREFIX=/usr DESTDIR=$PWD/rootfs   # staged install
-#   make PRECISION=f32                           # att_real = float
+#   make                                          # native build (your CC, CFLAGS)
+#   make TARGET=armv4t                            # mini2440 (ARM920T): the project's armv4t preset
+#   make TARGET=armv4t CROSS_COMPILE=arm-linux-   # the same flags with a vendor toolchain
+#   make TARGET=armv4t install PREFIX=/usr DESTDIR=$PWD/rootfs   # staged install
+#   make PRECISION=f32                            # att_real = float
 #
-# Honoured variables: CROSS_COMPILE, CC, AR, CFLAGS, CPPFLAGS, LDFLAGS,
-# TARGET_CFLAGS (architecture flags), PREFIX, DESTDIR, LIBDIR, INCLUDEDIR,
-# BINDIR, PKGCONFIGDIR, BUILDDIR, PRECISION (f64|f32), STATIC_APP (1 = link
-# attitude-rx statically, 0 = against libattitude.so), SHARED (0 = no .so).
+# TARGET=NAME takes the compiler and the target flags of toolchain/NAME.toml
+# (the presets are generated into toolchain/targets.mk by
+# `python -m toolchain.buildfiles`: the same flags as `invoke cross-build`
+# and cmake/NAME-toolchain.cmake): host, armv4t, armv4t-bare, armv7hf,
+# aarch64, host-asan, host-clang, mcs51 (SDCC: the 8051 parts, libattitude.lib).
 #
-# Products (in $(BUILDDIR)): libattitude.a, libattitude.so(.0, .VERSION),
-# attitude-rx, attitude.pc.
+# Honoured variables: TARGET, CROSS_COMPILE, CC, AR, CFLAGS, CPPFLAGS,
+# LDFLAGS, TARGET_CFLAGS (architecture flags; set by TARGET), PREFIX,
+# DESTDIR, LIBDIR, INCLUDEDIR, BINDIR, PKGCONFIGDIR, BUILDDIR, PRECISION
+# (f64|f32), STATIC_APP (1 = link attitude-rx statically, 0 = against
+# libattitude.so), SHARED (0 = no .so), APP (0 = no attitude-rx),
+# SHARED_LDFLAGS, SHARED_LIBGCC, SHARED_LIBS (the link of libattitude.so; set
+# by TARGET: armv4t links the ARMv4T libgcc.a of arm-none-eabi-gcc and only
+# -lm -lc, see docs/cross-build.md).
+#
+# Products (in $(BUILDDIR), default build/make, or build/make-NAME with
+# TARGET=NAME): libattitude.a (libattitude.lib with SDCC),
+# libattitude.so(.0, .VERSION), attitude-rx, attitude.pc.
+# A stamp of the compiler and every flag makes objects rebuild when either
+# changes (another TARGET, CFLAGS or compiler in the same BUILDDIR).
 
-VERSION      := 0.1.0
-SOVERSION    := 0
+# The version's one source: csrc/include/attitude/version.h (`make version` prints it).
+att_version_part = $(shell sed -n 's/^ *ATT_VERSION_$(1) = \([0-9][0-9]*\).*/\1/p' csrc/include/attitude/version.h)
+VERSION      := $(call att_version_part,MAJOR).$(call att_version_part,MINOR).$(call att_version_part,PATCH)
+SOVERSION    := $(call att_version_part,SO)
 
+TARGET ?=
+ifneq ($(TARGET),)
+include toolchain/targets.mk
+ifeq ($(filter $(TARGET),$(ATT_TARGETS)),)
+$(error TARGET must be one of: $(ATT_TARGETS) (toolchain/*.toml), not '$(TARGET)')
+endif
+KIND          := $(ATT_TARGET_KIND_$(TARGET))
+CROSS_COMPILE ?= $(ATT_TARGET_CROSS_COMPILE_$(TARGET))
+TARGET_CFLAGS ?= $(ATT_TARGET_CFLAGS_$(TARGET))
+TARGET_LDFLAGS := $(ATT_TARGET_LDFLAGS_$(TARGET))
+TARGET_LIBS   := $(ATT_TARGET_LIBS_$(TARGET))
+STATIC_APP    ?= $(ATT_TARGET_STATIC_APP_$(TARGET))
+SHARED        ?= $(ATT_TARGET_SHARED_$(TARGET))
+APP           ?= $(ATT_TARGET_APP_$(TARGET))
+APP_LIBS      := $(ATT_TARGET_APP_LIBS_$(TARGET))
+LIB_GLOBS     := $(ATT_TARGET_SOURCES_$(TARGET))
+SHARED_LDFLAGS ?= $(ATT_TARGET_SHARED_LDFLAGS_$(TARGET))
+SHARED_LIBGCC_CMD := $(ATT_TARGET_SHARED_LIBGCC_$(TARGET))
+SHARED_LIBS   ?= $(ATT_TARGET_SHARED_LIBS_$(TARGET))
+BUILDDIR      ?= build/make-$(TARGET)
+CFLAGS        ?=
+ifeq ($(origin CC),default)
+CC := $(CROSS_COMPILE)$(ATT_TARGET_CC_$(TARGET))
+endif
+ifeq ($(origin AR),default)
+AR := $(CROSS_COMPILE)$(ATT_TARGET_AR_$(TARGET))
+endif
+else
+KIND          := gcc
 CROSS_COMPILE ?=
+TARGET_CFLAGS ?=
+TARGET_LDFLAGS :=
+TARGET_LIBS   := -lm
+APP_LIBS      := -pthread
+LIB_GLOBS     := csrc/src/*.c
+SHARED_LDFLAGS ?=
+SHARED_LIBGCC_CMD :=
+SHARED_LIBS   ?= $(TARGET_LIBS)
+CFLAGS        ?= -O2
 ifeq ($(origin CC),default)
 CC := $(CROSS_COMPILE)gcc
 endif
 ifeq ($(origin AR),default)
 AR := $(CROSS_COMPILE)ar
+endif
 endif
 
 PREFIX       ?= /usr/local
@@ -36,11 +90,21 @@ BUILDDIR     ?= build/make
 PRECISION    ?= f64
 STATIC_APP   ?= 1
 SHARED       ?= 1
-
-CFLAGS       ?= -O2
-TARGET_CFLAGS ?=
+APP          ?= 1
 LDFLAGS      ?=
 
+# libattitude.so of a target that links its own libgcc (armv4t: the ARMv4T one
+# of arm-none-eabi-gcc, not the armel compiler's ARMv5TE runtime).
+ifeq ($(SHARED),1)
+ifneq ($(SHARED_LIBGCC_CMD),)
+SHARED_LIBGCC ?= $(shell $(SHARED_LIBGCC_CMD) 2>/dev/null)
+endif
+endif
+
+ifeq ($(KIND),sdcc)
+# SDCC has no double (it would silently be float): always the float build.
+override PRECISION := f32
+endif
 ifeq ($(PRECISION),f32)
 PREC_DEFS := -DATT_REAL_F32
 else ifeq ($(PRECISION),f64)
@@ -50,40 +114,64 @@ $(error PRECISION must be f64 or f32, not '$(PRECISION)')
 endif
 
 # Flags the library needs whatever the user's CFLAGS say.
+ifeq ($(KIND),sdcc)
+ATT_CFLAGS := --std-c99 -Icsrc/include $(PREC_DEFS)
+O := rel
+STATIC_LIB := $(BUILDDIR)/libattitude.lib
+override SHARED := 0
+override APP := 0
+else
 ATT_CFLAGS := -std=c99 -Wall -Wextra -Wpedantic -Icsrc/include $(PREC_DEFS)
+O := o
+STATIC_LIB := $(BUILDDIR)/libattitude.a
+endif
 
-LIB_SRCS := $(sort $(wildcard csrc/src/*.c))
-APP_SRCS := $(sort $(wildcard csrc/app/*.c))
+LIB_SRCS := $(sort $(wildcard $(LIB_GLOBS)))
+APP_SRCS := $(if $(filter 1,$(APP)),$(sort $(wildcard csrc/app/*.c)))
 HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h))
-LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.o)
+LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.$(O))
 PIC_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj-pic/%.o)
 APP_OBJS := $(APP_SRCS:csrc/app/%.c=$(BUILDDIR)/obj-app/%.o)
 
-STATIC_LIB := $(BUILDDIR)/libattitude.a
 SHARED_REAL := $(BUILDDIR)/libattitude.so.$(VERSION)
-APP := $(BUILDDIR)/attitude-rx
+APP_EXE := $(BUILDDIR)/attitude-rx
 PC := $(BUILDDIR)/attitude.pc
+STAMP := $(BUILDDIR)/flags.stamp
 
 ALL := $(STATIC_LIB) $(PC)
 ifeq ($(SHARED),1)
 ALL += $(BUILDDIR)/libattitude.so
 endif
 ifneq ($(APP_SRCS),)
-ALL += $(APP)
+ALL += $(APP_EXE)
 endif
 
-.PHONY: all install uninstall clean FORCE
+.PHONY: all install uninstall clean version FORCE
 all: $(ALL)
 
-$(BUILDDIR)/obj/%.o: csrc/src/%.c $(HEADERS)
+version:
+	@echo $(VERSION)
+
+# The stamp holds the compiler (name and version) and every flag that goes
+# into an object or a link; it is rewritten only when that text changes, so
+# objects rebuild exactly when the compiler or a flag changed.
+STAMP_TEXT := $(CC) $(shell $(CC) --version 2>/dev/null | head -n 1) | $(ATT_CFLAGS) $(TARGET_CFLAGS) \
+  $(CPPFLAGS) $(CFLAGS) | $(TARGET_LDFLAGS) $(LDFLAGS) $(TARGET_LIBS) | $(AR) | $(STATIC_APP) \
+  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS)
+$(STAMP): FORCE
+	@mkdir -p $(@D)
+	@if [ "$$(cat $@ 2>/dev/null)" != '$(subst ','\'',$(STAMP_TEXT))' ]; then \
+	  printf '%s\n' '$(subst ','\'',$(STAMP_TEXT))' > $@; fi
+
+$(BUILDDIR)/obj/%.$(O): csrc/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
-$(BUILDDIR)/obj-pic/%.o: csrc/src/%.c $(HEADERS)
+$(BUILDDIR)/obj-pic/%.o: csrc/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
 
-$(BUILDDIR)/obj-app/%.o: csrc/app/%.c $(HEADERS) $(wildcard csrc/app/*.h)
+$(BUILDDIR)/obj-app/%.o: csrc/app/%.c $(HEADERS) $(wildcard csrc/app/*.h) $(STAMP)
 	@mkdir -p $(@D)
 	$(CC) $(ATT_CFLAGS) -Icsrc/app $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
@@ -92,18 +180,21 @@ $(STATIC_LIB): $(LIB_OBJS)
 	$(AR) rcs $@ $^
 
 $(SHARED_REAL): $(PIC_OBJS)
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(LDFLAGS) -shared -Wl,-soname,libattitude.so.$(SOVERSION) $^ -o $@ -lm
+ifeq ($(origin SHARED_LIBGCC),file)
+	@test -f '$(SHARED_LIBGCC)' || { echo 'libattitude.so (TARGET=$(TARGET)) links the libgcc.a that `$(SHARED_LIBGCC_CMD)` prints: install that compiler, or pass SHARED_LIBGCC=/path/to/libgcc.a, or SHARED=0' >&2; exit 1; }
+endif
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) $(SHARED_LDFLAGS) -shared -Wl,-soname,libattitude.so.$(SOVERSION) $^ -o $@ $(SHARED_LIBGCC) $(SHARED_LIBS)
 
 $(BUILDDIR)/libattitude.so: $(SHARED_REAL)
 	ln -sf libattitude.so.$(VERSION) $(BUILDDIR)/libattitude.so.$(SOVERSION)
 	ln -sf libattitude.so.$(VERSION) $@
 
 ifeq ($(STATIC_APP),1)
-$(APP): $(APP_OBJS) $(STATIC_LIB)
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(LDFLAGS) -static $(APP_OBJS) $(STATIC_LIB) -o $@ -pthread -lm
+$(APP_EXE): $(APP_OBJS) $(STATIC_LIB)
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) -static $(APP_OBJS) $(STATIC_LIB) -o $@ $(APP_LIBS) $(TARGET_LIBS)
 else
-$(APP): $(APP_OBJS) $(BUILDDIR)/libattitude.so
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(LDFLAGS) $(APP_OBJS) -L$(BUILDDIR) -lattitude -o $@ -pthread -lm
+$(APP_EXE): $(APP_OBJS) $(BUILDDIR)/libattitude.so
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) $(APP_OBJS) -L$(BUILDDIR) -lattitude -o $@ $(APP_LIBS) $(TARGET_LIBS)
 endif
 
 $(PC): FORCE
@@ -118,7 +209,7 @@ $(PC): FORCE
 	  'Version: $(VERSION)' \
 	  'Cflags: -I$${includedir} $(PREC_DEFS)' \
 	  'Libs: -L$${libdir} -lattitude' \
-	  'Libs.private: -lm' > $@
+	  'Libs.private: $(TARGET_LIBS)' > $@
 
 install: all
 	install -d $(DESTDIR)$(LIBDIR) $(DESTDIR)$(INCLUDEDIR)/attitude $(DESTDIR)$(PKGCONFIGDIR)
@@ -132,12 +223,13 @@ ifeq ($(SHARED),1)
 endif
 ifneq ($(APP_SRCS),)
 	install -d $(DESTDIR)$(BINDIR)
-	install -m 755 $(APP) $(DESTDIR)$(BINDIR)/
+	install -m 755 $(APP_EXE) $(DESTDIR)$(BINDIR)/
 endif
 
 uninstall:
-	rm -f $(DESTDIR)$(LIBDIR)/libattitude.a $(DESTDIR)$(LIBDIR)/libattitude.so* \
-	      $(DESTDIR)$(PKGCONFIGDIR)/attitude.pc $(DESTDIR)$(BINDIR)/attitude-rx
+	rm -f $(DESTDIR)$(LIBDIR)/libattitude.a $(DESTDIR)$(LIBDIR)/libattitude.lib \
+	      $(DESTDIR)$(LIBDIR)/libattitude.so* $(DESTDIR)$(PKGCONFIGDIR)/attitude.pc \
+	      $(DESTDIR)$(BINDIR)/attitude-rx
 	rm -rf $(DESTDIR)$(INCLUDEDIR)/attitude
 
 clean:

@@ -10,6 +10,8 @@ angles ordered [yaw, pitch, roll]) are in docs/conventions.md.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from .errors import (
     AttitudeError,
     DeviceError,
@@ -21,7 +23,21 @@ from .errors import (
     RangeError,
 )
 
-__version__ = "0.1.0"
+#: libattitude's version "MAJOR.MINOR.PATCH", from the compiled library
+#: (enums of csrc/include/attitude/version.h, its one source); read on first
+#: access, so that importing the package still loads no C extension.
+__version__: str
+
+if not TYPE_CHECKING:
+    def __getattr__(name: str) -> str:
+        if name == "__version__":
+            from ._lib import ffi_lib
+
+            lib = ffi_lib("f64")[1]
+            v = f"{lib.ATT_VERSION_MAJOR}.{lib.ATT_VERSION_MINOR}.{lib.ATT_VERSION_PATCH}"
+            globals()["__version__"] = v
+            return v
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "AttitudeError",

@@ -9,14 +9,20 @@ source: ``precision="f64"`` (double) and ``precision="f32"`` (float).
 Conventions (docs/conventions.md): quaternions ``[λ, p1, p2, p3]`` scalar
 first, rotating body vectors into the ENU navigation frame; attitude
 matrices ``C = C_b^n`` (…, 3, 3); Euler angles ``[yaw ψ, pitch θ, roll γ]``
-of the z-x-y sequence, radians. Every function returns float64 arrays
-(the f32 build's results converted exactly).
+of the z-x-y sequence, radians.
+
+Output dtypes: with ``precision="f64"`` (the default) every function
+returns float64 arrays; with ``precision="f32"`` float32 arrays (the float
+build's own results, not widened); ``integrate(..., precision="fixed")``
+returns float64 (the Q2.30 results converted exactly: float32 cannot hold
+their 30 fraction bits). ``quat_conj`` returns float64. ``Integrator.q``
+and ``Integrator.update`` follow the integrator's precision.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -28,7 +34,10 @@ __all__ = [
     "INCREMENT_METHODS",
     "METHODS",
     "PRECISIONS",
+    "FloatPrecision",
     "Integrator",
+    "Method",
+    "Precision",
     "dcm_to_euler",
     "dcm_to_quat",
     "euler_to_dcm",
@@ -46,16 +55,21 @@ __all__ = [
     "rotvec_to_quat",
 ]
 
-#: Integration methods. The C enum value of each is the library's
-#: ``ATT_METHOD_<NAME>`` constant (see :func:`method_code`), never a position here.
-METHODS: tuple[str, ...] = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
+#: Integration methods (the type checkers' view; ``METHODS`` is the same list at
+#: run time). The C enum value of each is the library's ``ATT_METHOD_<NAME>``
+#: constant (see :func:`method_code`), never a position here.
+Method = Literal["rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4"]
+METHODS: tuple[Method, ...] = get_args(Method)
 #: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
-INCREMENT_METHODS: tuple[str, ...] = tuple(m for m in METHODS if m != "rk4")
+INCREMENT_METHODS: tuple[Method, ...] = tuple(m for m in METHODS if m != "rk4")
 #: Increments consumed per attitude update, per method.
 FRAME: dict[str, int] = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1,
                          "rv3-reuse-poly": 1}
 #: Numeric precisions: the two float builds and the fixed-point port.
-PRECISIONS: tuple[str, ...] = ("f64", "f32", "fixed")
+Precision = Literal["f64", "f32", "fixed"]
+PRECISIONS: tuple[Precision, ...] = get_args(Precision)
+#: The precisions of the float builds (rotation functions, ``Integrator``).
+FloatPrecision = Literal["f64", "f32"]
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
@@ -65,14 +79,15 @@ _INTEG_STATUS = {
     -21: (RangeError, "increment too large: the attitude update is not finite"),
 }
 
-FloatArray = NDArray[np.float64]
+#: float64, or float32 for ``precision="f32"`` (see the module docstring).
+FloatArray = NDArray[np.floating[Any]]
 
 
 # --------------------------------------------------------------------------
 # argument checking (one place for every public function)
 # --------------------------------------------------------------------------
 
-def _check_precision(precision: Any, allow_fixed: bool = False) -> str:
+def _check_precision(precision: Any, allow_fixed: bool = False) -> Any:
     """Validate ``precision``; the single place where it is checked."""
     if not isinstance(precision, str):
         raise InvalidType(f"precision must be a str, got {type(precision).__name__}")
@@ -82,7 +97,7 @@ def _check_precision(precision: Any, allow_fixed: bool = False) -> str:
     return precision
 
 
-def _check_method(method: Any, allowed: tuple[str, ...] = METHODS) -> str:
+def _check_method(method: Any, allowed: tuple[str, ...] = METHODS) -> Any:
     if not isinstance(method, str):
         raise InvalidType(f"method must be a str, got {type(method).__name__}")
     if method not in allowed:
@@ -116,23 +131,35 @@ def _first_bad(flat_ok: Any) -> int:
     return int(np.argmin(np.asarray(flat_ok, dtype=bool)))
 
 
-def _records(x: ArrayLike, name: str, tail: tuple[int, ...], what: str,
-             allow_empty: bool = True) -> NDArray[np.float64]:
-    """Check shape (..., *tail) and finiteness; return float64 (n, prod(tail))."""
+def _shaped(x: ArrayLike, name: str, tail: tuple[int, ...], what: str,
+            allow_empty: bool = True) -> tuple[NDArray[Any], tuple[int, ...]]:
+    """Check dtype and shape (..., *tail); return the records (n, prod(tail))
+    in their own dtype (no copy when possible) and the leading shape."""
     a = _as_real(x, name)
     nt = len(tail)
     if a.ndim < nt or a.shape[a.ndim - nt:] != tail:
         want = "(..., " + ", ".join(str(t) for t in tail) + ")"
         raise InvalidArgument(f"{name} must have shape {want} ({what}), got {a.shape}")
     lead = a.shape[: a.ndim - nt]
-    a = np.asarray(a, dtype=np.float64).reshape(-1, int(np.prod(tail)))
+    a = a.reshape(-1, int(np.prod(tail)))
     if a.shape[0] == 0 and not allow_empty:
         raise InvalidArgument(f"{name} is empty: at least one {what} is needed")
+    return a, lead
+
+
+def _nonfinite(name: str, i: int, lead: tuple[int, ...]) -> NonFiniteError:
+    where = np.unravel_index(i, lead) if len(lead) > 1 else i
+    return NonFiniteError(f"{name}: sample {where} holds NaN or Inf", index=i)
+
+
+def _records(x: ArrayLike, name: str, tail: tuple[int, ...], what: str,
+             allow_empty: bool = True) -> NDArray[np.float64]:
+    """Check shape (..., *tail) and finiteness; return float64 (n, prod(tail))."""
+    a, lead = _shaped(x, name, tail, what, allow_empty)
+    a = np.asarray(a, dtype=np.float64)
     ok = np.isfinite(a).all(axis=1)
     if not ok.all():
-        i = _first_bad(ok)
-        where = np.unravel_index(i, lead) if len(lead) > 1 else i
-        raise NonFiniteError(f"{name}: sample {where} holds NaN or Inf", index=i)
+        raise _nonfinite(name, _first_bad(ok), lead)
     return a
 
 
@@ -196,40 +223,40 @@ def _convert(cname: str, x: ArrayLike, name: str, tail_in: tuple[int, ...],
             if st == lib.ATT_E_ARG:
                 raise InvalidArgument(f"{name}: sample {where} is a zero quaternion")
             _raise(st, name, i)
-    return out.astype(np.float64).reshape(lead + tail_out)
+    return out.reshape(lead + tail_out)
 
 
-def quat_to_dcm(q: ArrayLike, precision: str = "f64") -> FloatArray:
+def quat_to_dcm(q: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Attitude matrix ``C_b^n`` (…, 3, 3) of quaternions (…, 4) (eq. 1 of q/|q|)."""
     return _convert("att_quat_to_dcm_n", q, "q", (4,), (3, 3), "quaternion", precision)
 
 
-def dcm_to_quat(C: ArrayLike, precision: str = "f64") -> FloatArray:
+def dcm_to_quat(C: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Unit quaternion (…, 4), λ ≥ 0, of attitude matrices (…, 3, 3)."""
     return _convert("att_dcm_to_quat_n", C, "C", (3, 3), (4,), "3×3 matrix", precision)
 
 
-def dcm_to_euler(C: ArrayLike, precision: str = "f64") -> FloatArray:
+def dcm_to_euler(C: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Euler angles ``[ψ, θ, γ]`` (…, 3) of attitude matrices (gimbal-lock rule in docs)."""
     return _convert("att_dcm_to_euler_n", C, "C", (3, 3), (3,), "3×3 matrix", precision)
 
 
-def euler_to_dcm(e: ArrayLike, precision: str = "f64") -> FloatArray:
+def euler_to_dcm(e: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """``C = R_z(ψ) R_x(θ) R_y(γ)`` (…, 3, 3) of Euler angles ``[ψ, θ, γ]`` (…, 3)."""
     return _convert("att_euler_to_dcm_n", e, "e", (3,), (3, 3), "[yaw, pitch, roll]", precision)
 
 
-def quat_to_euler(q: ArrayLike, precision: str = "f64") -> FloatArray:
+def quat_to_euler(q: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Euler angles ``[ψ, θ, γ]`` (…, 3) of quaternions (…, 4)."""
     return _convert("att_quat_to_euler_n", q, "q", (4,), (3,), "quaternion", precision)
 
 
-def euler_to_quat(e: ArrayLike, precision: str = "f64") -> FloatArray:
+def euler_to_quat(e: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Quaternion ``q_z(ψ) ⊗ q_x(θ) ⊗ q_y(γ)`` (…, 4), λ ≥ 0."""
     return _convert("att_euler_to_quat_n", e, "e", (3,), (4,), "[yaw, pitch, roll]", precision)
 
 
-def heading(x: ArrayLike, precision: str = "f64") -> FloatArray:
+def heading(x: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Heading from north, positive toward east, in [0, 2π) (rad).
 
     ``x`` is quaternions (…, 4) or attitude matrices (…, 3, 3) (told apart
@@ -243,7 +270,7 @@ def heading(x: ArrayLike, precision: str = "f64") -> FloatArray:
         f"x must be quaternions (..., 4) or attitude matrices (..., 3, 3), got shape {a.shape}")
 
 
-def quat_multiply(a: ArrayLike, b: ArrayLike, precision: str = "f64") -> FloatArray:
+def quat_multiply(a: ArrayLike, b: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Hamilton product ``a ⊗ b`` (…, 4) (broadcast over leading axes)."""
     precision = _check_precision(precision)
     aa, bb = np.broadcast_arrays(_as_real(a, "a"), _as_real(b, "b"))
@@ -257,7 +284,7 @@ def quat_multiply(a: ArrayLike, b: ArrayLike, precision: str = "f64") -> FloatAr
         err = ffi.new("size_t *")
         _raise(lib.att_quat_mul_n(_ptr(ffi, ca), _ptr(ffi, cb), _ptr(ffi, out), ca.shape[0], err),
                "a, b")
-    return out.astype(np.float64).reshape(lead + (4,))
+    return out.reshape(lead + (4,))
 
 
 def quat_conj(q: ArrayLike) -> FloatArray:
@@ -267,17 +294,17 @@ def quat_conj(q: ArrayLike) -> FloatArray:
     return np.asarray(a, dtype=np.float64) * np.array([1.0, -1.0, -1.0, -1.0])
 
 
-def quat_normalize(q: ArrayLike, precision: str = "f64") -> FloatArray:
+def quat_normalize(q: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """``q / |q|`` (…, 4); a zero quaternion is an error."""
     return _convert("att_quat_normalize_n", q, "q", (4,), (4,), "quaternion", precision)
 
 
-def rotvec_to_quat(phi: ArrayLike, precision: str = "f64") -> FloatArray:
+def rotvec_to_quat(phi: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Rotation-vector quaternion ``q(Φ)`` of eq. (3) (…, 4) for Φ (…, 3) in rad."""
     return _convert("att_rotvec_to_quat_n", phi, "phi", (3,), (4,), "rotation vector", precision)
 
 
-def quat_to_rotvec(q: ArrayLike, precision: str = "f64") -> FloatArray:
+def quat_to_rotvec(q: ArrayLike, precision: FloatPrecision = "f64") -> FloatArray:
     """Shortest rotation vector (…, 3), |Φ| ≤ π, of quaternions (…, 4)."""
     return _convert("att_quat_to_rotvec_n", q, "q", (4,), (3,), "quaternion", precision)
 
@@ -306,14 +333,15 @@ class Integrator:
     ``Integrator(method="rv3", q0=None, precision="f64")``. Feed angle
     increments (increment methods) or rate samples (``rk4``, with ``dt``)
     to :meth:`update`; it returns the attitude after every update completed
-    by these samples, as an (M, 4) float64 array (M may be 0: rv2/rv3 buffer
-    increments until their frame is full, rk4 rows until a step ends).
+    by these samples, as an (M, 4) array, float64 or float32 after the
+    precision (M may be 0: rv2/rv3 buffer increments until their frame is
+    full, rk4 rows until a step ends).
     """
 
-    def __init__(self, method: str = "rv3", q0: ArrayLike | None = None,
-                 precision: str = "f64") -> None:
-        self.method: str = _check_method(method)
-        self.precision: str = _check_precision(precision)
+    def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None,
+                 precision: FloatPrecision = "f64") -> None:
+        self.method: Method = _check_method(method)
+        self.precision: FloatPrecision = _check_precision(precision)
         self._ffi, self._lib = ffi_lib(self.precision)
         self._dtype = _DTYPES[self.precision]
         self._state = self._ffi.new("att_integ *")
@@ -337,8 +365,8 @@ class Integrator:
 
     @property
     def q(self) -> FloatArray:
-        """Current attitude quaternion (4,) float64."""
-        return np.array([float(self._state.q[i]) for i in range(4)])
+        """Current attitude quaternion (4,), float64 or float32 after the precision."""
+        return np.array([float(self._state.q[i]) for i in range(4)], dtype=self._dtype)
 
     @property
     def pending(self) -> int:
@@ -367,24 +395,53 @@ class Integrator:
         if (self.method != "rk4" and dt is None and isinstance(x, np.ndarray)
                 and x.shape == (3,) and x.dtype.kind == "f"):
             return self._update_one(x)
-        a = _records(x, "omega" if self.method == "rk4" else "dtheta", (3,),
-                     "3-vector per sample")
         if self.method == "rk4":
-            return self._update_rates(a, dt)
+            a, lead = _shaped(x, "omega", (3,), "3-vector per sample")
+            return self._update_rates(a, lead, dt)
         if dt is not None:
             raise InvalidArgument(f"dt is only used with method 'rk4', not {self.method!r}")
-        c = _to_c(a, self.precision, "dtheta")
+        a, lead = _shaped(x, "dtheta", (3,), "3-vector per sample")
+        return self._update_increments(a, lead)
+
+    def _update_increments(self, a: NDArray[Any], lead: tuple[int, ...],
+                           out: NDArray[Any] | None = None) -> FloatArray:
+        """``att_integ_batch`` on records ``a`` (n, 3) of any real dtype."""
+        return self._batch(a, lead, "dtheta", None, out)
+
+    def _batch(self, a: NDArray[Any], lead: tuple[int, ...], name: str,
+               h: NDArray[Any] | None, out: NDArray[Any] | None = None) -> FloatArray:
+        """One batch call (``att_integ_rk4_batch`` when step sizes ``h`` are
+        given). The C call checks every sample (NaN/Inf, divergence) and
+        leaves the state as it was on error, so the data get no second pass
+        here: only the conversion to the build's dtype when they have another.
+        ``out``: a buffer already checked by :func:`_check_out` for exactly
+        ``self.outputs(n)`` records; it is filled and returned itself."""
+        with np.errstate(over="ignore"):  # finite float64 -> inf float32: found below
+            c = np.ascontiguousarray(a, dtype=self._dtype)
         n = c.shape[0]
-        m = self.outputs(n)
-        out = np.empty((max(m, 1), 4), dtype=self._dtype)
+        given = out is not None
+        if out is None:
+            out = np.empty((max(self.outputs(n), 1), 4), dtype=self._dtype)
         if n:
-            ffi = self._ffi
+            ffi, lib = self._ffi, self._lib
             nout = ffi.new("size_t *")
             err = ffi.new("size_t *")
-            st = self._lib.att_integ_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, out), nout, err)
-            _raise(st, "dtheta", int(err[0]))
+            if h is None:
+                st = lib.att_integ_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, out), nout, err)
+            else:
+                st = lib.att_integ_rk4_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, h), h.shape[0],
+                                             _ptr(ffi, out), nout, err)
+            if st < 0:
+                i = int(err[0])
+                if st == lib.ATT_E_NONFINITE:
+                    if np.isfinite(a[i]).all():  # finite as given: lost in the conversion
+                        raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')")
+                    raise _nonfinite(name, i, lead)
+                _raise(st, name, i)
             m = int(nout[0])
-        return out[:m].astype(np.float64)
+        else:
+            m = 0
+        return out if given else out[:m]
 
     def _update_one(self, x: NDArray[Any]) -> FloatArray:
         """Fast path for one float increment (3,): no array conversions; the C
@@ -397,19 +454,31 @@ class Integrator:
         r = self._lib.att_integ_update(self._state, buf, self._one_out)
         if r == 1:
             o = self._one_out
-            return np.array([[o[0], o[1], o[2], o[3]]])
+            return np.array([[o[0], o[1], o[2], o[3]]], dtype=self._dtype)
         if r == 0:
-            return np.empty((0, 4))
+            return np.empty((0, 4), dtype=self._dtype)
         _raise(r, "dtheta", 0)
         raise AssertionError("unreachable")  # pragma: no cover
 
-    def _update_rates(self, a: NDArray[np.float64], dt: ArrayLike | None) -> FloatArray:
+    def _update_rates(self, a: NDArray[Any], lead: tuple[int, ...], dt: ArrayLike | None,
+                      out: NDArray[Any] | None = None) -> FloatArray:
         n = a.shape[0]
         if dt is None:
             raise InvalidArgument("dt is required with method 'rk4' (sampling interval, s)")
         d = _as_real(dt, "dt").astype(np.float64)
         if d.ndim == 0:
-            d = np.full(n, float(d))
+            d1 = d.reshape(1)
+            if not np.isfinite(d1).all():
+                raise NonFiniteError("dt: sample 0 holds NaN or Inf", index=0)
+            if n and not d1[0] > 0:
+                raise InvalidArgument(f"dt must be > 0: dt[0] = {d1[0]!r}")
+            if not len(self._pending_dt) or (self._pending_dt == d1[0]).all():
+                # one spacing throughout: every step is h = 2 dt, one value for the C call
+                q = self._batch(a, lead, "omega", _to_c((2 * d1).reshape(1, 1), self.precision, "dt")[0],
+                                out)
+                self._pending_dt = np.full(self.pending, d1[0])
+                return q
+            d = np.full(n, d1[0])
         elif d.shape != (n,):
             raise InvalidArgument(
                 f"dt must be a scalar or one value per row, shape ({n},), got {d.shape}")
@@ -422,20 +491,11 @@ class Integrator:
         m = self.outputs(n)
         alld = np.concatenate([self._pending_dt, d])
         h = alld[0: 2 * m: 2] + alld[1: 2 * m: 2] if m else np.ones(1)
-        c = _to_c(a, self.precision, "omega")
         hc = _to_c(h.reshape(-1, 1), self.precision, "dt").reshape(-1)
-        out = np.empty((max(m, 1), 4), dtype=self._dtype)
-        if n:
-            ffi = self._ffi
-            nout = ffi.new("size_t *")
-            err = ffi.new("size_t *")
-            st = self._lib.att_integ_rk4_batch(self._state, _ptr(ffi, c), n, _ptr(ffi, hc),
-                                               hc.shape[0], _ptr(ffi, out), nout, err)
-            _raise(st, "omega", int(err[0]))
-            m = int(nout[0])
-            nb = self.pending
-            self._pending_dt = alld[len(alld) - nb:] if nb else np.empty(0)
-        return out[:m].astype(np.float64)
+        q = self._batch(a, lead, "omega", hc, out)
+        nb = self.pending
+        self._pending_dt = alld[len(alld) - nb:] if nb else np.empty(0)
+        return q
 
     def __repr__(self) -> str:
         return (f"Integrator(method={self.method!r}, precision={self.precision!r}, "
@@ -452,48 +512,101 @@ def _fixedpoint() -> Any:
     return fixedpoint
 
 
-def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = None,
-              precision: str = "f64") -> FloatArray:
+def _n_outputs(method: str, n: int) -> int:
+    """Attitude updates that n samples complete from a fresh state (C count)."""
+    ffi, lib = ffi_lib("f64")
+    s = ffi.new("att_integ *")
+    lib.att_integ_init(s, method_code(method, lib), ffi.NULL)
+    return int(lib.att_integ_outputs(s, n))
+
+
+def _check_out(out: Any, m: int, precision: str, source: NDArray[Any], source_name: str) -> NDArray[Any]:
+    """Validate a caller's ``out`` buffer: an ndarray of shape (m, 4), the
+    precision's dtype, C-contiguous, writeable, not sharing memory with the
+    input. Checked before any computation, so a bad ``out`` changes nothing."""
+    dtype = np.dtype(np.float64 if precision == "fixed" else _DTYPES[precision])
+    if not isinstance(out, np.ndarray):
+        raise InvalidType(f"out must be a numpy.ndarray, got {type(out).__name__}")
+    if out.dtype != dtype:
+        raise InvalidType(f"out must have dtype {dtype.name} for precision={precision!r}, "
+                          f"got {out.dtype}")
+    if out.shape != (m, 4):
+        raise InvalidArgument(f"out must have shape ({m}, 4) (one quaternion per attitude "
+                              f"update), got {out.shape}")
+    if not out.flags.c_contiguous:
+        raise InvalidArgument("out must be C-contiguous (np.empty((M, 4)), not a strided view)")
+    if not out.flags.writeable:
+        raise InvalidArgument("out is read-only")
+    if np.may_share_memory(out, source):
+        raise InvalidArgument(f"out must not share memory with {source_name}")
+    return out
+
+
+def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = None,
+              precision: Precision = "f64", out: NDArray[Any] | None = None) -> FloatArray:
     """Integrate body angle increments Δθ (N, 3) (rad) from attitude q0.
 
-    Returns the quaternion after each attitude update, (M, 4) float64:
-    M = N for rv1 and rv3-reuse, N // 2 for rv2, N // 3 for rv3 and
-    rv3-coning (a trailing partial frame is ignored; use Integrator to
-    stream). ``precision`` is "f64", "f32" or "fixed".
+    Returns the quaternion after each attitude update, (M, 4): float64, or
+    float32 with ``precision="f32"`` (give float32 increments then, and no
+    conversion copy is made); M = N for rv1 and rv3-reuse, N // 2 for rv2,
+    N // 3 for rv3 and rv3-coning (a trailing partial frame is ignored; use
+    Integrator to stream). ``precision`` is "f64", "f32" or "fixed" (float64
+    results). NaN/Inf raise NonFiniteError naming the first bad sample
+    (checked once, by the C call).
+
+    ``out``: optional preallocated result array, a C-contiguous ndarray of
+    shape (M, 4) and the result's dtype (float64, float32 for "f32"), not
+    overlapping ``dtheta``; it is filled and returned (no allocation: reuse
+    one buffer across calls). A wrong ``out`` raises InvalidType (type,
+    dtype) or InvalidArgument (shape, layout, read-only, overlap) before any
+    work; after an error raised by the integration itself (NaN/Inf,
+    divergence) its content is unspecified.
     """
     precision = _check_precision(precision, allow_fixed=True)
     method = _check_method(method, INCREMENT_METHODS + ("rk4",))
     if method == "rk4":
         raise InvalidArgument("method 'rk4' integrates rates: use integrate_rates(omega, dt)")
-    a = _records(dtheta, "dtheta", (3,), "angle increment", allow_empty=False)
-    if _as_real(dtheta, "dtheta").ndim != 2:
+    a, lead = _shaped(dtheta, "dtheta", (3,), "angle increment", allow_empty=False)
+    if len(lead) != 1:
         raise InvalidArgument(f"dtheta must have shape (N, 3), got {np.shape(dtheta)}")
     if a.shape[0] < FRAME[method]:
         raise InvalidArgument(f"method {method!r} needs at least {FRAME[method]} increments "
                               f"per update, got {a.shape[0]}")
     q = _check_q0(q0)
     if precision == "fixed":
-        out = _fixedpoint().integrate(a, method, q)
-        return np.asarray(out, dtype=np.float64)
-    return Integrator(method, q, precision).update(a)
+        if out is not None:
+            _check_out(out, _n_outputs(method, a.shape[0]), precision, a, "dtheta")
+        res = _fixedpoint().integrate(_records(a, "dtheta", (3,), "angle increment"), method, q)
+        if out is None:
+            return np.asarray(res, dtype=np.float64)
+        out[...] = res
+        return out
+    it = Integrator(method, q, precision)
+    if out is not None:
+        _check_out(out, it.outputs(a.shape[0]), precision, a, "dtheta")
+    return it._update_increments(a, lead, out)
 
 
-def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: str = "rk4",
-                    q0: ArrayLike | None = None, precision: str = "f64") -> FloatArray:
+def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "rk4",
+                    q0: ArrayLike | None = None, precision: Precision = "f64",
+                    out: NDArray[Any] | None = None) -> FloatArray:
     """Integrate body rates ω (N, 3) (rad/s) sampled every ``dt`` s.
 
     ``dt``: scalar or one value per row (dt[i] = time from row i to row i+1).
     ``rk4``: rows are at t, t+h/2, t+h, t+3h/2, … (each step end is the
     next step's start), h = dt[2k] + dt[2k+1]; returns (N − 1) // 2
     attitudes. Increment methods: Δθ_i = ω_i · dt_i (ω_i the mean rate of
-    interval i), then as :func:`integrate`.
+    interval i), then as :func:`integrate`. ``out``: as in :func:`integrate`
+    (shape (M, 4), not overlapping ``omega``).
     """
     precision = _check_precision(precision, allow_fixed=True)
     method = _check_method(method)
-    a = _records(omega, "omega", (3,), "rate sample", allow_empty=False)
-    if _as_real(omega, "omega").ndim != 2:
+    a, lead = _shaped(omega, "omega", (3,), "rate sample", allow_empty=False)
+    if len(lead) != 1:
         raise InvalidArgument(f"omega must have shape (N, 3), got {np.shape(omega)}")
     q = _check_q0(q0)
+    if method != "rk4" or precision == "fixed":
+        a = _records(a, "omega", (3,), "rate sample")  # checked here: not by the C rk4 call
     if method != "rk4":
         d = _as_real(dt, "dt").astype(np.float64)
         if d.ndim == 0:
@@ -505,7 +618,9 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: str = "rk4"
             raise NonFiniteError("dt holds NaN or Inf", index=_first_bad(np.isfinite(d)))
         if not (d > 0).all():
             raise InvalidArgument("dt must be > 0")
-        return integrate(a * d[:, None], method, q, precision)
+        if out is not None and np.may_share_memory(out, omega):
+            raise InvalidArgument("out must not share memory with omega")
+        return integrate(a * d[:, None], method, q, precision, out)
     if a.shape[0] < 3:
         raise InvalidArgument(f"method 'rk4' needs at least 3 rate rows (t, t+h/2, t+h), "
                               f"got {a.shape[0]}")
@@ -513,5 +628,14 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: str = "rk4"
         fx = _fixedpoint()
         if not hasattr(fx, "integrate_rates"):
             raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
-        return np.asarray(fx.integrate_rates(a, dt, method, q), dtype=np.float64)
-    return Integrator("rk4", q, precision).update(a, dt)
+        if out is not None:
+            _check_out(out, _n_outputs("rk4", a.shape[0]), precision, a, "omega")
+        res = fx.integrate_rates(a, dt, method, q)
+        if out is None:
+            return np.asarray(res, dtype=np.float64)
+        out[...] = res
+        return out
+    it = Integrator("rk4", q, precision)
+    if out is not None:
+        _check_out(out, it.outputs(a.shape[0]), precision, a, "omega")
+    return it._update_rates(a, lead, dt, out)

@@ -18,13 +18,16 @@ and return the raw integers for bit-exact work (tests, firmware vectors).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
 from .core import INCREMENT_METHODS
+
+if TYPE_CHECKING:
+    from .core import Method
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = [
@@ -179,7 +182,7 @@ def integrate_q30(dtheta_q30: ArrayLike, method: str = "rv3",
     return out[: int(n_out[0])]
 
 
-def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = None) -> NDArray[np.float64]:
+def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = None) -> NDArray[np.float64]:
     """Integrate body-frame angle increments (rad, shape (N, 3)) in fixed point.
 
     Same contract as the float builds: returns the attitude quaternion after
@@ -197,7 +200,7 @@ def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = Non
 class Integrator:
     """Streaming fixed-point integrator (one increment at a time)."""
 
-    def __init__(self, method: str = "rv3", q0: ArrayLike | None = None) -> None:
+    def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None) -> None:
         self._ffi, self._lib_ = _lib()
         self.method = method
         self._m = _method(method)
@@ -247,7 +250,7 @@ def _ptr(ffi: Any, a: NDArray[Any], i: int, width: int, ctype: str = "int32_t *"
     return ffi.cast(ctype, a.ctypes.data + a.itemsize * width * i)
 
 
-def rotation_vector(dtheta: ArrayLike, method: str = "rv3") -> NDArray[np.float64]:
+def rotation_vector(dtheta: ArrayLike, method: Method = "rv3") -> NDArray[np.float64]:
     """Φ of one update from the increments of that update (shape (n, 3), oldest
     first; n = 1 rv1, 2 rv2, 3 rv3/rv3-coning, 1–3 rv3-reuse/rv3-reuse-poly)."""
     ffi, lib = _lib()

@@ -28,9 +28,13 @@ from __future__ import annotations
 
 from fractions import Fraction
 from math import factorial
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:  # types only: the reference runs without the C library
+    from .core import FloatPrecision, Method
 
 __all__ = [
     "COEFFICIENTS",
@@ -446,7 +450,7 @@ def _wrap(a: F) -> F:
     return np.where(a <= -np.pi, np.pi, a)
 
 
-def dcm_to_euler(C: ArrayLike, precision: str = "f64") -> F:
+def dcm_to_euler(C: ArrayLike, precision: FloatPrecision = "f64") -> F:
     """[ψ, θ, γ] with the gimbal-lock rule (γ = 0, ψ = atan2(C21, C11))."""
     m = _arr(C, (3, 3))
     c12, c22 = m[..., 0, 1], m[..., 1, 1]
@@ -476,7 +480,7 @@ def euler_to_dcm(e: ArrayLike) -> F:
     return _rot(2, a[..., 0]) @ _rot(0, a[..., 1]) @ _rot(1, a[..., 2])
 
 
-def quat_to_euler(q: ArrayLike, precision: str = "f64") -> F:
+def quat_to_euler(q: ArrayLike, precision: FloatPrecision = "f64") -> F:
     return dcm_to_euler(quat_to_dcm(q), precision)
 
 
@@ -493,7 +497,7 @@ def euler_to_quat(e: ArrayLike) -> F:
     return np.where(q[..., :1] < 0, -q, q)
 
 
-def heading(x: ArrayLike, precision: str = "f64") -> F:
+def heading(x: ArrayLike, precision: FloatPrecision = "f64") -> F:
     a = np.asarray(x, dtype=np.float64)
     psi = (quat_to_euler(a, precision) if a.shape[-1] == 4 else dcm_to_euler(a, precision))[..., 0]
     h = np.mod(-psi, 2 * np.pi)
@@ -521,7 +525,7 @@ def quat_to_rotvec(q: ArrayLike) -> F:
 # integrator
 # ---------------------------------------------------------------------------
 
-def rotation_vectors(dtheta: ArrayLike, method: str) -> F:
+def rotation_vectors(dtheta: ArrayLike, method: Method) -> F:
     """Φ of every update of ``method`` (M, 3) from increments (N, 3)."""
     d = np.asarray(dtheta, dtype=np.float64).reshape(-1, 3)
     k = [float(x) for x in COEFFICIENTS[method]]
@@ -556,7 +560,7 @@ def _prefix_product(q0: F, steps: F) -> F:
     return quat_normalize(quat_multiply(q0, acc))
 
 
-def integrate(dtheta: ArrayLike, method: str = "rv3", q0: ArrayLike | None = None) -> F:
+def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = None) -> F:
     """Attitude after each update, (M, 4); same output semantics as the C batch."""
     if method not in FRAME:
         raise ValueError(f"unknown increment method {method!r}")
@@ -581,7 +585,7 @@ def _rk4_step_quats(w0: F, wm: F, w1: F, h: F) -> F:
     return one + hh / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def integrate_rates(omega: ArrayLike, dt: ArrayLike, method: str = "rk4",
+def integrate_rates(omega: ArrayLike, dt: ArrayLike, method: Method = "rk4",
                     q0: ArrayLike | None = None) -> F:
     """Rates (N, 3) every dt (scalar or (N,)). rk4: rows t, t+h/2, t+h, …,
     h = dt[2k] + dt[2k+1]; others: Δθ_i = ω_i dt_i."""

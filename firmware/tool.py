@@ -319,7 +319,7 @@ class Attempt:
 class _Receiver:
     """Receiver B of libattitude (``attitude_c.link``): the C machine or the Python one."""
 
-    def __init__(self, impl: str, block_size: int, gap_timeout: int) -> None:
+    def __init__(self, impl: Any, block_size: int, gap_timeout: int) -> None:  # attitude_c.link.cends.Impl
         from attitude_c.link.cends import make_receiver
 
         self.r = make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
 import sys
 from pathlib import Path
 
@@ -55,3 +56,16 @@ def root() -> Path:
 def build_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A per-session scratch build directory (never inside the source tree)."""
     return tmp_path_factory.mktemp("build")
+
+
+def clean_copy(dst: Path, *paths: str) -> Path:
+    """Copy the files git knows under ``paths`` (tracked, or new and not
+    ignored: what a fresh clone has, plus uncommitted work) to ``dst``, so a
+    build there reuses no stale output of the working tree."""
+    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", *paths], cwd=ROOT, check=True,
+                           capture_output=True, text=True).stdout.split()
+    for f in files:
+        if (ROOT / f).is_file():  # a deleted but still tracked file is skipped
+            (dst / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(ROOT / f, dst / f)
+    return dst

@@ -1,10 +1,9 @@
-"""Cross builds: invoke cross-build, the ARMv4T instruction check, the plain
-Makefile, the CMake toolchain file and the qemu instruction counter."""
+"""Cross builds: invoke cross-build, the ARMv4T instruction check and the qemu
+instruction counter (make and CMake: tests/test_consumer.py, test_buildfiles.py)."""
 
 from __future__ import annotations
 
 import os
-import shutil
 import subprocess
 from pathlib import Path
 
@@ -14,24 +13,9 @@ from conftest import ROOT, require_target, require_tools
 from toolchain import armv4t_check
 from toolchain.tasks.cross import cross_build_target
 
-# A small user program: what a mini2440 application does with the library.
-EXAMPLE_C = r"""
-#include <stdio.h>
-#include "attitude/attitude.h"
-int main(void)
-{
-    const att_real d[9] = {0, 0, 0.01, 0, 0, 0.01, 0, 0, 0.01}; /* 0.03 rad about z */
-    att_real q[4];
-    att_integ s;
-    size_t n = 0;
-    if (att_integ_init(&s, ATT_METHOD_RV3, NULL) != ATT_OK
-        || att_integ_batch(&s, d, 3, q, &n, NULL) != ATT_OK || n != 1)
-        return 1;
-    printf("att_real=%d ok=%s q=%.6f %.6f\n", att_real_size(), att_status_str(ATT_OK),
-           (double)q[0], (double)q[3]);
-    return 0;
-}
-"""
+# A small user program: what a mini2440 application does with the library (the
+# consumer project's, tests/consumer/main.c).
+EXAMPLE_C = (ROOT / "tests" / "consumer" / "main.c").read_text()
 # q = [cos(0.015), 0, 0, sin(0.015)] to 6 decimals (the same in float and double)
 Q_TEXT = "q=0.999888 0.014999"
 
@@ -84,6 +68,48 @@ def test_armv4t_check_rejects_interworking_and_vfp(tmp_path: Path) -> None:
     assert "FPU" in reasons and "BLX" in reasons
 
 
+SHARED_C = r"""
+#include <math.h>
+double norm(double x, double y) { return sqrt(x * x + y * y) / (x + 1.0); }
+unsigned part(unsigned a, unsigned b) { return a / b; }
+"""
+
+
+def test_armv4t_shared_object_needs_the_armv4t_libgcc(tmp_path: Path) -> None:
+    """A shared object of ARMv4T code linked the armel compiler's default way
+    pulls its ARMv5TE runtime (soft-float/division helpers with clz and
+    pc-loading returns, crti.o) and fails the check; linked as the armv4t
+    target says (toolchain/armv4t.toml: the ARMv4T libgcc.a of
+    arm-none-eabi-gcc, -nostdlib, then -lm -lc) it passes, its PLT stubs
+    included."""
+    t = require_target("armv4t")
+    src = tmp_path / "shared.c"
+    src.write_text(SHARED_C)
+    obj = _cc(t, src, tmp_path / "shared.o", "-march=armv4t", "-fPIC")
+    default = tmp_path / "default.so"
+    subprocess.run([t.cc, *t.target_cflags, "-shared", str(obj), "-o", str(default), "-lm"], check=True,
+                   capture_output=True)
+    vs = armv4t_check.check_objects([default], objdump=t.objdump)
+    assert any(v.insn.startswith("clz") for v in vs) and any("v5TE" in v.reason for v in vs), vs
+    v4t = tmp_path / "v4t.so"
+    subprocess.run([t.cc, *t.target_cflags, "-shared", str(obj), "-o", str(v4t), *t.shared_ldflags,
+                    *t.shared_link_libs()], check=True, capture_output=True)
+    plt = subprocess.run([t.objdump, "-d", str(v4t)], check=True, capture_output=True, text=True).stdout
+    assert "<sqrt@plt>:" in plt  # a PLT stub is there, and accepted
+    assert armv4t_check.check_objects([v4t], objdump=t.objdump) == []
+
+
+def test_armv4t_check_accepts_only_the_linkers_plt_stubs() -> None:
+    """Only GNU ld's PLT pc loads, and only inside .plt / NAME@plt, are accepted."""
+    text = ("00000400 <.plt>:\n 400:\tstr\tlr, [sp, #-4]!\n 404:\tldr\tlr, [pc, #4]\n"
+            " 408:\tadd\tlr, pc, lr\n 40c:\tldr\tpc, [lr, #8]!\n 410:\t.word\t0x00010bf0\n"
+            "00000414 <sqrt@plt>:\n 414:\tadd\tip, pc, #0, 12\n 418:\tadd\tip, ip, #16, 20\n"
+            " 41c:\tldr\tpc, [ip, #3052]!\n 420:\tpop\t{r4, pc}\n"
+            "00000424 <f>:\n 424:\tldr\tpc, [ip, #8]!\n 428:\tbx\tlr\n")
+    vs = armv4t_check.check_disassembly(text, "x.so")
+    assert [(v.function, v.address) for v in vs] == [("sqrt@plt", "0x420"), ("f", "0x424")], vs
+
+
 def test_armv4t_check_cli_exit_status(tmp_path: Path) -> None:
     t = require_target("armv4t")
     src = tmp_path / "snippet.c"
@@ -123,7 +149,9 @@ def test_cross_build_armv4t(tmp_path: Path) -> None:
     if any((ROOT / "csrc" / "app").glob("*.c")):
         assert (out / "attitude-rx").exists()
     exe = _example_against(t, out, tmp_path)
-    assert armv4t_check.check_objects([out / "libattitude.a"], objdump=t.objdump) == []
+    # the .so too: linked against the ARMv4T libgcc, not the armel compiler's (toolchain/armv4t.toml)
+    assert armv4t_check.check_objects([out / "libattitude.a", (out / "libattitude.so").resolve()],
+                                      objdump=t.objdump) == []
     res = t.run([exe], timeout=60)
     assert res.stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 
@@ -154,63 +182,8 @@ def test_cross_build_f32_pc_carries_define(tmp_path: Path) -> None:
         == f"att_real=4 ok=ok {Q_TEXT}"
 
 
-# -- plain Makefile and CMake -----------------------------------------------
-
-def _clean_copy(tmp_path: Path) -> Path:
-    """The tracked sources only (what a fresh clone has), so no stale build output is reused."""
-    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard", "Makefile", "CMakeLists.txt",
-                            "cmake", "csrc", "pyproject.toml"], cwd=ROOT, check=True,
-                           capture_output=True, text=True).stdout.split()
-    dst = tmp_path / "src"
-    for f in files:
-        (dst / f).parent.mkdir(parents=True, exist_ok=True)
-        shutil.copy2(ROOT / f, dst / f)
-    return dst
-
-
-@pytest.mark.qemu
-def test_makefile_cross_compile_install_and_link(tmp_path: Path) -> None:
-    """make CROSS_COMPILE=arm-linux-gnueabi- from a clean tree; make install; an example links."""
-    t = require_target("armv4t")
-    require_tools("make", "pkg-config", apt="make pkg-config")
-    src = _clean_copy(tmp_path)
-    arch = "-march=armv4t -mtune=arm920t -marm -mfloat-abi=soft"
-    subprocess.run(["make", "-j2", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}"],
-                   cwd=src, check=True, capture_output=True)
-    root = tmp_path / "rootfs"
-    subprocess.run(["make", "install", "CROSS_COMPILE=arm-linux-gnueabi-", f"TARGET_CFLAGS={arch}",
-                    "PREFIX=/usr", f"DESTDIR={root}"], cwd=src, check=True, capture_output=True)
-    lib = root / "usr" / "lib"
-    for name in ("libattitude.a", "libattitude.so", "libattitude.so.0", "pkgconfig/attitude.pc"):
-        assert (lib / name).exists(), name
-    assert (root / "usr" / "include" / "attitude" / "attitude.h").exists()
-    assert "prefix=/usr" in (lib / "pkgconfig" / "attitude.pc").read_text()
-    assert armv4t_check.check_objects([lib / "libattitude.a"], objdump=t.objdump) == []
-    if any((ROOT / "csrc" / "app").glob("*.c")):
-        assert (root / "usr" / "bin" / "attitude-rx").exists()
-    env = dict(os.environ, PKG_CONFIG_PATH="", PKG_CONFIG_LIBDIR=str(lib / "pkgconfig"),
-               PKG_CONFIG_SYSROOT_DIR=str(root))
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", "--static", "attitude"], env=env,
-                           check=True, capture_output=True, text=True).stdout.split()
-    ex = tmp_path / "example.c"
-    ex.write_text(EXAMPLE_C)
-    exe = tmp_path / "example"
-    subprocess.run(["arm-linux-gnueabi-gcc", *arch.split(), str(ex), "-o", str(exe), "-static", *flags],
-                   check=True, capture_output=True)
-    assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
-
-
-def test_cmake_armv4t_toolchain(tmp_path: Path) -> None:
-    """CMake with cmake/armv4t-toolchain.cmake builds an ARMv4T-clean libattitude.a."""
-    t = require_target("armv4t")
-    require_tools("cmake", "make", apt="cmake make")
-    bdir = tmp_path / "cmake"
-    subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir),
-                    f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'armv4t-toolchain.cmake'}"],
-                   check=True, capture_output=True)
-    subprocess.run(["cmake", "--build", str(bdir), "-j2"], check=True, capture_output=True)
-    assert armv4t_check.check_objects([bdir / "libattitude.a"], objdump=t.objdump) == []
-    assert (bdir / "libattitude.so").exists()
+# -- plain Makefile and CMake: tests/test_consumer.py (installs, consumer project) and
+# tests/test_buildfiles.py (the same target flags on every path).
 
 
 # -- qemu instruction counter ----------------------------------------------

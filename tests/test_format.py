@@ -7,12 +7,12 @@ import subprocess
 from pathlib import Path
 
 import pytest
+from conftest import ROOT
 
-ROOT = Path(__file__).resolve().parents[1]
-# The C trees the style covers: the library, its host/app/test programs, the firmware,
-# the C benches and the s51 harness.
-C_GLOBS = ("csrc/**/*.[ch]", "firmware/**/*.[ch]", "bench/*.c", "tests/*.c", "tests/s51/*.c",
-           "toolchain/*.[ch]")
+# The C trees the style covers (the same list `invoke format` applies it to): the
+# library, its host/app/test programs, the firmware, the C benches, the s51 harness
+# and the consumer project.
+from toolchain.tasks.core import C_FORMAT_GLOBS as C_GLOBS
 
 
 def c_files() -> list[Path]:

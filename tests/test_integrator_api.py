@@ -19,7 +19,7 @@ D = RNG.normal(scale=0.01, size=(30, 3))
                                         ("rv3-reuse", 1)])
 def test_output_counts_and_leftovers(method: str, per: int, precision: str) -> None:
     q = ac.integrate(D[:29], method, precision=precision)
-    assert q.shape == (29 // per, 4) and q.dtype == np.float64
+    assert q.shape == (29 // per, 4) and q.dtype == (np.float32 if precision == "f32" else np.float64)
     # unit quaternions: renormalized every 16 updates, error between ~ 16 ulp of the build
     tol = 2e-6 if precision == "f32" else 1e-14
     np.testing.assert_allclose(np.linalg.norm(q, axis=1), 1.0, atol=tol)
@@ -200,3 +200,132 @@ def test_stream_cut_anywhere_is_bit_identical(method: str, precision: str, cuts:
         parts.append(it.update(x[i:i + c], **({"dt": dt[i:i + c]} if method == "rk4" else {})))
         i += c
     np.testing.assert_array_equal(np.concatenate(parts), whole)
+
+
+ROTATION_FUNCS = [
+    ("quat_to_dcm", (4,)), ("dcm_to_quat", (3, 3)), ("dcm_to_euler", (3, 3)), ("euler_to_dcm", (3,)),
+    ("quat_to_euler", (4,)), ("euler_to_quat", (3,)), ("heading", (4,)), ("quat_normalize", (4,)),
+    ("rotvec_to_quat", (3,)), ("quat_to_rotvec", (4,)),
+]
+
+
+@pytest.mark.parametrize("precision, dtype", [("f64", np.float64), ("f32", np.float32)])
+def test_output_dtype_follows_the_precision(precision: str, dtype: type) -> None:
+    """f32 returns the float build's own float32 results; f64 returns float64;
+    fixed returns float64 (the Q2.30 values exactly)."""
+    x = {(4,): np.array([[0.9, 0.1, -0.2, 0.3]] * 2), (3,): np.array([[0.1, -0.2, 0.3]] * 2),
+         (3, 3): ac.euler_to_dcm(np.array([[0.1, -0.2, 0.3]] * 2))}
+    for name, tail in ROTATION_FUNCS:
+        assert getattr(ac, name)(x[tail], precision=precision).dtype == dtype, name
+    assert ac.quat_multiply(x[(4,)], x[(4,)], precision=precision).dtype == dtype
+    assert ac.integrate(D, "rv3", precision=precision).dtype == dtype
+    assert ac.integrate_rates(D, 0.01, "rk4", precision=precision).dtype == dtype
+    it = ac.Integrator("rv1", precision=precision)
+    assert it.update(D[0]).dtype == dtype and it.update(D[:1]).dtype == dtype
+    assert it.update(D[:0]).dtype == dtype and it.q.dtype == dtype
+    assert ac.quat_conj(x[(4,)]).dtype == np.float64
+
+
+def test_fixed_precision_returns_float64() -> None:
+    assert ac.integrate(D, "rv3", precision="fixed").dtype == np.float64
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+def test_integrate_checks_samples_once_in_c(precision: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The batch call checks every sample itself: integrate() makes no
+    NumPy pass over good data (that pass cost three quarters of its time),
+    and a bad sample still gets today's message and index."""
+    x = D.astype(np.float32 if precision == "f32" else np.float64)
+    calls = []
+    real = np.isfinite
+    monkeypatch.setattr(np, "isfinite", lambda *a, **k: calls.append(1) or real(*a, **k))
+    ac.integrate(x, "rv3", precision=precision)
+    ac.Integrator("rv3", precision=precision).update(x)
+    assert calls == []
+    monkeypatch.undo()
+    bad = D.copy()
+    bad[22, 2] = np.inf
+    with pytest.raises(NonFiniteError, match=r"^dtheta: sample 22 holds NaN or Inf$") as ei:
+        ac.integrate(bad, "rv3-reuse", precision=precision)
+    assert ei.value.index == 22
+    big = D.copy()
+    big[4] = 1e39  # finite in float64, not in float32
+    if precision == "f32":
+        with pytest.raises(RangeError, match=r"^dtheta: sample 4 overflows float32"):
+            ac.integrate(big, "rv1", precision="f32")
+
+
+def test_method_and_precision_are_literal_types() -> None:
+    """The annotations are Literal types listing exactly the run-time choices,
+    so a type checker rejects method="rv4"."""
+    import typing
+
+    hints = typing.get_type_hints(ac.integrate)
+    assert typing.get_args(hints["method"]) == ac.METHODS
+    assert typing.get_args(hints["precision"]) == ac.PRECISIONS
+    assert set(typing.get_args(typing.get_type_hints(ac.Integrator.__init__)["precision"])) == {"f64", "f32"}
+    assert typing.get_args(typing.get_type_hints(ac.quat_to_dcm)["precision"]) == ("f64", "f32")
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32", "fixed"])
+def test_out_gives_identical_results(precision: str) -> None:
+    """``out=`` fills the caller's buffer with exactly the values a fresh
+    call returns (same C call, so bit-identical) and returns that buffer."""
+    dtype = np.float32 if precision == "f32" else np.float64
+    x = D.astype(dtype)
+    for method in ac.INCREMENT_METHODS:
+        want = ac.integrate(x, method, precision=precision)  # type: ignore[arg-type]
+        out = np.full_like(want, np.nan)
+        got = ac.integrate(x, method, precision=precision, out=out)  # type: ignore[arg-type]
+        assert got is out
+        np.testing.assert_array_equal(out, want)
+        want = ac.integrate_rates(x, 0.01, method, precision=precision)  # type: ignore[arg-type]
+        out = np.full_like(want, np.nan)
+        assert ac.integrate_rates(x, 0.01, method, precision=precision, out=out) is out  # type: ignore[arg-type]
+        np.testing.assert_array_equal(out, want)
+    if precision != "fixed":  # rk4 has no fixed-point port here
+        for dt in (0.01, 0.01 * (1 + 0.1 * (np.arange(len(x)) % 3))):
+            want = ac.integrate_rates(x, dt, "rk4", precision=precision)  # type: ignore[arg-type]
+            out = np.full_like(want, np.nan)
+            assert ac.integrate_rates(x, dt, "rk4", precision=precision, out=out) is out  # type: ignore[arg-type]
+            np.testing.assert_array_equal(out, want)
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+def test_out_is_validated(precision: str) -> None:
+    """A wrong ``out`` is rejected by name before any work, with the expected
+    shape or dtype in the message."""
+    dtype, other = (np.float32, np.float64) if precision == "f32" else (np.float64, np.float32)
+    name = np.dtype(dtype).name
+    x = D.astype(dtype)  # 30 increments: rv3 gives 10 updates, rk4 (30 - 1) // 2 = 14
+    cases = [
+        (np.empty((11, 4), dtype), InvalidArgument, r"^out must have shape \(10, 4\) .*got \(11, 4\)$"),
+        (np.empty((10, 3), dtype), InvalidArgument, r"^out must have shape \(10, 4\)"),
+        (np.empty(40, dtype), InvalidArgument, r"^out must have shape \(10, 4\)"),
+        (np.empty((10, 4), other), InvalidType, rf"^out must have dtype {name} for precision='{precision}'"),
+        (np.empty((10, 4), np.int64), InvalidType, rf"^out must have dtype {name}"),
+        (np.empty((10, 8), dtype)[:, :4], InvalidArgument, r"^out must be C-contiguous"),
+        (np.empty((4, 10), dtype).T, InvalidArgument, r"^out must be C-contiguous"),
+        ([[0.0] * 4] * 10, InvalidType, r"^out must be a numpy.ndarray, got list$"),
+    ]
+    ro = np.empty((10, 4), dtype)
+    ro.flags.writeable = False
+    cases.append((ro, InvalidArgument, r"^out is read-only$"))
+    for out, exc, msg in cases:
+        with pytest.raises(exc, match=msg):
+            ac.integrate(x, "rv3", precision=precision, out=out)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match=r"^out must have shape \(14, 4\)"):
+        ac.integrate_rates(x, 0.01, "rk4", precision=precision, out=np.empty((15, 4), dtype))  # type: ignore[arg-type]
+    with pytest.raises(InvalidType, match=r"^out must have dtype"):
+        ac.integrate_rates(x, 0.01, "rv1", precision=precision, out=np.empty((30, 4), other))  # type: ignore[arg-type]
+    # the output may not alias the input: rv1 writes 4 values per 3 read
+    buf = np.zeros((30, 4), dtype)
+    with pytest.raises(InvalidArgument, match=r"^out must not share memory with dtheta$"):
+        ac.integrate(buf[:, :3], "rv1", precision=precision, out=buf)  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgument, match=r"^out must not share memory with omega$"):
+        ac.integrate_rates(buf[:, :3], 0.01, "rv1", precision=precision, out=buf)  # type: ignore[arg-type]
+    # the integration's own errors still name the sample; out is the caller's
+    bad = x.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(NonFiniteError, match=r"^dtheta: sample 7 holds NaN or Inf$"):
+        ac.integrate(bad, "rv3", precision=precision, out=np.empty((10, 4), dtype))  # type: ignore[arg-type]

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import threading
 import time
+from typing import Any
 
 import pytest
 from conftest import ROOT
@@ -204,3 +205,119 @@ def test_other_pyserial_urls_loop_and_spy(tmp_path):
     assert rx.blocks == BLOCKS[:3]
     text = log.read_text().upper()
     assert "AA" in text and "BB" in text  # the handshake bytes in the hexdump
+
+
+# -- a sender whose receiver starts late (issue 11, section 3) -------------
+
+
+def _tx_in_thread(argv: list[str]) -> tuple[threading.Thread, dict]:
+    """`attitude link-tx ARGV` in a thread (no interpreter start-up to race
+    against); the box gets its exit status."""
+    box: dict = {}
+    th = threading.Thread(target=lambda: box.setdefault("rc", cli_main(["link-tx", *argv])), daemon=True)
+    th.start()
+    return th, box
+
+
+def _wait_for(cond, timeout: float, what: str) -> None:
+    t_end = time.monotonic() + timeout
+    while not cond():
+        assert time.monotonic() < t_end, f"timed out waiting for {what}"
+        time.sleep(0.01)
+
+
+def test_cli_tx_waits_for_a_receiver_that_starts_late(capsys):
+    """`link-tx --block-size 6 --count 5` started before its receiver: by
+    default it keeps offering block 0 until B answers, then sends all five;
+    nothing is given up (today's main gave up on every block)."""
+    with PtyPair() as (p0, p1):
+        th, box = _tx_in_thread(["--port", p0, "--block-size", "6", "--count", "5", "--generate"])
+        try:
+            # let A run through more than max_attempts (5) unanswered handshakes first
+            time.sleep(0.6)
+            pb = open_port(p1)
+            try:
+                rx = run_receiver(pb, count=5, duration=30, gap_timeout_ms=GAP_MS)
+            finally:
+                th.join(timeout=30)
+                pb.close()
+        finally:
+            assert not th.is_alive(), "link-tx did not finish"
+    cap = capsys.readouterr()
+    assert box["rc"] == 0, cap.err
+    assert cap.out.count(": accepted after") == 5
+    assert '"gave_up": 0' in cap.err
+    assert len(rx.blocks) == 5
+    # more than 5 attempts of 50 ms went unanswered before B opened its port
+    assert json_stats(cap.err)["timeouts"] >= 5
+
+
+def json_stats(err: str) -> dict:
+    import json
+
+    line = next(ln for ln in err.splitlines() if ln.startswith("link-tx stats: "))
+    return json.loads(line[len("link-tx stats: "):])
+
+
+def test_run_sender_wait_runs_out_and_reports_no_receiver():
+    """Nobody on the other side: with a bounded wait A offers block 0, says
+    every `waiting_every` seconds that it waits, and stops with the block
+    reported "no receiver" (not given up, nothing counted as gave_up)."""
+    notes: list[float] = []
+    with PtyPair() as (p0, _p1):
+        pa = open_port(p0)
+        try:
+            t0 = time.monotonic()
+            reports, stats = run_sender(pa, BLOCKS[:3], syn_timeout_ms=30, answer_timeout_ms=30, max_attempts=2,
+                                        wait_first=0.8, waiting_every=0.25, on_waiting=notes.append)
+            dt = time.monotonic() - t0
+        finally:
+            pa.close()
+    assert [(r.index, r.outcome) for r in reports] == [(0, "no receiver")]
+    assert stats["gave_up"] == 0 and stats["timeouts"] >= 5  # 0.8 s of 30 ms waits, far above 2 attempts
+    assert 0.8 <= dt < 5.0
+    assert len(notes) >= 2 and notes == sorted(notes)
+
+
+def test_cli_tx_wait_limit_exit_status(capsys):
+    with PtyPair() as (p0, _p1):
+        rc = cli_main(["link-tx", "--port", p0, "--generate", "--count", "2", "--wait", "0.3"])
+    err = capsys.readouterr().err
+    assert rc == 4
+    assert "no handshake from the receiver in 0.3 s: block 0" in err
+
+
+def _answer_first_block_then_go_silent(url: str) -> tuple[threading.Thread, Any]:
+    """A receiver B that accepts one block and then stays on the line, deaf."""
+    pb = open_port(url)
+    th = threading.Thread(target=lambda: run_receiver(pb, count=1, duration=30, gap_timeout_ms=GAP_MS),
+                          daemon=True)
+    th.start()
+    return th, pb
+
+
+@pytest.mark.parametrize("policy", ["fail", "skip"])
+def test_cli_tx_give_up_after_the_handshake(policy, capsys):
+    """After B has answered once, a give-up is a real loss: by default
+    link-tx stops with exit status 3 naming the block; with
+    `--on-give-up skip` it reports the block and goes on."""
+    with PtyPair() as (p0, p1):
+        peer, pb = _answer_first_block_then_go_silent(p1)
+        try:
+            rc = cli_main(["link-tx", "--port", p0, "--generate", "--count", "3", "--max-attempts", "2",
+                           "--syn-timeout-ms", "1000", "--answer-timeout-ms", "1000", "--on-give-up", policy])
+            peer.join(timeout=30)
+        finally:
+            pb.close()
+    cap = capsys.readouterr()
+    assert "block 0 " in cap.out and ": accepted after 1 attempt(s)" in cap.out
+    if policy == "fail":
+        assert rc == 3
+        assert "gave up on block 1 " in cap.err
+        assert "block 2 " not in cap.out  # nothing sent after the lost block
+        assert json_stats(cap.err)["gave_up"] == 1
+    else:
+        assert rc == 0
+        assert "block 1 " in cap.out and "block 2 " in cap.out
+        assert cap.out.count(": gave up after 2 attempt(s)") == 2
+        assert "skipped 2 block(s) given up: 1, 2" in cap.err

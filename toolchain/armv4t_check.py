@@ -16,7 +16,13 @@ and address:
   or ``mov pc, rN`` never switches to Thumb state, so such a return into a
   Thumb caller crashes; ARMv4T code must return with ``bx``. Jump tables
   (``ldr pc, [pc, ...]``, ``add pc, pc, ...``) stay in ARM state and are
-  accepted;
+  accepted, and so are the PLT stubs GNU ld writes into a linked shared
+  object or dynamic program (``.plt`` and ``NAME@plt``: ``ldr pc, [ip,
+  #N]!``, ``ldr pc, [lr, #8]!``, and nothing else loading the pc): ld has no
+  other ARM PLT (every ARMv4T dynamic binary has them); they jump in ARM
+  state to the function the dynamic linker resolved, so on ARMv4T the
+  callee must be ARM code: our own functions (built ``-marm``) and the
+  board's libc/libm (docs/cross-build.md);
 * Thumb code (the library is built with ``-marm``);
 * ELF build attributes that claim a later architecture or an FPU
   (``Tag_CPU_arch`` other than v4T/v4, any ``Tag_FP_arch``/VFP arguments).
@@ -95,8 +101,18 @@ def _reason_for(mnem: str) -> str:
     return "not an ARMv4T instruction"
 
 
-def classify(mnem: str, operands: str) -> str | None:
-    """Return why ``mnem operands`` is not acceptable ARMv4T code, or None if it is."""
+#: The pc loads of GNU ld's ARM PLT: PLT0 ``ldr pc, [lr, #8]!`` (to the
+#: dynamic linker's resolver), entries ``ldr pc, [ip, #N]!`` (through the GOT).
+_PLT_LDR_PC_RE = re.compile(r"pc,\[(ip,#\d+|lr,#8)\]!")
+
+
+def _is_plt(function: str) -> bool:
+    return function == ".plt" or function.endswith("@plt")
+
+
+def classify(mnem: str, operands: str, in_plt: bool = False) -> str | None:
+    """Return why ``mnem operands`` is not acceptable ARMv4T code, or None if it
+    is; ``in_plt``: the instruction is in a linker-generated PLT stub."""
     m = _MNEM_RE.match(mnem)
     if m is None or m.group("base") not in ARMV4T_BASES:
         # retry: a base ending in 's' such as "smulls" or "bics"
@@ -123,6 +139,8 @@ def classify(mnem: str, operands: str) -> str | None:
             and re.search(r"(^|,)pc($|,)", regs_block.group(1))):
         return "loads pc with LDM/POP: does not interwork on ARMv4T (return with bx)"
     if base == "ldr" and ops.startswith("pc,") and not ops.startswith("pc,[pc"):
+        if in_plt and _PLT_LDR_PC_RE.fullmatch(ops):
+            return None  # GNU ld's PLT stub (see the module docstring)
         return "loads pc from memory: does not interwork on ARMv4T (use bx)"
     if base == "mov" and re.fullmatch(r"pc,(r\d+|lr|ip|sl|fp|sb)", ops):
         return "mov pc, reg: does not interwork on ARMv4T (use bx)"
@@ -165,7 +183,7 @@ def check_disassembly(text: str, default_obj: str = "?") -> list[Violation]:
         if mnem.startswith("."):  # .word/.short/.byte: literal pools, data
             continue
         operands = operands.split(";")[0].split("@")[0].strip()
-        why = classify(mnem.lower(), operands.lower())
+        why = classify(mnem.lower(), operands.lower(), in_plt=_is_plt(func))
         if why:
             out.append(Violation(obj, func, "0x" + addr, f"{mnem} {operands}".strip(), why))
     return out

@@ -45,6 +45,7 @@ class Target:
     os: str
     cc: str
     ar: str
+    #: Every flag of the project's own compiles: ``strict_cflags + target_cflags``.
     cflags: list[str]
     ldflags: list[str] = field(default_factory=list)
     libs: list[str] = field(default_factory=list)
@@ -59,8 +60,20 @@ class Target:
     app: bool = False             # the attitude-rx program (needs POSIX threads and termios)
     app_libs: list[str] = field(default_factory=list)
     pic_flags: list[str] = field(default_factory=lambda: ["-fPIC"])
+    #: How libattitude.so is linked (TOML ``shared_ldflags``, ``shared_libgcc``,
+    #: ``shared_libs``): extra link flags; a command printing the path of a
+    #: libgcc.a to link instead of the compiler's own runtime (empty: the
+    #: compiler's); the libraries after it (default: ``libs``).
+    shared_ldflags: list[str] = field(default_factory=list)
+    shared_libgcc: list[str] = field(default_factory=list)
+    shared_libs: list[str] = field(default_factory=list)
     #: Post-build checks by name (e.g. "armv4t": toolchain/armv4t_check.py).
     checks: list[str] = field(default_factory=list)
+    #: The target itself (TOML ``cflags``: architecture, ABI, optimization): what
+    #: ``make TARGET=NAME`` and cmake/NAME-toolchain.cmake pass too.
+    target_cflags: list[str] = field(default_factory=list)
+    #: The project's compile policy (TOML ``strict_cflags``: -std, warnings, -Werror).
+    strict_cflags: list[str] = field(default_factory=list)
 
     def library_sources(self) -> list[Path]:
         """The library sources this target builds (sorted, de-duplicated)."""
@@ -75,11 +88,28 @@ class Target:
             return self.ar[: -len("ar")] + name
         return name
 
+    def shared_link_libs(self) -> list[str]:
+        """What follows the objects on the link line of libattitude.so: the
+        libgcc.a that ``shared_libgcc`` prints (if any), then ``shared_libs``."""
+        if not self.shared_libgcc:
+            return list(self.shared_libs)
+        if shutil.which(self.shared_libgcc[0]) is None:
+            raise ToolchainMissing(f"target {self.name}: libattitude.so links the libgcc of "
+                                   f"{self.shared_libgcc[0]}, which is not found; {self.install_hint()}")
+        proc = subprocess.run(self.shared_libgcc, capture_output=True, text=True, check=False)
+        path = proc.stdout.strip()
+        if proc.returncode != 0 or not Path(path).is_file():
+            raise ToolchainMissing(f"target {self.name}: {' '.join(self.shared_libgcc)} gave no libgcc.a "
+                                   f"({proc.stderr.strip() or path!r})")
+        return [path, *self.shared_libs]
+
     # -- availability -----------------------------------------------------
     def tools(self) -> list[str]:
         tools = [self.cc, self.ar]
         if self.run_cmd:
             tools.append(self.run_cmd[0])
+        if self.shared_libgcc:
+            tools.append(self.shared_libgcc[0])
         return tools
 
     def missing_tools(self) -> list[str]:
@@ -167,13 +197,18 @@ def load(name: str) -> Target:
         raise ValueError(f"unknown target {name!r}; known targets: {', '.join(names())}")
     d = tomllib.loads(path.read_text())
     cc = os.environ.get(f"ATT_CC_{name.upper().replace('-', '_')}", d["cc"])
+    strict, target = list(d.get("strict_cflags", [])), list(d.get("cflags", []))
     return Target(
         name=d["name"], kind=d["kind"], os=d["os"], cc=cc, ar=d["ar"],
-        cflags=list(d.get("cflags", [])), ldflags=list(d.get("ldflags", [])),
+        cflags=strict + target, target_cflags=target, strict_cflags=strict,
+        ldflags=list(d.get("ldflags", [])),
         libs=list(d.get("libs", [])), run_cmd=list(d.get("run", [])),
         apt=list(d.get("apt", [])), objdump=d.get("objdump"),
         lib_source_globs=list(d.get("lib_sources", ["csrc/src/*.c"])),
         shared=bool(d.get("shared", False)), app=bool(d.get("app", False)),
         app_libs=list(d.get("app_libs", [])), pic_flags=list(d.get("pic_flags", ["-fPIC"])),
         checks=list(d.get("checks", [])),
+        shared_ldflags=list(d.get("shared_ldflags", [])),
+        shared_libgcc=list(d.get("shared_libgcc", [])),
+        shared_libs=list(d.get("shared_libs", d.get("libs", []))),
     )

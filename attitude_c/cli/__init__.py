@@ -13,7 +13,19 @@ import importlib
 import sys
 from collections.abc import Sequence
 
-from .. import __version__
+
+class _VersionAction(argparse.Action):
+    """``--version``: print the version (resolved only when asked for)."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str = argparse.SUPPRESS,
+                 default: str = argparse.SUPPRESS, help: str = "show the version and exit") -> None:
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: object, option_string: str | None = None) -> None:
+        import attitude_c
+
+        parser.exit(message=f"{parser.prog} {attitude_c.__version__}\n")
 
 # Module names under attitude_c.cli, in the order their commands are listed.
 _MODULES = ("simulate", "link", "demo")
@@ -25,7 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="libattitude: strapdown attitude measurement tools "
         "(simulation, serial link, analysis).",
     )
-    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in _MODULES:
         try:

@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from ..errors import AttitudeError
+from .simulate import _nonneg
 
 
 def _hex_block(b: bytes) -> str:
@@ -42,6 +43,17 @@ def test_samples(count: int | None, block_size: int = 6) -> Iterator[bytes]:
         i += 1
 
 
+#: ``link-tx`` exit statuses (docs/link.md, "Commands").
+EXIT_OK = 0
+EXIT_PORT = 1  # the port cannot be opened or failed
+EXIT_USAGE = 2  # bad argument or bad input line
+EXIT_GAVE_UP = 3  # a block was given up after the receiver had answered (--on-give-up fail)
+EXIT_NO_RECEIVER = 4  # no handshake from the receiver within --wait seconds
+EXIT_INTERRUPTED = 130  # SIGINT / SIGTERM with a block in progress
+#: Seconds between two "waiting for the receiver" messages of link-tx.
+WAIT_NOTE_S = 5.0
+
+
 def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", required=True, help="device or pyserial URL (/dev/ttyS1, socket://host:port, ...)")
     p.add_argument("--baud", type=int, default=9600, help="line rate (default 9600, 8N1)")
@@ -69,6 +81,12 @@ def register(sub: Any) -> None:
     p.add_argument("--syn-timeout-ms", type=int, default=50)
     p.add_argument("--answer-timeout-ms", type=int, default=50)
     p.add_argument("--max-attempts", type=int, default=5)
+    p.add_argument("--wait", type=_nonneg("--wait"), default=None, metavar="S",
+                   help="wait at most S seconds for the receiver's first handshake (default: for ever, "
+                   f"with a message every {WAIT_NOTE_S:g} s; 0: no wait)")
+    p.add_argument("--on-give-up", choices=("fail", "skip"), default="fail",
+                   help="a block given up after the receiver has answered: fail (default) ends the "
+                   f"command with exit status {EXIT_GAVE_UP}, naming the block; skip goes on with the next")
     p.set_defaults(func=cmd_tx)
 
     p = sub.add_parser("link-test", help="N blocks through a pair of ends and a (bad) channel; print statistics")
@@ -177,7 +195,14 @@ def cmd_rx(args: argparse.Namespace) -> int:
 
 
 def cmd_tx(args: argparse.Namespace) -> int:
-    from ..link.transport import BlockReport, open_port, run_sender
+    from ..link.transport import (
+        OUTCOME_GAVE_UP,
+        OUTCOME_INTERRUPTED,
+        OUTCOME_NO_RECEIVER,
+        BlockReport,
+        open_port,
+        run_sender,
+    )
 
     stop = _stop_on_signals()
     if args.generate:
@@ -200,24 +225,49 @@ def cmd_tx(args: argparse.Namespace) -> int:
         return 1
 
     def show(r: BlockReport) -> None:
+        if r.outcome in (OUTCOME_NO_RECEIVER, OUTCOME_INTERRUPTED):
+            return  # said on stderr below
         print(f"block {r.index} {_hex_block(r.block)}: {r.outcome} after {r.attempts} attempt(s)"
               f" (naks {r.naks}, timeouts {r.timeouts})", flush=True)
+
+    def waiting(seconds: float) -> None:
+        print(f"link-tx: waiting for the receiver on {args.port} ({seconds:.0f} s, block 0 not sent yet)",
+              file=sys.stderr, flush=True)
 
     try:
         reports, stats = run_sender(port, blocks, impl=args.impl, block_size=args.block_size,
                                     syn_timeout_ms=args.syn_timeout_ms,
                                     answer_timeout_ms=args.answer_timeout_ms,
-                                    max_attempts=args.max_attempts, on_result=show, stop=stop)
+                                    max_attempts=args.max_attempts, on_result=show, stop=stop,
+                                    wait_first=args.wait, on_waiting=waiting, waiting_every=WAIT_NOTE_S,
+                                    on_give_up=args.on_give_up)
     except ValueError as exc:
         print(f"link-tx: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
     except AttitudeError as exc:
         print(f"link-tx: {exc}", file=sys.stderr)
-        return 1
+        return EXIT_PORT
     finally:
         port.close()
     print("link-tx stats: " + json.dumps(stats), file=sys.stderr)
-    return 0 if all(r.outcome == "accepted" for r in reports) else 3
+    last = reports[-1] if reports else None
+    if last is not None and last.outcome == OUTCOME_NO_RECEIVER:
+        print(f"link-tx: no handshake from the receiver in {args.wait:g} s: block {last.index} "
+              "and the rest not sent", file=sys.stderr)
+        return EXIT_NO_RECEIVER
+    if last is not None and last.outcome == OUTCOME_INTERRUPTED:
+        print(f"link-tx: interrupted: block {last.index} and the rest not sent", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    if args.on_give_up == "fail" and last is not None and last.outcome == OUTCOME_GAVE_UP:
+        print(f"link-tx: gave up on block {last.index} ({_hex_block(last.block)}) after {last.attempts} "
+              "attempt(s); the blocks after it were not sent (--on-give-up skip goes on instead)",
+              file=sys.stderr)
+        return EXIT_GAVE_UP
+    skipped = [r.index for r in reports if r.outcome == OUTCOME_GAVE_UP]
+    if skipped:
+        print(f"link-tx: skipped {len(skipped)} block(s) given up: {', '.join(map(str, skipped))}",
+              file=sys.stderr)
+    return EXIT_OK
 
 
 def _pair(text: str, what: str) -> tuple[str, str]:
@@ -234,7 +284,7 @@ def cmd_test(args: argparse.Namespace) -> int:
 
     try:
         dead = [tuple(float(x) for x in _pair(d, "--dead")) for d in args.dead]
-        reboots = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
+        reboots: list[Any] = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
         chan = ChannelConfig(ber=args.ber, drop=args.drop, insert=args.insert, duplicate=args.duplicate,
                              dead=dead, seed=args.seed)  # type: ignore[arg-type]
         blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),

@@ -11,7 +11,11 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
+from ..core import METHODS as _METHODS
+from ..sim.trajectory import TRAJECTORIES
+
+#: Simulated time when --duration is not given (and the trajectory is not a file).
+DEFAULT_DURATION_S = 60.0
 
 
 def _positive(kind: str) -> Callable[[str], float]:
@@ -97,14 +101,16 @@ def register(subparsers: Any) -> None:
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     g = p.add_argument_group("scenario")
-    g.add_argument("--trajectory", default="paper",
-                   choices=("paper", "coning", "static", "constant-rate", "csv"),
-                   help="reference motion (csv needs --trajectory-file)")
+    g.add_argument("--trajectory", default=argparse.SUPPRESS,
+                   choices=TRAJECTORIES,
+                   help="reference motion (default: paper, or csv when --trajectory-file is given; "
+                   "csv needs --trajectory-file)")
     g.add_argument("--trajectory-file", metavar="CSV", default=None,
                    help="CSV with columns time,yaw,pitch,roll (rad; *_deg for degrees) or "
-                   "time,q0,q1,q2,q3")
-    g.add_argument("--duration", type=_positive("--duration"), default=60.0, metavar="S",
-                   help="simulated time (s)")
+                   "time,q0,q1,q2,q3; implies --trajectory csv")
+    g.add_argument("--duration", type=_positive("--duration"), default=argparse.SUPPRESS, metavar="S",
+                   help=f"simulated time (s) (default: {DEFAULT_DURATION_S:g}, or the span of the "
+                   "--trajectory-file, which it may not exceed)")
     g.add_argument("--period", type=_positive("--period"), default=0.08, metavar="S",
                    help="gyro sample period: one angle increment per period (s); the paper: 0.08")
     g.add_argument("--amplitude", type=_triple("--amplitude"), default="30,20,25",
@@ -194,31 +200,41 @@ class _Progress:
 def build_config(args: argparse.Namespace) -> Any:
     from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
 
+    given = getattr(args, "trajectory", None)
+    trajectory = given or ("csv" if args.trajectory_file else "paper")
+    duration: float | None = getattr(args, "duration", None)
     if args.firmware == "s51":
         from ..sim.firmware import FirmwareTrajectory
         from ..sim.sensors import DEG, Conditioning
 
-        if args.trajectory != "paper" or args.trajectory_file:
+        if given or args.trajectory_file:
             raise ValueError("--firmware s51 uses the firmware's own motion: drop --trajectory")
         gyro = gyro_preset(args.gyro)
         cond = Conditioning()
         k = cond.vref / 4096 / (gyro.scale_v_per_dps / DEG * cond.gain(gyro))
         traj: Any = FirmwareTrajectory(period=args.period, rad_per_s_per_code=k,
-                                       duration=args.duration)
-    elif args.trajectory == "csv":
+                                       duration=duration or DEFAULT_DURATION_S)
+    elif trajectory == "csv":
         if not args.trajectory_file:
             raise ValueError("--trajectory csv needs --trajectory-file CSV")
         traj = make_trajectory("csv", path=args.trajectory_file)
+        if duration is None:
+            duration = traj.span  # the whole file, not a minute of it held still
+        elif duration > traj.span * (1 + 1e-9):
+            raise ValueError(f"--duration {duration:g} s is longer than the trajectory file "
+                             f"{args.trajectory_file} ({traj.span:g} s, t = {traj.t_start:g} .. "
+                             f"{traj.t_end:g} s): give at most {traj.span:g} s, or leave --duration "
+                             "out to run the whole file")
     elif args.trajectory_file:
         raise ValueError("--trajectory-file is only used with --trajectory csv")
-    elif args.trajectory == "paper":
+    elif trajectory == "paper":
         traj = make_trajectory("paper", amplitude=[math.radians(v) for v in args.amplitude],
                                frequency=list(args.frequency),
                                phase=[math.radians(v) for v in args.phase])
-    elif args.trajectory == "coning":
+    elif trajectory == "coning":
         traj = make_trajectory("coning", half_angle=math.radians(args.cone_angle),
                                frequency=args.cone_frequency)
-    elif args.trajectory == "constant-rate":
+    elif trajectory == "constant-rate":
         traj = make_trajectory("constant-rate", rate=[math.radians(v) for v in args.rate])
     else:
         traj = make_trajectory("static")
@@ -227,7 +243,7 @@ def build_config(args: argparse.Namespace) -> Any:
         from ..sim._tlc import available
 
         adc = "tlc2543" if available() else "ideal"
-    return SimConfig(trajectory=traj, duration=args.duration, period=args.period,
+    return SimConfig(trajectory=traj, duration=duration or DEFAULT_DURATION_S, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
                      board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,

@@ -4,7 +4,7 @@ same Python interface as :mod:`attitude_c.link.protocol`.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
 from .._lib import ffi_lib
 from ..errors import InvalidArgument, LinkError, raise_for_status
@@ -29,6 +29,9 @@ LINK_ERRORS: dict[int, tuple[type, str]] = {
     -62: (LinkBusy, "sender busy with the previous block"),
     -63: (LinkError, "link state corrupted"),
 }
+
+#: Which implementation of an end: the C machine or the Python one.
+Impl = Literal["c", "python"]
 
 _SENDER_FIELDS = ("blocks_sent", "blocks_accepted", "naks", "timeouts", "gave_up", "bytes_discarded")
 _RECEIVER_FIELDS = ("syns", "blocks_accepted", "naks", "timeouts", "resyncs", "bytes_discarded")
@@ -162,7 +165,7 @@ class CReceiver:
         return None if v == _NO_TIMER else int(v)
 
 
-def make_sender(impl: str = "c", **kw: int) -> CSender | Any:
+def make_sender(impl: Impl = "c", **kw: int) -> CSender | Any:
     """A sender A: ``impl`` is ``"c"`` or ``"python"``; keywords as :class:`CSender`."""
     from .protocol import Sender
 
@@ -173,7 +176,7 @@ def make_sender(impl: str = "c", **kw: int) -> CSender | Any:
     raise InvalidArgument(f"impl must be 'c' or 'python', got {impl!r}")
 
 
-def make_receiver(impl: str = "c", **kw: int) -> CReceiver | Any:
+def make_receiver(impl: Impl = "c", **kw: int) -> CReceiver | Any:
     """A receiver B: ``impl`` is ``"c"`` or ``"python"``; keywords as :class:`CReceiver`."""
     from .protocol import Receiver
 

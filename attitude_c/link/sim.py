@@ -17,13 +17,13 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Union
+from typing import Any, Literal, Union
 
 import numpy as np
 
 from .._lib import ffi_lib
 from ..errors import InvalidArgument, InvalidType, raise_for_status
-from .cends import LINK_ERRORS, make_receiver, make_sender
+from .cends import LINK_ERRORS, Impl, make_receiver, make_sender
 from .protocol import (
     BLOCK_MAX,
     DEFAULT_ANSWER_TIMEOUT_MS,
@@ -220,17 +220,17 @@ def simulate_link(
     blocks: Any,
     *,
     channel: ChannelConfig | None = None,
-    sender: str = "c",
-    receiver: str = "c",
+    sender: Impl = "c",
+    receiver: Impl = "c",
     baud: int = 9600,
     block_size: int | None = None,
     syn_timeout_ms: float = DEFAULT_SYN_TIMEOUT_MS,
     answer_timeout_ms: float = DEFAULT_ANSWER_TIMEOUT_MS,
     gap_timeout_ms: float = DEFAULT_GAP_TIMEOUT_MS,
     max_attempts: int = DEFAULT_MAX_ATTEMPTS,
-    reboots: Iterable[tuple[float, str]] = (),
+    reboots: Iterable[tuple[float, Literal["sender", "receiver"]]] = (),
     max_time_s: float | None = None,
-    engine: str | None = None,
+    engine: Impl | None = None,
 ) -> LinkRun:
     """Push ``blocks`` ((n, N) uint8, or a list of N-byte ``bytes``) through
     sender A -> :class:`ChannelConfig` line -> receiver B at ``baud`` 8N1.
@@ -333,7 +333,7 @@ def _run_c(arr: np.ndarray, chan_cfg: ChannelConfig, baud: int, timing: dict[str
 
 def _run_py(arr: np.ndarray, chan_cfg: ChannelConfig, baud: int, timing: dict[str, int],
             max_attempts: int, reb: list[tuple[int, int]], max_ticks: int,
-            sender_impl: str, receiver_impl: str) -> LinkRun:
+            sender_impl: Impl, receiver_impl: Impl) -> LinkRun:
     """The same event loop as att_link_sim_run, in Python, over any ends."""
     n_blocks, n = arr.shape
     channel = Channel(chan_cfg, baud)

@@ -26,12 +26,12 @@ import time
 import tty
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Literal
 
 import serial
 
 from ..errors import InvalidArgument, LinkError
-from .cends import make_receiver, make_sender
+from .cends import Impl, make_receiver, make_sender
 from .protocol import (
     BLOCK_DEFAULT,
     DEFAULT_ANSWER_TIMEOUT_MS,
@@ -41,6 +41,10 @@ from .protocol import (
     Result,
 )
 from .sim import BITS_PER_BYTE, Channel, ChannelConfig
+
+#: What :func:`run_sender` does when a block is given up after the first handshake.
+GiveUpPolicy = Literal["skip", "fail"]
+GIVE_UP_POLICIES: tuple[GiveUpPolicy, ...] = ("skip", "fail")
 
 
 def open_port(url: str, baud: int = 9600, timeout: float = 0.005) -> serial.SerialBase:
@@ -314,13 +318,20 @@ def _drain(rx: Any, tick: int, out: bytearray) -> None:
             return
 
 
+#: What happened to a block (:attr:`BlockReport.outcome`).
+OUTCOME_ACCEPTED = "accepted"  # B answered 0x00
+OUTCOME_GAVE_UP = "gave up"  # max_attempts failed after B had answered once: the block is lost
+OUTCOME_NO_RECEIVER = "no receiver"  # the wait for B's first handshake ran out: block not sent
+OUTCOME_INTERRUPTED = "interrupted"  # ``stop`` was set while the block was in progress
+
+
 @dataclass
 class BlockReport:
     """What happened to one block A sent."""
 
     index: int
     block: bytes
-    outcome: str  # "accepted" or "gave up"
+    outcome: str  # one of the OUTCOME_* strings
     attempts: int
     naks: int = 0
     timeouts: int = 0
@@ -334,7 +345,7 @@ class ReceiverReport:
     error: str | None = None
 
 
-def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
+def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT,
                  gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: int | None = None,
                  duration: float | None = None, on_block: Callable[[bytes], None] | None = None,
                  stop: threading.Event | None = None, eof_after: float | None = None,
@@ -389,16 +400,43 @@ def run_receiver(port: Any, *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
     return rep
 
 
-def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_size: int = BLOCK_DEFAULT,
+def run_sender(port: Any, blocks: Iterable[bytes], *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT,
                syn_timeout_ms: int = DEFAULT_SYN_TIMEOUT_MS,
                answer_timeout_ms: int = DEFAULT_ANSWER_TIMEOUT_MS,
                max_attempts: int = DEFAULT_MAX_ATTEMPTS,
                on_result: Callable[[BlockReport], None] | None = None,
-               stop: threading.Event | None = None) -> tuple[list[BlockReport], dict[str, int]]:
+               stop: threading.Event | None = None,
+               wait_first: float | None = 0.0,
+               on_waiting: Callable[[float], None] | None = None,
+               waiting_every: float = 5.0,
+               on_give_up: GiveUpPolicy = "skip") -> tuple[list[BlockReport], dict[str, int]]:
     """Run sender A on an open ``port`` over ``blocks`` (each ``block_size``
-    bytes). Returns one :class:`BlockReport` per block and A's statistics.
-    Raises :class:`LinkError` if the port fails (reports so far are passed
-    to ``on_result`` first)."""
+    bytes). Returns one :class:`BlockReport` per block handled and A's
+    statistics. Raises :class:`LinkError` if the port fails (reports so far
+    are passed to ``on_result`` first).
+
+    ``wait_first``: seconds A keeps offering its first block until B answers
+    a first handshake (``0xBB``): ``None`` waits for ever, ``0`` (the
+    default, the live-sampler behaviour of the firmware) treats the first
+    block like any other. While waiting, A restarts the block's attempts
+    instead of giving up (no ``gave_up`` is counted: only the unanswered
+    ``0xAA`` as ``timeouts``) and calls ``on_waiting(seconds)`` every
+    ``waiting_every`` seconds. If the wait runs out, the block is reported
+    as ``"no receiver"`` and nothing more is sent.
+
+    ``on_give_up``: what a give-up after B has answered once does:
+    ``"skip"`` reports ``"gave up"`` and moves on to the next block (the
+    firmware's behaviour), ``"fail"`` reports it and sends nothing more
+    (the caller sees the block as the last report).
+
+    If ``stop`` is set while a block is in progress, that block is reported
+    as ``"interrupted"``."""
+    if on_give_up not in GIVE_UP_POLICIES:
+        raise InvalidArgument(f"on_give_up must be one of {GIVE_UP_POLICIES}, got {on_give_up!r}")
+    if wait_first is not None and not (isinstance(wait_first, (int, float)) and wait_first >= 0):
+        raise InvalidArgument(f"wait_first must be None or a number of seconds >= 0, got {wait_first!r}")
+    if not (isinstance(waiting_every, (int, float)) and waiting_every > 0):
+        raise InvalidArgument(f"waiting_every must be a number of seconds > 0, got {waiting_every!r}")
     tx = make_sender(impl, block_size=block_size, syn_timeout=syn_timeout_ms,
                      answer_timeout=answer_timeout_ms, max_attempts=max_attempts)
     clock = _Clock()
@@ -406,19 +444,47 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
     it = iter(blocks)
     cur: BlockReport | None = None
     index = 0
-    while True:
+    # Until B has answered once, a lost handshake means "B not there yet", not a bad line.
+    waiting = wait_first is None or wait_first > 0
+    t_wait0 = time.monotonic()
+    next_note = t_wait0 + waiting_every
+
+    def finish(outcome: str, ok: bool = False) -> None:
+        nonlocal cur
+        assert cur is not None
+        cur.outcome = outcome
+        cur.attempts = cur.naks + cur.timeouts + (1 if ok else 0)
+        reports.append(cur)
+        if on_result is not None:
+            on_result(cur)
+        cur = None
+
+    ended = False
+    while not ended:
         if stop is not None and stop.is_set():
+            if cur is not None:
+                tx.reset()
+                finish(OUTCOME_INTERRUPTED)
             break
         tick = clock()
         out = bytearray()
-        finished = False
+        if waiting and cur is not None:
+            now = time.monotonic()
+            if wait_first is not None and now - t_wait0 >= wait_first:
+                tx.reset()
+                finish(OUTCOME_NO_RECEIVER)
+                break
+            if now >= next_note:
+                next_note = now + waiting_every
+                if on_waiting is not None:
+                    on_waiting(now - t_wait0)
         while True:
             r, o = tx.poll(tick)
             if r is Result.IDLE:
                 try:
                     blk = bytes(next(it))
                 except StopIteration:
-                    finished = True
+                    ended = True
                     break
                 tx.start(blk, tick)
                 cur = BlockReport(index=index, block=blk, outcome="", attempts=0)
@@ -429,19 +495,20 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
                 continue
             if r is Result.TIMEOUT and cur is not None:
                 cur.timeouts += 1
+                if waiting:  # offer the block again, from a fresh set of attempts
+                    tx.reset()
+                    tx.start(cur.block, tick)
                 continue
             if r is Result.GAVE_UP and cur is not None:
-                cur.outcome = "gave up"
-                cur.attempts = cur.naks + cur.timeouts
-                reports.append(cur)
-                if on_result is not None:
-                    on_result(cur)
-                cur = None
+                finish(OUTCOME_GAVE_UP)
+                if on_give_up == "fail":
+                    ended = True
+                    break
                 continue
             break  # NONE
         if out:
             _write(port, bytes(out))
-        if finished:
+        if ended:
             break
         left = tx.ticks_left(clock())
         wait = 0.02 if left is None else min(0.02, max(0.0005, left / 1000.0))
@@ -449,13 +516,10 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: str = "c", block_siz
         tick = clock()
         for b in data:
             r = tx.sink(b, tick)
-            if r is Result.ACCEPTED and cur is not None:
-                cur.outcome = "accepted"
-                cur.attempts = cur.naks + cur.timeouts + 1
-                reports.append(cur)
-                if on_result is not None:
-                    on_result(cur)
-                cur = None
+            if r is Result.SYN_RX:
+                waiting = False  # B is there
+            elif r is Result.ACCEPTED and cur is not None:
+                finish(OUTCOME_ACCEPTED, ok=True)
             elif r is Result.REJECTED and cur is not None:
                 cur.naks += 1
     return reports, tx.stats.as_dict()

@@ -10,10 +10,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..core import FRAME, METHODS
+from ..core import FRAME, METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
-
-PRECISIONS = ("f64", "f32", "fixed")
 
 
 def check_method(method: str) -> None:
@@ -26,7 +24,7 @@ def check_precision(precision: str) -> None:
         raise InvalidArgument(f"precision must be one of {PRECISIONS}, got {precision!r}")
 
 
-def precision_available(precision: str) -> bool:
+def precision_available(precision: Precision) -> bool:
     """Whether the installed core supports ``precision`` (fixed lands later)."""
     import attitude_c
 
@@ -37,8 +35,8 @@ def precision_available(precision: str) -> bool:
     return True
 
 
-def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.ndarray],
-                   precision: str, h: float) -> tuple[np.ndarray, np.ndarray, float]:
+def run_integrator(dtheta: np.ndarray, method: Method, q0_at: Callable[[float], np.ndarray],
+                   precision: Precision, h: float) -> tuple[np.ndarray, np.ndarray, float]:
     """Integrate increments (n, 3) of period h.
 
     ``q0_at(offset)`` gives the initial attitude ``offset`` periods after the
@@ -77,7 +75,7 @@ def run_integrator(dtheta: np.ndarray, method: str, q0_at: Callable[[float], np.
     if n_use == 0:
         return empty
     q = np.asarray(attitude_c.integrate(dtheta[:n_use], method=method, q0=q0_at(0.0),
-                                        precision=precision), dtype=float)
+                                        precision=precision), dtype=np.float64)
     m = len(q)
     if m * k == n_use:
         last = np.arange(1, m + 1) * k - 1

@@ -31,6 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..core import Method
 from ..errors import InvalidArgument
 from . import _integ
 from ._rot import quat_angle_between
@@ -85,7 +86,7 @@ def _stage_configs(base: SimConfig, ber: float) -> list[tuple[str, SimConfig]]:
     ]
 
 
-def run_budget(base: SimConfig, methods: tuple[str, ...] = _integ.METHODS, ber: float = 1e-3,
+def run_budget(base: SimConfig, methods: tuple[Method, ...] = _integ.METHODS, ber: float = 1e-3,
                progress: Callable[[str, int, int], None] | None = None) -> BudgetResult:
     """Run every stage for every method on the scenario of ``base``."""
     stages = _stage_configs(base, ber)

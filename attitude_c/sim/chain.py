@@ -9,11 +9,11 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Literal, get_args
 
 import numpy as np
 
-from .. import __version__
+from ..core import Method, Precision
 from ..errors import InvalidArgument
 from . import _integ
 from ._rot import quat_angle_between, quat_to_euler, wrap_angle
@@ -33,10 +33,19 @@ from .trajectory import PaperTrajectory, Trajectory
 
 __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "acquire", "simulate"]
 
+
+def _package_version() -> str:
+    """attitude_c.__version__ (read at use: the package resolves it lazily)."""
+    import attitude_c
+
+    return attitude_c.__version__
+
+
 # The paper's reported error extremes at a 0.08 s period (sec. 4, Fig. 8), rad.
 PAPER_MAXIMA = {"heading": (-0.05, 0.12), "pitch": (-0.10, 0.15)}
 
-SENSOR_MODES = ("ideal", "quantized", "full")
+SensorMode = Literal["ideal", "quantized", "full"]
+SENSOR_MODES: tuple[SensorMode, ...] = get_args(SensorMode)
 
 Progress = Callable[[str, int, int], None]
 
@@ -57,15 +66,15 @@ class SimConfig:
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
     duration: float = 60.0
     period: float = 0.08
-    method: str = "rv3"
-    precision: str = "f64"
-    sensors: str = "full"
+    method: Method = "rv3"
+    precision: Precision = "f64"
+    sensors: SensorMode = "full"
     gyro: GyroModel = field(default_factory=lambda: gyro_preset("cg-l53"))
     conditioning: Conditioning = field(default_factory=Conditioning)
     adc: AdcModel = field(default_factory=AdcModel)
     board: Board = field(default_factory=Board)
     calibration_s: float = 60.0
-    link: str = "c"
+    link: Literal["c", "none"] = "c"
     ber: float = 0.0
     link_attempts: int = 5
     seed: int = 0
@@ -81,6 +90,10 @@ class SimConfig:
         if self.duration < self.period:
             raise InvalidArgument(f"duration ({self.duration} s) must be at least one period "
                                   f"({self.period} s)")
+        span = getattr(self.trajectory, "span", None)  # a trajectory from data ends somewhere
+        if span is not None and self.duration > span * (1 + 1e-9):
+            raise InvalidArgument(f"duration ({self.duration:g} s) is longer than the trajectory's data "
+                                  f"({span:g} s): the run would hold the last attitude, not measure")
         if self.duration / self.period > 2_000_000:
             raise InvalidArgument("duration/period above 2e6 samples: choose a shorter run")
         if self.sensors not in SENSOR_MODES:
@@ -301,7 +314,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     err = wrap_angle(e_est - e_true)
     err_angle = quat_angle_between(q_true, q_est) if len(q_est) else np.zeros(0)
     summary: dict[str, Any] = {
-        "attitude_c_version": __version__,
+        "attitude_c_version": _package_version(),
         "parameters": cfg.params(),
         "updates": len(t_out),
         "samples": int(n),

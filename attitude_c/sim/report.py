@@ -12,7 +12,7 @@ import numpy as np
 
 from .chain import PAPER_MAXIMA, SimResult
 
-__all__ = ["format_table", "plot_attitude", "plot_errors", "to_jsonable", "write_run"]
+__all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "to_jsonable", "write_run"]
 
 
 def to_jsonable(x: Any) -> Any:
@@ -104,6 +104,23 @@ def write_csv(res: SimResult, path: Path) -> None:
             w.writerow([f"{v:.6f}" if j == 0 else f"{v:.12e}" for j, v in enumerate(row)])
 
 
+def format_ratio(ratio: float) -> str:
+    """The paper's maximum over ours, for a table: the true ratio, truncated
+    (never rounded up): ``212.9 -> "212"``, ``3.46 -> "3.4"``, ``0.996 ->
+    "0.99"`` (worse than the paper stays below 1), ``0.138 -> "0.13"``."""
+    from decimal import ROUND_DOWN, Decimal
+
+    if not math.isfinite(ratio):
+        return "inf" if ratio > 0 else "nan"
+    if ratio <= 0:
+        return "0"
+    d = Decimal(repr(float(ratio)))
+    if d >= 10:
+        return str(int(d))  # int() truncates
+    q = d.quantize(Decimal(1).scaleb(d.adjusted() - 1), rounding=ROUND_DOWN)  # 2 significant digits
+    return format(q.normalize(), "f") if q >= Decimal("0.001") else f"{float(q):.1e}"
+
+
 def format_table(summary: dict[str, Any]) -> str:
     e = summary["errors_rad"]
     p = summary["parameters"]
@@ -120,8 +137,10 @@ def format_table(summary: dict[str, Any]) -> str:
         pm = summary["paper_maxima_rad"].get(key)
         pm_s = f"{pm:>12.2f}" if pm is not None else f"{'':>12}"
         b = better.get(key)
-        b_s = f"{b:>10.0f}" if b is not None else f"{'':>10}"
+        b_s = f"{format_ratio(b):>10}" if b is not None else f"{'':>10}"
         lines.append(f"{key:<16}{s['max']:>12.3e}{s['min']:>12.3e}{s['rms']:>12.3e}{pm_s}{b_s}")
+    if any(v < 1 for v in better.values()):
+        lines.append("(× better below 1: the error is larger than the paper's maximum)")
     lk = summary.get("link", {})
     if lk.get("link") == "c":
         lines += ["", (f"link ({lk.get('backend')}, BER {lk.get('ber', 0):g}): sent {lk.get('sent')}, "

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, replace
-from typing import Any, Callable
+from typing import Any, Callable, Literal
 
 import numpy as np
 
@@ -138,7 +138,7 @@ class AdcModel:
 
     vref: float = 5.0
     bits: int = 12
-    backend: str = "tlc2543"
+    backend: Literal["tlc2543", "ideal"] = "tlc2543"
 
     def convert(self, volts: np.ndarray, progress: Callable[[int], None] | None = None) -> np.ndarray:
         """(n, 3) voltages of channels X, Y, Z → (n, 3) integer codes."""
@@ -161,7 +161,7 @@ class Board:
 
     oversample: int = 16
     delay_comp: bool = True
-    sample_at: str = "mid"  # "mid": sub-interval midpoints; "start": their starts
+    sample_at: Literal["mid", "start"] = "mid"  # "mid": sub-interval midpoints; "start": their starts
 
     def check(self, bits: int) -> None:
         if self.sample_at not in ("mid", "start"):

@@ -21,7 +21,7 @@ import csv
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -270,7 +270,9 @@ class CsvTrajectory(Trajectory):
     seconds. Between two rows the attitude moves at the constant body rate
     that takes one row to the next (spherical linear interpolation), so the
     truth, the body rates and the increments are exactly consistent. Before
-    the first row the body is at rest; after the last it stays still.
+    the first row the body is at rest (the static calibration); a run may
+    not go past the last row (``SimConfig.validate`` checks the duration
+    against :attr:`span`).
     """
 
     def __init__(self, path: str | Path) -> None:
@@ -344,6 +346,11 @@ class CsvTrajectory(Trajectory):
         # cumulative integral of ω at the rows (piecewise linear in between)
         self._cum = np.vstack([np.zeros(3), np.cumsum(rv, axis=0)])
 
+    @property
+    def span(self) -> float:
+        """Seconds the file covers (first to last row): the longest run it can drive."""
+        return self.t_end - self.t_start
+
     def _seg(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         tc = np.clip(t, self.t[0], self.t[-1])
         i = np.clip(np.searchsorted(self.t, tc, side="right") - 1, 0, len(self.t) - 2)
@@ -375,10 +382,11 @@ class CsvTrajectory(Trajectory):
                 "t_start": self.t_start, "t_end": self.t_end}
 
 
-TRAJECTORIES = ("paper", "coning", "static", "constant-rate", "csv")
+TrajectoryKind = Literal["paper", "coning", "static", "constant-rate", "csv"]
+TRAJECTORIES: tuple[TrajectoryKind, ...] = get_args(TrajectoryKind)
 
 
-def make_trajectory(kind: str, **kw: Any) -> Trajectory:
+def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
     """Build a trajectory by name (``paper``, ``coning``, ``static``,
     ``constant-rate``, ``csv`` with ``path=``)."""
     if kind == "paper":

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import datetime
 import importlib
+import itertools
 import platform
 import shutil
 import sys
@@ -15,11 +16,58 @@ ROOT = Path(__file__).resolve().parents[2]
 BENCH_DOC = ROOT / "docs" / "benchmarks.md"
 
 
+def _version_tuple(text: str) -> tuple[int, ...]:
+    out = []
+    for part in text.split("."):
+        digits = "".join(itertools.takewhile(str.isdigit, part))
+        if not digits:
+            break
+        out.append(int(digits))
+    return tuple(out)
+
+
+def build_requirements_met(reqs: list[str] | None = None) -> bool:
+    """True if this interpreter already has every requirement of ``reqs``
+    (default: pyproject.toml's ``[build-system] requires``) at a good
+    version. Only ``name`` and ``name>=X`` are understood; anything else
+    counts as not met."""
+    import re
+    from importlib import metadata
+
+    if reqs is None:
+        if sys.version_info >= (3, 11):
+            import tomllib
+        else:  # pragma: no cover
+            import tomli as tomllib
+        reqs = tomllib.loads((ROOT / "pyproject.toml").read_text())["build-system"]["requires"]
+    for req in reqs:
+        m = re.fullmatch(r"\s*([A-Za-z0-9_.-]+)\s*(?:>=\s*([0-9][0-9.]*))?\s*", req)
+        if m is None:
+            return False
+        try:
+            have = metadata.version(m.group(1))
+        except metadata.PackageNotFoundError:
+            return False
+        if m.group(2) and _version_tuple(have) < _version_tuple(m.group(2)):
+            return False
+    return True
+
+
 @task(help={"force": "rebuild the CFFI extensions even if up to date"})
 def build(c, force=False):
-    """Build the Python package and its CFFI extensions in place (editable install)."""
+    """Build the Python package and its CFFI extensions in place (editable install).
+
+    pip builds in an isolated environment with pyproject's build requirements
+    (setuptools >= 77 for the SPDX license field), fetched from the index:
+    that works on a fresh machine whose own setuptools is older. When this
+    interpreter already has them, the build reuses them (--no-build-isolation:
+    faster, and works offline)."""
+    isolation = "" if build_requirements_met() else " (isolated build environment)"
+    flags = "--no-build-isolation " if not isolation else ""
+    print(f"build: pip install -e .{isolation}", flush=True)
     with c.cd(str(ROOT)):
-        c.run(f"{sys.executable} -m pip install -q --no-build-isolation -e .{' --force-reinstall --no-deps' if force else ''}")
+        c.run(f"{sys.executable} -m pip install -q {flags}-e ."
+              f"{' --force-reinstall --no-deps' if force else ''}")
 
 
 @task(help={
@@ -56,7 +104,7 @@ def lint(c):
 
 
 C_FORMAT_GLOBS = ("csrc/**/*.[ch]", "firmware/**/*.[ch]", "bench/*.c", "tests/*.c", "tests/s51/*.c",
-                  "toolchain/*.[ch]")
+                  "tests/consumer/*.c", "toolchain/*.[ch]")
 
 
 def _c_format_files() -> list[str]:

@@ -11,16 +11,18 @@ Produces in ``build/NAME/``:
   to the .pc file, so ``PKG_CONFIG_PATH=build/NAME pkg-config --cflags
   --libs attitude`` works wherever the tree is);
 * on ``armv4t``/``armv4t-bare``: the ARMv4T instruction check of every
-  object (toolchain/armv4t_check.py); the build fails on a violation.
+  object and of the linked ``libattitude.so`` (toolchain/armv4t_check.py);
+  the build fails on a violation.
 
 The build is done from Python (not by calling make) so that every
-target, including SDCC, uses exactly the flags of its TOML file.
+target, including SDCC, uses exactly the flags of its TOML file;
+``make TARGET=NAME`` and cmake/NAME-toolchain.cmake use the same ones
+(generated from the TOML files by toolchain/buildfiles.py).
 """
 
 from __future__ import annotations
 
 import os
-import re
 import shutil
 import subprocess
 from collections.abc import Sequence
@@ -28,16 +30,19 @@ from pathlib import Path
 
 from invoke import task
 
+from attitude_c._build import version as _version
 from toolchain import targets as T
+from toolchain.buildfiles import shared_ldflags
 
 ROOT = T.ROOT
 APP_DIR = ROOT / "csrc" / "app"
-SOVERSION = "0"
+#: N of the soname libattitude.so.N (csrc/include/attitude/version.h).
+SOVERSION = str(_version.read()["SO"])
 
 
 def version() -> str:
-    m = re.search(r'^version\s*=\s*"([^"]+)"', (ROOT / "pyproject.toml").read_text(), re.MULTILINE)
-    return m.group(1) if m else "0.0.0"
+    """MAJOR.MINOR.PATCH from csrc/include/attitude/version.h, the one source."""
+    return _version.version()
 
 
 def _run(cmd: Sequence[str], verbose: bool) -> None:
@@ -81,6 +86,14 @@ def pc_text(t: T.Target, defines: Sequence[str], libs: Sequence[str]) -> str:
     )
 
 
+def shared_link_cmd(t: T.Target, objs: Sequence[Path], real: Path) -> list[str]:
+    """The link of libattitude.so: the target's flags, its program link flags
+    without the program-only ones, its ``shared_ldflags``, then the libraries
+    (armv4t: the ARMv4T libgcc.a, -lm, -lc; toolchain/armv4t.toml)."""
+    return [t.cc, *t.cflags, "-shared", f"-Wl,-soname,libattitude.so.{SOVERSION}", *map(str, objs),
+            "-o", str(real), *shared_ldflags(t), *t.shared_ldflags, *t.shared_link_libs()]
+
+
 def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = None,
                        verbose: bool = False) -> dict[str, Path]:
     """Build target ``name`` into ``out`` (default build/NAME); returns the products."""
@@ -111,9 +124,7 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
     if t.shared and t.kind == "gcc":
         pobjs = _compile_all(t, srcs, out / "obj-pic", t.pic_flags, defines, verbose)
         real = out / f"libattitude.so.{version()}"
-        ldflags = [f for f in t.ldflags if f != "-static"]
-        _run([t.cc, *t.cflags, "-shared", f"-Wl,-soname,libattitude.so.{SOVERSION}",
-              *pobjs, "-o", real, *ldflags, *t.libs], verbose)
+        _run(shared_link_cmd(t, pobjs, real), verbose)
         for link in (f"libattitude.so.{SOVERSION}", "libattitude.so"):
             (out / link).symlink_to(real.name)
         products["shared"] = out / "libattitude.so"
@@ -140,7 +151,8 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
     if "armv4t" in t.checks:
         from toolchain.armv4t_check import check_objects
 
-        vs = check_objects([lib, *app_objs], objdump=t.objdump or t.tool("objdump"))
+        shared = [products["shared"].resolve()] if "shared" in products else []
+        vs = check_objects([lib, *shared, *app_objs], objdump=t.objdump or t.tool("objdump"))
         if vs:
             raise BuildError(f"target {name}: {len(vs)} instruction(s) the ARM920T cannot execute:\n"
                              + "\n".join(map(str, vs)))
@@ -164,7 +176,7 @@ def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
     for kind, p in products.items():
         rel = os.path.relpath(p, ROOT)
         if kind == "armv4t_check":
-            print("  ARMv4T check: every object is ARMv4T clean")
+            print("  ARMv4T check: every object and libattitude.so are ARMv4T clean")
         else:
             print(f"  {kind:8s} {rel}")
 

@@ -6,6 +6,7 @@
 #define ATTITUDE_ATTITUDE_H
 
 #include "attitude/common.h"
+#include "attitude/version.h"
 #include "attitude/tlc2543.h"
 #include "attitude/quat.h"
 #include "attitude/integrator.h"

@@ -1,0 +1,16 @@
+# GENERATED from toolchain/host-asan.toml by `python -m toolchain.buildfiles`: do not edit.
+# Host build with AddressSanitizer + UndefinedBehaviorSanitizer (C test programs).
+#
+#   cmake -S . -B build/cmake-host-asan -DCMAKE_TOOLCHAIN_FILE=cmake/host-asan-toolchain.cmake
+#
+
+set(CMAKE_C_COMPILER gcc)
+
+# The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.
+set(CMAKE_C_FLAGS_INIT "-O1 -g -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "-fsanitize=address,undefined")
+set(CMAKE_SHARED_LINKER_FLAGS_INIT "-fsanitize=address,undefined")
+
+# What this target builds (toolchain/<name>.toml shared/app).
+set(ATT_BUILD_SHARED OFF CACHE BOOL "build libattitude.so as well as libattitude.a")
+set(ATT_BUILD_APP OFF CACHE BOOL "build the attitude-rx receiver app")
