@@ -10,6 +10,7 @@ of attitude_c answer the imports instead of the wheel.
 
 from __future__ import annotations
 
+import importlib.metadata
 import importlib.util
 import json
 import os
@@ -54,12 +55,15 @@ def _clean_env() -> dict[str, str]:
 
 @pytest.mark.slow
 def test_sdist_wheel_fresh_venv_smoke(tmp_path: Path) -> None:
-    if importlib.util.find_spec("build") is None:
+    try:  # by its metadata: a build/ output folder on sys.path would fool find_spec
+        importlib.metadata.version("build")
+    except importlib.metadata.PackageNotFoundError:
         _missing("needs the 'build' package: pip install -e '.[test]'")
     src = clean_copy(tmp_path / "src", ".")
     dist = tmp_path / "dist"
     # builds the sdist, then the wheel from the unpacked sdist (not from the tree)
-    _run([sys.executable, "-m", "build", "--outdir", dist, src], env=_clean_env(), timeout=600)
+    _run([sys.executable, "-m", "build", "--outdir", dist, src], cwd=tmp_path, env=_clean_env(),
+         timeout=600)
     sdist = next(dist.glob("attitude_c-*.tar.gz"))
     wheel = next(dist.glob("attitude_c-*.whl"))
 

@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .. import core
 
 
 def register(subparsers: Any) -> None:
@@ -32,7 +35,7 @@ def register(subparsers: Any) -> None:
 
 
 def coning_drifts(beta: float, omega: float, T: float, seconds: float,
-                  precision: str = "f64") -> dict[str, tuple[int, float, float]]:
+                  precision: core.Precision = "f64") -> dict[str, tuple[int, float, float]]:
     """Every method of :data:`attitude_c.METHODS` under classical coning
     (half-angle ``beta`` rad, rate ``omega`` rad/s), sampled every ``T`` s
     for ``seconds``: ``{method: (updates, final error angle (rad), drift
@@ -46,7 +49,7 @@ def coning_drifts(beta: float, omega: float, T: float, seconds: float,
     n = round(seconds / T)
     d, t = ref.coning_increments(beta, omega, T, n)
     q0 = ref.coning_attitude(beta, omega, 0.0)
-    out = {}
+    out: dict[str, tuple[int, float, float]] = {}
     for m in core.METHODS:
         if m == "rk4":
             q = core.integrate_rates(ref.coning_rates(beta, omega, t), T, "rk4", q0=q0,
