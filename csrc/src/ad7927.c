@@ -201,7 +201,7 @@ static int wake(ad7927 *dev, uint16_t tx)
 
 int ad7927_power_up(ad7927 *dev)
 {
-    uint16_t tx[2], rx[2];
+    uint16_t tx[1], rx[1];
     int st;
     if (dev == 0) {
         return ATT_E_NULL;
@@ -209,14 +209,16 @@ int ad7927_power_up(ad7927 *dev)
     dev->flags = 0u;
     dev->seq_len = 0u;
     dev->pending = AD7927_NO_CHANNEL;
-    /* Two frames with DIN high. Whatever the part woke in, the second one
-     * is a control write of 0xFFF (the first may have gone to a pending
-     * shadow-register load): normal power, range 0..REFIN, straight
-     * binary, consecutive sequence VIN0..VIN7. The part powers up on that
-     * CS rising edge if it was shut down: t_POWER-UP before the next frame. */
+    /* Two frames with DIN high. Whatever the part woke in, one of them is
+     * a control write of 0xFFF (the first may go to a pending shadow-register
+     * load): normal power, range 0..REFIN, straight binary, consecutive
+     * sequence VIN0..VIN7. If the part was shut down it powers up on the CS
+     * rising edge of that write: each frame is followed by t_POWER-UP. */
     tx[0] = 0xFFFFu;
-    tx[1] = 0xFFFFu;
-    st = xfer(dev, tx, rx, 2u, AD7927_T_POWER_UP_NS);
+    st = xfer(dev, tx, rx, 1u, AD7927_T_POWER_UP_NS);
+    if (st == ATT_OK) {
+        st = xfer(dev, tx, rx, 1u, AD7927_T_POWER_UP_NS);
+    }
     if (st != ATT_OK) {
         return st;
     }

@@ -174,12 +174,13 @@ typedef struct {
 int ad7927_init(ad7927 *dev, const ad7927_hal *hal, const ad7927_settings *settings);
 
 /* The power-up sequence (datasheet "Powering up the AD7927"): two frames
- * with DIN high (all ones: whatever state the part woke in, the second one
- * is a control write of 0xFFF: normal power, consecutive sequence 0..7),
- * CS held high t_POWER-UP, then the control write of the configured mode
+ * with DIN high (all ones: whatever state the part woke in, one of them is
+ * a control write of 0xFFF: normal power, consecutive sequence 0..7), each
+ * followed by t_POWER-UP with CS high (that write may be the one that
+ * leaves full shutdown), then the control write of the configured mode
  * selecting VIN0. The third frame's output must be the VIN0 conversion of
  * that all-ones sequence (checked: AD7927_E_FRAME / AD7927_E_CHANNEL); the
- * next frame converts VIN0 in the configured mode. 3 frames. */
+ * next frame converts VIN0 in the configured mode. 3 frames, 3 transfers. */
 int ad7927_power_up(ad7927 *dev);
 
 /* Read channels[0..n-1] (0..7, n = 1..AD7927_MAX_SCAN) into codes[0..n-1]
