@@ -10,7 +10,9 @@
 # Honoured variables: CROSS_COMPILE, CC, AR, CFLAGS, CPPFLAGS, LDFLAGS,
 # TARGET_CFLAGS (architecture flags), PREFIX, DESTDIR, LIBDIR, INCLUDEDIR,
 # BINDIR, PKGCONFIGDIR, BUILDDIR, PRECISION (f64|f32), STATIC_APP (1 = link
-# attitude-rx statically, 0 = against libattitude.so), SHARED (0 = no .so).
+# attitude-rx statically, 0 = against libattitude.so), SHARED (0 = no .so),
+# PLATFORM (linux = build csrc/platform/linux into the library, e.g. the
+# AD7927 spidev HAL; empty = the portable library only).
 #
 # Products (in $(BUILDDIR)): libattitude.a, libattitude.so(.0, .VERSION),
 # attitude-rx, attitude.pc.
@@ -36,6 +38,7 @@ BUILDDIR     ?= build/make
 PRECISION    ?= f64
 STATIC_APP   ?= 1
 SHARED       ?= 1
+PLATFORM     ?= linux
 
 CFLAGS       ?= -O2
 TARGET_CFLAGS ?=
@@ -49,14 +52,21 @@ else
 $(error PRECISION must be f64 or f32, not '$(PRECISION)')
 endif
 
+# Platform code (HALs on the OS's drivers), if any for PLATFORM.
+PLAT_DIR  := csrc/platform/$(PLATFORM)
+PLAT_SRCS := $(if $(PLATFORM),$(sort $(wildcard $(PLAT_DIR)/src/*.c)))
+PLAT_INC  := $(if $(PLAT_SRCS),-I$(PLAT_DIR)/include)
+
 # Flags the library needs whatever the user's CFLAGS say.
-ATT_CFLAGS := -std=c99 -Wall -Wextra -Wpedantic -Icsrc/include $(PREC_DEFS)
+ATT_CFLAGS := -std=c99 -Wall -Wextra -Wpedantic -Icsrc/include $(PLAT_INC) $(PREC_DEFS)
 
 LIB_SRCS := $(sort $(wildcard csrc/src/*.c))
 APP_SRCS := $(sort $(wildcard csrc/app/*.c))
-HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h))
-LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.o)
-PIC_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj-pic/%.o)
+HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h) \
+                   $(if $(PLAT_SRCS),$(wildcard $(PLAT_DIR)/include/attitude/*.h)))
+LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.o) $(PLAT_SRCS:$(PLAT_DIR)/src/%.c=$(BUILDDIR)/obj/%.o)
+PIC_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj-pic/%.o) \
+            $(PLAT_SRCS:$(PLAT_DIR)/src/%.c=$(BUILDDIR)/obj-pic/%.o)
 APP_OBJS := $(APP_SRCS:csrc/app/%.c=$(BUILDDIR)/obj-app/%.o)
 
 STATIC_LIB := $(BUILDDIR)/libattitude.a
@@ -80,6 +90,14 @@ $(BUILDDIR)/obj/%.o: csrc/src/%.c $(HEADERS)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
 $(BUILDDIR)/obj-pic/%.o: csrc/src/%.c $(HEADERS)
+	@mkdir -p $(@D)
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
+
+$(BUILDDIR)/obj/%.o: $(PLAT_DIR)/src/%.c $(HEADERS)
+	@mkdir -p $(@D)
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(BUILDDIR)/obj-pic/%.o: $(PLAT_DIR)/src/%.c $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
 
