@@ -129,14 +129,15 @@ int ad7927_spidev_close(ad7927_spidev *s)
 
 int ad7927_spidev_transfer(void *ctx, const uint16_t *tx, uint16_t *rx, uint8_t n, uint32_t hold_ns)
 {
+    static const struct spi_ioc_transfer zero; /* unused fields must be zero */
     ad7927_spidev *s = (ad7927_spidev *)ctx;
     uint8_t i;
     int r;
     if (s == 0 || tx == 0 || rx == 0 || n == 0u || n > AD7927_MAX_FRAMES) {
         return -1;
     }
-    memset(s->xfer, 0, (size_t)n * sizeof s->xfer[0]); /* unused fields must be zero */
     for (i = 0u; i < n; i++) {
+        s->xfer[i] = zero;
         s->tx[2u * i] = (uint8_t)(tx[i] >> 8); /* MSB first on the wire */
         s->tx[2u * i + 1u] = (uint8_t)(tx[i] & 0xFFu);
         s->xfer[i].tx_buf = (uint64_t)(uintptr_t)&s->tx[2u * i];
@@ -146,9 +147,8 @@ int ad7927_spidev_transfer(void *ctx, const uint16_t *tx, uint16_t *rx, uint8_t 
         s->xfer[i].bits_per_word = 8u;
         s->xfer[i].cs_change = (uint8_t)(i + 1u < n); /* CS high between frames, not after the last */
     }
-    errno = 0;
     r = s->os.ioctl(s->os.ctx, s->fd, SPI_IOC_MESSAGE(n), s->xfer);
-    if (r < 0 || r != 2 * (int)n) {
+    if (r != 2 * (int)n) { /* -1 and errno, or a short transfer (EIO) */
         s->last_errno = (r < 0 && errno != 0) ? errno : EIO;
         return -1;
     }
