@@ -27,6 +27,7 @@ from typing import Any, Callable, Literal
 
 import numpy as np
 
+from .._devmodel import check_inputs, check_level, convert_in_chunks
 from ..errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 from . import _capi
 from ._errors import AddressMismatch, FrameError
@@ -91,14 +92,6 @@ THESIS_BOARD = Board(spi_hz=9_260_000, refin=2.5, range_double=True, channels={
     "accel_x": 4, "accel_y": 5, "accel_z": 6, "ref_2v5": 7})
 
 
-def _check_level(name: str, v: int | None) -> int:
-    if v is None:
-        return -1
-    if isinstance(v, float) or v not in (0, 1):
-        raise InvalidArgument(f"{name} must be None, 0 or 1, got {v!r}")
-    return int(v)
-
-
 def _check_hal(hal: str) -> bool:
     if hal not in ("pins", "frames"):
         raise InvalidArgument(f"hal must be 'pins' or 'frames', got {hal!r}")
@@ -133,8 +126,8 @@ class CTwin:
             raise InvalidArgument(f"powerup_control must be a 12-bit word, got {powerup_control!r}")
         st = lib.ad7927m_init(self._m, float(refin), int(powerup_control), 1 if powerup_shadow else 0)
         raise_for_status(st, "CTwin(refin, powerup_control)")
-        self._m.stuck_dout = _check_level("stuck_dout", stuck_dout)
-        self._m.stuck_din = _check_level("stuck_din", stuck_din)
+        self._m.stuck_dout = check_level("stuck_dout", stuck_dout)
+        self._m.stuck_din = check_level("stuck_din", stuck_din)
         if not 0 <= int(address_xor) <= 7:
             raise InvalidArgument(f"address_xor must be 0..7, got {address_xor!r}")
         self._m.address_xor = int(address_xor)
@@ -148,12 +141,7 @@ class CTwin:
         self.set_inputs(inputs)
 
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        v = np.ascontiguousarray(np.asarray(inputs, dtype=float).reshape(-1))
-        if v.size > 8:
-            raise InvalidArgument(f"inputs: at most 8 channels (VIN0..VIN7), got {v.size}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise NonFiniteError(f"inputs: VIN{bad} is not finite ({v[bad]})", index=bad)
+        v = check_inputs(inputs, 8, "VIN")
         st = self._lib.ad7927m_set_inputs(self._m, self._ffi.cast("double *", v.ctypes.data), v.size)
         raise_for_status(st, "CTwin.set_inputs(inputs)")
 
@@ -373,36 +361,18 @@ def convert(volts: np.ndarray, refin: float = 2.5, *, channels: Sequence[int] | 
     bad_rows = np.flatnonzero(~np.all(np.isfinite(v), axis=1))
     if bad_rows.size:
         raise NonFiniteError(f"volts: row {int(bad_rows[0])} holds NaN or Inf", index=int(bad_rows[0]))
-    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
-        raise InvalidArgument(f"chunk must be a positive int, got {chunk!r}")
-
     twin = CTwin(refin=refin, stuck_dout=stuck_dout, stuck_din=stuck_din, address_xor=address_xor,
                  trace_capacity=0, frames_capacity=0, precision=precision)
     drv = Ad7927(twin, hal=hal, range_double=range_double, twos_complement=twos_complement,
                  precision=precision)
     ffi, lib = drv._ffi, drv._lib
-    out = np.zeros((n, k), dtype=np.int32)
     cbuf = ffi.new("uint8_t[]", chans)
     done = ffi.new("size_t *")
-    row = 0
-    first = True
-    while first or row < n:
-        m = min(chunk, n - row)
-        vin = v[row:row + m]
-        st = lib.ad7927m_convert(twin._m, drv._dev, cbuf, k, ffi.cast("double *", vin.ctypes.data), m,
-                                 ffi.cast("int32_t *", out[row:].ctypes.data),
+
+    def step(row: int, m: int, first: bool, out: np.ndarray) -> tuple[int, int]:
+        st = lib.ad7927m_convert(twin._m, drv._dev, cbuf, k, ffi.cast("double *", v[row:row + m].ctypes.data),
+                                 m, ffi.cast("int32_t *", out[row:].ctypes.data),
                                  1 if mode == "sequence" else 0, 1 if first else 0, done)
-        first = False
-        row += int(done[0])
-        if st != 0:
-            try:
-                drv._after(st, "ad7927 convert")
-            except Exception as exc:  # attach what was converted before the error
-                exc.codes = out[:row].astype(np.int64)  # type: ignore[attr-defined]
-                exc.rows_done = row  # type: ignore[attr-defined]
-                raise
-        if progress is not None and m:
-            progress(row)
-        if m == 0:
-            break
-    return out.astype(np.int64)
+        return int(st), int(done[0])
+
+    return convert_in_chunks(n, k, chunk, step, lambda st: drv._after(st, "ad7927 convert"), progress)

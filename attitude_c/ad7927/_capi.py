@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from .. import _devmodel
 from .._bridge import Bridge
 from .._lib import ffi_lib
 from ..errors import DeviceError
@@ -94,14 +95,11 @@ def status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
 
 def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
     """The C twin's latched violation as a ProtocolViolation (or None)."""
-    if m.violation == 0:
-        return None
-    return ProtocolViolation(RULES[m.violation - 1], ffi.string(m.message).decode(), int(m.violation_t))
+    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
 
 
 def twin_trace(m: Any) -> list[tuple[int, str, int]]:
-    return [(int(m.trace[i].t), SIGNALS[m.trace[i].signal], int(m.trace[i].value))
-            for i in range(m.trace_len)]
+    return _devmodel.twin_trace(m, SIGNALS)
 
 
 def frame_log(m: Any) -> list[Frame]:

@@ -63,7 +63,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DeviceError, InvalidArgument, NonFiniteError
+from .._devmodel import ProtocolViolationBase, check_inputs, check_level
+from ..errors import InvalidArgument
 
 #: Trace signal names, in the order of the C twin's codes.
 SIGNALS = ("CS", "SCLK", "DIN", "DOUT", "DOUT?")
@@ -95,16 +96,13 @@ POWERUP_CONTROL = PM_FULL << 4
 GARBAGE = 0x5A5A
 
 
-class ProtocolViolation(DeviceError):
+class ProtocolViolation(ProtocolViolationBase):
     """The driver broke an AD7927 protocol or timing rule.
 
     ``rule`` is one of :data:`RULES`; ``time_ns`` is the model time.
     """
 
-    def __init__(self, rule: str, message: str, time_ns: int) -> None:
-        super().__init__(f"AD7927 protocol violation [{rule}] at t={time_ns} ns: {message}")
-        self.rule = rule
-        self.time_ns = time_ns
+    device = "AD7927"
 
 
 @dataclass(frozen=True)
@@ -168,9 +166,8 @@ class Ad7927Model:
                  sclk_period_ns: int = 108, record: bool = True) -> None:
         if not (isinstance(refin, (int, float)) and math.isfinite(refin) and refin > 0):
             raise InvalidArgument(f"refin must be a positive finite voltage, got {refin!r}")
-        for name, v in (("stuck_dout", stuck_dout), ("stuck_din", stuck_din)):
-            if v is not None and v not in (0, 1):
-                raise InvalidArgument(f"{name} must be None, 0 or 1, got {v!r}")
+        check_level("stuck_dout", stuck_dout)
+        check_level("stuck_din", stuck_din)
         if not 0 <= int(address_xor) <= 7:
             raise InvalidArgument(f"address_xor must be 0..7, got {address_xor!r}")
         if not 0 <= int(powerup_control) <= 0xFFF or (powerup_control >> 4) & 3 == 0:
@@ -222,12 +219,7 @@ class Ad7927Model:
 
     # -- configuration -----------------------------------------------------
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        v = np.asarray(inputs, dtype=float).reshape(-1)
-        if v.size > 8:
-            raise InvalidArgument(f"inputs: at most 8 channels (VIN0..VIN7), got {v.size}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise NonFiniteError(f"inputs: VIN{bad} is not finite ({v[bad]})", index=bad)
+        v = check_inputs(inputs, 8, "VIN")
         self.inputs[: v.size] = v
 
     # -- helpers -----------------------------------------------------------

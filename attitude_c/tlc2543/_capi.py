@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from .. import _devmodel
 from .._bridge import Bridge
 from .._lib import ffi_lib
 from .model import RULES, SIGNALS, ProtocolViolation
@@ -65,12 +66,8 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge) -> tuple[Any, Any]:
 
 def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
     """The C twin's latched violation as a ProtocolViolation (or None)."""
-    if m.violation == 0:
-        return None
-    rule = RULES[m.violation - 1]
-    return ProtocolViolation(rule, ffi.string(m.message).decode(), int(m.violation_t))
+    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
 
 
 def twin_trace(m: Any) -> list[tuple[int, str, int]]:
-    return [(int(m.trace[i].t), SIGNALS[m.trace[i].signal], int(m.trace[i].value))
-            for i in range(m.trace_len)]
+    return _devmodel.twin_trace(m, SIGNALS)

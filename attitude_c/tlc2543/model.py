@@ -40,7 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DeviceError, InvalidArgument, NonFiniteError
+from .._devmodel import ProtocolViolationBase, check_inputs, check_level
+from ..errors import InvalidArgument, NonFiniteError
 
 #: Trace signal names, in the order of the C twin's codes.
 SIGNALS = ("CS", "CLOCK", "DIN", "DOUT", "EOC", "DOUT?", "EOC?")
@@ -67,16 +68,13 @@ RULES = (
 )
 
 
-class ProtocolViolation(DeviceError):
+class ProtocolViolation(ProtocolViolationBase):
     """The driver broke a TLC2543 protocol or timing rule.
 
     ``rule`` is one of :data:`RULES`; ``time_ns`` is the model time.
     """
 
-    def __init__(self, rule: str, message: str, time_ns: int) -> None:
-        super().__init__(f"TLC2543 protocol violation [{rule}] at t={time_ns} ns: {message}")
-        self.rule = rule
-        self.time_ns = time_ns
+    device = "TLC2543"
 
 
 @dataclass(frozen=True)
@@ -144,9 +142,8 @@ class Tlc2543Model:
             raise NonFiniteError("vref_plus/vref_minus must be finite")
         if not vref_plus > vref_minus:
             raise InvalidArgument(f"vref_plus ({vref_plus}) must be above vref_minus ({vref_minus})")
-        for name, val in (("stuck_eoc", stuck_eoc), ("stuck_dout", stuck_dout)):
-            if val not in (None, 0, 1):
-                raise InvalidArgument(f"{name} must be None, 0 or 1, got {val!r}")
+        check_level("stuck_eoc", stuck_eoc)
+        check_level("stuck_dout", stuck_dout)
         self.vref_plus = float(vref_plus)
         self.vref_minus = float(vref_minus)
         self.timing = timing or Timing()
@@ -174,12 +171,7 @@ class Tlc2543Model:
     # -- configuration ------------------------------------------------------
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
         """Set AIN0.. (up to 11 voltages, V); missing ones keep their value."""
-        v = np.asarray(inputs, dtype=float).reshape(-1)
-        if v.size > 11:
-            raise InvalidArgument(f"inputs: at most 11 channels (AIN0..AIN10), got {v.size}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise NonFiniteError(f"inputs: AIN{bad} is not finite ({v[bad]})", index=bad)
+        v = check_inputs(inputs, 11, "AIN")
         self.inputs[: v.size] = v
 
     # -- internals -----------------------------------------------------------

@@ -6,7 +6,6 @@
 
 #include <math.h>
 #include <stdarg.h>
-#include <stdio.h>
 #include <string.h>
 
 enum {
@@ -44,17 +43,7 @@ uint16_t ad7927m_quantize(double v, double refin, int range_double)
 
 static void log_event(ad7927m *m, uint8_t signal, uint8_t value)
 {
-    if (m->trace == 0) {
-        return;
-    }
-    if (m->trace_len < m->trace_cap) {
-        m->trace[m->trace_len].t = m->t;
-        m->trace[m->trace_len].signal = signal;
-        m->trace[m->trace_len].value = value;
-        m->trace_len++;
-    } else {
-        m->trace_dropped++;
-    }
+    devm_log(m->trace, m->trace_cap, &m->trace_len, &m->trace_dropped, m->t, signal, value);
 }
 
 static void log_frame(ad7927m *m, uint16_t din)
@@ -77,14 +66,10 @@ static void log_frame(ad7927m *m, uint16_t din)
 /* Latch the first violation. */
 static void fail(ad7927m *m, int code, const char *fmt, ...)
 {
-    if (m->violation == AD7927M_V_NONE) {
-        va_list ap;
-        m->violation = code;
-        m->violation_t = m->t;
-        va_start(ap, fmt);
-        vsnprintf(m->message, sizeof m->message, fmt, ap);
-        va_end(ap);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    devm_vfail(&m->violation, &m->violation_t, m->message, sizeof m->message, m->t, code, fmt, ap);
+    va_end(ap);
 }
 
 static void set_dout(ad7927m *m, uint8_t level)
@@ -266,22 +251,7 @@ int ad7927m_init(ad7927m *m, double refin, uint16_t powerup_control, int powerup
 
 int ad7927m_set_inputs(ad7927m *m, const double *volts, size_t n)
 {
-    size_t i;
-    if (m == 0 || (volts == 0 && n != 0u)) {
-        return ATT_E_NULL;
-    }
-    if (n > 8u) {
-        return ATT_E_ARG;
-    }
-    for (i = 0; i < n; i++) {
-        if (!isfinite(volts[i])) {
-            return ATT_E_NONFINITE;
-        }
-    }
-    for (i = 0; i < n; i++) {
-        m->inputs[i] = volts[i];
-    }
-    return ATT_OK;
+    return m == 0 ? ATT_E_NULL : devm_set_inputs(m->inputs, 8u, volts, n);
 }
 
 void ad7927m_delay_ns(void *ctx, uint32_t ns)

@@ -16,6 +16,7 @@
 
 #include "attitude/common.h"
 #include "attitude/ad7927.h"
+#include "devmodel.h"
 
 /* Trace signals (same order as attitude_c.ad7927.model.SIGNALS). */
 enum {
@@ -57,11 +58,8 @@ enum {
     AD7927M_SCLK_PERIOD_NS = 108     /* frame-level SCLK period: 9.26 MHz */
 };
 
-typedef struct {
-    int64_t t;      /* ns */
-    uint8_t signal; /* AD7927M_SIG_* */
-    uint8_t value;  /* 0, 1, or AD7927M_HIGH_Z */
-} ad7927m_event;
+/* One trace event: signal = AD7927M_SIG_*, value 0, 1, or AD7927M_HIGH_Z. */
+typedef devm_event ad7927m_event;
 
 typedef struct {
     int64_t t;       /* CS falling edge, ns */
