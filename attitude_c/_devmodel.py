@@ -5,7 +5,7 @@ read-out, and the chunked batch conversion through a C driver."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Callable
+from typing import Any, Callable, NoReturn
 
 import numpy as np
 
@@ -23,6 +23,35 @@ class ProtocolViolationBase(DeviceError):
         super().__init__(f"{self.device} protocol violation [{rule}] at t={time_ns} ns: {message}")
         self.rule = rule
         self.time_ns = time_ns
+
+
+class PinModel:
+    """What the pin-level device models share: the first-violation raise,
+    the trace log and the DOUT pin (with its stuck-at fault). Subclasses set
+    ``violation`` and keep ``t``, ``record``, ``trace``, ``stuck_dout`` and
+    ``dout_level``."""
+
+    violation: type[ProtocolViolationBase] = ProtocolViolationBase
+    HIGH_Z = 2  #: DOUT value in the trace while it is not driven
+    t: int
+    record: bool
+    trace: list[tuple[int, str, int]]
+    stuck_dout: int | None
+    dout_level: int
+
+    def _fail(self, rule: str, message: str) -> NoReturn:
+        raise self.violation(rule, message, self.t)
+
+    def _log(self, signal: str, value: int) -> None:
+        if self.record:
+            self.trace.append((self.t, signal, value))
+
+    def _set_dout(self, level: int) -> None:
+        if self.stuck_dout is not None and level != self.HIGH_Z:
+            level = self.stuck_dout
+        if level != self.dout_level:
+            self.dout_level = level
+            self._log("DOUT", level)
 
 
 def check_inputs(inputs: Sequence[float] | np.ndarray, count: int, pin: str) -> np.ndarray:

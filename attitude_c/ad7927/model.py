@@ -63,13 +63,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._devmodel import ProtocolViolationBase, check_inputs, check_level
+from .._devmodel import PinModel, ProtocolViolationBase, check_inputs, check_level
 from ..errors import InvalidArgument
 
 #: Trace signal names, in the order of the C twin's codes.
 SIGNALS = ("CS", "SCLK", "DIN", "DOUT", "DOUT?")
 #: DOUT value in the trace while it is three-state.
-HIGH_Z = 2
+HIGH_Z = PinModel.HIGH_Z
 
 #: Rules checked by the model (ProtocolViolation.rule), in the order of the
 #: C twin's violation codes (1-based there; 0 = none).
@@ -149,7 +149,7 @@ def shadow_channels(shadow: int) -> list[int]:
     return one + two
 
 
-class Ad7927Model:
+class Ad7927Model(PinModel):
     """AD7927 with simulated time (ns). See the module docstring.
 
     ``inputs``: VIN0..VIN7 in volts; ``refin``: REFIN (V). Faults:
@@ -158,6 +158,8 @@ class Ad7927Model:
     every output word). ``sclk_period_ns``: SCLK period of frame-level
     transfers (default 108 ns = 9.26 MHz, the thesis's SPI0).
     """
+
+    violation = ProtocolViolation
 
     def __init__(self, inputs: Sequence[float] | np.ndarray = (), *, refin: float = 2.5,
                  timing: Timing | None = None, powerup_control: int = POWERUP_CONTROL,
@@ -223,20 +225,6 @@ class Ad7927Model:
         self.inputs[: v.size] = v
 
     # -- helpers -----------------------------------------------------------
-    def _fail(self, rule: str, message: str) -> None:
-        raise ProtocolViolation(rule, message, self.t)
-
-    def _log(self, signal: str, value: int) -> None:
-        if self.record:
-            self.trace.append((self.t, signal, value))
-
-    def _set_dout(self, level: int) -> None:
-        if self.stuck_dout is not None and level != HIGH_Z:
-            level = self.stuck_dout
-        if level != self.dout_level:
-            self.dout_level = level
-            self._log("DOUT", level)
-
     def code_of(self, channel: int) -> int:
         """The straight-binary code a valid conversion of ``channel`` gives now."""
         return quantize(float(self.inputs[channel]), self.refin, self.range_bit == 0)

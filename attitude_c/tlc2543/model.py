@@ -40,13 +40,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._devmodel import ProtocolViolationBase, check_inputs, check_level
+from .._devmodel import PinModel, ProtocolViolationBase, check_inputs, check_level
 from ..errors import InvalidArgument, NonFiniteError
 
 #: Trace signal names, in the order of the C twin's codes.
 SIGNALS = ("CS", "CLOCK", "DIN", "DOUT", "EOC", "DOUT?", "EOC?")
 #: DATA OUT value in the trace while CS is high (high impedance).
-HIGH_Z = 2
+HIGH_Z = PinModel.HIGH_Z
 
 #: Rules checked by the model (ProtocolViolation.rule), in the order of the
 #: C twin's violation codes (1-based there; 0 = none).
@@ -125,7 +125,7 @@ def clocks_of(in_byte: int) -> int:
     return 8 if length == 1 else 16 if length == 3 else 12
 
 
-class Tlc2543Model:
+class Tlc2543Model(PinModel):
     """Pin-level TLC2543 with simulated time (ns). See the module docstring.
 
     ``inputs``: voltages of AIN0..AIN10 (V). ``stuck_eoc`` / ``stuck_dout``:
@@ -133,6 +133,8 @@ class Tlc2543Model:
     register holds ``powerup_word`` (12-bit, MSB first) until the first
     conversion ends.
     """
+
+    violation = ProtocolViolation
 
     def __init__(self, inputs: Sequence[float] | np.ndarray = (), *, vref_plus: float = 5.0,
                  vref_minus: float = 0.0, timing: Timing | None = None,
@@ -183,20 +185,6 @@ class Tlc2543Model:
         self.t_cs_fall = 0
         self.t_rise = -(10 ** 9)
         self.t_fall = -(10 ** 9)
-
-    def _log(self, signal: str, value: int) -> None:
-        if self.record:
-            self.trace.append((self.t, signal, value))
-
-    def _fail(self, rule: str, message: str) -> None:
-        raise ProtocolViolation(rule, message, self.t)
-
-    def _set_dout(self, level: int) -> None:
-        if self.stuck_dout is not None and level != HIGH_Z:
-            level = self.stuck_dout
-        if level != self.dout_level:
-            self.dout_level = level
-            self._log("DOUT", level)
 
     def _set_eoc(self, level: int) -> None:
         if self.stuck_eoc is not None:
