@@ -249,10 +249,11 @@ class Ad7927:
         ``next_channel`` (default channels[0]: the next scan of the same list
         then takes len(channels) frames)."""
         ch = np.asarray(channels)
-        if ch.ndim != 1 or ch.size == 0 or ch.size > 16 or ch.dtype.kind not in "iu":
-            raise InvalidArgument(f"channels must be a 1-D list of 1..16 ints, got {channels!r}")
-        if np.any((ch < 0) | (ch > 7)):
-            raise InvalidArgument(f"channels must be 0..7, got {ch.tolist()}")
+        most, top = int(self._lib.AD7927_MAX_SCAN), int(self._lib.AD7927_CHANNELS) - 1
+        if ch.ndim != 1 or ch.size == 0 or ch.size > most or ch.dtype.kind not in "iu":
+            raise InvalidArgument(f"channels must be a 1-D list of 1..{most} ints, got {channels!r}")
+        if np.any((ch < 0) | (ch > top)):
+            raise InvalidArgument(f"channels must be 0..{top}, got {ch.tolist()}")
         nxt = int(ch[0]) if next_channel is None else _channel("next_channel", next_channel)
         cbuf = self._ffi.new("uint8_t[]", [int(c) for c in ch])
         codes = self._ffi.new("int16_t[]", ch.size)
@@ -281,8 +282,9 @@ class Ad7927:
 
     def seq_read(self, n: int) -> tuple[np.ndarray, np.ndarray]:
         """``n`` (1..16) conversions of the running sequence: (codes, channels)."""
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= 16:
-            raise InvalidArgument(f"n must be an int 1..16, got {n!r}")
+        most = int(self._lib.AD7927_MAX_SCAN)
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 1 <= n <= most:
+            raise InvalidArgument(f"n must be an int 1..{most}, got {n!r}")
         codes = self._ffi.new("int16_t[]", int(n))
         chans = self._ffi.new("uint8_t[]", int(n))
         self._after(self._lib.ad7927_seq_read(self._dev, codes, chans, int(n)), f"ad7927_seq_read({n})")
