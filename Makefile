@@ -12,6 +12,10 @@
 # `python -m toolchain.buildfiles`: the same flags as `invoke cross-build`
 # and cmake/NAME-toolchain.cmake): host, armv4t, armv4t-bare, armv7hf,
 # aarch64, host-asan, host-clang, mcs51 (SDCC: the 8051 parts, libattitude.lib).
+# PLATFORM=linux (the default on Linux targets and without TARGET) also builds
+# the platform code of csrc/platform/linux into the library (HALs on Linux
+# drivers, e.g. the AD7927 spidev HAL); PLATFORM= builds the portable
+# library only. Bare-metal targets (os = "none") never take platform code.
 #
 # Honoured variables: TARGET, CROSS_COMPILE, CC, AR, CFLAGS, CPPFLAGS,
 # LDFLAGS, TARGET_CFLAGS (architecture flags; set by TARGET), PREFIX,
@@ -92,6 +96,11 @@ STATIC_APP   ?= 1
 SHARED       ?= 1
 APP          ?= 1
 LDFLAGS      ?=
+ifneq ($(TARGET),)
+PLATFORM     ?= $(if $(filter linux,$(ATT_TARGET_OS_$(TARGET))),linux,)
+else
+PLATFORM     ?= linux
+endif
 
 # libattitude.so of a target that links its own libgcc (armv4t: the ARMv4T one
 # of arm-none-eabi-gcc, not the armel compiler's ARMv5TE runtime).
@@ -113,6 +122,11 @@ else
 $(error PRECISION must be f64 or f32, not '$(PRECISION)')
 endif
 
+# Platform code (HALs on the OS's drivers), if any for PLATFORM.
+PLAT_DIR  := csrc/platform/$(PLATFORM)
+PLAT_SRCS := $(if $(filter-out sdcc,$(KIND)),$(if $(PLATFORM),$(sort $(wildcard $(PLAT_DIR)/src/*.c))))
+PLAT_INC  := $(if $(PLAT_SRCS),-I$(PLAT_DIR)/include)
+
 # Flags the library needs whatever the user's CFLAGS say.
 ifeq ($(KIND),sdcc)
 ATT_CFLAGS := --std-c99 -Icsrc/include $(PREC_DEFS)
@@ -121,16 +135,19 @@ STATIC_LIB := $(BUILDDIR)/libattitude.lib
 override SHARED := 0
 override APP := 0
 else
-ATT_CFLAGS := -std=c99 -Wall -Wextra -Wpedantic -Icsrc/include $(PREC_DEFS)
+ATT_CFLAGS := -std=c99 -Wall -Wextra -Wpedantic -Icsrc/include $(PLAT_INC) $(PREC_DEFS)
 O := o
 STATIC_LIB := $(BUILDDIR)/libattitude.a
 endif
 
 LIB_SRCS := $(sort $(wildcard $(LIB_GLOBS)))
 APP_SRCS := $(if $(filter 1,$(APP)),$(sort $(wildcard csrc/app/*.c)))
-HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h))
-LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.$(O))
-PIC_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj-pic/%.o)
+HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h) \
+                   $(if $(PLAT_SRCS),$(wildcard $(PLAT_DIR)/include/attitude/*.h)))
+LIB_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj/%.$(O)) \
+            $(PLAT_SRCS:$(PLAT_DIR)/src/%.c=$(BUILDDIR)/obj/%.o)
+PIC_OBJS := $(LIB_SRCS:csrc/src/%.c=$(BUILDDIR)/obj-pic/%.o) \
+            $(PLAT_SRCS:$(PLAT_DIR)/src/%.c=$(BUILDDIR)/obj-pic/%.o)
 APP_OBJS := $(APP_SRCS:csrc/app/%.c=$(BUILDDIR)/obj-app/%.o)
 
 SHARED_REAL := $(BUILDDIR)/libattitude.so.$(VERSION)
@@ -168,6 +185,14 @@ $(BUILDDIR)/obj/%.$(O): csrc/src/%.c $(HEADERS) $(STAMP)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
 $(BUILDDIR)/obj-pic/%.o: csrc/src/%.c $(HEADERS) $(STAMP)
+	@mkdir -p $(@D)
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
+
+$(BUILDDIR)/obj/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
+	@mkdir -p $(@D)
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(BUILDDIR)/obj-pic/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
 	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
 

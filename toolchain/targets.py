@@ -32,6 +32,10 @@ BUILD = ROOT / "build"
 
 #: Library sources that make up libattitude (portable C99).
 LIB_SOURCES_DIR = CSRC / "src"
+#: Platform code (HALs on an operating system's drivers): csrc/platform/<os>/
+#: with src/*.c and include/attitude/*.h, built into the library of every
+#: target of that ``os`` (e.g. the spidev HAL of the AD7927 on Linux).
+PLATFORM_DIR = CSRC / "platform"
 
 
 class ToolchainMissing(RuntimeError):
@@ -81,6 +85,21 @@ class Target:
         for pat in self.lib_source_globs:
             out.update(ROOT.glob(pat))
         return sorted(out)
+
+    def platform_dir(self) -> Path | None:
+        """csrc/platform/<os> when that folder exists (None on bare metal)."""
+        d = PLATFORM_DIR / self.os
+        return d if self.os != "none" and d.is_dir() else None
+
+    def platform_sources(self) -> list[Path]:
+        """The platform sources this target builds into its library (sorted)."""
+        d = self.platform_dir()
+        return sorted((d / "src").glob("*.c")) if d else []
+
+    def platform_include_dirs(self) -> list[Path]:
+        """Include directories of the platform code (headers as attitude/NAME.h)."""
+        d = self.platform_dir()
+        return [d / "include"] if d and (d / "include").is_dir() else []
 
     def tool(self, name: str) -> str:
         """A binutils tool of this toolchain (``readelf``, ``size``...) next to ``ar``."""

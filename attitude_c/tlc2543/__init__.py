@@ -21,6 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .._devmodel import check_inputs, check_level, convert_in_chunks
 from ..errors import (
     DeviceError,
     DeviceTimeout,
@@ -85,14 +86,6 @@ def _check_length(length: int) -> int:
     return int(length)
 
 
-def _check_level(name: str, v: int | None) -> int:
-    if v is None:
-        return -1
-    if v not in (0, 1) or isinstance(v, float):
-        raise InvalidArgument(f"{name} must be None, 0 or 1, got {v!r}")
-    return int(v)
-
-
 class CTwin:
     """The C twin of :class:`Tlc2543Model` (csrc/host/tlc2543_model.c).
 
@@ -110,8 +103,8 @@ class CTwin:
         self._m = ffi.new("tlc2543m *")
         st = lib.tlc2543m_init(self._m, float(vref_plus), float(vref_minus), int(powerup_word) & 0xFFFF)
         raise_for_status(st, "CTwin(vref_plus, vref_minus)")
-        self._m.stuck_eoc = _check_level("stuck_eoc", stuck_eoc)
-        self._m.stuck_dout = _check_level("stuck_dout", stuck_dout)
+        self._m.stuck_eoc = check_level("stuck_eoc", stuck_eoc)
+        self._m.stuck_dout = check_level("stuck_dout", stuck_dout)
         if stuck_eoc is not None:
             self._m.eoc_level = stuck_eoc
         self._buf = ffi.new("tlc2543m_event[]", max(int(trace_capacity), 1)) if trace_capacity else ffi.NULL
@@ -120,12 +113,7 @@ class CTwin:
         self.set_inputs(inputs)
 
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        v = np.ascontiguousarray(np.asarray(inputs, dtype=float).reshape(-1))
-        if v.size > 11:
-            raise InvalidArgument(f"inputs: at most 11 channels (AIN0..AIN10), got {v.size}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise NonFiniteError(f"inputs: AIN{bad} is not finite ({v[bad]})", index=bad)
+        v = check_inputs(inputs, 11, "AIN")
         st = self._lib.tlc2543m_set_inputs(self._m, self._ffi.cast("double *", v.ctypes.data), v.size)
         raise_for_status(st, "CTwin.set_inputs(inputs)")
 
@@ -291,36 +279,18 @@ def convert(volts: np.ndarray, vref_plus: float = 5.0, *, vref_minus: float = 0.
     bad_rows = np.flatnonzero(~np.all(np.isfinite(v), axis=1))
     if bad_rows.size:
         raise NonFiniteError(f"volts: row {int(bad_rows[0])} holds NaN or Inf", index=int(bad_rows[0]))
-    if not isinstance(chunk, (int, np.integer)) or chunk < 1:
-        raise InvalidArgument(f"chunk must be a positive int, got {chunk!r}")
-
     twin = CTwin(vref_plus=vref_plus, vref_minus=vref_minus, stuck_eoc=stuck_eoc,
                  stuck_dout=stuck_dout, trace_capacity=0, precision=precision)
     drv = Tlc2543(twin, length=length, lsb_first=lsb_first, bipolar=bipolar,
                   eoc_polls=eoc_polls, precision=precision)
     ffi, lib = drv._ffi, drv._lib
-    out = np.zeros((n, k), dtype=np.int32)
     cbuf = ffi.new("uint8_t[]", chans)
     done = ffi.new("size_t *")
-    row = 0
-    first = True
-    while first or row < n:
-        m = min(chunk, n - row)
-        vin = v[row:row + m]
-        st = lib.tlc2543m_convert(twin._m, drv._dev, cbuf, k, ffi.cast("double *", vin.ctypes.data), m,
+
+    def step(row: int, m: int, first: bool, out: np.ndarray) -> tuple[int, int]:
+        st = lib.tlc2543m_convert(twin._m, drv._dev, cbuf, k, ffi.cast("double *", v[row:row + m].ctypes.data), m,
                                   ffi.cast("int32_t *", out[row:].ctypes.data), 1 if (self_test and first) else 0,
                                   done)
-        first = False
-        row += int(done[0])
-        if st != 0:
-            try:
-                drv._after(st, "tlc2543 convert")
-            except Exception as exc:  # attach what was converted before the error
-                exc.codes = out[:row].astype(np.int64)  # type: ignore[attr-defined]
-                exc.rows_done = row  # type: ignore[attr-defined]
-                raise
-        if progress is not None and m:
-            progress(row)
-        if m == 0:
-            break
-    return out.astype(np.int64)
+        return int(st), int(done[0])
+
+    return convert_in_chunks(n, k, chunk, step, lambda st: drv._after(st, "tlc2543 convert"), progress)

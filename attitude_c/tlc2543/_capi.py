@@ -5,35 +5,14 @@ from __future__ import annotations
 
 from typing import Any
 
+from .. import _devmodel
+from .._bridge import Bridge
 from .._lib import ffi_lib
-from .model import RULES, SIGNALS, ProtocolViolation, Tlc2543Model
+from .model import RULES, SIGNALS, ProtocolViolation
+
+__all__ = ["Bridge", "python_hal", "register", "twin_trace", "twin_violation"]
 
 _registered: set[str] = set()
-
-
-class Bridge:
-    """What the C callbacks see as ``ctx``: the Python model plus the first
-    exception raised inside a callback (exceptions cannot cross C frames, so
-    they are kept here and re-raised once the C call returns)."""
-
-    def __init__(self, model: Tlc2543Model) -> None:
-        self.model = model
-        self.error: BaseException | None = None
-
-    def call(self, name: str, *args: Any) -> int:
-        if self.error is not None:
-            return 0  # the driver is already off the rails; stay quiet
-        try:
-            r = getattr(self.model, name)(*args)
-        except BaseException as exc:  # noqa: BLE001 - re-raised by raise_pending()
-            self.error = exc
-            return 0
-        return int(r) if r is not None else 0
-
-    def raise_pending(self) -> None:
-        if self.error is not None:
-            exc, self.error = self.error, None
-            raise exc
 
 
 def register(precision: str) -> tuple[Any, Any]:
@@ -87,12 +66,8 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge) -> tuple[Any, Any]:
 
 def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
     """The C twin's latched violation as a ProtocolViolation (or None)."""
-    if m.violation == 0:
-        return None
-    rule = RULES[m.violation - 1]
-    return ProtocolViolation(rule, ffi.string(m.message).decode(), int(m.violation_t))
+    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
 
 
 def twin_trace(m: Any) -> list[tuple[int, str, int]]:
-    return [(int(m.trace[i].t), SIGNALS[m.trace[i].signal], int(m.trace[i].value))
-            for i in range(m.trace_len)]
+    return _devmodel.twin_trace(m, SIGNALS)

@@ -40,12 +40,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DeviceError, InvalidArgument, NonFiniteError
+from .._devmodel import PinModel, ProtocolViolationBase, check_inputs, check_level
+from ..errors import InvalidArgument, NonFiniteError
 
 #: Trace signal names, in the order of the C twin's codes.
 SIGNALS = ("CS", "CLOCK", "DIN", "DOUT", "EOC", "DOUT?", "EOC?")
 #: DATA OUT value in the trace while CS is high (high impedance).
-HIGH_Z = 2
+HIGH_Z = PinModel.HIGH_Z
 
 #: Rules checked by the model (ProtocolViolation.rule), in the order of the
 #: C twin's violation codes (1-based there; 0 = none).
@@ -67,16 +68,13 @@ RULES = (
 )
 
 
-class ProtocolViolation(DeviceError):
+class ProtocolViolation(ProtocolViolationBase):
     """The driver broke a TLC2543 protocol or timing rule.
 
     ``rule`` is one of :data:`RULES`; ``time_ns`` is the model time.
     """
 
-    def __init__(self, rule: str, message: str, time_ns: int) -> None:
-        super().__init__(f"TLC2543 protocol violation [{rule}] at t={time_ns} ns: {message}")
-        self.rule = rule
-        self.time_ns = time_ns
+    device = "TLC2543"
 
 
 @dataclass(frozen=True)
@@ -127,7 +125,7 @@ def clocks_of(in_byte: int) -> int:
     return 8 if length == 1 else 16 if length == 3 else 12
 
 
-class Tlc2543Model:
+class Tlc2543Model(PinModel):
     """Pin-level TLC2543 with simulated time (ns). See the module docstring.
 
     ``inputs``: voltages of AIN0..AIN10 (V). ``stuck_eoc`` / ``stuck_dout``:
@@ -135,6 +133,8 @@ class Tlc2543Model:
     register holds ``powerup_word`` (12-bit, MSB first) until the first
     conversion ends.
     """
+
+    violation = ProtocolViolation
 
     def __init__(self, inputs: Sequence[float] | np.ndarray = (), *, vref_plus: float = 5.0,
                  vref_minus: float = 0.0, timing: Timing | None = None,
@@ -144,9 +144,8 @@ class Tlc2543Model:
             raise NonFiniteError("vref_plus/vref_minus must be finite")
         if not vref_plus > vref_minus:
             raise InvalidArgument(f"vref_plus ({vref_plus}) must be above vref_minus ({vref_minus})")
-        for name, val in (("stuck_eoc", stuck_eoc), ("stuck_dout", stuck_dout)):
-            if val not in (None, 0, 1):
-                raise InvalidArgument(f"{name} must be None, 0 or 1, got {val!r}")
+        check_level("stuck_eoc", stuck_eoc)
+        check_level("stuck_dout", stuck_dout)
         self.vref_plus = float(vref_plus)
         self.vref_minus = float(vref_minus)
         self.timing = timing or Timing()
@@ -174,12 +173,7 @@ class Tlc2543Model:
     # -- configuration ------------------------------------------------------
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
         """Set AIN0.. (up to 11 voltages, V); missing ones keep their value."""
-        v = np.asarray(inputs, dtype=float).reshape(-1)
-        if v.size > 11:
-            raise InvalidArgument(f"inputs: at most 11 channels (AIN0..AIN10), got {v.size}")
-        if not np.all(np.isfinite(v)):
-            bad = int(np.flatnonzero(~np.isfinite(v))[0])
-            raise NonFiniteError(f"inputs: AIN{bad} is not finite ({v[bad]})", index=bad)
+        v = check_inputs(inputs, 11, "AIN")
         self.inputs[: v.size] = v
 
     # -- internals -----------------------------------------------------------
@@ -191,20 +185,6 @@ class Tlc2543Model:
         self.t_cs_fall = 0
         self.t_rise = -(10 ** 9)
         self.t_fall = -(10 ** 9)
-
-    def _log(self, signal: str, value: int) -> None:
-        if self.record:
-            self.trace.append((self.t, signal, value))
-
-    def _fail(self, rule: str, message: str) -> None:
-        raise ProtocolViolation(rule, message, self.t)
-
-    def _set_dout(self, level: int) -> None:
-        if self.stuck_dout is not None and level != HIGH_Z:
-            level = self.stuck_dout
-        if level != self.dout_level:
-            self.dout_level = level
-            self._log("DOUT", level)
 
     def _set_eoc(self, level: int) -> None:
         if self.stuck_eoc is not None:

@@ -9,5 +9,6 @@
 #include "attitude/attitude.h"
 #include "link_sim.h"
 #include "tlc2543_model.h"
+#include "ad7927_model.h"
 
 #endif

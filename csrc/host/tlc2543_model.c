@@ -6,7 +6,6 @@
 
 #include <math.h>
 #include <stdarg.h>
-#include <stdio.h>
 #include <string.h>
 
 #define FAR_PAST (-1000000000LL)
@@ -73,30 +72,16 @@ static uint8_t clocks_of(uint8_t in_byte)
 
 static void log_event(tlc2543m *m, uint8_t signal, uint8_t value)
 {
-    if (m->trace == 0) {
-        return;
-    }
-    if (m->trace_len < m->trace_cap) {
-        m->trace[m->trace_len].t = m->t;
-        m->trace[m->trace_len].signal = signal;
-        m->trace[m->trace_len].value = value;
-        m->trace_len++;
-    } else {
-        m->trace_dropped++;
-    }
+    devm_log(m->trace, m->trace_cap, &m->trace_len, &m->trace_dropped, m->t, signal, value);
 }
 
 /* Latch the first violation; returns 1 (so callers can `if (fail(...)) return;`). */
 static int fail(tlc2543m *m, int code, const char *fmt, ...)
 {
-    if (m->violation == TLC2543M_V_NONE) {
-        va_list ap;
-        m->violation = code;
-        m->violation_t = m->t;
-        va_start(ap, fmt);
-        vsnprintf(m->message, sizeof m->message, fmt, ap);
-        va_end(ap);
-    }
+    va_list ap;
+    va_start(ap, fmt);
+    devm_vfail(&m->violation, &m->violation_t, m->message, sizeof m->message, m->t, code, fmt, ap);
+    va_end(ap);
     return 1;
 }
 
@@ -236,22 +221,7 @@ int tlc2543m_init(tlc2543m *m, double vref_plus, double vref_minus, uint16_t pow
 
 int tlc2543m_set_inputs(tlc2543m *m, const double *volts, size_t n)
 {
-    size_t i;
-    if (m == 0 || (volts == 0 && n != 0u)) {
-        return ATT_E_NULL;
-    }
-    if (n > 11u) {
-        return ATT_E_ARG;
-    }
-    for (i = 0; i < n; i++) {
-        if (!isfinite(volts[i])) {
-            return ATT_E_NONFINITE;
-        }
-    }
-    for (i = 0; i < n; i++) {
-        m->inputs[i] = volts[i];
-    }
-    return ATT_OK;
+    return m == 0 ? ATT_E_NULL : devm_set_inputs(m->inputs, 11u, volts, n);
 }
 
 void tlc2543m_delay_ns(void *ctx, uint32_t ns)

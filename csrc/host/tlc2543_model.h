@@ -13,6 +13,7 @@
 
 #include "attitude/common.h"
 #include "attitude/tlc2543.h"
+#include "devmodel.h"
 
 /* Trace signals (same order as attitude_c.tlc2543.model.SIGNALS). */
 enum {
@@ -50,11 +51,8 @@ enum {
     TLC2543M_E_VIOLATION = -50 /* the model latched a protocol violation */
 };
 
-typedef struct {
-    int64_t t;      /* ns */
-    uint8_t signal; /* TLC2543M_SIG_* */
-    uint8_t value;  /* 0, 1, or TLC2543M_HIGH_Z */
-} tlc2543m_event;
+/* One trace event: signal = TLC2543M_SIG_*, value 0, 1, or TLC2543M_HIGH_Z. */
+typedef devm_event tlc2543m_event;
 
 typedef struct {
     int32_t t_cs_setup, t_dout_enable, t_din_setup, t_din_hold, t_clk_high, t_clk_low, t_dout_valid,

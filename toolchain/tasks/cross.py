@@ -4,7 +4,8 @@ Produces in ``build/NAME/``:
 
 * ``libattitude.a`` (``libattitude.lib`` for SDCC targets) from the target's
   library sources (all of ``csrc/src`` except on mcs51, which builds only
-  the 8051 parts);
+  the 8051 parts) plus, on Linux targets, the platform code of
+  ``csrc/platform/linux`` (the AD7927 spidev HAL);
 * ``libattitude.so`` (+ ``.so.0`` and the versioned file) on Linux targets;
 * ``attitude-rx`` (statically linked) on Linux targets;
 * ``include/attitude/*.h`` and ``attitude.pc`` (relocatable: paths relative
@@ -65,8 +66,8 @@ def _compile_all(t: T.Target, srcs: Sequence[Path], objdir: Path, extra: Sequenc
     suffix = ".rel" if t.kind == "sdcc" else ".o"
     for s in srcs:
         o = objdir / (s.stem + suffix)
-        _run(t.compile_cmd(s, o, defines=defines, extra_cflags=extra,
-                           include_dirs=[APP_DIR] if s.parent == APP_DIR else []), verbose)
+        incs = [*t.platform_include_dirs(), *([APP_DIR] if s.parent == APP_DIR else [])]
+        _run(t.compile_cmd(s, o, defines=defines, extra_cflags=extra, include_dirs=incs), verbose)
         objs.append(o)
     return objs
 
@@ -110,6 +111,7 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
     srcs = t.library_sources()
     if not srcs:
         raise BuildError(f"target {name}: no library sources match {t.lib_source_globs}")
+    srcs = [*srcs, *t.platform_sources()]
     products: dict[str, Path] = {}
 
     objs = _compile_all(t, srcs, out / "obj", [], defines, verbose)
@@ -141,8 +143,9 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
 
     inc = out / "include" / "attitude"
     inc.mkdir(parents=True)
-    for h in sorted((T.INCLUDE / "attitude").glob("*.h")):
-        shutil.copy2(h, inc / h.name)
+    for d in (T.INCLUDE, *t.platform_include_dirs()):
+        for h in sorted((d / "attitude").glob("*.h")):
+            shutil.copy2(h, inc / h.name)
     products["include"] = inc
     pc = out / "attitude.pc"
     pc.write_text(pc_text(t, defines, t.libs))

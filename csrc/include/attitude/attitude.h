@@ -13,5 +13,6 @@
 #include "attitude/link.h"
 #include "attitude/block.h"
 #include "attitude/fixed.h"
+#include "attitude/ad7927.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

@@ -1,0 +1,107 @@
+"""CFFI plumbing: the C driver's HAL pointed at a Python model (extern
+"Python" callbacks, pin level or frame level) or at the C twin
+(csrc/host/ad7927_model.c), and the C status codes read from the library."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from .. import _devmodel
+from .._bridge import Bridge
+from .._lib import ffi_lib
+from ..errors import DeviceError
+from ._errors import AddressMismatch, FrameError
+from .model import RULES, SIGNALS, Frame, ProtocolViolation
+
+__all__ = ["Bridge", "frame_log", "python_hal", "register", "status_table", "twin_trace",
+           "twin_violation"]
+
+_registered: set[str] = set()
+
+
+def register(precision: str) -> tuple[Any, Any]:
+    """(ffi, lib) with the Python callbacks registered."""
+    ffi, lib = ffi_lib(precision)
+    if precision in _registered:
+        return ffi, lib
+
+    @ffi.def_extern(name="ad7927py_set_cs")
+    def _set_cs(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_cs", level)
+
+    @ffi.def_extern(name="ad7927py_set_sclk")
+    def _set_sclk(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_sclk", level)
+
+    @ffi.def_extern(name="ad7927py_set_din")
+    def _set_din(ctx: Any, level: int) -> None:
+        ffi.from_handle(ctx).call("set_din", level)
+
+    @ffi.def_extern(name="ad7927py_get_dout")
+    def _get_dout(ctx: Any) -> int:
+        return 1 if ffi.from_handle(ctx).call("get_dout") == 1 else 0
+
+    @ffi.def_extern(name="ad7927py_delay_ns")
+    def _delay_ns(ctx: Any, ns: int) -> None:
+        ffi.from_handle(ctx).call("delay_ns", ns)
+
+    @ffi.def_extern(name="ad7927py_transfer")
+    def _transfer(ctx: Any, tx: Any, rx: Any, n: int, hold_ns: int) -> int:
+        bridge = ffi.from_handle(ctx)
+        out = bridge.call("transfer", [tx[i] for i in range(n)], hold_ns)
+        if bridge.error is not None:
+            return -1
+        for i in range(n):
+            rx[i] = out[i]
+        return 0
+
+    _registered.add(precision)
+    return ffi, lib
+
+
+def python_hal(ffi: Any, lib: Any, bridge: Bridge, frames: bool) -> tuple[Any, Any, Any]:
+    """An ad7927_hal reaching ``bridge.model``: frame level (the model's
+    ``transfer``) or pin level (ad7927_pins_transfer over pin callbacks).
+    Returns (hal, pins, handle); keep all three alive while the driver runs."""
+    handle = ffi.new_handle(bridge)
+    hal = ffi.new("ad7927_hal *")
+    if frames:
+        hal.ctx = handle
+        hal.transfer = lib.ad7927py_transfer
+        return hal, None, handle
+    pins = ffi.new("ad7927_pins *")
+    pins.ctx = handle
+    pins.set_cs = lib.ad7927py_set_cs
+    pins.set_sclk = lib.ad7927py_set_sclk
+    pins.set_din = lib.ad7927py_set_din
+    pins.get_dout = lib.ad7927py_get_dout
+    pins.delay_ns = lib.ad7927py_delay_ns
+    hal.ctx = pins
+    hal.transfer = ffi.addressof(lib, "ad7927_pins_transfer")
+    return hal, pins, handle
+
+
+def status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
+    """The module's C status codes (read from the library) -> (class, text)."""
+    return {
+        int(lib.AD7927_E_CHANNEL): (AddressMismatch, ("an output word names another channel "
+                                                      "than the one written for that frame")),
+        int(lib.AD7927_E_FRAME): (FrameError, ("an output word's leading bit is 1 (DOUT stuck "
+                                               "high or no part on the bus?)")),
+        int(lib.AD7927_E_TRANSFER): (DeviceError, "the frame-transfer HAL failed"),
+        int(lib.AD7927M_E_VIOLATION): (ProtocolViolation, "protocol violation"),
+    }
+
+
+def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
+    """The C twin's latched violation as a ProtocolViolation (or None)."""
+    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
+
+
+def twin_trace(m: Any) -> list[tuple[int, str, int]]:
+    return _devmodel.twin_trace(m, SIGNALS)
+
+
+def frame_log(m: Any) -> list[Frame]:
+    return [Frame(int(f.t), int(f.din), int(f.dout), int(f.channel), bool(f.valid))
+            for f in (m.frames[i] for i in range(m.frames_len))]
