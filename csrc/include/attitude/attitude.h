@@ -11,5 +11,6 @@
 #include "attitude/integrator.h"
 #include "attitude/link.h"
 #include "attitude/fixed.h"
+#include "attitude/denoise.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
