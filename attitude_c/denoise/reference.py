@@ -25,6 +25,7 @@ The phase of the periodized filtering is the one PyWavelets uses in its
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from statistics import NormalDist
@@ -119,7 +120,7 @@ def wavedec(x: ArrayLike, wavelet: str, levels: int) -> list[F]:
         raise ValueError(f"block length {n} is not a multiple of 2^{levels}")
     details: list[F] = []
     for _ in range(levels):
-        c = analysis_matrix(len(a), wavelet) @ a
+        c = _analysis_matrix(len(a), wavelet) @ a
         a, d = c[: len(c) // 2], c[len(c) // 2:]
         details.append(d)
     return [a, *details[::-1]]
@@ -130,7 +131,7 @@ def waverec(coeffs: list[F], wavelet: str) -> F:
     a = np.asarray(coeffs[0], dtype=np.float64)
     for d in coeffs[1:]:
         c = np.concatenate([a, np.asarray(d, dtype=np.float64)])
-        a = analysis_matrix(len(c), wavelet).T @ c
+        a = _analysis_matrix(len(c), wavelet).T @ c
     return a
 
 

@@ -72,7 +72,7 @@ static int all_finite(const att_real *x, size_t n)
 
 /* ---- configuration ---------------------------------------------------------- */
 
-att_status att_wden_config_default(att_wden_config *cfg)
+int att_wden_config_default(att_wden_config *cfg)
 {
     if (cfg == NULL)
         return ATT_E_NULL;
@@ -85,29 +85,29 @@ att_status att_wden_config_default(att_wden_config *cfg)
     return ATT_OK;
 }
 
-static att_status check_shape(unsigned int levels, size_t n)
+static int check_shape(unsigned int levels, size_t n)
 {
     if (levels < 1 || levels > ATT_WDEN_MAX_LEVELS)
-        return (att_status)ATT_E_WDEN_LEVELS;
+        return ATT_E_WDEN_LEVELS;
     if (n < 2 || n > ATT_WDEN_MAX_BLOCK || (n & (((size_t)1 << levels) - 1)) != 0)
-        return (att_status)ATT_E_WDEN_BLOCK;
+        return ATT_E_WDEN_BLOCK;
     return ATT_OK;
 }
 
-att_status att_wden_config_check(const att_wden_config *cfg)
+int att_wden_config_check(const att_wden_config *cfg)
 {
-    att_status st;
+    int st;
     if (cfg == NULL)
         return ATT_E_NULL;
     if (cfg->wavelet < 0 || cfg->wavelet >= ATT_WDEN_WAVELET_COUNT)
-        return (att_status)ATT_E_WDEN_WAVELET;
+        return ATT_E_WDEN_WAVELET;
     if (cfg->mode < 0 || cfg->mode >= ATT_WDEN_MODE_COUNT)
-        return (att_status)ATT_E_WDEN_MODE;
+        return ATT_E_WDEN_MODE;
     st = check_shape(cfg->levels, cfg->block);
     if (st != ATT_OK)
         return st;
     if (cfg->edge > (cfg->block - 1) / 2) /* 2E < N */
-        return (att_status)ATT_E_WDEN_EDGE;
+        return ATT_E_WDEN_EDGE;
     if (cfg->detrend != 0 && cfg->detrend != 1)
         return ATT_E_ARG;
     return ATT_OK;
@@ -133,15 +133,14 @@ size_t att_wden_latency(const att_wden_config *cfg)
     return att_wden_config_check(cfg) == ATT_OK ? cfg->block - 1 - cfg->edge : 0;
 }
 
-att_status att_wden_filters(int wavelet, att_real h[ATT_WDEN_MAX_TAPS], att_real g[ATT_WDEN_MAX_TAPS],
-                            size_t *taps)
+int att_wden_filters(int wavelet, att_real h[ATT_WDEN_MAX_TAPS], att_real g[ATT_WDEN_MAX_TAPS], size_t *taps)
 {
     bank b;
     size_t m;
     if (h == NULL || g == NULL || taps == NULL)
         return ATT_E_NULL;
     if (!load_bank(wavelet, &b))
-        return (att_status)ATT_E_WDEN_WAVELET;
+        return ATT_E_WDEN_WAVELET;
     for (m = 0; m < b.f; m++) {
         h[m] = b.h[m];
         g[m] = b.g[m];
@@ -245,15 +244,14 @@ static void idwt(const bank *b, unsigned int levels, const att_real *c, size_t n
     }
 }
 
-att_status att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c,
-                        att_real *tmp)
+int att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c, att_real *tmp)
 {
     bank b;
-    att_status st;
+    int st;
     if (x == NULL || c == NULL || tmp == NULL)
         return ATT_E_NULL;
     if (!load_bank(wavelet, &b))
-        return (att_status)ATT_E_WDEN_WAVELET;
+        return ATT_E_WDEN_WAVELET;
     st = check_shape(levels, n);
     if (st != ATT_OK)
         return st;
@@ -263,15 +261,14 @@ att_status att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, siz
     return all_finite(c, n) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
 }
 
-att_status att_wden_idwt(int wavelet, unsigned int levels, const att_real *c, size_t n, att_real *y,
-                         att_real *tmp)
+int att_wden_idwt(int wavelet, unsigned int levels, const att_real *c, size_t n, att_real *y, att_real *tmp)
 {
     bank b;
-    att_status st;
+    int st;
     if (c == NULL || y == NULL || tmp == NULL)
         return ATT_E_NULL;
     if (!load_bank(wavelet, &b))
-        return (att_status)ATT_E_WDEN_WAVELET;
+        return ATT_E_WDEN_WAVELET;
     st = check_shape(levels, n);
     if (st != ATT_OK)
         return st;
@@ -298,12 +295,12 @@ static void threshold(att_real *c, size_t n, att_real lambda, int mode)
     }
 }
 
-att_status att_wden_threshold(att_real *c, size_t n, att_real lambda, int mode)
+int att_wden_threshold(att_real *c, size_t n, att_real lambda, int mode)
 {
     if (c == NULL)
         return ATT_E_NULL;
     if (mode < 0 || mode >= ATT_WDEN_MODE_COUNT)
-        return (att_status)ATT_E_WDEN_MODE;
+        return ATT_E_WDEN_MODE;
     if (!isfinite(lambda))
         return ATT_E_NONFINITE;
     if (lambda < ATT_R(0.0))
@@ -402,7 +399,7 @@ att_real att__wden_select(att_real *a, size_t n, size_t k, unsigned int depth)
     return a[k];
 }
 
-att_status att_wden_median(att_real *a, size_t n, att_real *median)
+int att_wden_median(att_real *a, size_t n, att_real *median)
 {
     size_t k, i;
     att_real lower, upper;
@@ -430,11 +427,11 @@ att_status att_wden_median(att_real *a, size_t n, att_real *median)
     return ATT_OK;
 }
 
-att_status att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_real *sigma)
+int att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_real *sigma)
 {
     size_t i;
     att_real med;
-    att_status st;
+    int st;
     if (d == NULL || work == NULL || sigma == NULL)
         return ATT_E_NULL;
     if (n == 0)
@@ -450,7 +447,7 @@ att_status att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_r
     return isfinite(*sigma) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
 }
 
-att_status att_wden_universal(att_real sigma, size_t n, att_real *lambda)
+int att_wden_universal(att_real sigma, size_t n, att_real *lambda)
 {
     if (lambda == NULL)
         return ATT_E_NULL;
@@ -470,12 +467,12 @@ static att_real centred(size_t i, size_t n)
     return ATT_R(0.5) * ((att_real)(2 * i + 1) - (att_real)n);
 }
 
-att_status att__wden_block_core(const att_wden_config *cfg, att_real *c, att_real *tmp, att_real *sigma)
+int att__wden_block_core(const att_wden_config *cfg, att_real *c, att_real *tmp, att_real *sigma)
 {
     const size_t n = cfg->block;
     size_t i;
     att_real mean = ATT_R(0.0), slope = ATT_R(0.0), s, lambda;
-    att_status st;
+    int st;
     bank b;
     load_bank(cfg->wavelet, &b);
     if (cfg->detrend) {
@@ -497,7 +494,7 @@ att_status att__wden_block_core(const att_wden_config *cfg, att_real *c, att_rea
     if (st == ATT_OK)
         st = att_wden_universal(s, n, &lambda);
     if (st != ATT_OK)
-        return (att_status)ATT_E_WDEN_OVERFLOW; /* the only way here: finite input, overflowing sums */
+        return ATT_E_WDEN_OVERFLOW; /* the only way here: finite input, overflowing sums */
     threshold(c + (n >> cfg->levels), n - (n >> cfg->levels), lambda, cfg->mode);
     idwt(&b, cfg->levels, c, n, c, tmp);
     if (cfg->detrend)
@@ -508,10 +505,10 @@ att_status att__wden_block_core(const att_wden_config *cfg, att_real *c, att_rea
     return all_finite(c, n) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
 }
 
-att_status att_wden_block(const att_wden_config *cfg, const att_real *x, att_real *y, att_real *scratch,
-                          att_real *sigma)
+int att_wden_block(const att_wden_config *cfg, const att_real *x, att_real *y, att_real *scratch,
+                   att_real *sigma)
 {
-    att_status st;
+    int st;
     if (cfg == NULL || x == NULL || y == NULL || scratch == NULL)
         return ATT_E_NULL;
     st = att_wden_config_check(cfg);

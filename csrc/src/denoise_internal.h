@@ -19,6 +19,6 @@ unsigned int att__wden_depth(size_t n);
 /* The block denoiser on a block already in c[0..N) (cfg valid, c finite):
  * c ← denoised block, tmp: N samples of scratch. ATT_E_WDEN_OVERFLOW if
  * the result is not finite. */
-att_status att__wden_block_core(const att_wden_config *cfg, att_real *c, att_real *tmp, att_real *sigma);
+int att__wden_block_core(const att_wden_config *cfg, att_real *c, att_real *tmp, att_real *sigma);
 
 #endif /* ATT_SRC_DENOISE_INTERNAL_H */

@@ -5,10 +5,10 @@
 #include "att_math.h"
 #include "denoise_internal.h"
 
-att_status att_wden_init(att_wden *s, const att_wden_config *cfg, att_real *state, size_t state_len,
-                         att_real *scratch, size_t scratch_len)
+int att_wden_init(att_wden *s, const att_wden_config *cfg, att_real *state, size_t state_len,
+                  att_real *scratch, size_t scratch_len)
 {
-    att_status st;
+    int st;
     if (s == NULL || cfg == NULL || state == NULL || scratch == NULL)
         return ATT_E_NULL;
     st = att_wden_config_check(cfg);
@@ -22,7 +22,7 @@ att_status att_wden_init(att_wden *s, const att_wden_config *cfg, att_real *stat
     return att_wden_reset(s);
 }
 
-att_status att_wden_reset(att_wden *s)
+int att_wden_reset(att_wden *s)
 {
     if (s == NULL)
         return ATT_E_NULL;
@@ -56,13 +56,13 @@ size_t att_wden_pending(const att_wden *s)
 /* Denoise the window of the last N samples (the ring is full) and write its
  * positions [a, b), corrected to the input's sum over them, to out. Only
  * sigma and the window count change in the state, and only on success. */
-static att_status run_window(att_wden *s, size_t a, size_t b, att_real *out)
+static int run_window(att_wden *s, size_t a, size_t b, att_real *out)
 {
     const size_t n = s->cfg.block;
     att_real *c = s->scratch;
     att_real sum_in = ATT_R(0.0), sum_out = ATT_R(0.0), corr, sigma = ATT_R(0.0);
     size_t i, j = s->head; /* the oldest sample */
-    att_status st;
+    int st;
     for (i = 0; i < n; i++) {
         c[i] = s->ring[j];
         if (++j == n)
@@ -79,7 +79,7 @@ static att_status run_window(att_wden *s, size_t a, size_t b, att_real *out)
     for (i = a; i < b; i++) {
         out[i - a] = c[i] + corr;
         if (!isfinite(out[i - a]))
-            return (att_status)ATT_E_WDEN_OVERFLOW;
+            return ATT_E_WDEN_OVERFLOW;
     }
     s->sigma = sigma;
     s->windows++;
@@ -91,7 +91,7 @@ int att_wden_push(att_wden *s, att_real x, att_real *out)
     att_wden saved;
     att_real overwritten;
     size_t nb, e;
-    att_status st;
+    int st;
     int produced;
     if (s == NULL || out == NULL)
         return ATT_E_NULL;
@@ -128,8 +128,8 @@ int att_wden_push(att_wden *s, att_real x, att_real *out)
     return produced;
 }
 
-att_status att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *out, size_t out_cap,
-                           size_t *n_out, size_t *err_index)
+int att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *out, size_t out_cap, size_t *n_out,
+                    size_t *err_index)
 {
     size_t i, k = 0;
     if (n_out != NULL)
@@ -154,7 +154,7 @@ att_status att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *o
                 *err_index = i;
             if (n_out != NULL)
                 *n_out = k;
-            return (att_status)r;
+            return r;
         }
         k += (size_t)r;
     }
@@ -163,10 +163,10 @@ att_status att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *o
     return ATT_OK;
 }
 
-att_status att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out)
+int att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out)
 {
     const size_t nb = s != NULL ? s->cfg.block : 0;
-    att_status st;
+    int st;
     if (n_out != NULL)
         *n_out = 0;
     if (s == NULL)
@@ -174,7 +174,7 @@ att_status att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_
     if (s->pending == 0)
         return att_wden_reset(s);
     if (!s->started)
-        return (att_status)ATT_E_WDEN_SHORT;
+        return ATT_E_WDEN_SHORT;
     if (out == NULL)
         return ATT_E_NULL;
     if (out_cap < s->pending)

@@ -49,8 +49,12 @@
  * call: several streams run one after the other, e.g. the three gyro axes,
  * may share one). No malloc, no global state, no I/O.
  *
- * Errors: negative att_status; inputs and outputs are checked (NaN/Inf in
- * → ATT_E_NONFINITE, finite in but non-finite out → ATT_E_WDEN_OVERFLOW).
+ * Errors: every function returns ATT_OK (0) or a negative status code, the
+ * generic ones of common.h or this module's ATT_E_WDEN_*, as an int (as
+ * tlc2543.h does): att_status is a one-byte enum where enums are short
+ * (arm-none-eabi, SDCC) and cannot hold codes below -128. Inputs and outputs
+ * are checked (NaN/Inf in → ATT_E_NONFINITE, finite in but non-finite out →
+ * ATT_E_WDEN_OVERFLOW).
  */
 #ifndef ATTITUDE_DENOISE_H
 #define ATTITUDE_DENOISE_H
@@ -76,7 +80,7 @@ typedef enum {
 enum {
     ATT_WDEN_MAX_TAPS = 8,        /* longest filter (db4) */
     ATT_WDEN_MAX_LEVELS = 16,     /* decomposition levels 1..16 */
-    ATT_WDEN_MAX_BLOCK = 65536,   /* block length N, 2..65536, a multiple of 2^levels */
+    ATT_WDEN_MAX_BLOCK = 16384,   /* block length N, 2..16384, a multiple of 2^levels */
     ATT_WDEN_DEFAULT_WAVELET = 2, /* ATT_WDEN_DB4 */
     ATT_WDEN_DEFAULT_MODE = 0,    /* ATT_WDEN_SOFT */
     ATT_WDEN_DEFAULT_LEVELS = 3,
@@ -125,12 +129,12 @@ typedef struct {
 
 /* Fill cfg with the defaults: db4, soft, L = 3, N = 64, E = 16, detrend on
  * (docs/denoise.md: why). ATT_E_NULL if cfg is NULL. */
-att_status att_wden_config_default(att_wden_config *cfg);
+int att_wden_config_default(att_wden_config *cfg);
 
 /* ATT_OK if cfg is valid, else the status naming the first bad field
  * (checked in the order wavelet, mode, levels, block, edge, detrend
  * (ATT_E_ARG unless 0 or 1)). */
-att_status att_wden_config_check(const att_wden_config *cfg);
+int att_wden_config_check(const att_wden_config *cfg);
 
 /* Buffer sizes in att_real elements for a valid cfg (0 if cfg is invalid):
  * state = N (per stream), scratch = 2N (shareable), and the most samples a
@@ -152,44 +156,41 @@ size_t att_wden_latency(const att_wden_config *cfg);
 /* The F-tap scaling filter h and wavelet filter g of wavelet w (F ≤
  * ATT_WDEN_MAX_TAPS values each; *taps = F). h is PyWavelets' rec_lo, g its
  * rec_hi. */
-att_status att_wden_filters(int wavelet, att_real h[ATT_WDEN_MAX_TAPS], att_real g[ATT_WDEN_MAX_TAPS],
-                            size_t *taps);
+int att_wden_filters(int wavelet, att_real h[ATT_WDEN_MAX_TAPS], att_real g[ATT_WDEN_MAX_TAPS], size_t *taps);
 
 /* L-level periodized DWT of x[0..n) into c[0..n) in wavedec order. n is a
  * multiple of 2^L (ATT_E_WDEN_BLOCK otherwise), 1 ≤ L ≤ ATT_WDEN_MAX_LEVELS.
  * tmp: n samples of scratch. c may be x (in place). Any filter length works
  * for any n (a filter longer than a level wraps around it several times, as
  * in PyWavelets). ATT_E_NONFINITE if x holds NaN/Inf (c untouched). */
-att_status att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c,
-                        att_real *tmp);
+int att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c, att_real *tmp);
 
 /* Inverse of att_wden_dwt (the transpose: perfect reconstruction to
  * rounding). Same arguments and rules; y may be c. */
-att_status att_wden_idwt(int wavelet, unsigned int levels, const att_real *c, size_t n, att_real *y,
-                         att_real *tmp);
+int att_wden_idwt(int wavelet, unsigned int levels, const att_real *c, size_t n, att_real *y, att_real *tmp);
 
 /* Threshold c[0..n) in place with λ ≥ 0 (finite; ATT_E_ARG otherwise). */
-att_status att_wden_threshold(att_real *c, size_t n, att_real lambda, int mode);
+int att_wden_threshold(att_real *c, size_t n, att_real lambda, int mode);
 
 /* Median of a[0..n) (n ≥ 1; even n: the mean of the two middle values, as
  * numpy.median). Selection in place: a is permuted. NaN or Inf in a:
  * ATT_E_NONFINITE, a untouched. */
-att_status att_wden_median(att_real *a, size_t n, att_real *median);
+int att_wden_median(att_real *a, size_t n, att_real *median);
 
 /* Noise level σ = median(|d|) / Φ⁻¹(3/4) (Φ⁻¹(3/4) = 0.6744897501960817)
  * of detail coefficients d[0..n) (n ≥ 1); work: n samples of scratch. */
-att_status att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_real *sigma);
+int att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_real *sigma);
 
 /* Universal threshold λ = σ √(2 ln n) (σ ≥ 0 finite, n ≥ 1). */
-att_status att_wden_universal(att_real sigma, size_t n, att_real *lambda);
+int att_wden_universal(att_real sigma, size_t n, att_real *lambda);
 
 /* Denoise one block x[0..N) into y[0..N) (y may be x) with cfg (cfg->edge is
  * not used): detrend (optional), dwt, σ from cD_1 by MAD, universal
  * threshold on every detail level, idwt, the line back. scratch: 2N
  * samples. *sigma (may be NULL) receives σ. The sum of y equals the sum of x
  * to rounding. */
-att_status att_wden_block(const att_wden_config *cfg, const att_real *x, att_real *y, att_real *scratch,
-                          att_real *sigma);
+int att_wden_block(const att_wden_config *cfg, const att_real *x, att_real *y, att_real *scratch,
+                   att_real *sigma);
 
 /* ---- stream ------------------------------------------------------------------ */
 
@@ -197,11 +198,11 @@ att_status att_wden_block(const att_wden_config *cfg, const att_real *x, att_rea
  * samples owned by this stream; scratch: scratch_len ≥ att_wden_scratch_len()
  * samples (ATT_E_BUFFER if smaller), may be shared with other streams that
  * are not used concurrently. */
-att_status att_wden_init(att_wden *s, const att_wden_config *cfg, att_real *state, size_t state_len,
-                         att_real *scratch, size_t scratch_len);
+int att_wden_init(att_wden *s, const att_wden_config *cfg, att_real *state, size_t state_len,
+                  att_real *scratch, size_t scratch_len);
 
 /* Drop every sample received; start a new stream with the same buffers. */
-att_status att_wden_reset(att_wden *s);
+int att_wden_reset(att_wden *s);
 
 /* Number of samples that n more att_wden_push() calls would output. */
 size_t att_wden_outputs(const att_wden *s, size_t n);
@@ -223,15 +224,15 @@ int att_wden_push(att_wden *s, att_real x, att_real *out);
  * state unchanged). On ATT_E_WDEN_OVERFLOW the samples before *err_index
  * were consumed and their outputs are in out (*n_out). n_out and err_index
  * may be NULL. */
-att_status att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *out, size_t out_cap,
-                           size_t *n_out, size_t *err_index);
+int att_wden_push_n(att_wden *s, const att_real *x, size_t n, att_real *out, size_t out_cap, size_t *n_out,
+                    size_t *err_index);
 
 /* End the stream: output the att_wden_pending() samples left (room in out,
  * ≤ N − 1 samples) from a last window over the final N samples (no edge
  * discarded at the end), then reset. ATT_E_WDEN_SHORT (state unchanged) if
  * fewer than N samples were received and some are pending; 0 outputs if
  * none are pending. */
-att_status att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out);
+int att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out);
 
 #ifndef ATT_CDEF
 /* Compile-time buffer sizes for static arrays (same values as the
