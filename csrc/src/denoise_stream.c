@@ -88,43 +88,46 @@ static int run_window(att_wden *s, size_t a, size_t b, att_real *out)
 
 int att_wden_push(att_wden *s, att_real x, att_real *out)
 {
-    att_wden saved;
+    size_t nb, e, hop, head;
     att_real overwritten;
-    size_t nb, e;
-    int st;
-    int produced;
+    int st, produced;
     if (s == NULL || out == NULL)
         return ATT_E_NULL;
     if (!isfinite(x))
         return ATT_E_NONFINITE;
-    saved = *s; /* for the roll-back on overflow */
-    overwritten = s->ring[s->head];
     nb = s->cfg.block;
     e = s->cfg.edge;
-    s->ring[s->head] = x;
-    s->head = s->head + 1 == nb ? 0 : s->head + 1;
-    if (s->fill < nb)
-        s->fill++;
-    s->pending++;
+    hop = nb - 2 * e;
+    head = s->head;
+    overwritten = s->ring[head]; /* kept for the roll-back on overflow */
+    s->ring[head] = x;
+    s->head = head + 1 == nb ? 0 : head + 1;
     if (!s->started) {
-        if (s->fill < nb)
+        if (++s->fill < nb) {
+            s->pending++;
             return 0;
+        }
         st = run_window(s, 0, nb - e, out); /* the first window outputs from the stream's start */
         produced = (int)(nb - e);
-        s->started = 1;
     } else {
-        if (++s->since < nb - 2 * e)
+        if (s->since + 1 < hop) {
+            s->since++;
+            s->pending++;
             return 0;
+        }
         st = run_window(s, e, nb - e, out);
-        produced = (int)(nb - 2 * e);
+        produced = (int)hop;
     }
-    if (st != ATT_OK) {
-        *s = saved;
-        s->ring[s->head] = overwritten;
+    if (st != ATT_OK) { /* state as before the call */
+        s->ring[head] = overwritten;
+        s->head = head;
+        if (!s->started)
+            s->fill--;
         return st;
     }
+    s->started = 1;
     s->since = 0;
-    s->pending -= (size_t)produced;
+    s->pending = s->pending + 1 - (size_t)produced;
     return produced;
 }
 
