@@ -101,6 +101,11 @@ def analysis_matrix(n: int, wavelet: str) -> F:
     1 − F/2 is PyWavelets' periodization phase. The rows are orthonormal
     (the filters' double-shift orthogonality), so the inverse is the
     transpose."""
+    return _analysis_matrix(n, wavelet).copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _analysis_matrix(n: int, wavelet: str) -> F:
     h, g = filter_bank(wavelet)
     f = len(h)
     W = np.zeros((n, n))
