@@ -164,7 +164,7 @@ def test_denoise_block_matches_pywt(wavelet: str, mode: str, n: int, levels: int
             break
     else:  # pragma: no cover - would need a different signal
         pytest.fail("every seed puts a coefficient at the threshold")
-    y, sigma = D.denoise_block(x, D.DenoiseConfig(wavelet=wavelet, levels=levels, block=n, edge=0,
+    y, sigma = D.denoise_block(x, D.DenoiseConfig(wavelet=wavelet, levels=levels, block=n, edge_start=0, edge_end=0,
                                                   threshold=mode, detrend=False), precision=precision)
     # σ: a median of coefficients each good to tol, divided once
     assert sigma == pytest.approx(sigma_ref, abs=tol / R.MAD_NORMAL + 4 * U[precision] * sigma_ref)
@@ -180,7 +180,8 @@ def test_denoise_block_with_detrend_matches_reference(wavelet: str, precision: s
     rng = np.random.default_rng(5)
     n, levels = 128, 4
     x = _f32(0.5 + 0.01 * np.arange(n) + 0.05 * rng.normal(size=n))
-    y, sigma = D.denoise_block(x, D.DenoiseConfig(wavelet=wavelet, levels=levels, block=n, edge=0),
+    y, sigma = D.denoise_block(x, D.DenoiseConfig(wavelet=wavelet, levels=levels, block=n, edge_start=0,
+                                                  edge_end=0),
                                precision=precision)
     y_ref, sigma_ref = R.denoise_block(x, wavelet, levels, "soft", True)
     scale = float(np.max(np.abs(x)))
@@ -195,24 +196,25 @@ def test_denoise_block_with_detrend_matches_reference(wavelet: str, precision: s
 
 CONFIGS = [
     D.DenoiseConfig(),
-    D.DenoiseConfig(edge=0),
-    D.DenoiseConfig(wavelet="haar", levels=2, block=32, edge=3, threshold="hard"),
-    D.DenoiseConfig(wavelet="db2", levels=4, block=128, edge=40, detrend=False),
-    D.DenoiseConfig(block=64, edge=31),
+    D.DenoiseConfig(edge_start=0, edge_end=0),
+    D.DenoiseConfig(wavelet="haar", levels=2, block=32, edge_start=3, edge_end=3, threshold="hard"),
+    D.DenoiseConfig(wavelet="db2", levels=4, block=128, edge_start=40, edge_end=30, detrend=False),
+    D.DenoiseConfig(block=64, edge_start=2, edge_end=61),
 ]
 
 
 @pytest.mark.parametrize("precision", PRECISIONS)
-@pytest.mark.parametrize("cfg", CONFIGS, ids=lambda c: f"{c.wavelet}-L{c.levels}-N{c.block}-E{c.edge}-"
+@pytest.mark.parametrize("cfg", CONFIGS, ids=lambda c: f"{c.wavelet}-L{c.levels}-N{c.block}-E{c.edge_start},{c.edge_end}-"
                                                         f"{c.threshold}-{'d' if c.detrend else 'nod'}")
 def test_stream_matches_reference(cfg: D.DenoiseConfig, precision: str) -> None:
-    rng = np.random.default_rng(cfg.block + cfg.edge)
-    n = 1000 + cfg.edge  # not a multiple of the hop: the flush window overlaps the last one
+    rng = np.random.default_rng(cfg.block + cfg.edge_start)
+    n = 1000 + cfg.edge_end  # not a multiple of the hop: the flush window overlaps the last one
     t = np.arange(n) * 0.005
     x = _f32(np.column_stack([0.2 * np.sin(2 * np.pi * 0.4 * t), 0.01 + 0 * t, -0.3 + 0.02 * t])
              + 0.01 * rng.normal(size=(n, 3)))
     y = D.denoise(x, cfg, precision=precision)
-    y_ref = R.denoise(x, cfg.wavelet, cfg.levels, cfg.block, cfg.edge, cfg.threshold, cfg.detrend)
+    y_ref = R.denoise(x, cfg.wavelet, cfg.levels, cfg.block, cfg.edge_start, cfg.edge_end,
+                        cfg.threshold, cfg.detrend)
     scale = float(np.max(np.abs(x)))
     # per window as the block test above, plus the segment constant (sums of ≤ N terms)
     tol = 2 * _tol(cfg.wavelet, cfg.levels, scale, precision) * (
@@ -230,21 +232,22 @@ def test_stream_matches_reference(cfg: D.DenoiseConfig, precision: str) -> None:
 
 
 def test_stream_bursts_latency_and_segment_sums() -> None:
-    cfg = D.DenoiseConfig()  # N = 64, E = 16, hop 32
+    cfg = D.DenoiseConfig(levels=3, block=64, edge_start=24, edge_end=8)  # hop 32
     rng = np.random.default_rng(2)
     x = 0.3 + 0.01 * rng.normal(size=(700, 2))
     d = D.Denoiser(cfg, channels=2)
-    assert d.latency == cfg.latency == 47 and cfg.hop == 32
-    assert cfg.latency_s(200.0) == pytest.approx(0.235)
+    assert d.latency == cfg.latency == 39 and cfg.hop == 32
+    assert cfg.latency_s(200.0) == pytest.approx(0.195)
+    assert D.DenoiseConfig().latency == 71  # the defaults: N − 1 − Es = 128 − 1 − 56
     done = 0
     for i in range(len(x)):
-        assert d.outputs(1) in (0, 32, 48)
+        assert d.outputs(1) in (0, 32, 56)
         out = d.update(x[i])
         if len(out):
             # the burst is samples [done, done + len) and its first sample waited
-            # N − 1 − E samples (N − 1 for the first window)
-            assert i - done == (63 if done == 0 else 47)
-            assert len(out) == (48 if done == 0 else 32)
+            # N − 1 − Es samples (N − 1 for the first window)
+            assert i - done == (63 if done == 0 else 39)
+            assert len(out) == (56 if done == 0 else 32)
             np.testing.assert_allclose(out.sum(axis=0), x[done: done + len(out)].sum(axis=0), rtol=1e-14)
             done += len(out)
         assert d.pending == i + 1 - done
@@ -279,8 +282,8 @@ def test_constants_and_ramps_pass_unchanged(wavelet: str, threshold: str, precis
     t = np.arange(n)
     # a slope of 2^-9: the ramp is exact in float32 too (a rounded ramp is not a ramp)
     x = _f32(np.column_stack([np.full(n, 0.0123), 1.5 - t / 512, -3.0 + 0 * t]))
-    for edge in (0, 16):
-        cfg = D.DenoiseConfig(wavelet=wavelet, threshold=threshold, edge=edge)
+    for edges in ((0, 0), (24, 8), (5, 30)):
+        cfg = D.DenoiseConfig(wavelet=wavelet, threshold=threshold, edge_start=edges[0], edge_end=edges[1])
         y = D.denoise(x, cfg, precision=precision)
         # the line fit and its restoration: a few roundings per sample of
         # values ≤ 3, plus the transform of a residual at rounding level
@@ -288,8 +291,8 @@ def test_constants_and_ramps_pass_unchanged(wavelet: str, threshold: str, precis
 
 
 def test_denoising_reduces_white_noise() -> None:
-    """The point of it: on white noise, the defaults cut the RMS to ~0.36 and the
-    peak-to-peak to ~0.4 (docs/denoise.md); the mean is untouched."""
+    """The point of it: on white noise, the defaults cut the RMS to ~0.3 and the
+    peak-to-peak to ~0.3 (docs/denoise.md); the mean is untouched."""
     rng = np.random.default_rng(1)
     x = 0.05 + 0.01 * rng.normal(size=(20_000, 1))
     y = D.denoise(x)
@@ -305,7 +308,8 @@ def test_defaults_come_from_the_library() -> None:
     c = ffi.new("att_wden_config *")
     lib.att_wden_config_default(c)
     cfg = D.DenoiseConfig()
-    assert (cfg.levels, cfg.block, cfg.edge, cfg.detrend) == (c.levels, c.block, c.edge, bool(c.detrend))
+    assert (cfg.levels, cfg.block, cfg.edge_start, cfg.edge_end, cfg.detrend) == (
+        c.levels, c.block, c.edge_start, c.edge_end, bool(c.detrend))
     assert D.WAVELETS.index(cfg.wavelet) == c.wavelet == lib.ATT_WDEN_DB4
     assert D.THRESHOLDS.index(cfg.threshold) == c.mode == lib.ATT_WDEN_SOFT
     assert len(D.WAVELETS) == lib.ATT_WDEN_WAVELET_COUNT and len(D.THRESHOLDS) == lib.ATT_WDEN_MODE_COUNT
@@ -323,8 +327,9 @@ def test_defaults_come_from_the_library() -> None:
     ({"levels": True}, InvalidType, "levels"),
     ({"block": 60}, InvalidArgument, r"multiple of 2\*\*levels"),
     ({"block": 1 << 15}, InvalidArgument, "block"),
-    ({"edge": 32}, InvalidArgument, "edge"),
-    ({"edge": -1}, InvalidArgument, "edge"),
+    ({"edge_start": 100, "edge_end": 28}, InvalidArgument, "edge_start \\+ edge_end"),
+    ({"edge_start": -1}, InvalidArgument, "edge_start"),
+    ({"edge_end": 2.5}, InvalidType, "edge_end"),
     ({"detrend": 1}, InvalidType, "detrend"),
 ])
 def test_config_errors_name_the_field(kw: dict, exc: type, words: str) -> None:
@@ -333,22 +338,22 @@ def test_config_errors_name_the_field(kw: dict, exc: type, words: str) -> None:
 
 
 def test_argument_errors() -> None:
-    x = np.zeros((100, 3))
+    x = np.zeros((200, 3))
     with pytest.raises(InvalidArgument, match="fewer than one block"):
-        D.denoise(x[:63])
+        D.denoise(x[:127])
     with pytest.raises(InvalidArgument, match=r"shape \(N,\) or \(N, C\)"):
-        D.denoise(np.zeros((100, 3, 1)))
+        D.denoise(np.zeros((200, 3, 1)))
     with pytest.raises(InvalidType, match="real numbers"):
-        D.denoise(np.array(["a"] * 100))
+        D.denoise(np.array(["a"] * 200))
     bad = x.copy()
     bad[70, 2] = np.nan
     with pytest.raises(NonFiniteError, match="sample 70") as ei:
         D.denoise(bad)
     assert ei.value.index == 70
     with pytest.raises(RangeError, match="float32"):
-        D.denoise(np.full(100, 1e300), precision="f32")
+        D.denoise(np.full(200, 1e300), precision="f32")
     with pytest.raises(RangeError, match="overflows"):
-        D.denoise(np.full(100, 1e306))  # finite, but τ·x of the line fit overflows
+        D.denoise(np.full(200, 1e306))  # finite, but τ·x of the line fit overflows
     with pytest.raises(InvalidType, match="config"):
         D.denoise(x, config={"block": 64})  # type: ignore[arg-type]
     with pytest.raises(InvalidArgument, match="precision"):
@@ -376,5 +381,5 @@ def test_overflow_resets_the_stream() -> None:
     d = D.Denoiser(channels=1)
     d.update(np.zeros((30, 1)))
     with pytest.raises(RangeError, match="reset"):
-        d.update(np.full((40, 1), 1e306))
+        d.update(np.full((140, 1), 1e306))
     assert d.pending == 0

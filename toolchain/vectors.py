@@ -230,15 +230,16 @@ def denoise_cases(rng: np.random.Generator) -> list[Case]:
                             ops=_wden_ops(w, lv), scale=float(np.max(np.abs(cf)))))
     t = np.arange(700) * 0.005
     sig = 0.3 * np.sin(2 * np.pi * 0.5 * t) + 0.02 * t
-    for w, lv, block, edge, det in (("db4", 3, 64, 16, 1), ("haar", 2, 32, 0, 1), ("db2", 4, 128, 40, 0)):
+    for w, lv, block, es, ee, det in (("db4", 3, 64, 24, 8, 1), ("haar", 2, 32, 0, 0, 1),
+                                      ("db2", 4, 128, 40, 30, 0)):
         x = _f32((sig + 0.01 * rng.normal(size=len(t)))[:, None])
-        y = wref.denoise(x[:, 0], w, lv, block, edge, "soft", bool(det))
+        y = wref.denoise(x[:, 0], w, lv, block, es, ee, "soft", bool(det))
         out.append(Case(f"wden_stream.{w}", "wden_stream", x,
-                        params=[w, "soft", str(lv), str(block), str(edge), str(det)], expected=y[:, None],
+                        params=[w, "soft", str(lv), str(block), str(es), str(ee), str(det)], expected=y[:, None],
                         ops=_wden_ops(w, lv, block), scale=float(np.max(np.abs(x)))))
     bad = _f32(rng.normal(size=(100, 1)))
     bad[77, 0] = np.nan
-    out.append(Case("wden_stream.nan", "wden_stream", bad, params=["db4", "soft", "3", "64", "16", "1"],
+    out.append(Case("wden_stream.nan", "wden_stream", bad, params=["db4", "soft", "3", "64", "24", "8", "1"],
                     status_ok=False, err_index=77))
     return out
 

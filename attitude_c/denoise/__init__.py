@@ -3,8 +3,9 @@
 The C denoiser of ``csrc/include/attitude/denoise.h`` over NumPy arrays, in
 the double (``precision="f64"``) and float (``"f32"``) builds:
 
-* :class:`DenoiseConfig` — wavelet, levels, block N, edge E, thresholding
-  rule, detrending (defaults from the C library);
+* :class:`DenoiseConfig` — wavelet, levels, block N, the samples dropped
+  at each window's start and end, thresholding rule, detrending (defaults
+  from the C library);
 * :func:`denoise` — a whole record, (N,) or (N, C), as a pure function;
 * :class:`Denoiser` — the same as a stream: :meth:`Denoiser.update` takes
   (M, C) samples and returns the (K, C) denoised samples completed so far,
@@ -75,7 +76,7 @@ def _status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
         lib.ATT_E_WDEN_BLOCK: (InvalidArgument,
                                f"the block length must be 2..{lib.ATT_WDEN_MAX_BLOCK} and a "
                                "multiple of 2**levels"),
-        lib.ATT_E_WDEN_EDGE: (InvalidArgument, "2*edge must be smaller than the block length"),
+        lib.ATT_E_WDEN_EDGE: (InvalidArgument, "edge_start + edge_end must be smaller than the block"),
         lib.ATT_E_WDEN_SHORT: (InvalidArgument, "fewer samples than one block were received"),
         lib.ATT_E_WDEN_OVERFLOW: (RangeError, "finite input, but the result overflows"),
     }
@@ -107,7 +108,8 @@ def _c_defaults() -> dict[str, Any]:
     lib.att_wden_config_default(c)
     return {"wavelet": WAVELETS[[_wavelet_code(lib, w) for w in WAVELETS].index(c.wavelet)],
             "threshold": THRESHOLDS[[_mode_code(lib, m) for m in THRESHOLDS].index(c.mode)],
-            "levels": int(c.levels), "block": int(c.block), "edge": int(c.edge),
+            "levels": int(c.levels), "block": int(c.block),
+            "edge_start": int(c.edge_start), "edge_end": int(c.edge_end),
             "detrend": bool(c.detrend)}
 
 
@@ -119,22 +121,25 @@ class DenoiseConfig:
     """Denoiser settings (docs/denoise.md). Defaults: the C library's.
 
     ``block`` N samples per window, ``levels`` L (N a multiple of 2^L),
-    ``edge`` E samples dropped at each end of a window (windows advance by
-    the hop N − 2E; E = 0: non-overlapping blocks), ``threshold`` soft or
-    hard, ``detrend``: remove and restore the least-squares line per block
-    (a ramp then passes unchanged for every wavelet)."""
+    ``edge_start`` and ``edge_end``: the oldest and the newest samples of a
+    window that are not output (windows advance by the hop
+    N − edge_start − edge_end; both 0: non-overlapping blocks),
+    ``threshold`` soft or hard, ``detrend``: remove and restore the
+    least-squares line per block (a ramp then passes unchanged for every
+    wavelet)."""
 
     wavelet: Wavelet = _DEFAULT["wavelet"]
     levels: int = _DEFAULT["levels"]
     block: int = _DEFAULT["block"]
-    edge: int = _DEFAULT["edge"]
+    edge_start: int = _DEFAULT["edge_start"]
+    edge_end: int = _DEFAULT["edge_end"]
     threshold: Threshold = _DEFAULT["threshold"]
     detrend: bool = _DEFAULT["detrend"]
 
     def __post_init__(self) -> None:
         _choice(self.wavelet, "wavelet", WAVELETS)
         _choice(self.threshold, "threshold", THRESHOLDS)
-        for name, minimum in (("levels", 1), ("block", 2), ("edge", 0)):
+        for name, minimum in (("levels", 1), ("block", 2), ("edge_start", 0), ("edge_end", 0)):
             object.__setattr__(self, name, _count(getattr(self, name), name, minimum))
         if not isinstance(self.detrend, (bool, np.bool_)):
             raise InvalidType(f"detrend must be a bool, got {type(self.detrend).__name__}")
@@ -149,7 +154,8 @@ class DenoiseConfig:
             raise InvalidArgument(f"block must be a multiple of 2**levels = {1 << self.levels}, "
                                   f"got block={self.block}")
         if st == lib.ATT_E_WDEN_EDGE:
-            raise InvalidArgument(f"edge must be < block/2 (2*edge < {self.block}), got {self.edge}")
+            raise InvalidArgument(f"edge_start + edge_end must be < block = {self.block}, got "
+                                  f"edge_start={self.edge_start}, edge_end={self.edge_end}")
         _check(st, "DenoiseConfig", lib)
 
     def _struct(self, ffi: Any, lib: Any) -> Any:
@@ -158,14 +164,15 @@ class DenoiseConfig:
         c.mode = _mode_code(lib, self.threshold)
         c.levels = self.levels
         c.block = self.block
-        c.edge = self.edge
+        c.edge_start = self.edge_start
+        c.edge_end = self.edge_end
         c.detrend = int(self.detrend)
         return c
 
     @property
     def hop(self) -> int:
-        """Samples between two windows (and output burst size), N − 2E."""
-        return self.block - 2 * self.edge
+        """Samples between two windows (and output burst size), N − Es − Ee."""
+        return self.block - self.edge_start - self.edge_end
 
     @property
     def latency(self) -> int:
@@ -315,7 +322,7 @@ def universal_threshold(sigma: float, n: int, precision: str = "f64") -> float:
 def denoise_block(x: ArrayLike, config: DenoiseConfig | None = None,
                   precision: str = "f64") -> tuple[FloatArray, float]:
     """Denoise one block x (its length is the block; ``config.block`` and
-    ``config.edge`` are not used). Returns (y, σ)."""
+    the edges are not used). Returns (y, σ)."""
     precision = _check_precision(precision)
     cfg = _config(config)
     a = _vector(x, "x")
@@ -324,7 +331,8 @@ def denoise_block(x: ArrayLike, config: DenoiseConfig | None = None,
     _shape_check(n, cfg.levels, "x", lib)
     c = ffi.new("att_wden_config *")
     c.wavelet, c.mode = _wavelet_code(lib, cfg.wavelet), _mode_code(lib, cfg.threshold)
-    c.levels, c.block, c.edge, c.detrend = cfg.levels, n, 0, int(cfg.detrend)
+    c.levels, c.block, c.detrend = cfg.levels, n, int(cfg.detrend)
+    c.edge_start = c.edge_end = 0
     buf = _to_c(a, precision, "x")
     out = np.empty_like(buf)
     scratch = np.empty(2 * n, dtype=_DTYPES[precision])
@@ -354,7 +362,7 @@ class Denoiser:
     samples completed by them, (K, C) float64 (K is 0 until a window fills,
     then bursts of ``config.hop``); :meth:`flush` ends the stream and returns
     the rest. Output k is input sample k denoised, delayed by at most
-    ``config.latency`` samples (``block − 1`` for the first ``edge``)."""
+    ``config.latency`` samples (``block − 1`` for the first ``edge_start``)."""
 
     def __init__(self, config: DenoiseConfig | None = None, channels: int = 3,
                  precision: str = "f64") -> None:

@@ -193,20 +193,20 @@ class Windowing:
     out_stop: int
 
 
-def windows(total: int, block: int, edge: int) -> list[Windowing]:
-    """The windows of docs/denoise.md: hop H = block − 2·edge; window k ≥ 0
-    covers [kH, kH + block) and outputs [kH + edge, kH + block − edge),
-    except window 0, which outputs from 0 (the record's start is a true
-    edge); a final window over the last ``block`` samples outputs what is
-    left up to the end."""
-    hop = block - 2 * edge
+def windows(total: int, block: int, edge_start: int, edge_end: int) -> list[Windowing]:
+    """The windows of docs/denoise.md: hop H = block − edge_start − edge_end;
+    window k ≥ 0 covers [kH, kH + block) and outputs
+    [kH + edge_start, kH + block − edge_end), except window 0, which outputs
+    from 0 (the record's start is a true edge); a final window over the last
+    ``block`` samples outputs what is left up to the end."""
+    hop = block - edge_start - edge_end
     if total < block:
         raise ValueError(f"a record of {total} samples is shorter than one block ({block})")
     out: list[Windowing] = []
     k = 0
     while k * hop + block <= total:
         s = k * hop
-        out.append(Windowing(s, 0 if k == 0 else s + edge, s + block - edge))
+        out.append(Windowing(s, 0 if k == 0 else s + edge_start, s + block - edge_end))
         k += 1
     done = out[-1].out_stop
     if done < total:
@@ -214,8 +214,8 @@ def windows(total: int, block: int, edge: int) -> list[Windowing]:
     return out
 
 
-def denoise(x: ArrayLike, wavelet: str = "db4", levels: int = 4, block: int = 128,
-            edge: int = 16, mode: str = "soft", detrend: bool = True) -> F:
+def denoise(x: ArrayLike, wavelet: str = "db4", levels: int = 3, block: int = 64,
+            edge_start: int = 24, edge_end: int = 8, mode: str = "soft", detrend: bool = True) -> F:
     """Denoise a record (N,) or (N, C) column by column, window by window.
 
     Each output segment is the window's denoised samples plus the constant
@@ -223,7 +223,7 @@ def denoise(x: ArrayLike, wavelet: str = "db4", levels: int = 4, block: int = 12
     a = np.asarray(x, dtype=np.float64)
     cols = a.reshape(len(a), -1)
     y = np.empty_like(cols)
-    for w in windows(len(a), block, edge):
+    for w in windows(len(a), block, edge_start, edge_end):
         for j in range(cols.shape[1]):
             u = cols[w.start: w.start + block, j]
             v, _ = denoise_block(u, wavelet, levels, mode, detrend)

@@ -80,7 +80,8 @@ int att_wden_config_default(att_wden_config *cfg)
     cfg->mode = ATT_WDEN_DEFAULT_MODE;
     cfg->levels = ATT_WDEN_DEFAULT_LEVELS;
     cfg->block = ATT_WDEN_DEFAULT_BLOCK;
-    cfg->edge = ATT_WDEN_DEFAULT_EDGE;
+    cfg->edge_start = ATT_WDEN_DEFAULT_EDGE_START;
+    cfg->edge_end = ATT_WDEN_DEFAULT_EDGE_END;
     cfg->detrend = ATT_WDEN_DEFAULT_DETREND;
     return ATT_OK;
 }
@@ -106,7 +107,7 @@ int att_wden_config_check(const att_wden_config *cfg)
     st = check_shape(cfg->levels, cfg->block);
     if (st != ATT_OK)
         return st;
-    if (cfg->edge > (cfg->block - 1) / 2) /* 2E < N */
+    if (cfg->edge_start >= cfg->block || cfg->edge_end >= cfg->block - cfg->edge_start) /* Es + Ee < N */
         return ATT_E_WDEN_EDGE;
     if (cfg->detrend != 0 && cfg->detrend != 1)
         return ATT_E_ARG;
@@ -125,12 +126,12 @@ size_t att_wden_scratch_len(const att_wden_config *cfg)
 
 size_t att_wden_max_out(const att_wden_config *cfg)
 {
-    return att_wden_config_check(cfg) == ATT_OK ? cfg->block - cfg->edge : 0;
+    return att_wden_config_check(cfg) == ATT_OK ? cfg->block - cfg->edge_end : 0;
 }
 
 size_t att_wden_latency(const att_wden_config *cfg)
 {
-    return att_wden_config_check(cfg) == ATT_OK ? cfg->block - 1 - cfg->edge : 0;
+    return att_wden_config_check(cfg) == ATT_OK ? cfg->block - 1 - cfg->edge_start : 0;
 }
 
 int att_wden_filters(int wavelet, att_real h[ATT_WDEN_MAX_TAPS], att_real g[ATT_WDEN_MAX_TAPS], size_t *taps)

@@ -38,12 +38,12 @@ int att_wden_reset(att_wden *s)
 
 size_t att_wden_outputs(const att_wden *s, size_t n)
 {
-    const size_t nb = s->cfg.block, e = s->cfg.edge, hop = nb - 2 * e;
+    const size_t nb = s->cfg.block, ee = s->cfg.edge_end, hop = nb - s->cfg.edge_start - ee;
     if (!s->started) {
         if (n < nb - s->fill)
             return 0;
         n -= nb - s->fill; /* samples after the one that completes the first window */
-        return (nb - e) + (n / hop) * hop;
+        return (nb - ee) + (n / hop) * hop;
     }
     return ((s->since + n) / hop) * hop;
 }
@@ -88,7 +88,7 @@ static int run_window(att_wden *s, size_t a, size_t b, att_real *out)
 
 int att_wden_push(att_wden *s, att_real x, att_real *out)
 {
-    size_t nb, e, hop, head;
+    size_t nb, es, ee, hop, head;
     att_real overwritten;
     int st, produced;
     if (s == NULL || out == NULL)
@@ -96,8 +96,9 @@ int att_wden_push(att_wden *s, att_real x, att_real *out)
     if (!isfinite(x))
         return ATT_E_NONFINITE;
     nb = s->cfg.block;
-    e = s->cfg.edge;
-    hop = nb - 2 * e;
+    es = s->cfg.edge_start;
+    ee = s->cfg.edge_end;
+    hop = nb - es - ee;
     head = s->head;
     overwritten = s->ring[head]; /* kept for the roll-back on overflow */
     s->ring[head] = x;
@@ -107,15 +108,15 @@ int att_wden_push(att_wden *s, att_real x, att_real *out)
             s->pending++;
             return 0;
         }
-        st = run_window(s, 0, nb - e, out); /* the first window outputs from the stream's start */
-        produced = (int)(nb - e);
+        st = run_window(s, 0, nb - ee, out); /* the first window outputs from the stream's start */
+        produced = (int)(nb - ee);
     } else {
         if (s->since + 1 < hop) {
             s->since++;
             s->pending++;
             return 0;
         }
-        st = run_window(s, e, nb - e, out);
+        st = run_window(s, es, nb - ee, out);
         produced = (int)hop;
     }
     if (st != ATT_OK) { /* state as before the call */

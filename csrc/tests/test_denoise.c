@@ -45,6 +45,17 @@ static double urand(void) /* uniform in [-1, 1): a 32-bit LCG (Numerical Recipes
 }
 
 static const int wavelets[3] = { ATT_WDEN_HAAR, ATT_WDEN_DB2, ATT_WDEN_DB4 };
+
+/* The defaults with a 64-sample block (L = 3, Es = 24, Ee = 8, hop 32): the
+ * stream tests below are written for it. */
+static void small_config(att_wden_config *cfg)
+{
+    att_wden_config_default(cfg);
+    cfg->levels = 3;
+    cfg->block = 64;
+    cfg->edge_start = 24;
+    cfg->edge_end = 8;
+}
 static const size_t taps_of[3] = { 2, 4, 8 };
 static const int moments_of[3] = { 1, 2, 4 };
 
@@ -55,16 +66,17 @@ static void test_config(void)
     CHECK_EQ_INT(att_wden_config_default(&cfg), ATT_OK);
     CHECK_EQ_INT(cfg.wavelet, ATT_WDEN_DB4);
     CHECK_EQ_INT(cfg.mode, ATT_WDEN_SOFT);
-    CHECK_EQ_INT(cfg.levels, 3);
-    CHECK_EQ_INT(cfg.block, 64);
-    CHECK_EQ_INT(cfg.edge, 16);
+    CHECK_EQ_INT(cfg.levels, 4);
+    CHECK_EQ_INT(cfg.block, 128);
+    CHECK_EQ_INT(cfg.edge_start, 56);
+    CHECK_EQ_INT(cfg.edge_end, 24);
     CHECK_EQ_INT(cfg.detrend, 1);
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_OK);
-    CHECK_EQ_INT(att_wden_state_len(&cfg), 64);
-    CHECK_EQ_INT(att_wden_scratch_len(&cfg), 128);
-    CHECK_EQ_INT(att_wden_max_out(&cfg), 48);
-    CHECK_EQ_INT(att_wden_latency(&cfg), 47);
-    CHECK_EQ_INT(ATT_WDEN_LATENCY(64, 16), 47);
+    CHECK_EQ_INT(att_wden_state_len(&cfg), 128);
+    CHECK_EQ_INT(att_wden_scratch_len(&cfg), 256);
+    CHECK_EQ_INT(att_wden_max_out(&cfg), 104);
+    CHECK_EQ_INT(att_wden_latency(&cfg), 71);
+    CHECK_EQ_INT(ATT_WDEN_LATENCY(128, 56), 71);
     CHECK_EQ_INT(att_wden_config_check(NULL), ATT_E_NULL);
     cfg.wavelet = 3;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_WAVELET);
@@ -80,7 +92,7 @@ static void test_config(void)
     cfg.levels = ATT_WDEN_MAX_LEVELS + 1;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_LEVELS);
     att_wden_config_default(&cfg);
-    cfg.block = 60; /* not a multiple of 8 */
+    cfg.block = 60; /* not a multiple of 16 */
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_BLOCK);
     cfg.block = (size_t)ATT_WDEN_MAX_BLOCK * 2;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_BLOCK);
@@ -88,11 +100,18 @@ static void test_config(void)
     cfg.block = 0;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_BLOCK);
     att_wden_config_default(&cfg);
-    cfg.edge = 32; /* 2E = N */
+    cfg.edge_start = 64;
+    cfg.edge_end = 64; /* Es + Ee = N */
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_EDGE);
-    cfg.edge = 31;
+    cfg.edge_end = 63;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_OK);
-    cfg.edge = (size_t)-1; /* no overflow in the 2E < N test */
+    cfg.edge_start = 0;
+    cfg.edge_end = 127;
+    CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_OK);
+    cfg.edge_end = (size_t)-1; /* no overflow in the Es + Ee < N test */
+    CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_EDGE);
+    cfg.edge_end = 0;
+    cfg.edge_start = (size_t)-1;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_E_WDEN_EDGE);
     att_wden_config_default(&cfg);
     cfg.detrend = 2;
@@ -100,6 +119,8 @@ static void test_config(void)
     cfg.detrend = 0;
     cfg.levels = 6;
     cfg.block = 64; /* one approximation coefficient: allowed */
+    cfg.edge_start = 24;
+    cfg.edge_end = 8;
     CHECK_EQ_INT(att_wden_config_check(&cfg), ATT_OK);
 }
 
@@ -358,7 +379,7 @@ static void test_block(void)
     double sx, sy;
     for (w = 0; w < 3; w++) {
         for (mode = 0; mode < 2; mode++) {
-            att_wden_config_default(&cfg);
+            small_config(&cfg);
             cfg.wavelet = wavelets[w];
             cfg.mode = (int)mode;
             /* a ramp passes unchanged with detrend (the noise-free σ is 0) */
@@ -388,7 +409,7 @@ static void test_block(void)
             CHECK(max_abs_diff(c, y, 64) == 0);
         }
     }
-    att_wden_config_default(&cfg);
+    small_config(&cfg);
     x[3] = (att_real)NAN;
     CHECK_EQ_INT(att_wden_block(&cfg, x, y, scratch, NULL), ATT_E_NONFINITE);
     line(x, 64, 0, 1, 0);
@@ -429,14 +450,15 @@ static size_t run_stream(const att_wden_config *cfg, size_t n, att_real *out)
 
 static void test_stream_passes_lines(void)
 {
-    static const size_t edges[] = { 0, 5, 16, 31 };
+    static const size_t edges[][2] = { { 0, 0 }, { 5, 5 }, { 24, 8 }, { 8, 24 }, { 40, 20 } };
     att_wden_config cfg;
     size_t w, e, n;
     for (w = 0; w < 3; w++) {
         for (e = 0; e < sizeof edges / sizeof edges[0]; e++) {
-            att_wden_config_default(&cfg);
+            small_config(&cfg);
             cfg.wavelet = wavelets[w];
-            cfg.edge = edges[e];
+            cfg.edge_start = edges[e][0];
+            cfg.edge_end = edges[e][1];
             cfg.mode = (int)(e & 1u);
             line(sin_, SLEN, 2.0, 0.01, 0); /* a ramp from 2 to 8 */
             n = run_stream(&cfg, SLEN - (size_t)e * 7, sout);
@@ -451,7 +473,7 @@ static void test_stream_segments(void)
     att_wden_config cfg;
     att_wden s;
     size_t i, k = 0, burst = 0, first = 1;
-    att_wden_config_default(&cfg); /* N = 64, E = 16, H = 32 */
+    small_config(&cfg); /* N = 64, Es = 24, Ee = 8, H = 32 */
     line(sin_, SLEN, 0.2, 0.0005, 0.05);
     CHECK_EQ_INT(att_wden_init(&s, &cfg, ring1, 64, scratch, 128), ATT_OK);
     for (i = 0; i < SLEN; i++) {
@@ -459,20 +481,20 @@ static void test_stream_segments(void)
         if (r > 0) {
             double sx = 0, sy = 0, sa = 0;
             size_t j;
-            /* the burst: window ending at sample i; it outputs [i+1−N+E, i+1−E) (first: from 0) */
-            CHECK_EQ_INT(r, first ? 48 : 32);
-            CHECK_EQ_INT(k, first ? 0 : i + 1 - 64 + 16);
-            CHECK_EQ_INT(i + 1 - (k + (size_t)r), 16); /* E samples stay pending */
+            /* the burst: window ending at sample i; it outputs [i+1−N+Es, i+1−Ee) (first: from 0) */
+            CHECK_EQ_INT(r, first ? 56 : 32);
+            CHECK_EQ_INT(k, first ? 0 : i + 1 - 64 + 24);
+            CHECK_EQ_INT(i + 1 - (k + (size_t)r), 8); /* Ee samples stay pending */
             for (j = k; j < k + (size_t)r; j++) {
                 sx += (double)sin_[j];
                 sy += (double)sout[j];
                 sa += fabs((double)sin_[j]);
             }
-            /* the segment's sum is restored: the two sums of r ≤ 48 terms and the r
+            /* the segment's sum is restored: the two sums of r ≤ 56 terms and the r
              * corrected outputs each err by ≤ r·EPS·Σ|x| */
             CHECK_CLOSE(sy, sx, 4 * (double)r * EPS * sa);
-            /* latency: the segment's first sample waited N − 1 − E samples (N − 1 for window 0) */
-            CHECK_EQ_INT(i - k, first ? 63 : 47);
+            /* latency: the segment's first sample waited N − 1 − Es samples (N − 1 for window 0) */
+            CHECK_EQ_INT(i - k, first ? 63 : 39);
             first = 0;
             burst++;
             k += (size_t)r;
@@ -489,9 +511,10 @@ static void test_stream_batch_and_errors(void)
     att_wden a, b, c3[3];
     size_t n1 = 0, n2 = 0, err = 0, i, k, got;
     int r;
-    att_wden_config_default(&cfg);
+    small_config(&cfg);
     cfg.wavelet = ATT_WDEN_DB2;
-    cfg.edge = 8;
+    cfg.edge_start = 8;
+    cfg.edge_end = 8;
     line(sin_, SLEN, -0.1, 0.0002, 0.02);
     /* push_n in uneven chunks == one push at a time, bit for bit */
     n1 = run_stream(&cfg, SLEN, sout);
@@ -579,7 +602,7 @@ static void test_stream_batch_and_errors(void)
     sout2[64 + 48 - 1] = HUGEV; /* completes window 1 (hop 48) */
     CHECK_EQ_INT(att_wden_push_n(&a, sout2, 200, sout, 200, &n2, &err), ATT_E_WDEN_OVERFLOW);
     CHECK_EQ_INT(err, 64 + 48 - 1);
-    CHECK_EQ_INT(n2, 56); /* window 0 output N − E = 56 samples */
+    CHECK_EQ_INT(n2, 56); /* window 0 output N − Ee = 56 samples */
     CHECK_EQ_INT(att_wden_pending(&a), 64 + 48 - 1 - 56);
 }
 

@@ -8,7 +8,7 @@
  * samples come from a precomputed table (start-up cancels out), indexed
  * with a mask so that the loop adds a few instructions only.
  *
- *   bench_denoise WAVELET MODE LEVELS BLOCK EDGE N
+ *   bench_denoise WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END N
  *     WAVELET = haar|db2|db4, MODE = soft|hard
  */
 #include <stdio.h>
@@ -29,7 +29,7 @@ int main(int argc, char **argv)
     att_wden s;
     unsigned long n, i, outputs = 0, lcg = 1u;
     int w, r;
-    if (argc != 7)
+    if (argc != 8)
         return 2;
     for (w = 0; w < 3; w++)
         if (strcmp(argv[1], wavelets[w]) == 0)
@@ -39,8 +39,9 @@ int main(int argc, char **argv)
     cfg.mode = strcmp(argv[2], "hard") == 0 ? ATT_WDEN_HARD : ATT_WDEN_SOFT;
     cfg.levels = (unsigned int)strtoul(argv[3], NULL, 10);
     cfg.block = (size_t)strtoul(argv[4], NULL, 10);
-    cfg.edge = (size_t)strtoul(argv[5], NULL, 10);
-    n = strtoul(argv[6], NULL, 10);
+    cfg.edge_start = (size_t)strtoul(argv[5], NULL, 10);
+    cfg.edge_end = (size_t)strtoul(argv[6], NULL, 10);
+    n = strtoul(argv[7], NULL, 10);
     if (cfg.block > NMAX || att_wden_init(&s, &cfg, ring, NMAX, scratch, 2 * NMAX) != ATT_OK)
         return 3;
     for (i = 0; i < TABLE; i++) { /* a gyro at rest: 0.01 rad/s of bias, ±1e-3 rad/s of noise */

@@ -21,7 +21,7 @@
  *   link_tx BLOCK SYN_TO ANS_TO ATTEMPTS BYTES... -- N events for sender A;
  *   wden_dwt WAVELET LEVELS, wden_idwt WAVELET LEVELS -- N samples (1) -> N coefficients
  *     (wavedec order) and back;
- *   wden_stream WAVELET MODE LEVELS BLOCK EDGE DETREND -- N samples (1) pushed in one
+ *   wden_stream WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END DETREND -- N samples (1) pushed in one
  *     att_wden_push_n() call, then flushed -> N denoised samples;
  *     WAVELET = haar|db2|db4, MODE = soft|hard;
  *     event byte: 0..255 = sink it, -1 = poll only, -2 = (sender) start the block.
@@ -255,7 +255,7 @@ static int run_wden(const char *id, const char *fn, size_t n)
 {
     static att_real ring[WDEN_BLOCK_MAX], scratch[2 * WDEN_BLOCK_MAX];
     char wname[16], mname[16];
-    double v[4];
+    double v[5];
     int st;
     size_t nout = 0, err = 0, got = 0;
     if (token(wname, sizeof wname) != 0 || wavelet_code(wname) < 0)
@@ -274,14 +274,15 @@ static int run_wden(const char *id, const char *fn, size_t n)
         att_wden_config cfg;
         att_wden s;
         if (token(mname, sizeof mname) != 0 || number(&v[0]) != 0 || number(&v[1]) != 0 || number(&v[2]) != 0
-            || number(&v[3]) != 0 || read_values(in_buf, n) != 0)
+            || number(&v[3]) != 0 || number(&v[4]) != 0 || read_values(in_buf, n) != 0)
             return -1;
         cfg.wavelet = wavelet_code(wname);
         cfg.mode = strcmp(mname, "hard") == 0 ? ATT_WDEN_HARD : ATT_WDEN_SOFT;
         cfg.levels = (unsigned int)v[0];
         cfg.block = (size_t)v[1];
-        cfg.edge = (size_t)v[2];
-        cfg.detrend = (int)v[3];
+        cfg.edge_start = (size_t)v[2];
+        cfg.edge_end = (size_t)v[3];
+        cfg.detrend = (int)v[4];
         st = att_wden_init(&s, &cfg, ring, WDEN_BLOCK_MAX, scratch, 2 * WDEN_BLOCK_MAX);
         if (st == ATT_OK)
             st = att_wden_push_n(&s, in_buf, n, out_buf, MAX_OUT, &nout, &err);

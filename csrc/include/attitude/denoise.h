@@ -27,21 +27,24 @@
  * periodic wrap of a ramp is a jump that thresholding would shrink.
  *
  * Stream (att_wden_push). Windows of N = block samples advance by the hop
- * H = N − 2E (E = edge). Window k covers stream samples [kH, kH + N) and
- * outputs its central samples [kH + E, kH + N − E) (window 0 outputs from
- * sample 0: the stream's start is a true edge); the E samples at each end,
+ * H = N − Es − Ee. Window k covers stream samples [kH, kH + N) and outputs
+ * [kH + Es, kH + N − Ee) (window 0 outputs from sample 0: the stream's start
+ * is a true edge): the Es oldest and the Ee newest samples of each window,
  * where the periodic wrap and the line fit disturb the estimate, are
- * discarded. Each output segment gets the constant that makes its sum equal
- * the input's sum over the same samples: the integral of the signal over
- * every segment (the angle, for a gyro rate) is preserved, the mean exactly.
- * att_wden_flush() ends the stream with a last window over the final N
- * samples, outputting what is left.
+ * discarded. The disturbed stretch is not symmetric: the extremal-phase
+ * filters put the wrap's error mostly at the window's start (docs/denoise.md
+ * gives the measured profile), hence Es = 56, Ee = 24 for the default db4,
+ * L = 4, N = 128. Each output segment gets the constant that makes its sum
+ * equal the input's sum over the same samples: the integral of the signal
+ * over every segment (the angle, for a gyro rate) is preserved, the mean
+ * exactly. att_wden_flush() ends the stream with a last window over the
+ * final N samples, outputting what is left.
  *
- * Latency: a sample leaves at the latest ATT_WDEN_LATENCY = N − 1 − E
- * samples after it arrived (N − 1 for the first E samples of the stream);
- * outputs come in bursts of H samples (N − E for the first window). With
- * the defaults (N = 64, E = 16, H = 32) that is 47 samples: 0.235 s at
- * 200 Hz.
+ * Latency: a sample leaves at the latest ATT_WDEN_LATENCY = N − 1 − Es
+ * samples after it arrived (N − 1 for the first Es samples of the stream);
+ * outputs come in bursts of H samples (N − Ee for the first window). With
+ * the defaults (N = 128, Es = 56, Ee = 24, H = 48) that is 71 samples:
+ * 0.355 s at 200 Hz.
  *
  * Caller-owned memory: the state struct, a state buffer of
  * att_wden_state_len() samples (the window ring, one per stream) and a
@@ -83,9 +86,10 @@ enum {
     ATT_WDEN_MAX_BLOCK = 16384,   /* block length N, 2..16384, a multiple of 2^levels */
     ATT_WDEN_DEFAULT_WAVELET = 2, /* ATT_WDEN_DB4 */
     ATT_WDEN_DEFAULT_MODE = 0,    /* ATT_WDEN_SOFT */
-    ATT_WDEN_DEFAULT_LEVELS = 3,
-    ATT_WDEN_DEFAULT_BLOCK = 64,
-    ATT_WDEN_DEFAULT_EDGE = 16,
+    ATT_WDEN_DEFAULT_LEVELS = 4,
+    ATT_WDEN_DEFAULT_BLOCK = 128,
+    ATT_WDEN_DEFAULT_EDGE_START = 56,
+    ATT_WDEN_DEFAULT_EDGE_END = 24,
     ATT_WDEN_DEFAULT_DETREND = 1
 };
 
@@ -95,7 +99,7 @@ enum {
     ATT_E_WDEN_MODE = -161,    /* unknown thresholding rule */
     ATT_E_WDEN_LEVELS = -162,  /* levels outside 1..ATT_WDEN_MAX_LEVELS */
     ATT_E_WDEN_BLOCK = -163,   /* block length outside 2..ATT_WDEN_MAX_BLOCK or not a multiple of 2^levels */
-    ATT_E_WDEN_EDGE = -164,    /* 2·edge ≥ block (no sample left to output) */
+    ATT_E_WDEN_EDGE = -164,    /* edge_start + edge_end ≥ block (no sample left to output) */
     ATT_E_WDEN_SHORT = -165,   /* flush before one full block was received */
     ATT_E_WDEN_OVERFLOW = -166 /* finite input, non-finite result (|x| near the type's maximum) */
 };
@@ -106,8 +110,9 @@ typedef struct {
     int mode;            /* att_wden_mode */
     unsigned int levels; /* L, 1..ATT_WDEN_MAX_LEVELS */
     size_t block;        /* N (samples per window), 2..ATT_WDEN_MAX_BLOCK, N mod 2^L = 0 */
-    size_t edge;         /* E (samples discarded at each end of a window), 0 ≤ 2E < N;
-                            E = 0: non-overlapping blocks */
+    size_t edge_start;   /* Es: oldest samples of a window not output */
+    size_t edge_end;     /* Ee: newest samples of a window not output; Es + Ee < N;
+                            Es = Ee = 0: non-overlapping blocks */
     int detrend;         /* 1: remove and restore the least-squares line per block; 0: not */
 } att_wden_config;
 
@@ -127,24 +132,24 @@ typedef struct {
 
 /* ---- configuration ------------------------------------------------------ */
 
-/* Fill cfg with the defaults: db4, soft, L = 3, N = 64, E = 16, detrend on
+/* Fill cfg with the defaults: db4, soft, L = 4, N = 128, Es = 56, Ee = 24, detrend on
  * (docs/denoise.md: why). ATT_E_NULL if cfg is NULL. */
 int att_wden_config_default(att_wden_config *cfg);
 
 /* ATT_OK if cfg is valid, else the status naming the first bad field
- * (checked in the order wavelet, mode, levels, block, edge, detrend
+ * (checked in the order wavelet, mode, levels, block, edges, detrend
  * (ATT_E_ARG unless 0 or 1)). */
 int att_wden_config_check(const att_wden_config *cfg);
 
 /* Buffer sizes in att_real elements for a valid cfg (0 if cfg is invalid):
  * state = N (per stream), scratch = 2N (shareable), and the most samples a
- * single att_wden_push() call can output, N − E. */
+ * single att_wden_push() call can output, N − Ee. */
 size_t att_wden_state_len(const att_wden_config *cfg);
 size_t att_wden_scratch_len(const att_wden_config *cfg);
 size_t att_wden_max_out(const att_wden_config *cfg);
 
 /* Largest delay in samples from a sample's arrival to its output in the
- * steady state, N − 1 − E (0 if cfg is invalid). */
+ * steady state, N − 1 − Es (0 if cfg is invalid). */
 size_t att_wden_latency(const att_wden_config *cfg);
 
 /* ---- block transform (pure functions) -------------------------------------
@@ -184,7 +189,7 @@ int att_wden_mad_sigma(const att_real *d, size_t n, att_real *work, att_real *si
 /* Universal threshold λ = σ √(2 ln n) (σ ≥ 0 finite, n ≥ 1). */
 int att_wden_universal(att_real sigma, size_t n, att_real *lambda);
 
-/* Denoise one block x[0..N) into y[0..N) (y may be x) with cfg (cfg->edge is
+/* Denoise one block x[0..N) into y[0..N) (y may be x) with cfg (the edges are
  * not used): detrend (optional), dwt, σ from cD_1 by MAD, universal
  * threshold on every detail level, idwt, the line back. scratch: 2N
  * samples. *sigma (may be NULL) receives σ. The sum of y equals the sum of x
@@ -211,7 +216,7 @@ size_t att_wden_outputs(const att_wden *s, size_t n);
 size_t att_wden_pending(const att_wden *s);
 
 /* Feed one sample. Returns the number of denoised samples written to out
- * (0, H, or N − E for the first window; room for att_wden_max_out()), in
+ * (0, H, or N − Ee for the first window; room for att_wden_max_out()), in
  * stream order, or a negative status with the state unchanged:
  * ATT_E_NONFINITE, ATT_E_WDEN_OVERFLOW. Cost: one block denoiser run and
  * 2N copies every H samples, O(1) otherwise. */
@@ -237,9 +242,9 @@ int att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out);
 #ifndef ATT_CDEF
 /* Compile-time buffer sizes for static arrays (same values as the
  * functions above for a valid configuration). */
-#define ATT_WDEN_STATE_LEN(block)     (block)
-#define ATT_WDEN_SCRATCH_LEN(block)   (2 * (block))
-#define ATT_WDEN_LATENCY(block, edge) ((block)-1 - (edge))
+#define ATT_WDEN_STATE_LEN(block)           (block)
+#define ATT_WDEN_SCRATCH_LEN(block)         (2 * (block))
+#define ATT_WDEN_LATENCY(block, edge_start) ((block)-1 - (edge_start))
 #endif
 
 #endif /* ATTITUDE_DENOISE_H */
