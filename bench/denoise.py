@@ -238,6 +238,7 @@ def plot_static(res: dict[str, Any], path: Path = PLOT) -> Path:
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=110)
+        os.chmod(tmp, 0o644)  # mkstemp makes it private
         os.replace(tmp, path)
     finally:
         plt.close(fig)

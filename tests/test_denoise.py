@@ -231,6 +231,22 @@ def test_stream_matches_reference(cfg: D.DenoiseConfig, precision: str) -> None:
     np.testing.assert_allclose(y.mean(axis=0), x.mean(axis=0), rtol=0, atol=4 * cfg.block * U[precision] * scale)
 
 
+@pytest.mark.parametrize("cfg", CONFIGS[:4], ids=lambda c: f"{c.wavelet}-N{c.block}-{c.threshold}")
+def test_stream_matches_pywt_per_window(cfg: D.DenoiseConfig) -> None:
+    """The whole stream with PyWavelets doing every block (bench/denoise.py's
+    pywt_stream: the windows of the reference, the line fit in closed form)."""
+    from bench.denoise import pywt_stream
+
+    rng = np.random.default_rng(4)
+    x = 0.01 + np.cumsum(rng.normal(size=(900, 3)), axis=0) * 1e-3
+    y = D.denoise(x, cfg)
+    scale = float(np.max(np.abs(x)))
+    # as test_stream_matches_reference (f64)
+    tol = 2 * _tol(cfg.wavelet, cfg.levels, scale, "f64") * (
+        1 + math.sqrt(2 * math.log(cfg.block)) * math.sqrt(cfg.block)) + 4 * cfg.block * U["f64"] * scale
+    np.testing.assert_allclose(y, pywt_stream(x, cfg), rtol=0, atol=tol)
+
+
 def test_stream_bursts_latency_and_segment_sums() -> None:
     cfg = D.DenoiseConfig(levels=3, block=64, edge_start=24, edge_end=8)  # hop 32
     rng = np.random.default_rng(2)
