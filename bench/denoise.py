@@ -98,7 +98,7 @@ def static_experiment(config: Any = None, gyro: Any = None, seed: int = SEED,
     cfg = config or DenoiseConfig()
     gyro = gyro or fig5_gyro()
     rb, rn, rc = _streams(seed)
-    n = int(round(STATIC_S * RATE_HZ))
+    n = round(STATIC_S * RATE_HZ)
     bias = rb.normal(0.0, gyro.bias_dps, 3) * DEG
     x = measure(np.zeros((n, 3)), gyro, bias, rn)
     y = denoise(x, cfg, precision=precision)
@@ -141,7 +141,7 @@ def turntable_experiment(config: Any = None, gyro: Any = None, seed: int = SEED,
     gyro = gyro or fig5_gyro()
     rb, rn, rc = _streams(seed)
     traj = ConstantRateTrajectory(rate=(0.0, 0.0, TURNTABLE_DPS * DEG))
-    n = int(round(TURNTABLE_S * RATE_HZ))
+    n = round(TURNTABLE_S * RATE_HZ)
     t = np.arange(n) * DT
     bias = rb.normal(0.0, gyro.bias_dps, 3) * DEG
     # the table turns at a constant rate: every sample's mean rate is the rate

@@ -24,10 +24,10 @@ import pytest
 
 pywt = pytest.importorskip("pywt", reason="needs PyWavelets: pip install PyWavelets (test extra)")
 
-from attitude_c import InvalidArgument, InvalidType, NonFiniteError, RangeError  # noqa: E402
-from attitude_c import denoise as D  # noqa: E402
-from attitude_c._lib import ffi_lib  # noqa: E402
-from attitude_c.denoise import reference as R  # noqa: E402
+from attitude_c import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from attitude_c import denoise as D
+from attitude_c._lib import ffi_lib
+from attitude_c.denoise import reference as R
 
 U = {"f64": 2.0 ** -53, "f32": 2.0 ** -24}
 PRECISIONS = ("f64", "f32")

@@ -204,7 +204,7 @@ def _wden_ops(wavelet: str, levels: int, block: int | None = None) -> int:
     ops = levels * f * l1 ** levels
     if block is not None:
         ops = 2 * ops * (1 + math.sqrt(2 * math.log(block)) * math.sqrt(block)) + block
-    return int(math.ceil(ops))
+    return math.ceil(ops)
 
 
 def denoise_cases(rng: np.random.Generator) -> list[Case]:

@@ -73,9 +73,8 @@ def _status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
         lib.ATT_E_WDEN_WAVELET: (InvalidArgument, f"wavelet must be one of {WAVELETS}"),
         lib.ATT_E_WDEN_MODE: (InvalidArgument, f"threshold must be one of {THRESHOLDS}"),
         lib.ATT_E_WDEN_LEVELS: (InvalidArgument, f"levels must be 1..{lib.ATT_WDEN_MAX_LEVELS}"),
-        lib.ATT_E_WDEN_BLOCK: (InvalidArgument,
-                               f"the block length must be 2..{lib.ATT_WDEN_MAX_BLOCK} and a "
-                               "multiple of 2**levels"),
+        lib.ATT_E_WDEN_BLOCK: (InvalidArgument, (f"the block length must be 2..{lib.ATT_WDEN_MAX_BLOCK} "
+                                                 "and a multiple of 2**levels")),
         lib.ATT_E_WDEN_EDGE: (InvalidArgument, "edge_start + edge_end must be smaller than the block"),
         lib.ATT_E_WDEN_SHORT: (InvalidArgument, "fewer samples than one block were received"),
         lib.ATT_E_WDEN_OVERFLOW: (RangeError, "finite input, but the result overflows"),
