@@ -24,9 +24,8 @@ import math
 import os
 import sys
 import tempfile
-import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -289,15 +288,6 @@ def armv4t_counts(quick: bool) -> list[tuple[str, str, float, float, float]]:
 
 # -- host throughput (run on a quiet machine) ----------------------------------------------
 
-def _best(fn: Callable[[], Any], reps: int) -> float:
-    best = float("inf")
-    for _ in range(reps):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
-
-
 def pywt_stream(x: np.ndarray, cfg: Any) -> np.ndarray:
     """The same windowed denoiser with PyWavelets doing each block (the
     segment bookkeeping of attitude_c.denoise.reference.windows)."""
@@ -326,6 +316,8 @@ def throughput(quick: bool) -> list[tuple[str, float]]:
     import pywt
 
     from attitude_c.denoise import DenoiseConfig, denoise, wavedec, waverec
+
+    from .host import _best  # best of a few runs, time.perf_counter
 
     cfg = DenoiseConfig()
     reps = 2 if quick else 5

@@ -225,16 +225,8 @@ def wavedec(x: ArrayLike, wavelet: Wavelet = "db4", levels: int = 3,
     precision = _check_precision(precision)
     _choice(wavelet, "wavelet", WAVELETS)
     levels = _count(levels, "levels", 1)
-    a = _vector(x, "x")
-    ffi, lib = ffi_lib(precision)
-    n = a.shape[0]
-    _shape_check(n, levels, "x", lib)
-    c = _to_c(a, precision, "x")
-    out = np.empty(n, dtype=_DTYPES[precision])
-    tmp = np.empty(n, dtype=_DTYPES[precision])
-    _check(lib.att_wden_dwt(_wavelet_code(lib, wavelet), levels, _ptr(ffi, c), n, _ptr(ffi, out),
-                            _ptr(ffi, tmp)), "wavedec(x)", lib)
-    out64 = out.astype(np.float64)
+    out64 = _transform("att_wden_dwt", _vector(x, "x"), wavelet, levels, precision, "x")
+    n = out64.shape[0]
     parts, m = [out64[: n >> levels]], n >> levels
     while m < n:
         parts.append(out64[m: 2 * m])
@@ -255,16 +247,20 @@ def waverec(coeffs: Sequence[ArrayLike], wavelet: Wavelet = "db4", precision: st
             raise InvalidArgument(f"coeffs[{i}] has {len(p)} values, expected {want} "
                                   "([cA_L, cD_L, ..., cD_1] as wavedec returns them)")
         want = 2 * len(p)
-    levels = len(parts) - 1
-    flat = np.concatenate(parts)
+    return _transform("att_wden_idwt", np.concatenate(parts), wavelet, len(parts) - 1, precision, "coeffs")
+
+
+def _transform(cname: str, a: NDArray[np.float64], wavelet: str, levels: int, precision: str,
+               name: str) -> FloatArray:
+    """One C transform (att_wden_dwt or att_wden_idwt) of the flat block a."""
     ffi, lib = ffi_lib(precision)
-    n = flat.shape[0]
-    _shape_check(n, levels, "coeffs", lib)
-    c = _to_c(flat, precision, "coeffs")
+    n = a.shape[0]
+    _shape_check(n, levels, name, lib)
+    c = _to_c(a, precision, name)
     out = np.empty(n, dtype=_DTYPES[precision])
     tmp = np.empty(n, dtype=_DTYPES[precision])
-    _check(lib.att_wden_idwt(_wavelet_code(lib, wavelet), levels, _ptr(ffi, c), n, _ptr(ffi, out),
-                             _ptr(ffi, tmp)), "waverec(coeffs)", lib)
+    _check(getattr(lib, cname)(_wavelet_code(lib, wavelet), levels, _ptr(ffi, c), n, _ptr(ffi, out),
+                               _ptr(ffi, tmp)), f"{cname}({name})", lib)
     return out.astype(np.float64)
 
 

@@ -250,38 +250,36 @@ static void idwt(const bank *b, unsigned int levels, const att_real *c, size_t n
     }
 }
 
-int att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c, att_real *tmp)
+/* The checks both transforms share, then one of them. */
+static int transform(int inverse, int wavelet, unsigned int levels, const att_real *in, size_t n,
+                     att_real *out, att_real *tmp)
 {
     bank b;
     int st;
-    if (x == NULL || c == NULL || tmp == NULL)
+    if (in == NULL || out == NULL || tmp == NULL)
         return ATT_E_NULL;
     if (!load_bank(wavelet, &b))
         return ATT_E_WDEN_WAVELET;
     st = check_shape(levels, n);
     if (st != ATT_OK)
         return st;
-    if (!all_finite(x, n))
+    if (!all_finite(in, n))
         return ATT_E_NONFINITE;
-    dwt(&b, levels, x, n, c, tmp);
-    return all_finite(c, n) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
+    if (inverse)
+        idwt(&b, levels, in, n, out, tmp);
+    else
+        dwt(&b, levels, in, n, out, tmp);
+    return all_finite(out, n) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
+}
+
+int att_wden_dwt(int wavelet, unsigned int levels, const att_real *x, size_t n, att_real *c, att_real *tmp)
+{
+    return transform(0, wavelet, levels, x, n, c, tmp);
 }
 
 int att_wden_idwt(int wavelet, unsigned int levels, const att_real *c, size_t n, att_real *y, att_real *tmp)
 {
-    bank b;
-    int st;
-    if (c == NULL || y == NULL || tmp == NULL)
-        return ATT_E_NULL;
-    if (!load_bank(wavelet, &b))
-        return ATT_E_WDEN_WAVELET;
-    st = check_shape(levels, n);
-    if (st != ATT_OK)
-        return st;
-    if (!all_finite(c, n))
-        return ATT_E_NONFINITE;
-    idwt(&b, levels, c, n, y, tmp);
-    return all_finite(y, n) ? ATT_OK : ATT_E_WDEN_OVERFLOW;
+    return transform(1, wavelet, levels, c, n, y, tmp);
 }
 
 /* ---- thresholding ---------------------------------------------------------------- */
