@@ -55,6 +55,7 @@ def test_vectors_cover_every_public_function() -> None:
     funcs = {c.func for c in V.generate(n=4)}
     assert public <= funcs | {"quat_mul"}, public - funcs
     assert {"quat_mul", "quat_conj", "integ", "rk4", "link_checksum", "link_rx", "link_tx"} <= funcs
+    assert {"wden_dwt", "wden_idwt", "wden_stream"} <= funcs
     methods = {c.params[0] for c in V.generate(n=4) if c.func == "integ"}
     assert set(V.INCREMENT_METHODS) <= methods
 

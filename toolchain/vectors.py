@@ -183,7 +183,65 @@ def generate(seed: int = 20100601, n: int = 64) -> list[Case]:
     for c in link_cases(rng):
         c.id = f"{c.id}.{len(cases)}"
         cases.append(c)
+    for c in denoise_cases(rng):
+        c.id = f"{c.id}.{len(cases)}"
+        cases.append(c)
     return cases
+
+
+def _wden_ops(wavelet: str, levels: int, block: int | None = None) -> int:
+    """Roundings (in units of the output scale) behind one denoiser output.
+
+    One transform level sums F products per coefficient, and the magnitude
+    bound grows by ‖h‖₁ per level: L·F·‖h‖₁^L for a transform (the same
+    bound as tests/test_denoise.py). A stream sample adds the inverse, the
+    line fit and λ's error spread through the inverse (√(2 ln N)·√N) and
+    the segment constant (sums of ≤ N terms)."""
+    from attitude_c.denoise import reference as wref
+
+    f = 2 * wref.VANISHING_MOMENTS[wavelet]
+    l1 = float(np.abs(wref.filter_bank(wavelet)[0]).sum())
+    ops = levels * f * l1 ** levels
+    if block is not None:
+        ops = 2 * ops * (1 + math.sqrt(2 * math.log(block)) * math.sqrt(block)) + block
+    return math.ceil(ops)
+
+
+def denoise_cases(rng: np.random.Generator) -> list[Case]:
+    """The wavelet denoiser: the periodized transform both ways (every
+    wavelet, a filter longer than the coarsest level included) and whole
+    streams through push_n and flush, against attitude_c.denoise.reference.
+    Streams use soft thresholding: with hard thresholding a float32
+    rounding may move a coefficient across λ (tests/test_denoise.py
+    covers hard thresholding in both builds on the host)."""
+    from attitude_c.denoise import reference as wref
+
+    out: list[Case] = []
+    for w in ("haar", "db2", "db4"):
+        for n, lv in ((64, 3), (16, 4)):
+            x = _f32(rng.normal(size=(n, 1)) * 2.0 + 0.5)
+            c = np.concatenate(wref.wavedec(x[:, 0], w, lv))
+            scale = float(np.max(np.abs(x)))
+            out.append(Case(f"wden_dwt.{w}", "wden_dwt", x, params=[w, str(lv)], expected=c[:, None],
+                            ops=_wden_ops(w, lv), scale=scale))
+            cf = _f32(c[:, None])
+            back = wref.waverec([cf[: n >> lv, 0]] + [cf[(n >> k) // 2: n >> k, 0] for k in range(lv - 1, -1, -1)], w)
+            out.append(Case(f"wden_idwt.{w}", "wden_idwt", cf, params=[w, str(lv)], expected=back[:, None],
+                            ops=_wden_ops(w, lv), scale=float(np.max(np.abs(cf)))))
+    t = np.arange(700) * 0.005
+    sig = 0.3 * np.sin(2 * np.pi * 0.5 * t) + 0.02 * t
+    for w, lv, block, es, ee, det in (("db4", 3, 64, 24, 8, 1), ("haar", 2, 32, 0, 0, 1),
+                                      ("db2", 4, 128, 40, 30, 0)):
+        x = _f32((sig + 0.01 * rng.normal(size=len(t)))[:, None])
+        y = wref.denoise(x[:, 0], w, lv, block, es, ee, "soft", bool(det))
+        out.append(Case(f"wden_stream.{w}", "wden_stream", x,
+                        params=[w, "soft", str(lv), str(block), str(es), str(ee), str(det)], expected=y[:, None],
+                        ops=_wden_ops(w, lv, block), scale=float(np.max(np.abs(x)))))
+    bad = _f32(rng.normal(size=(100, 1)))
+    bad[77, 0] = np.nan
+    out.append(Case("wden_stream.nan", "wden_stream", bad, params=["db4", "soft", "3", "64", "24", "8", "1"],
+                    status_ok=False, err_index=77))
+    return out
 
 
 def _link_transcript(machine: Any, events: np.ndarray, block: bytes | None) -> np.ndarray:

@@ -19,6 +19,11 @@
  *   link_checksum                        -- N bytes (one record of N values) -> 1;
  *   link_rx BLOCK GAP                    -- N events "byte tick" for receiver B;
  *   link_tx BLOCK SYN_TO ANS_TO ATTEMPTS BYTES... -- N events for sender A;
+ *   wden_dwt WAVELET LEVELS, wden_idwt WAVELET LEVELS -- N samples (1) -> N coefficients
+ *     (wavedec order) and back;
+ *   wden_stream WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END DETREND -- N samples (1) pushed in one
+ *     att_wden_push_n() call, then flushed -> N denoised samples;
+ *     WAVELET = haar|db2|db4, MODE = soft|hard;
  *     event byte: 0..255 = sink it, -1 = poll only, -2 = (sender) start the block.
  *     After each event the machine is polled until NONE or IDLE; output rows
  *     "event kind value": kind 0 = sink/start result, 1 = poll result,
@@ -35,6 +40,7 @@
 #include "attitude/attitude.h"
 
 enum {
+    WDEN_BLOCK_MAX = 256, /* largest denoiser block of the vectors */
     MAX_REC = 2048,
     MAX_VALS = MAX_REC * 9,
     MAX_OUT = MAX_REC * 9
@@ -121,6 +127,16 @@ static const struct {
     { "euler_to_quat", 3, 4, att_euler_to_quat_n },   { "quat_heading", 4, 1, att_quat_heading_n },
     { "dcm_heading", 9, 1, att_dcm_heading_n },
 };
+
+static int wavelet_code(const char *name)
+{
+    static const char *names[] = { "haar", "db2", "db4" };
+    int w;
+    for (w = 0; w < 3; w++)
+        if (strcmp(name, names[w]) == 0)
+            return w;
+    return -1;
+}
 
 static void result(const char *id, int status, long err, size_t nout)
 {
@@ -223,6 +239,51 @@ static int run_link(const char *id, int tx, size_t n)
     return 0;
 }
 
+/* The wavelet denoiser: the block transform both ways, and a whole stream. */
+static int run_wden(const char *id, const char *fn, size_t n)
+{
+    static att_real ring[WDEN_BLOCK_MAX], scratch[2 * WDEN_BLOCK_MAX];
+    char wname[16], mname[16];
+    double v[5];
+    int st;
+    size_t nout = 0, err = 0, got = 0;
+    if (token(wname, sizeof wname) != 0 || wavelet_code(wname) < 0)
+        return -1;
+    if (strcmp(fn, "wden_dwt") == 0 || strcmp(fn, "wden_idwt") == 0) {
+        if (number(&v[0]) != 0 || read_values(in_buf, n) != 0)
+            return -1;
+        st = strcmp(fn, "wden_dwt") == 0
+                 ? att_wden_dwt(wavelet_code(wname), (unsigned int)v[0], in_buf, n, out_buf, in_buf2)
+                 : att_wden_idwt(wavelet_code(wname), (unsigned int)v[0], in_buf, n, out_buf, in_buf2);
+        result(id, st, st == ATT_OK ? -1L : 0L, st == ATT_OK ? n : 0);
+        print_records(out_buf, st == ATT_OK ? n : 0, 1);
+        return 0;
+    }
+    if (strcmp(fn, "wden_stream") == 0) {
+        att_wden_config cfg;
+        att_wden s;
+        if (token(mname, sizeof mname) != 0 || number(&v[0]) != 0 || number(&v[1]) != 0 || number(&v[2]) != 0
+            || number(&v[3]) != 0 || number(&v[4]) != 0 || read_values(in_buf, n) != 0)
+            return -1;
+        cfg.wavelet = wavelet_code(wname);
+        cfg.mode = strcmp(mname, "hard") == 0 ? ATT_WDEN_HARD : ATT_WDEN_SOFT;
+        cfg.levels = (unsigned int)v[0];
+        cfg.block = (size_t)v[1];
+        cfg.edge_start = (size_t)v[2];
+        cfg.edge_end = (size_t)v[3];
+        cfg.detrend = (int)v[4];
+        st = att_wden_init(&s, &cfg, ring, WDEN_BLOCK_MAX, scratch, 2 * WDEN_BLOCK_MAX);
+        if (st == ATT_OK)
+            st = att_wden_push_n(&s, in_buf, n, out_buf, MAX_OUT, &nout, &err);
+        if (st == ATT_OK)
+            st = att_wden_flush(&s, out_buf + nout, MAX_OUT - nout, &got);
+        result(id, st, st == ATT_OK ? -1L : (long)err, st == ATT_OK ? nout + got : 0);
+        print_records(out_buf, st == ATT_OK ? nout + got : 0, 1);
+        return 0;
+    }
+    return -1;
+}
+
 static int run_case(const char *id, const char *fn, size_t n)
 {
     size_t i, err = 0;
@@ -274,6 +335,8 @@ static int run_case(const char *id, const char *fn, size_t n)
     }
     if (strcmp(fn, "link_rx") == 0 || strcmp(fn, "link_tx") == 0)
         return run_link(id, strcmp(fn, "link_tx") == 0, n);
+    if (strncmp(fn, "wden_", 5) == 0)
+        return run_wden(id, fn, n);
     if (strcmp(fn, "integ") == 0 || strcmp(fn, "rk4") == 0) {
         char mname[32];
         att_real q0[4], h = 0;

@@ -14,5 +14,6 @@
 #include "attitude/block.h"
 #include "attitude/fixed.h"
 #include "attitude/ad7927.h"
+#include "attitude/denoise.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
