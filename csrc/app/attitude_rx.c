@@ -9,18 +9,29 @@
  * integrator and prints one line per attitude update, and logs every
  * report (stderr, and a JSON Lines record with --format jsonl).
  *
- * Missing samples are never skipped silently: a loss report (GAVE_UP,
- * OVERRUN, ADC_ERROR), a sample whose code is outside 0..4095, a gap in
- * the numbering and samples dropped on a full queue are each filled by
- * holding the last good rate over the missing sample periods, so the time
- * base stays the firmware's; they are counted (held, missing). The sample
- * period comes from the BOOT report unless --period is given.
+ * Acknowledged => delivered. A block whose checksum matched is answered
+ * 0x00 only once all its records are in the queue. When the queue is
+ * full the answer waits up to --hold-ms for room (back-pressure: the
+ * sender waits), then the block is answered 0xFF and the sender sends it
+ * again; nothing acknowledged is ever dropped. With --count, blocks that
+ * the count no longer needs are answered 0xFF too, so what was
+ * acknowledged is what gets printed.
  *
- * SIGINT/SIGTERM (or --count) stop it cleanly: the receiver stops, the
- * attitude thread finishes the records already queued, the link, sample
- * and report statistics go to stderr. A port that disappears (EIO,
- * hang-up) is reported and reopened every --reopen-delay seconds, never
- * spun on.
+ * Missing samples are never skipped silently: a loss report (GAVE_UP,
+ * OVERRUN, ADC_ERROR), a sample whose code is outside 0..4095 and a gap
+ * in the numbering are each filled by holding the last good rate over the
+ * missing sample periods, so the time base stays the firmware's; they are
+ * counted (held, missing). The sample period comes from the BOOT report
+ * unless --period is given.
+ *
+ * SIGINT/SIGTERM (or --count) stop it within a bounded time whatever is
+ * blocked: every wait (port, stdout, stderr, queue, delays) is a poll()
+ * that also watches a self-pipe. The receiver stops answering at once,
+ * the attitude thread prints every acknowledged record still queued,
+ * within RX_STOP_GRACE_MS if stdout is blocked (what it could not print
+ * is counted and the exit code says so), and the statistics go to stderr.
+ * A port that disappears (EIO, hang-up) is reported and reopened every
+ * --reopen-delay seconds, never spun on. docs/attitude-rx.md.
  */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
@@ -40,42 +51,41 @@
 typedef struct {
     rx_config cfg;
     rx_queue queue;
+    rx_stop stop;                 /* stop requests (signal handler, --count, stdout failure) */
     int fd;                       /* serial port (owned by the receiver thread once started) */
-    int wake_rd, wake_wr;         /* self-pipe: stop requests (signal handler, --count) */
     att_link_receiver_stats link; /* copied by the receiver thread when it ends */
     /* receiver thread */
-    unsigned long samples;       /* sample records received in accepted blocks (good or not) */
-    unsigned long queue_missing; /* samples dropped on a full queue */
+    unsigned long samples;      /* sample records in acknowledged blocks (good or not) */
+    unsigned long acks;         /* 0x00 answers sent: blocks acknowledged */
+    unsigned long busy_naks;    /* 0xFF answers for good blocks: the queue stayed full for --hold-ms */
+    unsigned long count_naks;   /* 0xFF answers for good blocks --count no longer needs */
+    unsigned long held_answers; /* answers that waited for room in the queue */
+    unsigned long unanswered;   /* good blocks a stop request left unanswered */
     unsigned long port_errors, reopens;
     /* attitude thread */
     unsigned long integrated, held, missing, updates, integ_errors, code_errors;
+    unsigned long pending;     /* sample periods integrated since the last update (rv2/rv3/rk4) */
+    unsigned long undelivered; /* acknowledged samples never integrated: output failed or blocked */
+    unsigned long lines_lost;  /* attitude lines that could not be written */
     unsigned long reports[ATT_BLOCK_ADC_ERROR + 1];
     unsigned long block_errors, seq_errors;
-    double period; /* s, the sample period in use */
-    double t;      /* s, time integrated so far (sample periods, held ones included) */
-    int out_error; /* stdout failed (closed pipe) */
+    double period;   /* s, the sample period in use */
+    double t;        /* s, time integrated so far (sample periods, held ones included) */
+    int out_error;   /* stdout failed (closed pipe, ...): errno in out_errno */
+    int out_errno;   /* the error */
+    int out_blocked; /* stdout stayed blocked past the grace time after a stop */
 } rx_app;
 
 static const char *const report_names[ATT_BLOCK_ADC_ERROR + 1] = { "BOOT", "SELFTEST", "GAVE_UP", "OVERRUN",
                                                                    "ADC_ERROR" };
 
-static int g_wake_wr = -1; /* for the signal handler only */
+static rx_stop *g_stop = NULL; /* for the signal handler only */
 static volatile sig_atomic_t g_signal = 0;
 
 static void on_signal(int sig)
 {
-    char c = 's';
-    ssize_t r;
     g_signal = sig;
-    r = write(g_wake_wr, &c, 1);
-    (void)r;
-}
-
-static void request_stop(rx_app *app)
-{
-    char c = 'c';
-    ssize_t r = write(app->wake_wr, &c, 1);
-    (void)r;
+    rx_stop_request(g_stop);
 }
 
 static uint16_t now_tick(void)
@@ -85,82 +95,161 @@ static uint16_t now_tick(void)
     return (uint16_t)((unsigned long)ts.tv_sec * 1000UL + (unsigned long)(ts.tv_nsec / 1000000L));
 }
 
-static int write_all(int fd, const uint8_t *p, size_t n)
+/* t = now + ms (CLOCK_MONOTONIC) */
+static void after_ms(struct timespec *t, unsigned ms)
 {
-    while (n > 0) {
-        ssize_t w = write(fd, p, n);
-        if (w < 0) {
-            if (errno == EINTR || errno == EAGAIN)
-                continue;
-            return -1;
-        }
-        p += w;
-        n -= (size_t)w;
+    clock_gettime(CLOCK_MONOTONIC, t);
+    t->tv_sec += (time_t)(ms / 1000u);
+    t->tv_nsec += (long)(ms % 1000u) * 1000000L;
+    if (t->tv_nsec >= 1000000000L) {
+        t->tv_sec++;
+        t->tv_nsec -= 1000000000L;
     }
-    return 0;
 }
 
-/* Hand out everything the receiver wants to send (0xBB, 0x00, 0xFF). */
-static int drain_receiver(att_link_receiver *r, int fd)
+static int before(const struct timespec *a, const struct timespec *b)
+{
+    return a->tv_sec < b->tv_sec || (a->tv_sec == b->tv_sec && a->tv_nsec < b->tv_nsec);
+}
+
+enum {
+    ANSWER_AS_IS = -2, /* the receiver machine's own byte */
+    ANSWER_NONE = -1   /* no answer at all (stopping) */
+};
+
+/* Hand out everything the receiver machine wants to send (0xBB, 0x00,
+ * 0xFF); the 0x00 of a block it just accepted becomes `ack` (ATT_LINK_ACK,
+ * ATT_LINK_NAK, ANSWER_NONE) unless ANSWER_AS_IS. 0, 1 = a stop request
+ * came while the port did not take the byte, -1 = port error. */
+static int answer(rx_app *app, att_link_receiver *r, int ack)
 {
     for (;;) {
         uint8_t out;
+        int rc;
         att_link_result res = att_link_receiver_poll(r, now_tick(), &out);
-        if (res == ATT_LINK_SEND) {
-            if (write_all(fd, &out, 1) != 0)
-                return -1;
-        } else if (res == ATT_LINK_TIMEOUT) {
+        if (res == ATT_LINK_TIMEOUT)
             continue;
-        } else {
+        if (res != ATT_LINK_SEND)
             return 0;
+        if (out == (uint8_t)ATT_LINK_ACK && ack != ANSWER_AS_IS) {
+            if (ack == ANSWER_NONE)
+                continue;
+            out = (uint8_t)ack;
         }
+        if ((rc = rx_port_write(&app->stop, app->fd, &out, 1)) != 0)
+            return rc;
     }
-}
-
-/* Wait up to `seconds` for a stop request; 1 if one came. */
-static int wait_stop(rx_app *app, double seconds)
-{
-    struct pollfd p;
-    p.fd = app->wake_rd;
-    p.events = POLLIN;
-    p.revents = 0;
-    return poll(&p, 1, (int)(seconds * 1000.0)) > 0;
 }
 
 static void port_lost(rx_app *app, const char *what, int err)
 {
-    fprintf(stderr, "attitude-rx: port %s %s: %s; reopening every %.3g s\n", app->cfg.port, what,
-            err ? strerror(err) : "hang-up", app->cfg.reopen_delay);
+    rx_log(&app->stop, "port %s %s: %s; reopening every %.3g s", app->cfg.port, what,
+           err ? strerror(err) : "hang-up", app->cfg.reopen_delay);
     app->port_errors++;
-    close(app->fd);
+    rx_serial_close(app->fd);
     app->fd = -1;
 }
 
-/* Decode and number one record (attitude/block.h) and queue it. Records
- * that find the queue full are counted; the samples they stood for are
- * handed on with the next record that gets through (missing), so the
- * attitude thread fills them like any other loss. */
-static void queue_record(rx_app *app, att_block_seq *seq, const uint8_t *raw, uint32_t *missing_first,
-                         uint32_t *missing)
+/* The receiver thread's view of what it acknowledged. */
+typedef struct {
+    att_block_seq seq;     /* numbering of the acknowledged records */
+    att_integ shape;       /* a fresh integrator of the method: att_integ_outputs counts lines */
+    unsigned long periods; /* sample periods the attitude thread will integrate for them */
+    int have_good;         /* a good sample was acknowledged (periods before it are not integrated) */
+} rx_acked;
+
+static int is_loss(unsigned kind)
 {
-    rx_item it;
-    memset(&it, 0, sizeof it);
-    memcpy(it.raw, raw, sizeof it.raw);
-    it.status = att_block_decode(raw, &it.blk);
-    if (it.status == ATT_OK || it.status == ATT_BLOCK_E_CODE) /* a bad sample still takes its number */
-        it.seq_status = att_block_seq_feed(seq, &it.blk, &it.span);
-    if (it.blk.kind == ATT_BLOCK_SAMPLE)
-        app->samples++;
-    it.missing_first = *missing_first;
-    it.missing = *missing;
-    if (rx_queue_push(&app->queue, &it) == 0) {
-        *missing = 0;
-    } else if (it.status == ATT_OK || it.status == ATT_BLOCK_E_CODE) {
-        if (*missing == 0)
-            *missing_first = it.span.first;
-        *missing += it.span.count; /* a dropped sample: 1; a dropped loss report: its samples */
-        app->queue_missing += it.span.count;
+    return kind == ATT_BLOCK_GAVE_UP || kind == ATT_BLOCK_OVERRUN || kind == ATT_BLOCK_ADC_ERROR;
+}
+
+/* Sample periods the attitude thread integrates for record `it` (the same
+ * rules as sample(), bad_record() and hold() below). */
+static unsigned long periods_of(const rx_item *it, int *have_good)
+{
+    if (it->status == ATT_OK && it->blk.kind == ATT_BLOCK_SAMPLE) {
+        *have_good = 1;
+        return 1;
     }
+    if (!*have_good)
+        return 0; /* before the first good sample, missing periods only advance t */
+    if (it->status == ATT_BLOCK_E_CODE)
+        return 1;
+    if (it->status == ATT_OK && is_loss(it->blk.kind))
+        return it->span.count;
+    return 0;
+}
+
+/* --count: are the acknowledged samples already enough for it? */
+static int count_reached(rx_app *app, const rx_acked *x)
+{
+    unsigned long failed, n;
+    if (app->cfg.count == 0)
+        return 0;
+    failed = rx_queue_failed(&app->queue);
+    n = x->periods > failed ? x->periods - failed : 0;
+    return att_integ_outputs(&x->shape, (size_t)n) >= app->cfg.count;
+}
+
+/* A block passed the checksum (the receiver machine queued 0x00). Decode
+ * and number its records and queue them all; only then is the block
+ * acknowledged. Returns the answer: ATT_LINK_ACK; ATT_LINK_NAK when the
+ * queue stayed full for --hold-ms or --count needs no more samples (the
+ * block takes no number); ANSWER_NONE when a stop request came first. */
+static int deliver(rx_app *app, rx_acked *x, const uint8_t *block)
+{
+    rx_item items[RX_RECORDS_MAX];
+    att_block_seq seq = x->seq; /* numbered on a copy: a refused block takes no number */
+    unsigned long periods = 0;
+    int have_good = x->have_good, waited = 0;
+    unsigned k, n = 0, samples = 0;
+    struct timespec deadline, slice, now;
+
+    if (rx_stop_check(&app->stop)) {
+        app->unanswered++;
+        return ANSWER_NONE;
+    }
+    if (count_reached(app, x)) {
+        app->count_naks++;
+        return ATT_LINK_NAK;
+    }
+    for (k = 0; k + ATT_BLOCK_SIZE <= app->cfg.block_size; k += ATT_BLOCK_SIZE, n++) {
+        rx_item *it = &items[n];
+        memset(it, 0, sizeof *it);
+        memcpy(it->raw, block + k, sizeof it->raw);
+        it->status = att_block_decode(it->raw, &it->blk);
+        if (it->status == ATT_OK || it->status == ATT_BLOCK_E_CODE) /* a bad sample still takes its number */
+            it->seq_status = att_block_seq_feed(&seq, &it->blk, &it->span);
+        if (it->blk.kind == ATT_BLOCK_SAMPLE)
+            samples++;
+        periods += periods_of(it, &have_good);
+    }
+    after_ms(&deadline, app->cfg.hold_ms);
+    for (;;) { /* wait for room in slices of 10 ms, watching for a stop request */
+        after_ms(&slice, 10);
+        if (before(&deadline, &slice))
+            slice = deadline;
+        if (rx_queue_push_all(&app->queue, items, n, &slice) == 0)
+            break;
+        waited = 1;
+        if (rx_stop_check(&app->stop)) {
+            app->unanswered++;
+            return ANSWER_NONE;
+        }
+        clock_gettime(CLOCK_MONOTONIC, &now);
+        if (!before(&now, &deadline)) {
+            app->held_answers++;
+            app->busy_naks++;
+            return ATT_LINK_NAK;
+        }
+    }
+    app->held_answers += (unsigned long)waited;
+    x->seq = seq;
+    x->periods += periods;
+    x->have_good = have_good;
+    app->samples += samples;
+    app->acks++;
+    return ATT_LINK_ACK;
 }
 
 static void *receiver_thread(void *arg)
@@ -170,29 +259,32 @@ static void *receiver_thread(void *arg)
     att_link_receiver_config rc;
     uint8_t block[ATT_LINK_BLOCK_MAX];
     uint8_t buf[256];
-    att_block_seq seq;
-    uint32_t missing_first = 0, missing = 0; /* samples dropped on a full queue, not yet told */
+    rx_acked x;
+    int stop = 0;
 
-    att_block_seq_init(&seq);
+    att_block_seq_init(&x.seq);
+    x.periods = 0;
+    x.have_good = 0;
     att_link_receiver_config_init(&rc, (uint8_t)app->cfg.block_size);
     rc.gap_timeout = (uint16_t)app->cfg.gap_ms;
-    if (att_link_receiver_init(&r, &rc, block) != ATT_OK) {
-        fprintf(stderr, "attitude-rx: link receiver configuration rejected\n");
-        request_stop(app);
+    if (att_link_receiver_init(&r, &rc, block) != ATT_OK
+        || att_integ_init(&x.shape, app->cfg.method, NULL) != ATT_OK) {
+        rx_log(&app->stop, "link receiver configuration rejected");
+        rx_stop_request(&app->stop);
         return NULL;
     }
-    for (;;) {
+    while (!stop) {
         struct pollfd p[2];
         int timeout, n;
         uint16_t left;
         if (app->fd < 0) { /* port gone: retry, sleeping in between */
             char msg[RX_MSG_MAX];
-            if (wait_stop(app, app->cfg.reopen_delay))
+            if (rx_stop_wait(&app->stop, app->cfg.reopen_delay))
                 break;
             app->fd = rx_serial_open(app->cfg.port, app->cfg.baud, msg, sizeof msg);
             if (app->fd < 0)
                 continue;
-            fprintf(stderr, "attitude-rx: port %s reopened\n", app->cfg.port);
+            rx_log(&app->stop, "port %s reopened", app->cfg.port);
             app->reopens++;
             att_link_receiver_reset(&r);
         }
@@ -200,17 +292,17 @@ static void *receiver_thread(void *arg)
         timeout = (left == ATT_LINK_NO_TIMER || left > 100) ? 100 : (int)left;
         p[0].fd = app->fd;
         p[0].events = POLLIN;
-        p[1].fd = app->wake_rd;
+        p[1].fd = app->stop.wake_rd;
         p[1].events = POLLIN;
         p[0].revents = p[1].revents = 0;
         n = poll(p, 2, timeout);
         if (n < 0) {
             if (errno == EINTR)
-                continue;
-            fprintf(stderr, "attitude-rx: poll: %s\n", strerror(errno));
+                continue; /* a signal's byte is in the pipe: the next poll sees it */
+            rx_log(&app->stop, "poll: %s", strerror(errno));
             break;
         }
-        if (p[1].revents & POLLIN)
+        if ((p[1].revents & POLLIN) && rx_stop_check(&app->stop))
             break;
         if (p[0].revents & (POLLIN | POLLHUP | POLLERR)) {
             ssize_t got = read(app->fd, buf, sizeof buf);
@@ -221,20 +313,21 @@ static void *receiver_thread(void *arg)
                 port_lost(app, got == 0 ? "closed" : "read failed", got == 0 ? 0 : errno);
                 continue;
             }
-            for (i = 0; i < got; i++) {
-                att_link_result res = att_link_receiver_sink(&r, buf[i], now_tick());
-                if (res == ATT_LINK_ACCEPTED) {
-                    unsigned k;
-                    for (k = 0; k + ATT_BLOCK_SIZE <= app->cfg.block_size; k += ATT_BLOCK_SIZE)
-                        queue_record(app, &seq, block + k, &missing_first, &missing);
-                }
+            for (i = 0; i < got && !stop; i++) {
+                int ack = ANSWER_AS_IS, w;
+                if (att_link_receiver_sink(&r, buf[i], now_tick()) == ATT_LINK_ACCEPTED)
+                    ack = deliver(app, &x, block);
                 /* answer at once (the sender waits for 0xBB / 0x00 / 0xFF) */
-                if (drain_receiver(&r, app->fd) != 0) {
+                w = answer(app, &r, ack);
+                if (w < 0) {
                     port_lost(app, "write failed", errno);
                     break;
                 }
+                stop = w > 0 || ack == ANSWER_NONE;
             }
-        } else if (drain_receiver(&r, app->fd) != 0) { /* gap timer */
+        } else if ((n = answer(app, &r, ANSWER_AS_IS)) != 0) { /* gap timer */
+            if (n > 0)
+                break;
             port_lost(app, "write failed", errno);
         }
     }
@@ -242,19 +335,40 @@ static void *receiver_thread(void *arg)
     return NULL;
 }
 
-static void print_header(const rx_app *app)
+static int abandoned(const rx_app *app)
 {
-    if (app->cfg.format == RX_FORMAT_CSV && app->cfg.header)
-        printf("t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg\n");
+    return app->out_error || app->out_blocked;
 }
 
-/* Flush stdout; on failure (closed pipe) stop. */
-static void out_done(rx_app *app, int rc)
+/* Write one line to stdout. An attitude line (update) that cannot be
+ * written is counted (lines_lost); a write error (closed pipe) or stdout
+ * still blocked when the grace time after a stop ends abandon all output. */
+static void out_line(rx_app *app, const char *line, int len, int update)
 {
-    if (rc < 0 || fflush(stdout) != 0) {
+    int rc;
+    if (len < 0)
+        return;
+    if (len >= RX_LINE_MAX)
+        len = RX_LINE_MAX - 1; /* snprintf truncated it (cannot happen with these formats) */
+    rc = abandoned(app) ? 1 : rx_out_write(&app->stop, 1, line, (size_t)len);
+    if (rc == 0)
+        return;
+    if (update)
+        app->lines_lost++;
+    if (rc < 0 && !app->out_error) {
         app->out_error = 1;
-        request_stop(app);
+        app->out_errno = errno;
+        rx_stop_request(&app->stop);
+    } else if (rc > 0) {
+        app->out_blocked = 1;
     }
+}
+
+static void print_header(rx_app *app)
+{
+    static const char h[] = "t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg\n";
+    if (app->cfg.format == RX_FORMAT_CSV && app->cfg.header)
+        out_line(app, h, (int)sizeof h - 1, 0);
 }
 
 static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real q[4])
@@ -263,22 +377,24 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
     const double r2d = 180.0 / 3.14159265358979323846;
     const int digits = att_real_size() == 4 ? 9 : 17; /* round-trip precision */
     double t = app->t;
-    int rc;
+    char line[RX_LINE_MAX];
+    int len;
     if (att_quat_to_euler(q, e) != ATT_OK || att_quat_heading(q, &h) != ATT_OK)
         e[0] = e[1] = e[2] = h = (att_real)0;
     if (app->cfg.format == RX_FORMAT_CSV)
-        rc = printf("%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g\n", t, (unsigned long)n,
-                    code[0], code[1], code[2], digits, (double)q[0], digits, (double)q[1], digits,
-                    (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
-                    (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
+        len = snprintf(line, sizeof line, "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g\n", t,
+                       (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
+                       (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d,
+                       digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
     else
-        rc = printf(
+        len = snprintf(
+            line, sizeof line,
             "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
             "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu}\n",
             t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits, (double)q[1],
             digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
             (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held);
-    out_done(app, rc);
+    out_line(app, line, len, 1);
 }
 
 /* The attitude thread's integration state. */
@@ -291,7 +407,7 @@ typedef struct {
 
 static int finished(const rx_app *app)
 {
-    return app->out_error || (app->cfg.count && app->updates >= app->cfg.count);
+    return abandoned(app) || (app->cfg.count && app->updates >= app->cfg.count);
 }
 
 /* Integrate one sample period (number n) at body rate v; codes for the output line. */
@@ -309,17 +425,22 @@ static void integrate(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], c
     }
     if (rc < 0) {
         app->integ_errors++;
-        fprintf(stderr, "attitude-rx: sample %lu rejected by the integrator: %s\n", (unsigned long)n,
-                att_status_str(rc));
+        rx_queue_count_failed(&app->queue); /* the receiver's --count accounting */
+        rx_log(&app->stop, "sample %lu rejected by the integrator: %s", (unsigned long)n, att_status_str(rc));
         return;
     }
     app->t += app->period;
-    if (rc == ATT_INTEG_UPDATED) {
-        app->updates++;
-        print_update(app, n, code, q);
-        if (c->count && app->updates >= c->count)
-            request_stop(app);
+    if (rc != ATT_INTEG_UPDATED) {
+        app->pending++;
+        return;
     }
+    app->pending = 0;
+    if (c->count && app->updates >= c->count)
+        return; /* past --count (the rest of a block of several samples): integrated, not printed */
+    app->updates++;
+    print_update(app, n, code, q);
+    if (c->count && app->updates == c->count)
+        rx_stop_request(&app->stop);
 }
 
 /* Samples first .. first + n - 1 will never come (why: for the log): hold
@@ -336,13 +457,12 @@ static void hold(rx_app *app, rx_att *a, uint32_t first, uint32_t n, const char 
                  (unsigned long)(first + n - 1u));
     app->missing += n;
     if (!a->have_rate) {
-        fprintf(stderr, "attitude-rx: %s missing (%s) before the first sample: no rate to hold\n", which,
-                why);
+        rx_log(&app->stop, "%s missing (%s) before the first sample: no rate to hold", which, why);
         app->t += (double)n * app->period;
         return;
     }
-    fprintf(stderr, "attitude-rx: %s missing (%s): holding the last rate over %lu sample period%s\n", which,
-            why, (unsigned long)n, n == 1u ? "" : "s");
+    rx_log(&app->stop, "%s missing (%s): holding the last rate over %lu sample period%s", which, why,
+           (unsigned long)n, n == 1u ? "" : "s");
     for (k = 0; k < n && !finished(app); k++) {
         app->held++;
         integrate(app, a, first + k, a->rate, a->code);
@@ -369,8 +489,17 @@ static void sample(rx_app *app, rx_att *a, const rx_item *it)
 /* JSON Lines record for a report or an error (--format jsonl only); body: ,"key":value... */
 static void json_record(rx_app *app, const char *body)
 {
+    char line[RX_LINE_MAX];
     if (app->cfg.format == RX_FORMAT_JSONL)
-        out_done(app, printf("{\"t\":%.9g,%s}\n", app->t, body));
+        out_line(app, line, snprintf(line, sizeof line, "{\"t\":%.9g,%s}\n", app->t, body), 0);
+}
+
+/* Warn when a sample every `period` s cannot fit the line. */
+static void rate_check(rx_app *app, double period)
+{
+    char msg[RX_MSG_MAX];
+    if (rx_rate_check(app->cfg.baud, app->cfg.block_size, period, msg, sizeof msg))
+        rx_log(&app->stop, "warning: %s", msg);
 }
 
 static void boot(rx_app *app, const att_block *b)
@@ -378,19 +507,20 @@ static void boot(rx_app *app, const att_block *b)
     char body[RX_MSG_MAX];
     double p = (double)b->period_ticks / (double)ATT_BLOCK_TICK_HZ;
     long baud = (long)b->baud_div * ATT_BLOCK_BAUD_UNIT;
-    fprintf(stderr, "attitude-rx: BOOT: block format %u, sample period %u ticks = %g s, %ld baud\n",
-            b->version, b->period_ticks, p, baud);
+    rx_log(&app->stop, "BOOT: block format %u, sample period %u ticks = %g s, %ld baud", b->version,
+           b->period_ticks, p, baud);
     if (!app->cfg.period_set) {
         app->period = p;
     } else if (fabs(p - app->cfg.period) > 1e-9 * p) {
-        fprintf(stderr,
-                "attitude-rx: warning: the board samples every %g s (BOOT) but --period %g s was "
-                "given: integrating with %g s\n",
-                p, app->cfg.period, app->cfg.period);
+        rx_log(&app->stop,
+               "warning: the board samples every %g s (BOOT) but --period %g s was given: integrating "
+               "with %g s",
+               p, app->cfg.period, app->cfg.period);
     }
     if (baud != app->cfg.baud)
-        fprintf(stderr, "attitude-rx: warning: the board announces %ld baud, the port runs at %ld\n", baud,
-                app->cfg.baud);
+        rx_log(&app->stop, "warning: the board announces %ld baud, the port runs at %ld", baud,
+               app->cfg.baud);
+    rate_check(app, p); /* the board's real rate against this port's line */
     snprintf(body, sizeof body,
              "\"report\":\"BOOT\",\"version\":%u,\"period_ticks\":%u,\"period_s\":%.9g,\"baud\":%ld,"
              "\"period_used_s\":%.9g",
@@ -401,7 +531,7 @@ static void boot(rx_app *app, const att_block *b)
 static void report(rx_app *app, rx_att *a, const rx_item *it)
 {
     const att_block *b = &it->blk;
-    char body[RX_MSG_MAX];
+    char body[RX_MSG_MAX], scan[32] = "";
     const char *name = report_names[b->kind];
     app->reports[b->kind]++;
     if (b->kind == ATT_BLOCK_BOOT) {
@@ -409,8 +539,8 @@ static void report(rx_app *app, rx_att *a, const rx_item *it)
         return;
     }
     if (b->kind == ATT_BLOCK_SELFTEST) {
-        fprintf(stderr, "attitude-rx: SELFTEST failed: status %d, code %u, attempt %u\n", b->status,
-                b->bad_code, b->attempt);
+        rx_log(&app->stop, "SELFTEST failed: status %d, code %u, attempt %u", b->status, b->bad_code,
+               b->attempt);
         snprintf(body, sizeof body, "\"report\":\"SELFTEST\",\"status\":%d,\"bad_code\":%u,\"attempt\":%u",
                  b->status, b->bad_code, b->attempt);
         json_record(app, body);
@@ -419,16 +549,15 @@ static void report(rx_app *app, rx_att *a, const rx_item *it)
     /* a loss report: span = the samples missing here (an unreported gap included) */
     if (it->seq_status == ATT_BLOCK_E_SEQ) {
         app->seq_errors++;
-        fprintf(stderr, "attitude-rx: %s for sample %u, but %ld sample%s %s: numbering follows the report\n",
-                name, b->first, (long)(it->span.slip < 0 ? -it->span.slip : it->span.slip),
-                (it->span.slip == 1 || it->span.slip == -1) ? "" : "s",
-                it->span.slip > 0 ? "vanished unreported before it" : "were counted twice");
+        rx_log(&app->stop, "%s for sample %u, but %ld sample%s %s: numbering follows the report", name,
+               b->first, (long)(it->span.slip < 0 ? -it->span.slip : it->span.slip),
+               (it->span.slip == 1 || it->span.slip == -1) ? "" : "s",
+               it->span.slip > 0 ? "vanished unreported before it" : "were counted twice");
     }
-    fprintf(stderr, "attitude-rx: %s: %u sample%s lost at sample %u", name, b->count,
-            b->count == 1u ? "" : "s", b->first);
     if (b->kind == ATT_BLOCK_ADC_ERROR)
-        fprintf(stderr, " (scan status %d)", b->status);
-    fputc('\n', stderr);
+        snprintf(scan, sizeof scan, " (scan status %d)", b->status);
+    rx_log(&app->stop, "%s: %u sample%s lost at sample %u%s", name, b->count, b->count == 1u ? "" : "s",
+           b->first, scan);
     snprintf(body, sizeof body, "\"report\":\"%s\",\"first\":%lu,\"count\":%lu,\"slip\":%ld", name,
              (unsigned long)it->span.first, (unsigned long)it->span.count, (long)it->span.slip);
     if (b->kind == ATT_BLOCK_ADC_ERROR)
@@ -446,9 +575,9 @@ static void bad_record(rx_app *app, rx_att *a, const rx_item *it)
         snprintf(hex + 2 * i, 3, "%02x", it->raw[i]);
     if (it->status == ATT_BLOCK_E_CODE) { /* a sample with a code above 4095: it is missing */
         app->code_errors++;
-        fprintf(stderr, "attitude-rx: sample %lu rejected: code out of 0..%d (%u, %u, %u)\n",
-                (unsigned long)it->span.first, ATT_BLOCK_CODE_MAX, it->blk.code[0], it->blk.code[1],
-                it->blk.code[2]);
+        rx_log(&app->stop, "sample %lu rejected: code out of 0..%d (%u, %u, %u)",
+               (unsigned long)it->span.first, ATT_BLOCK_CODE_MAX, it->blk.code[0], it->blk.code[1],
+               it->blk.code[2]);
         snprintf(body, sizeof body, "\"error\":\"code\",\"n\":%lu,\"codes\":[%u,%u,%u]",
                  (unsigned long)it->span.first, it->blk.code[0], it->blk.code[1], it->blk.code[2]);
         json_record(app, body);
@@ -457,11 +586,11 @@ static void bad_record(rx_app *app, rx_att *a, const rx_item *it)
     }
     app->block_errors++;
     if (it->blk.kind == ATT_BLOCK_BOOT && it->blk.version != ATT_BLOCK_VERSION)
-        fprintf(stderr, "attitude-rx: BOOT %s ignored: block format %u, this program reads format %d\n", hex,
-                it->blk.version, ATT_BLOCK_VERSION);
+        rx_log(&app->stop, "BOOT %s ignored: block format %u, this program reads format %d", hex,
+               it->blk.version, ATT_BLOCK_VERSION);
     else
-        fprintf(stderr, "attitude-rx: record %s ignored: %s\n", hex,
-                it->status == ATT_BLOCK_E_KIND ? "unknown report kind" : "report field out of range");
+        rx_log(&app->stop, "record %s ignored: %s", hex,
+               it->status == ATT_BLOCK_E_KIND ? "unknown report kind" : "report field out of range");
     snprintf(body, sizeof body, "\"error\":\"%s\",\"raw\":\"%s\"",
              it->status == ATT_BLOCK_E_KIND ? "kind" : "field", hex);
     json_record(app, body);
@@ -476,24 +605,20 @@ static void *attitude_thread(void *arg)
 
     memset(&a, 0, sizeof a);
     if (att_integ_init(&a.integ, c->method, NULL) != ATT_OK) {
-        fprintf(stderr, "attitude-rx: integrator rejected method %s\n", rx_method_name(c->method));
-        request_stop(app);
+        rx_log(&app->stop, "integrator rejected method %s", rx_method_name(c->method));
+        rx_stop_request(&app->stop);
         return NULL;
     }
     print_header(app);
+    /* every record in the queue was acknowledged: each is handled, also after a stop request */
     while (rx_queue_pop(&app->queue, &it) == 0) {
-        if (c->consumer_delay > 0) {
-            struct timespec d;
-            d.tv_sec = (time_t)c->consumer_delay;
-            d.tv_nsec = (long)((c->consumer_delay - (double)d.tv_sec) * 1e9);
-            nanosleep(&d, NULL);
-        }
-        if (finished(app))
-            continue; /* finished: just drain */
-        if (it.missing != 0)
-            hold(app, &a, it.missing_first, it.missing, "queue overflow");
-        if (finished(app))
+        if (abandoned(app)) { /* stdout failed or stayed blocked: count what cannot be printed */
+            if (it.status == ATT_OK && it.blk.kind == ATT_BLOCK_SAMPLE)
+                app->undelivered++;
             continue;
+        }
+        if (c->consumer_delay > 0)
+            (void)rx_stop_wait(&app->stop, c->consumer_delay); /* a diagnostic: not once stopping */
         if (it.status != ATT_OK)
             bad_record(app, &a, &it);
         else if (it.blk.kind == ATT_BLOCK_SAMPLE)
@@ -513,11 +638,44 @@ static int open_error_code(int err)
     return RX_EXIT_IOERR;
 }
 
+static void print_statistics(rx_app *app)
+{
+    const att_link_receiver_stats *l = &app->link;
+    /* the link machine counts every good block as accepted; attitude-rx answered some of
+     * them 0xFF (queue full, --count done) or not at all (stop): count what went on the wire */
+    if (g_signal)
+        rx_log(&app->stop, "stopped by signal %d", (int)g_signal);
+    rx_log(&app->stop,
+           "link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu bytes_discarded=%lu "
+           "busy_naks=%lu count_naks=%lu held_answers=%lu unanswered=%lu",
+           (unsigned long)l->syns, app->acks, (unsigned long)l->naks + app->busy_naks + app->count_naks,
+           (unsigned long)l->timeouts, (unsigned long)l->resyncs, (unsigned long)l->bytes_discarded,
+           app->busy_naks, app->count_naks, app->held_answers, app->unanswered);
+    rx_log(&app->stop,
+           "samples: received=%lu integrated=%lu held=%lu missing=%lu code_errors=%lu pending=%lu "
+           "undelivered=%lu lines_lost=%lu queue_high_water=%u updates=%lu integrator_errors=%lu "
+           "port_errors=%lu reopens=%lu",
+           app->samples, app->integrated, app->held, app->missing, app->code_errors, app->pending,
+           app->undelivered, app->lines_lost, app->queue.high_water, app->updates, app->integ_errors,
+           app->port_errors, app->reopens);
+    rx_log(&app->stop,
+           "reports: boot=%lu selftest=%lu gave_up=%lu overrun=%lu adc_error=%lu block_errors=%lu "
+           "seq_errors=%lu",
+           app->reports[ATT_BLOCK_BOOT], app->reports[ATT_BLOCK_SELFTEST], app->reports[ATT_BLOCK_GAVE_UP],
+           app->reports[ATT_BLOCK_OVERRUN], app->reports[ATT_BLOCK_ADC_ERROR], app->block_errors,
+           app->seq_errors);
+    if (app->undelivered || app->lines_lost)
+        rx_log(&app->stop, "%lu acknowledged sample%s not integrated and %lu attitude line%s not printed: %s",
+               app->undelivered, app->undelivered == 1 ? "" : "s", app->lines_lost,
+               app->lines_lost == 1 ? "" : "s",
+               app->out_error ? strerror(app->out_errno) : "stdout stayed blocked after the stop");
+}
+
 int main(int argc, char **argv)
 {
     static rx_app app; /* large (queue): not on the stack */
     char msg[RX_MSG_MAX];
-    int rc, pipefd[2];
+    int rc;
     rx_action action;
     pthread_t rx_thr, att_thr;
     struct sigaction sa;
@@ -537,66 +695,46 @@ int main(int argc, char **argv)
         fprintf(stderr, "attitude-rx: %s\n", msg);
         return rc;
     }
-    app.fd = rx_serial_open(app.cfg.port, app.cfg.baud, msg, sizeof msg);
-    if (app.fd < 0) {
-        int e = errno;
-        fprintf(stderr, "attitude-rx: %s\n", msg);
-        return open_error_code(e);
-    }
-    if (pipe(pipefd) != 0 || rx_queue_init(&app.queue, app.cfg.queue_size) != 0) {
+    if (rx_stop_init(&app.stop) != 0 || rx_queue_init(&app.queue, app.cfg.queue_size) != 0) {
         fprintf(stderr, "attitude-rx: cannot set up threads: %s\n", strerror(errno));
         return RX_EXIT_INTERNAL;
     }
-    app.wake_rd = pipefd[0];
-    app.wake_wr = g_wake_wr = pipefd[1];
-    fcntl(app.wake_wr, F_SETFL, fcntl(app.wake_wr, F_GETFL) | O_NONBLOCK);
-
+    /* from here on all output goes through rx_out_write (never blocks past a stop) */
+    rx_out_private(1);
+    rx_out_private(2);
+    app.period = app.cfg.period;
+    rate_check(&app, app.cfg.period);
+    app.fd = rx_serial_open(app.cfg.port, app.cfg.baud, msg, sizeof msg);
+    if (app.fd < 0) {
+        int e = errno;
+        rx_log(&app.stop, "%s", msg);
+        return open_error_code(e);
+    }
+    g_stop = &app.stop;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     sa.sa_handler = SIG_IGN;
-    sigaction(SIGPIPE, &sa, NULL); /* a closed stdout is reported by printf */
+    sigaction(SIGPIPE, &sa, NULL); /* a closed stdout is reported by write (EPIPE) */
 
-    app.period = app.cfg.period;
-    fprintf(stderr, "attitude-rx: %s at %ld baud 8N1, block %u bytes, method %s, period %g s%s\n",
-            app.cfg.port, app.cfg.baud, app.cfg.block_size, rx_method_name(app.cfg.method), app.cfg.period,
-            app.cfg.period_set ? "" : " until a BOOT report announces it");
+    rx_log(&app.stop, "%s at %ld baud 8N1, block %u bytes, method %s, period %g s%s", app.cfg.port,
+           app.cfg.baud, app.cfg.block_size, rx_method_name(app.cfg.method), app.cfg.period,
+           app.cfg.period_set ? "" : " until a BOOT report announces it");
     if (pthread_create(&att_thr, NULL, attitude_thread, &app) != 0
         || pthread_create(&rx_thr, NULL, receiver_thread, &app) != 0) {
-        fprintf(stderr, "attitude-rx: cannot start threads\n");
+        rx_log(&app.stop, "cannot start threads");
         return RX_EXIT_INTERNAL;
     }
-    pthread_join(rx_thr, NULL);
-    rx_queue_close(&app.queue); /* the attitude thread finishes what is queued */
-    pthread_join(att_thr, NULL);
+    pthread_join(rx_thr, NULL);  /* ends at a stop request: at most one hold slice later */
+    rx_queue_close(&app.queue);  /* the attitude thread handles what is queued (acknowledged) */
+    pthread_join(att_thr, NULL); /* within the grace time if stdout blocks */
     if (app.fd >= 0)
-        close(app.fd);
-
-    if (g_signal)
-        fprintf(stderr, "attitude-rx: stopped by signal %d\n", (int)g_signal);
-    fprintf(stderr,
-            "attitude-rx: link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu "
-            "bytes_discarded=%lu\n",
-            (unsigned long)app.link.syns, (unsigned long)app.link.blocks_accepted,
-            (unsigned long)app.link.naks, (unsigned long)app.link.timeouts, (unsigned long)app.link.resyncs,
-            (unsigned long)app.link.bytes_discarded);
-    fprintf(stderr,
-            "attitude-rx: samples: received=%lu integrated=%lu held=%lu missing=%lu code_errors=%lu "
-            "queue_overflows=%lu queue_high_water=%u updates=%lu integrator_errors=%lu port_errors=%lu "
-            "reopens=%lu\n",
-            app.samples, app.integrated, app.held, app.missing, app.code_errors, app.queue.overflows,
-            app.queue.high_water, app.updates, app.integ_errors, app.port_errors, app.reopens);
-    fprintf(stderr,
-            "attitude-rx: reports: boot=%lu selftest=%lu gave_up=%lu overrun=%lu adc_error=%lu "
-            "block_errors=%lu seq_errors=%lu\n",
-            app.reports[ATT_BLOCK_BOOT], app.reports[ATT_BLOCK_SELFTEST], app.reports[ATT_BLOCK_GAVE_UP],
-            app.reports[ATT_BLOCK_OVERRUN], app.reports[ATT_BLOCK_ADC_ERROR], app.block_errors,
-            app.seq_errors);
-    if (app.queue_missing)
-        fprintf(stderr, "attitude-rx: %lu samples were dropped on a full queue (--queue %u)\n",
-                app.queue_missing, app.cfg.queue_size);
+        rx_serial_close(app.fd);
+    print_statistics(&app);
     rx_queue_destroy(&app.queue);
-    return app.out_error ? RX_EXIT_IOERR : RX_EXIT_OK;
+    if (app.out_error)
+        return RX_EXIT_IOERR;
+    return app.undelivered || app.lines_lost ? RX_EXIT_TEMPFAIL : RX_EXIT_OK;
 }

@@ -9,6 +9,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <pthread.h>
+#include <time.h>
 
 #include "attitude/attitude.h"
 
@@ -18,16 +19,22 @@ enum {
     RX_EXIT_USAGE = 64,  /* bad command line */
     RX_EXIT_NOPORT = 66, /* port does not exist */
     RX_EXIT_INTERNAL = 70,
-    RX_EXIT_IOERR = 74,  /* port cannot be configured (not a tty...) */
-    RX_EXIT_NOPERM = 77, /* no permission to open the port */
-    RX_EXIT_CONFIG = 78  /* bad config file or value */
+    RX_EXIT_IOERR = 74,    /* port cannot be configured (not a tty...), or stdout failed */
+    RX_EXIT_TEMPFAIL = 75, /* stopped while stdout stayed blocked: acknowledged samples unprinted */
+    RX_EXIT_NOPERM = 77,   /* no permission to open the port */
+    RX_EXIT_CONFIG = 78    /* bad config file or value */
 };
 
 enum {
     RX_QUEUE_MAX = 4096,    /* largest --queue */
     RX_REPORT_RESERVE = 64, /* queue slots beyond --queue that only reports may take */
+    RX_RECORDS_MAX = ATT_LINK_BLOCK_MAX / ATT_BLOCK_SIZE, /* records in one link block */
     RX_PATH_MAX = 256,
-    RX_MSG_MAX = 256
+    RX_MSG_MAX = 256,
+    RX_LINE_MAX = 1024,      /* one output or log line */
+    RX_HOLD_MS_DEFAULT = 20, /* --hold-ms: below the senders' 50 ms answer timeout (docs/attitude-rx.md) */
+    RX_HOLD_MS_MAX = 10000,
+    RX_STOP_GRACE_MS = 500 /* after a stop request, time left to print what was acknowledged */
 };
 
 #define RX_VERSION "0.1.0" /* the project's version (pyproject.toml; a test keeps them equal) */
@@ -63,6 +70,7 @@ typedef struct {
     unsigned block_size;   /* link block N: a multiple of 6 (3 x 16-bit codes per sample) */
     unsigned queue_size;   /* samples the queue holds (1..RX_QUEUE_MAX) */
     unsigned gap_ms;       /* link receiver gap timeout, ms */
+    unsigned hold_ms;      /* how long an answer waits for room in a full queue, ms */
     unsigned long count;   /* stop after this many output lines (0 = run until signalled) */
     double consumer_delay; /* s the attitude thread sleeps per sample (diagnostics/tests) */
     double reopen_delay;   /* s between attempts to reopen a port that went away */
@@ -71,7 +79,7 @@ typedef struct {
 
 /* Defaults: 9600 baud, period 0.02 s (RX_PERIOD_DEFAULT), zero 2048,
  * scale = 90 deg/s per 2048 codes, axes x,y,z, rv3, CSV, N = 6, queue 256,
- * gap 20 ms. */
+ * gap 20 ms, hold 20 ms. */
 void rx_config_defaults(rx_config *c);
 
 /* Parse argv with getopt_long (and the --config files it names, whose
@@ -89,46 +97,103 @@ int rx_config_file(rx_config *c, const char *path, char *msg, size_t msglen);
 
 const char *rx_method_name(att_method m);
 
+/* Does a sample every `period` s, sent in link blocks of `block_size`
+ * bytes (block_size / 6 samples each), fit a line of `baud` bits/s? One
+ * exchange of the handshake protocol is block_size + 4 bytes of 10 bits
+ * (8N1), one after the other (each side waits for the other's byte), so
+ * the line carries at most baud / (10 (block_size + 4)) blocks/s. Returns
+ * 0 if the rate fits, 1 with the numbers in msg if it does not. */
+int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t msglen);
+
 void rx_usage(const char *prog, void *stream);
 
 /* ---- bounded record queue (one producer, one consumer) ---- */
 /* One record of an accepted block, decoded and numbered by the receiver
  * thread (attitude/block.h), in stream order. */
 typedef struct {
-    att_block blk;          /* the record (a sample: blk.kind == ATT_BLOCK_SAMPLE) */
-    att_block_span span;    /* its place in the numbering (sample: span.first = its number) */
-    int status;             /* att_block_decode's status (ATT_BLOCK_E_CODE: bad sample) */
-    int seq_status;         /* att_block_seq_feed's status (ATT_BLOCK_E_SEQ: numbering slipped) */
-    uint32_t missing_first; /* samples dropped on a full queue just before this record: */
-    uint32_t missing;       /* their first number and how many (the attitude thread holds them) */
+    att_block blk;       /* the record (a sample: blk.kind == ATT_BLOCK_SAMPLE) */
+    att_block_span span; /* its place in the numbering (sample: span.first = its number) */
+    int status;          /* att_block_decode's status (ATT_BLOCK_E_CODE: bad sample) */
+    int seq_status;      /* att_block_seq_feed's status (ATT_BLOCK_E_SEQ: numbering slipped) */
     uint8_t raw[ATT_BLOCK_SIZE];
 } rx_item;
 
 typedef struct {
     pthread_mutex_t lock;
-    pthread_cond_t nonempty;
+    pthread_cond_t nonempty, notfull; /* notfull: CLOCK_MONOTONIC timed waits */
     rx_item buf[RX_QUEUE_MAX + RX_REPORT_RESERVE];
     unsigned cap, head, count;
-    unsigned long pushed, popped, overflows;
+    unsigned long pushed, popped;
     unsigned high_water;
+    unsigned long failed; /* sample periods the integrator rejected (the attitude thread tells) */
     int closed;
 } rx_queue;
 
 int rx_queue_init(rx_queue *q, unsigned cap);
 void rx_queue_destroy(rx_queue *q);
-/* Non-blocking: 0 = queued, 1 = full (item dropped, overflow counted).
- * Samples fill up to cap items; reports may use RX_REPORT_RESERVE more, so
- * a BOOT or a loss report is not lost behind a backlog of samples. */
-int rx_queue_push(rx_queue *q, const rx_item *it);
+/* Queue all n records of one block, or none: wait until there is room for
+ * all of them (samples fill up to cap items; reports may use
+ * RX_REPORT_RESERVE more, so a BOOT or a loss report does not wait behind
+ * a backlog of samples) or until `deadline` (CLOCK_MONOTONIC). 0 = queued,
+ * 1 = still full at the deadline (nothing queued). Never drops. */
+int rx_queue_push_all(rx_queue *q, const rx_item *items, unsigned n, const struct timespec *deadline);
 /* Blocking until an item or the queue is closed and empty: 0 = got one, 1 = closed. */
 int rx_queue_pop(rx_queue *q, rx_item *it);
 void rx_queue_close(rx_queue *q);
+/* The attitude thread could not integrate one sample period. */
+void rx_queue_count_failed(rx_queue *q);
+unsigned long rx_queue_failed(rx_queue *q);
+
+/* ---- stop requests and bounded I/O ---- */
+/* A self-pipe that a signal handler or a thread writes one byte into to
+ * request the stop; it is never read, so it stays readable and every
+ * thread can poll it. The first thread to see it starts the grace time:
+ * RX_STOP_GRACE_MS to print what is queued, then output is abandoned. */
+typedef struct {
+    int wake_rd, wake_wr;
+    pthread_mutex_t lock;
+    int stopping;             /* the request was seen */
+    struct timespec deadline; /* CLOCK_MONOTONIC: end of the grace time */
+} rx_stop;
+
+int rx_stop_init(rx_stop *s);
+/* Request the stop (async-signal-safe). */
+void rx_stop_request(rx_stop *s);
+/* Has a stop been requested? (polls the pipe without waiting) */
+int rx_stop_check(rx_stop *s);
+/* Wait up to `seconds` for a stop request: 1 if one came. */
+int rx_stop_wait(rx_stop *s, double seconds);
+/* Give the private copy of `fd` (stdout, stderr) its own non-blocking
+ * open file description when it is a pipe or a character device (a tty),
+ * by reopening /proc/self/fd/N: the shell's description stays blocking.
+ * Otherwise (regular file, socket, no /proc) the fd is kept as it is and
+ * rx_out_write polls before writing at most PIPE_BUF bytes. */
+void rx_out_private(int fd);
+/* Write n bytes to fd (stdout, stderr), waiting in poll() for room or a
+ * stop request; once the stop is requested, only until its grace time
+ * ends. 0 = written, 1 = abandoned (stopping and the fd stayed blocked),
+ * -1 = write error (errno: EPIPE for a closed pipe, ...). */
+int rx_out_write(rx_stop *s, int fd, const char *p, size_t n);
+/* One line of log on stderr ("attitude-rx: " + fmt), through rx_out_write. */
+void rx_log(rx_stop *s, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+/* Write n bytes to the (non-blocking) serial port, waiting in poll() for
+ * room: 0 = written, 1 = a stop was requested first (not all written),
+ * -1 = error (errno). */
+int rx_port_write(rx_stop *s, int fd, const uint8_t *p, size_t n);
 
 /* ---- serial port ---- */
-/* Open and configure `path` raw 8N1 at `baud`. Returns the fd, or -1 with
- * errno set and a message in msg. */
+/* Open and configure `path` raw 8N1 at `baud`, non-blocking (reads and
+ * writes wait in poll()). Returns the fd, or -1 with errno set and a
+ * message in msg. */
 int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
 /* 1 if baud is one the termios layer knows. */
 int rx_serial_baud_ok(long baud);
+/* Close the port without waiting for its unsent output (a tty's close
+ * would wait for it to drain, up to 30 s on a UART whose flow is stopped). */
+void rx_serial_close(int fd);
 
 #endif /* ATTITUDE_RX_H */

@@ -51,8 +51,27 @@ void rx_config_defaults(rx_config *c)
     c->block_size = 6;
     c->queue_size = 256;
     c->gap_ms = 20;
+    c->hold_ms = RX_HOLD_MS_DEFAULT;
     c->reopen_delay = 1.0;
     c->header = 1;
+}
+
+int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t len)
+{
+    const unsigned per_block = block_size / ATT_BLOCK_SIZE; /* samples per block */
+    const unsigned exchange = block_size + 4u;              /* 0xAA, 0xBB, N data, checksum, answer */
+    double need, cap;
+    if (per_block == 0 || !(period > 0))
+        return 0;
+    need = 1.0 / period / (double)per_block;        /* blocks/s */
+    cap = (double)baud / (10.0 * (double)exchange); /* 10 bit times per byte (8N1) */
+    if (need <= cap)
+        return 0;
+    snprintf(msg, len,
+             "a sample every %g s needs %.1f blocks/s (%u-byte blocks, %u sample%s each), but %ld baud "
+             "carries at most %.1f (%u bytes of 10 bits per exchange): the board will lose samples",
+             period, need, block_size, per_block, per_block == 1u ? "" : "s", baud, cap, exchange);
+    return 1;
 }
 
 static int fail(char *msg, size_t len, int code, const char *fmt, ...)
@@ -242,6 +261,10 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
             return fail(msg, len, RX_EXIT_CONFIG, "gap-ms: '%s' must be 1..%d ms", value,
                         ATT_LINK_TIMEOUT_MAX);
         c->gap_ms = (unsigned)u;
+    } else if (strcmp(name, "hold-ms") == 0) {
+        if (parse_ulong(value, &u) != 0 || u > RX_HOLD_MS_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG, "hold-ms: '%s' must be 0..%d ms", value, RX_HOLD_MS_MAX);
+        c->hold_ms = (unsigned)u;
     } else if (strcmp(name, "count") == 0) {
         if (parse_ulong(value, &u) != 0)
             return fail(msg, len, RX_EXIT_CONFIG, "count: '%s' must be a number of output lines", value);
@@ -347,6 +370,7 @@ static const struct option long_options[] = { { "help", no_argument, NULL, OPT_H
                                               { "block-size", required_argument, NULL, OPT_SETTING },
                                               { "queue", required_argument, NULL, OPT_SETTING },
                                               { "gap-ms", required_argument, NULL, OPT_SETTING },
+                                              { "hold-ms", required_argument, NULL, OPT_SETTING },
                                               { "count", required_argument, NULL, OPT_SETTING },
                                               { "consumer-delay", required_argument, NULL, OPT_SETTING },
                                               { "reopen-delay", required_argument, NULL, OPT_SETTING },
@@ -446,14 +470,19 @@ void rx_usage(const char *prog, void *stream)
             "  --block-size N           link block bytes (multiple of 6), default 6\n"
             "  --queue N                records the inter-thread queue holds, default 256\n"
             "  --gap-ms MS              link gap timeout inside a block, default 20\n"
+            "  --hold-ms MS             a block that finds the queue full waits this long for room\n"
+            "                           before it is answered 0xFF (send again), default 20\n"
             "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
             "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
             "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
             "  --config FILE            'name = value' lines with the names above; the command line wins\n"
             "  -h, --help               this text;  --version: the version\n"
-            "Missing samples (loss reports, bad codes, queue overflow) are filled by holding the last\n"
-            "rate and counted (docs/cross-build.md).\n"
-            "Exit codes: 0 ok, 64 usage, 66 no such port, 74 port not usable, 77 permission denied,\n"
-            "78 bad configuration.\n",
+            "A block is acknowledged (0x00) only once its records are queued; every acknowledged\n"
+            "sample is integrated and printed, also on --count and SIGINT/SIGTERM. Missing samples\n"
+            "(loss reports, bad codes) are filled by holding the last rate and counted\n"
+            "(docs/attitude-rx.md).\n"
+            "Exit codes: 0 ok, 64 usage, 66 no such port, 74 port not usable or stdout failed,\n"
+            "75 stopped while stdout stayed blocked (acknowledged samples unprinted), 77 permission\n"
+            "denied, 78 bad configuration.\n",
             prog);
 }
