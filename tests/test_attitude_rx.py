@@ -374,6 +374,25 @@ def test_rx_count_acknowledges_only_what_it_prints(rx_builds) -> None:
     assert len(acked) == 100
 
 
+@pytest.mark.parametrize(("method", "count", "samples", "every", "first"),
+                         [("rv3", 20, 60, 3, 2),   # an update per 3 samples
+                          ("rk4", 20, 41, 2, 2)])  # start sample, then (midpoint, end) pairs
+def test_rx_count_multi_sample_methods_acknowledge_whole_updates(rx_builds, method: str, count: int,
+                                                                  samples: int, every: int, first: int) -> None:
+    """--count with methods that need several samples per update: exactly the samples of the
+    N updates are acknowledged (att_integ_outputs), integrated, and end in a printed line."""
+    rx = Rx(rx_builds["host"], "--method", method, "--no-header", "--count", str(count),
+            "--consumer-delay", "0.01", "--gap-ms", "2000")
+    feeder = Feeder(rx.master, impl="c", timeout_ms=300)
+    acked = _send_while_alive(feeder, rx, _unique_codes(samples + 60))
+    rc, out, err = rx.finish(sig=None)
+    assert rc == 0, err
+    st = _stats(err)
+    assert feeder.b_bytes[0x00] == len(acked) == st["integrated"] == samples, st
+    assert st["pending"] == 0 and st["updates"] == count, st
+    assert _rows(out) == acked[first::every]  # each line carries the codes of its newest sample
+
+
 class SlowReader:
     """Reads a child's stdout pipe (shrunk to one page) slowly until told to hurry."""
 
