@@ -1,0 +1,290 @@
+/*
+ * libFuzzer target for the block format (attitude/block.h): the decoder,
+ * the sequence tracker and the encoders, built with AddressSanitizer +
+ * UndefinedBehaviorSanitizer (`invoke fuzz --target block`).
+ *
+ * Input: chunks of 7 bytes, an operation byte and 6 record bytes. Even
+ * operation: decode the 6 bytes as a record and feed it to a sequence
+ * tracker; odd: call one of the encoders (chosen by the operation) with
+ * arguments taken from the 6 bytes.
+ *
+ * Oracles (abort() on a violation), from the header's contract:
+ *  - decode: a record whose byte 0 is not the mark is a sample with the
+ *    big-endian codes, ATT_OK exactly when every code is <= 4095 (else
+ *    ATT_BLOCK_E_CODE); a report has kind = byte 1, ATT_BLOCK_E_KIND
+ *    above ADC_ERROR, ATT_BLOCK_E_FIELD exactly when a field is out of
+ *    its range; the fields a kind does not use are 0; every record it
+ *    accepts encodes back to the same 6 bytes, and every field it rejects
+ *    is rejected by the encoder too.
+ *  - the sequence tracker: a sample takes the next number, BOOT restarts
+ *    at 0, SELFTEST takes none, a loss report is adopted as it is before
+ *    the numbering is fixed, then its slip is its first minus the count
+ *    (in -32768..32767), ATT_BLOCK_E_SEQ exactly when it is not 0, and the
+ *    count goes on after the report's samples; rejected records change
+ *    nothing.
+ *  - an encoder returns ATT_OK exactly for arguments in range, and its
+ *    record decodes to those arguments.
+ *  - NULL pointers give ATT_E_NULL.
+ */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "attitude/block.h"
+
+static void check(int cond)
+{
+    if (!cond) {
+        abort();
+    }
+}
+
+static uint16_t be16(const uint8_t *p)
+{
+    return (uint16_t)((uint16_t)p[0] << 8 | p[1]);
+}
+
+static int8_t s8(uint8_t b)
+{
+    return (int8_t)(b >= 128 ? (int)b - 256 : (int)b);
+}
+
+static int is_loss(unsigned kind)
+{
+    return kind == ATT_BLOCK_GAVE_UP || kind == ATT_BLOCK_OVERRUN || kind == ATT_BLOCK_ADC_ERROR;
+}
+
+/* The decoded record b of raw (status st) against the format. */
+static void check_decoded(const uint8_t *raw, const att_block *b, int st)
+{
+    att_block zero;
+    uint8_t enc[ATT_BLOCK_SIZE];
+    int e;
+    memset(&zero, 0, sizeof zero);
+    if (raw[0] != (uint8_t)ATT_BLOCK_MARK) {
+        int big = be16(raw) > ATT_BLOCK_CODE_MAX || be16(raw + 2) > ATT_BLOCK_CODE_MAX
+                  || be16(raw + 4) > ATT_BLOCK_CODE_MAX;
+        check(b->kind == (uint16_t)ATT_BLOCK_SAMPLE && st == (big ? ATT_BLOCK_E_CODE : ATT_OK));
+        check(b->code[0] == be16(raw) && b->code[1] == be16(raw + 2) && b->code[2] == be16(raw + 4));
+        zero.kind = b->kind;
+        memcpy(zero.code, b->code, sizeof zero.code);
+        check(memcmp(&zero, b, sizeof zero) == 0); /* nothing else set */
+        e = att_block_encode_sample(enc, b->code);
+        check(e == st && (st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0));
+        return;
+    }
+    check(b->kind == raw[1]);
+    zero.kind = b->kind;
+    switch (raw[1]) {
+    case ATT_BLOCK_BOOT:
+        check(b->version == raw[2] && b->period_ticks == be16(raw + 3) && b->baud_div == raw[5]);
+        check(st
+              == ((raw[2] == ATT_BLOCK_VERSION && be16(raw + 3) >= 1 && be16(raw + 3) <= ATT_BLOCK_PERIOD_MAX
+                   && raw[5] != 0)
+                      ? ATT_OK
+                      : ATT_BLOCK_E_FIELD));
+        zero.version = b->version;
+        zero.period_ticks = b->period_ticks;
+        zero.baud_div = b->baud_div;
+        e = att_block_encode_boot(enc, b->period_ticks, b->baud_div);
+        if (b->version == ATT_BLOCK_VERSION) { /* the encoder writes no other version */
+            check(e == st);
+        }
+        break;
+    case ATT_BLOCK_SELFTEST:
+        check(b->status == s8(raw[2]) && b->bad_code == be16(raw + 3) && b->attempt == raw[5]);
+        check(st == (s8(raw[2]) < 0 && be16(raw + 3) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        zero.status = b->status;
+        zero.bad_code = b->bad_code;
+        zero.attempt = b->attempt;
+        e = att_block_encode_selftest(enc, b->status, b->bad_code, b->attempt);
+        check(e == st);
+        break;
+    case ATT_BLOCK_GAVE_UP:
+    case ATT_BLOCK_OVERRUN:
+        check(b->first == be16(raw + 2) && b->count == be16(raw + 4));
+        check(st == (b->count != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        zero.first = b->first;
+        zero.count = b->count;
+        e = att_block_encode_loss(enc, raw[1], b->first, b->count);
+        check(e == st);
+        break;
+    case ATT_BLOCK_ADC_ERROR:
+        check(b->first == be16(raw + 2) && b->count == 1 && b->status == s8(raw[4]));
+        check(st == (s8(raw[4]) < 0 && raw[5] == 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        zero.first = b->first;
+        zero.count = 1;
+        zero.status = b->status;
+        e = att_block_encode_adc_error(enc, b->first, b->status);
+        if (raw[5] == 0) { /* the encoder always writes 0 there */
+            check(e == st);
+        }
+        break;
+    default:
+        check(st == ATT_BLOCK_E_KIND);
+        return;
+    }
+    check(memcmp(&zero, b, sizeof zero) == 0); /* the fields a kind does not use are 0 */
+    check(st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0);
+}
+
+/* Feed b to the tracker and check the span against the contract. */
+static void check_seq(att_block_seq *s, const att_block *b)
+{
+    att_block_seq before = *s;
+    att_block_span sp;
+    int st = att_block_seq_feed(s, b, &sp);
+    int32_t d;
+    uint16_t u;
+    if (b->kind == (uint16_t)ATT_BLOCK_SAMPLE) {
+        check(st == ATT_OK && sp.first == before.next && sp.count == 1 && sp.slip == 0);
+        check(s->next == before.next + 1 && s->synced == before.synced);
+        return;
+    }
+    if (b->kind == ATT_BLOCK_BOOT) {
+        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && s->next == 0 && s->synced);
+        return;
+    }
+    if (b->kind == ATT_BLOCK_SELFTEST) {
+        check(st == ATT_OK && sp.first == before.next && sp.count == 0 && s->next == before.next
+              && s->synced == before.synced);
+        return;
+    }
+    if (!is_loss(b->kind) || b->count == 0) { /* rejected: nothing changes */
+        check(st == (is_loss(b->kind) ? ATT_BLOCK_E_FIELD : ATT_BLOCK_E_KIND));
+        check(s->next == before.next && s->synced == before.synced);
+        return;
+    }
+    if (!before.synced) { /* adopted as it is */
+        check(st == ATT_OK && sp.first == b->first && sp.count == b->count && sp.slip == 0);
+        check(s->synced && s->next == (uint32_t)b->first + b->count);
+        return;
+    }
+    u = (uint16_t)(b->first - (uint16_t)before.next);
+    d = u < 0x8000u ? (int32_t)u : (int32_t)u - 65536;
+    check(sp.slip == d && st == (d == 0 ? ATT_OK : ATT_BLOCK_E_SEQ));
+    if (d >= 0) {
+        check(sp.first == before.next && sp.count == (uint32_t)d + b->count);
+    } else {
+        check(sp.first == ((uint32_t)-d > before.next ? 0u : before.next - (uint32_t)-d)
+              && sp.count == b->count);
+    }
+    check(s->next == sp.first + sp.count && s->synced);
+}
+
+/* An encoder with arguments from p: ATT_OK exactly in range, and its record decodes back. */
+static void check_encode(uint8_t which, const uint8_t *p)
+{
+    uint8_t enc[ATT_BLOCK_SIZE];
+    att_block b;
+    int e, want, d;
+    switch (which % 5) {
+    case 0: {
+        uint16_t codes[3];
+        codes[0] = (uint16_t)(be16(p) & 0x1FFF); /* mostly in range, sometimes not */
+        codes[1] = (uint16_t)(be16(p + 2) & 0x1FFF);
+        codes[2] = (uint16_t)(be16(p + 4) & 0x1FFF);
+        want = codes[0] > ATT_BLOCK_CODE_MAX || codes[1] > ATT_BLOCK_CODE_MAX || codes[2] > ATT_BLOCK_CODE_MAX
+                   ? ATT_BLOCK_E_CODE
+                   : ATT_OK;
+        e = att_block_encode_sample(enc, codes);
+        check(e == want);
+        if (e == ATT_OK) {
+            d = att_block_decode(enc, &b);
+            check(d == ATT_OK && b.kind == (uint16_t)ATT_BLOCK_SAMPLE
+                  && memcmp(b.code, codes, sizeof codes) == 0);
+        }
+        { /* in place, as the firmware does: the codes' memory is the block */
+            uint16_t words[3];
+            memcpy(words, codes, sizeof codes);
+            check(att_block_encode_sample((uint8_t *)words, words) == want);
+            if (want == ATT_OK) {
+                check(att_block_decode((const uint8_t *)words, &b) == ATT_OK
+                      && memcmp(b.code, codes, sizeof codes) == 0);
+            }
+        }
+        return;
+    }
+    case 1:
+        e = att_block_encode_boot(enc, be16(p), p[2]);
+        check(e
+              == (be16(p) >= 1 && be16(p) <= ATT_BLOCK_PERIOD_MAX && p[2] != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_BOOT && b.period_ticks == be16(p)
+                  && b.baud_div == p[2] && b.version == ATT_BLOCK_VERSION);
+        }
+        return;
+    case 2:
+        e = att_block_encode_selftest(enc, s8(p[0]), be16(p + 1), p[3]);
+        check(e == (s8(p[0]) < 0 && be16(p + 1) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_SELFTEST && b.status == s8(p[0])
+                  && b.bad_code == be16(p + 1) && b.attempt == p[3]);
+        }
+        return;
+    case 3:
+        e = att_block_encode_loss(enc, p[0] % 6, be16(p + 1), be16(p + 3));
+        want = p[0] % 6 != ATT_BLOCK_GAVE_UP && p[0] % 6 != ATT_BLOCK_OVERRUN ? ATT_BLOCK_E_KIND
+               : be16(p + 3) == 0                                             ? ATT_BLOCK_E_FIELD
+                                                                              : ATT_OK;
+        check(e == want);
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == p[0] % 6 && b.first == be16(p + 1)
+                  && b.count == be16(p + 3));
+        }
+        return;
+    default:
+        e = att_block_encode_adc_error(enc, be16(p), s8(p[2]));
+        check(e == (s8(p[2]) < 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_ADC_ERROR && b.first == be16(p)
+                  && b.count == 1 && b.status == s8(p[2]));
+        }
+        return;
+    }
+}
+
+static void misuse(void)
+{
+    uint8_t raw[ATT_BLOCK_SIZE] = { 0 };
+    uint16_t codes[3] = { 0 };
+    att_block b;
+    att_block_seq s;
+    att_block_span sp;
+    att_block_seq_init(NULL);
+    att_block_seq_init(&s);
+    check(att_block_decode(NULL, &b) == ATT_E_NULL && att_block_decode(raw, NULL) == ATT_E_NULL);
+    check(att_block_decode(raw, &b) == ATT_OK);
+    check(att_block_seq_feed(NULL, &b, &sp) == ATT_E_NULL && att_block_seq_feed(&s, NULL, &sp) == ATT_E_NULL
+          && att_block_seq_feed(&s, &b, NULL) == ATT_E_NULL);
+    check(att_block_encode_sample(NULL, codes) == ATT_E_NULL
+          && att_block_encode_sample(raw, NULL) == ATT_E_NULL);
+    check(att_block_encode_boot(NULL, 72, 8) == ATT_E_NULL
+          && att_block_encode_selftest(NULL, -1, 0, 1) == ATT_E_NULL);
+    check(att_block_encode_loss(NULL, ATT_BLOCK_GAVE_UP, 0, 1) == ATT_E_NULL);
+    check(att_block_encode_adc_error(NULL, 0, -1) == ATT_E_NULL);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    att_block_seq seq;
+    size_t i;
+    if (size > 0 && data[0] == 0xA5) {
+        misuse();
+    }
+    att_block_seq_init(&seq);
+    check(seq.next == 0 && seq.synced == 0);
+    for (i = 0; i + 7 <= size; i += 7) {
+        const uint8_t *raw = data + i + 1;
+        if ((data[i] & 1) == 0) {
+            att_block b;
+            int st = att_block_decode(raw, &b);
+            check_decoded(raw, &b, st);
+            check_seq(&seq, &b);
+        } else {
+            check_encode((uint8_t)(data[i] >> 1), raw);
+        }
+    }
+    return 0;
+}
