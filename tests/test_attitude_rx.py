@@ -474,6 +474,7 @@ def test_rx_signal_stops_it_while_the_port_write_blocks(rx_builds, sig: int) -> 
     time.sleep(0.5)
     dt, rc = _wait_exit(rx.proc, sig)
     _, _, err = rx.finish(sig=None)
+    print(f"port write blocked: signal {sig} -> exit {rc} after {dt:.3f} s")
     assert dt < STOP_BOUND_S, f"{dt:.2f} s"
     assert rc == 0, err
     assert f"stopped by signal {sig}" in err
@@ -497,6 +498,7 @@ def test_rx_signal_stops_it_while_stdout_blocks(rx_builds) -> None:
     out, err = rx.proc.communicate(timeout=10)
     rx.finish(sig=None)
     err = err.decode()
+    print(f"stdout blocked: SIGTERM -> exit {rc} after {dt:.3f} s")
     assert dt < STOP_BOUND_S, f"{dt:.2f} s"
     assert rc == 75, err
     st = _stats(err)
