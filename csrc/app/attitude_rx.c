@@ -49,15 +49,15 @@ typedef struct {
     unsigned long port_errors, reopens;
     /* attitude thread */
     unsigned long integrated, held, missing, updates, integ_errors, code_errors;
-    unsigned long reports[ATT_BLOCK_ADC_ERROR + 1];
+    unsigned long reports[ATT_BLOCK_OVERSAMPLE + 1];
     unsigned long block_errors, seq_errors;
     double period; /* s, the sample period in use */
     double t;      /* s, time integrated so far (sample periods, held ones included) */
     int out_error; /* stdout failed (closed pipe) */
 } rx_app;
 
-static const char *const report_names[ATT_BLOCK_ADC_ERROR + 1] = { "BOOT", "SELFTEST", "GAVE_UP", "OVERRUN",
-                                                                   "ADC_ERROR" };
+static const char *const report_names[ATT_BLOCK_OVERSAMPLE + 1] = { "BOOT",    "SELFTEST",  "GAVE_UP",
+                                                                    "OVERRUN", "ADC_ERROR", "OVERSAMPLE" };
 
 static int g_wake_wr = -1; /* for the signal handler only */
 static volatile sig_atomic_t g_signal = 0;
@@ -146,9 +146,11 @@ static void queue_record(rx_app *app, att_block_seq *seq, const uint8_t *raw, ui
     rx_item it;
     memset(&it, 0, sizeof it);
     memcpy(it.raw, raw, sizeof it.raw);
-    it.status = att_block_decode(raw, &it.blk);
-    if (it.status == ATT_OK || it.status == ATT_BLOCK_E_CODE) /* a bad sample still takes its number */
-        it.seq_status = att_block_seq_feed(seq, &it.blk, &it.span);
+    it.status = att_block_seq_decode(seq, raw, &it.blk, &it.span); /* a bad sample still takes its number */
+    if (it.status == ATT_BLOCK_E_SEQ) {
+        it.seq_status = it.status;
+        it.status = ATT_OK;
+    }
     if (it.blk.kind == ATT_BLOCK_SAMPLE)
         app->samples++;
     it.missing_first = *missing_first;
@@ -284,9 +286,11 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
 /* The attitude thread's integration state. */
 typedef struct {
     att_integ integ;
-    att_real rate[3]; /* body rate of the last good sample, rad/s */
-    uint16_t code[3]; /* its codes */
-    int have_rate;    /* a good sample has been integrated */
+    att_sensor gyro;    /* codes -> body rate (--gyro-zero, --gyro-scale, --axes) */
+    uint8_t oversample; /* conversions per sample word: 1, or the stream's OVERSAMPLE */
+    att_real rate[3];   /* body rate of the last good sample, rad/s */
+    uint16_t code[3];   /* its codes */
+    int have_rate;      /* a good sample has been integrated */
 } rx_att;
 
 static int finished(const rx_app *app)
@@ -349,18 +353,14 @@ static void hold(rx_app *app, rx_att *a, uint32_t first, uint32_t n, const char 
     }
 }
 
-/* A good sample: codes -> body rate (calibration, axes) -> integrator. */
+/* A good sample: codes -> body rate (calibration, axes: att_sensor) -> integrator. */
 static void sample(rx_app *app, rx_att *a, const rx_item *it)
 {
-    const rx_config *c = &app->cfg;
-    att_real ch[3];
     int i;
+    if (att_sensor_convert(&a->gyro, it->blk.code, a->oversample, a->rate) != ATT_OK)
+        return; /* not reached: the tracker checked the codes against the stream's limit */
     for (i = 0; i < 3; i++)
-        ch[i] = (att_real)(((double)it->blk.code[i] - c->zero[i]) * c->scale[i]); /* rad/s */
-    for (i = 0; i < 3; i++) {
-        a->rate[i] = (att_real)c->axis_sign[i] * ch[c->axis_src[i]];
         a->code[i] = it->blk.code[i];
-    }
     a->have_rate = 1;
     app->integrated++;
     integrate(app, a, it->span.first, a->rate, a->code);
@@ -405,7 +405,16 @@ static void report(rx_app *app, rx_att *a, const rx_item *it)
     const char *name = report_names[b->kind];
     app->reports[b->kind]++;
     if (b->kind == ATT_BLOCK_BOOT) {
+        a->oversample = 1; /* a new stream: plain codes until an OVERSAMPLE report */
         boot(app, b);
+        return;
+    }
+    if (b->kind == ATT_BLOCK_OVERSAMPLE) {
+        a->oversample = b->oversample;
+        fprintf(stderr, "attitude-rx: OVERSAMPLE: each sample word is the sum of %u conversions\n",
+                b->oversample);
+        snprintf(body, sizeof body, "\"report\":\"OVERSAMPLE\",\"n\":%u", b->oversample);
+        json_record(app, body);
         return;
     }
     if (b->kind == ATT_BLOCK_SELFTEST) {
@@ -475,6 +484,12 @@ static void *attitude_thread(void *arg)
     rx_item it;
 
     memset(&a, 0, sizeof a);
+    a.oversample = 1;
+    if (rx_gyro_init(c, &a.gyro) != ATT_OK) {
+        fprintf(stderr, "attitude-rx: gyro calibration rejected (--gyro-zero, --gyro-scale, --axes)\n");
+        request_stop(app);
+        return NULL;
+    }
     if (att_integ_init(&a.integ, c->method, NULL) != ATT_OK) {
         fprintf(stderr, "attitude-rx: integrator rejected method %s\n", rx_method_name(c->method));
         request_stop(app);
@@ -590,10 +605,10 @@ int main(int argc, char **argv)
             app.queue.high_water, app.updates, app.integ_errors, app.port_errors, app.reopens);
     fprintf(stderr,
             "attitude-rx: reports: boot=%lu selftest=%lu gave_up=%lu overrun=%lu adc_error=%lu "
-            "block_errors=%lu seq_errors=%lu\n",
+            "oversample=%lu block_errors=%lu seq_errors=%lu\n",
             app.reports[ATT_BLOCK_BOOT], app.reports[ATT_BLOCK_SELFTEST], app.reports[ATT_BLOCK_GAVE_UP],
-            app.reports[ATT_BLOCK_OVERRUN], app.reports[ATT_BLOCK_ADC_ERROR], app.block_errors,
-            app.seq_errors);
+            app.reports[ATT_BLOCK_OVERRUN], app.reports[ATT_BLOCK_ADC_ERROR],
+            app.reports[ATT_BLOCK_OVERSAMPLE], app.block_errors, app.seq_errors);
     if (app.queue_missing)
         fprintf(stderr, "attitude-rx: %lu samples were dropped on a full queue (--queue %u)\n",
                 app.queue_missing, app.cfg.queue_size);

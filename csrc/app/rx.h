@@ -89,6 +89,10 @@ int rx_config_file(rx_config *c, const char *path, char *msg, size_t msglen);
 
 const char *rx_method_name(att_method m);
 
+/* The gyro converter (attitude/sensor.h) of the configuration's zero,
+ * scale and axes: att_sensor_init's status. */
+int rx_gyro_init(const rx_config *c, att_sensor *gyro);
+
 void rx_usage(const char *prog, void *stream);
 
 /* ---- bounded record queue (one producer, one consumer) ---- */
