@@ -60,7 +60,7 @@ def run(quick: bool = False) -> str:
         t = (np.arange(1, m + 1) * k_per - 1 + offset) * h
         return float(np.max(quat_angle_between(tr.quat(t), q)))
 
-    per = attitude_c.core.FRAME
+    per = {m: attitude_c.names.samples_per_update(m) for m in attitude_c.INCREMENT_METHODS}
     inc_peer = inc_all[:n_peer]
     precs = ["f64", "f32"]
     try:

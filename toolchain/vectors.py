@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from attitude_c import core
+
 ROOT = Path(__file__).resolve().parents[1]
 RUNNER_SRC = ROOT / "csrc" / "vectors" / "run_vectors.c"
 
@@ -42,7 +44,8 @@ EPS32 = 2.0 ** -24
 #: float64 unit roundoff (2^-53).
 EPS64 = 2.0 ** -53
 
-INCREMENT_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly")
+#: The methods whose increments the vectors integrate (every one but rk4: the library's list).
+INCREMENT_METHODS = core.INCREMENT_METHODS
 
 
 @dataclass

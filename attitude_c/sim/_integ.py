@@ -10,7 +10,8 @@ from typing import Callable
 
 import numpy as np
 
-from ..core import FRAME, METHODS, PRECISIONS, Method, Precision
+from ..core import METHODS, PRECISIONS, Method, Precision
+from ..names import samples_per_update
 from ..errors import InvalidArgument
 
 
@@ -70,7 +71,7 @@ def run_integrator(dtheta: np.ndarray, method: Method, q0_at: Callable[[float], 
         q = np.asarray(q, dtype=float)
         last = 2 * np.arange(1, len(q) + 1)
         return q, last, 0.5
-    k = FRAME[method]  # increments consumed per update
+    k = samples_per_update(method)  # increments consumed per update
     n_use = (n // k) * k
     if n_use == 0:
         return empty
