@@ -60,6 +60,7 @@ __all__ = [
     "integrate",
     "integrate_rates",
     "quat_conj",
+    "quat_angle",
     "quat_multiply",
     "quat_normalize",
     "quat_to_dcm",
@@ -510,6 +511,13 @@ def rotvec_to_quat(phi: ArrayLike) -> F:
     p = _arr(phi, (3,))
     n = np.linalg.norm(p, axis=-1, keepdims=True)
     return np.concatenate([np.cos(n / 2), 0.5 * np.sinc(n / (2 * np.pi)) * p], axis=-1)
+
+
+def quat_angle(qa: ArrayLike, qb: ArrayLike) -> F:
+    """Angle (rad, [0, π]) of the rotation taking attitude qa to qb: 2 atan2(|v|, |w|)
+    of qa* ⊗ qb (the sign of the quaternion does not matter)."""
+    d = quat_multiply(quat_conj(qa), qb)
+    return 2 * np.arctan2(np.linalg.norm(d[..., 1:], axis=-1), np.abs(d[..., 0]))
 
 
 def quat_to_rotvec(q: ArrayLike) -> F:

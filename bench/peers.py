@@ -41,7 +41,7 @@ def _version(pkg: str) -> str:
 def run(quick: bool = False) -> str:
     import attitude_c
     from attitude_c.sim import PaperTrajectory
-    from attitude_c.sim._rot import quat_angle_between
+    from attitude_c.sim import attitude_angle as quat_angle_between
 
     h = 0.01
     n_peer = 6_000 if quick else 60_000  # peers loop in Python: 60 s or 600 s of data

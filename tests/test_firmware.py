@@ -2,11 +2,11 @@
 
 Every run is ``s51 -t C51 -R 1`` with the UART on a ``socat`` pty pair and
 libattitude's C receiver B (through CFFI) on the other end
-(:class:`firmware.tool.LinkHost`); the firmware stops itself through the
+(:class:`toolchain.firmware.LinkHost`); the firmware stops itself through the
 simulator interface after a given number of accepted blocks, and every
 s51/socat process is killed in a ``finally`` (wall-clock timeouts on all).
 
-Images (firmware/tool.py): ``production`` (what goes into the chip),
+Images (toolchain/firmware.py): ``production`` (what goes into the chip),
 ``bench`` (production pins and RAM layout, cycle counters in unused SFR
 cells) and ``sim`` (the production driver and HAL with the pins pointed at
 a TLC2543 + gyro model kept in unused SFR cells: same RAM layout again).
@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 from conftest import require_target, require_tools
 
-from firmware import tool
+from toolchain import firmware as tool
 
 #: Stack margin we require in the production RAM layout: the highest SP
 #: s51 sees running the bench image (production code, RAM layout and call

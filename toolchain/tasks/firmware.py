@@ -4,19 +4,15 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from types import ModuleType
 
 from invoke import task
 
-ROOT = Path(__file__).resolve().parents[2]
-NAMESPACE = True
 
+def _tool() -> ModuleType:
+    from toolchain import firmware  # imported at use: the other tasks need no simulator
 
-def _tool():  # type: ignore[no-untyped-def]
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from firmware import tool
-
-    return tool
+    return firmware
 
 
 @task(help={
