@@ -76,9 +76,6 @@ def test_sender_fits_8051_ram_budget(tmp_path: Path):
 
 def test_fuzz_smoke_run(tmp_path: Path):
     require_tools("clang", apt="clang libclang-rt-14-dev")
-    import sys
-
-    sys.path.insert(0, str(ROOT))
     from toolchain.tasks.link import build_fuzzer, run_fuzzer
 
     exe = build_fuzzer(tmp_path / "fuzz")
