@@ -10,7 +10,8 @@ unchanged):
 * ``sim`` — the same firmware, but the driver's pin HAL calls a TLC2543 +
   gyro device model compiled into the image (firmware/sim/tlc_model.c), and
   the program stops itself through the uCsim simulator interface after a
-  given number of accepted sample blocks, printing its link statistics.
+  given number of accepted blocks (or sample records), printing its link
+  statistics (main.c's hooks, firmware/hooks.h and firmware/sim/hooks.h).
 * ``bench`` — production pins plus machine-cycle counters (Timer 0 based).
 
 Running: s51 (``-t C51``, 128 B RAM) gets its UART on one end of a
@@ -216,13 +217,14 @@ def parse_mem(mem: Path) -> tuple[int, int, int]:
 
 
 def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
-          sim_blocks: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
+          sim_blocks: int = 0, sim_samples: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
           extra_defines: Iterable[str] = (), name: str | None = None,
           code_size: int = FLASH_SIZE) -> Image:
     """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
 
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
-    ``sim_blocks`` accepted blocks, 0 = never) or ``bench`` (production pins,
+    ``sim_blocks`` accepted blocks or ``sim_samples`` accepted sample records, whichever
+    comes first; 0 = that count never stops it) or ``bench`` (production pins,
     self-test skipped because s51's port pins read 1, cycle counters).
     ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck`` (every
     conversion), ``adc_error_at=K`` (EOC stuck in the scan of sample K only, 0 <= K < 256: one
@@ -246,7 +248,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if faults and kind != "sim":
         raise ValueError("faults need kind='sim'")
     if kind in ("sim", "bench"):
-        defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}"]
+        defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}", f"FW_SIM_SAMPLES={int(sim_samples)}"]
         sources.append(FW_DIR / "sim" / "sim_io.c")
     if kind == "sim":
         defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
