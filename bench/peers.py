@@ -62,12 +62,7 @@ def run(quick: bool = False) -> str:
 
     per = {m: attitude_c.names.samples_per_update(m) for m in attitude_c.INCREMENT_METHODS}
     inc_peer = inc_all[:n_peer]
-    precs = ["f64", "f32"]
-    try:
-        attitude_c.integrate(inc_all[:3], method="rv3", precision="fixed")
-        precs.append("fixed")
-    except (ValueError, TypeError, ImportError):
-        pass  # the fixed-point core is not in this build
+    precs = ["f64", "f32", "fixed"]
     for prec in precs:
         for m, k in per.items():
             dt, q = _best(lambda m=m, prec=prec: attitude_c.integrate(inc_all, method=m, q0=q0,

@@ -249,7 +249,7 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         return _run(args)
-    except (AttitudeError, ValueError, TypeError, ImportError) as exc:
+    except (AttitudeError, ValueError, TypeError) as exc:
         print(f"attitude simulate: error: {exc}", file=sys.stderr)
         return 2
 

@@ -52,4 +52,3 @@ def fuzz(c, seconds=60, corpus=""):
     print(f"fuzz: {seconds} s clean")
 
 
-TOP_LEVEL = (fuzz,)
