@@ -22,7 +22,7 @@ The table is filled on first use: importing this module loads no C extension.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from functools import lru_cache
+from functools import cache
 from typing import Any
 
 from .errors import (
@@ -37,8 +37,8 @@ from .errors import (
 )
 
 __all__ = [
-    "C",
     "STATUS",
+    "C",
     "method_code",
     "method_names",
     "raise_for_status",
@@ -127,7 +127,7 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
 }
 
 
-@lru_cache(maxsize=None)
+@cache
 def _status_names() -> dict[int, str]:
     """Status value -> C name: the negative constants named ``*_E_*``."""
     out: dict[int, str] = {}
@@ -166,7 +166,7 @@ def raise_for_status(status: int, what: str,
     raise cls(msg)
 
 
-@lru_cache(maxsize=None)
+@cache
 def method_names() -> tuple[str, ...]:
     """The integration methods' names in ``att_method`` order (``att_integ_method_name``)."""
     from ._lib import ffi_lib
@@ -183,7 +183,7 @@ def method_code(method: str) -> int:
         raise InvalidArgument(f"method must be one of {method_names()!r}, got {method!r}") from None
 
 
-@lru_cache(maxsize=None)
+@cache
 def samples_per_update(method: str) -> int:
     """Increments (rk4: rate rows) ``method`` consumes per attitude update once
     running, from the library's own count (``att_integ_outputs``): 1 for rv1 and

@@ -59,8 +59,8 @@ __all__ = [
     "heading",
     "integrate",
     "integrate_rates",
-    "quat_conj",
     "quat_angle",
+    "quat_conj",
     "quat_multiply",
     "quat_normalize",
     "quat_to_dcm",
@@ -622,5 +622,5 @@ def sensor_values(words: ArrayLike, zero: ArrayLike, scale: ArrayLike, n: int = 
     w = np.asarray(words, dtype=np.float64).reshape(-1, 3)
     mean = w / float(n)
     chan = (mean - np.asarray(zero, dtype=np.float64)) * np.asarray(scale, dtype=np.float64)
-    return chan[:, list(axes)] * np.asarray(signs, dtype=np.float64)
+    return chan[:, np.asarray(axes, dtype=np.intp)] * np.asarray(signs, dtype=np.float64)
 

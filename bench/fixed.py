@@ -83,7 +83,6 @@ def _s51(tmp: Path) -> dict[str, dict[str, object]]:
     import subprocess
 
     from toolchain import targets as T
-
     from toolchain.fixed_harness import KERNELS as DEFS
     from toolchain.fixed_harness import s51_kernel_run
 
@@ -125,10 +124,9 @@ def _s51(tmp: Path) -> dict[str, dict[str, object]]:
 def _accuracy(quick: bool) -> list[tuple[str, int, float, float, float]]:
     import numpy as np
 
-    from toolchain.fixed_harness import MOTIONS, angle_error, noise_limit, quantize
-
     from attitude_c import core
     from attitude_c import fixedpoint as fx
+    from toolchain.fixed_harness import MOTIONS, angle_error, noise_limit, quantize
 
     n_upd = 100_000 if quick else 1_000_000
     rows = []

@@ -12,7 +12,6 @@ from typing import Any, Callable
 
 import numpy as np
 
-from attitude_c import core
 from attitude_c.names import samples_per_update
 
 TITLE = "Host integrator throughput (C batch call vs NumPy, Python loops, imufusion)"

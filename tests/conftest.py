@@ -20,7 +20,9 @@ from pathlib import Path
 
 import pytest
 
-from toolchain import targets as _targets  # the checkout's root is on sys.path: python -m pytest from it
+from toolchain import (
+    targets as _targets,  # the checkout's root is on sys.path: python -m pytest from it
+)
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -173,9 +173,9 @@ def test_oversampled_stream_keeps_the_sums() -> None:
     for raw in (boot, block.encode_oversample(2)):
         tr.decode(raw)
     assert (tr.oversample, tr.code_limit) == (2, 8190)
-    rec, span, st = tr.decode(block.encode_sums([8191 - 1, 0, 0], 16))
+    _, span, st = tr.decode(block.encode_sums([8191 - 1, 0, 0], 16))
     assert st == 0 and span is not None and span.first == 0
-    rec, span, st = tr.decode(bytes([0x20, 0, 0, 0, 0, 0]))  # 8192 > 2 × 4095
+    _, span, st = tr.decode(bytes([0x20, 0, 0, 0, 0, 0]))  # 8192 > 2 × 4095
     assert tr.error(st) == "sample code above 8190" and span is not None and span.first == 1
     tr.decode(boot)  # a new stream is plain
     assert tr.oversample == 1

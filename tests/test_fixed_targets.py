@@ -18,7 +18,6 @@ from __future__ import annotations
 import re
 import subprocess
 from pathlib import Path
-from typing import Any
 
 import pytest
 from conftest import ROOT, require_target

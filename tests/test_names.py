@@ -25,7 +25,7 @@ def _header_enums() -> dict[str, int]:
     value is the previous one plus 1), read from the text."""
     out: dict[str, int] = {}
     for h in HEADERS:
-        text = re.sub(r"/\*.*?\*/", " ", h.read_text(), flags=re.S)
+        text = re.sub(r"/\*.*?\*/", " ", h.read_text(), flags=re.DOTALL)
         text = re.sub(r"//[^\n]*", " ", text)
         for body in re.findall(r"\benum\b[^{;]*\{([^}]*)\}", text):
             nxt = 0

@@ -20,6 +20,7 @@ from attitude_c.sim import (
     run_budget,
     simulate,
 )
+
 PAPER_HEADING, PAPER_PITCH = 0.12, 0.15  # sec. 4 of the paper, rad
 ADC = "tlc2543"
 

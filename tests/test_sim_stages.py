@@ -120,7 +120,7 @@ def test_link_stage_delivers_the_records_and_says_where_each_came_from() -> None
 
 
 def test_host_decodes_with_the_library_and_holds_reported_losses() -> None:
-    b, s, words = _stream()
+    _, s, words = _stream()
     cal = Calibration(np.array([2048.0, 2047.5, 2049.25]), 7.5e-4, 16)
     dec = HostDecoder(cal, 0.08).decode(Delivered(s.records, np.arange(len(s.records))), s.sample)
     np.testing.assert_array_equal(dec.sample_index, np.arange(30))

@@ -51,7 +51,15 @@ import numpy as np
 from attitude_c.errors import BlockFormatError, DeviceError, InvalidArgument
 from attitude_c.link import block
 from attitude_c.reference import quat_multiply, rotvec_to_quat
-from attitude_c.sim import Conditioning, GyroModel, SimConfig, Source, SourceOutput, Trajectory, register_source
+from attitude_c.sim import (
+    Conditioning,
+    GyroModel,
+    SimConfig,
+    Source,
+    SourceOutput,
+    Trajectory,
+    register_source,
+)
 from attitude_c.sim.host import Calibration
 from attitude_c.sim.link import Delivered
 from attitude_c.sim.sensors import DEG
@@ -513,7 +521,7 @@ class Session:
         self._s51: subprocess.Popen[bytes] | None = None
         self._t0 = time.monotonic()
 
-    def __enter__(self) -> Session:
+    def __enter__(self) -> Session:  # noqa: PYI034 - typing.Self needs Python 3.11
         try:
             self._socat = subprocess.Popen(
                 ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],

@@ -13,8 +13,15 @@ from ..errors import DeviceError
 from ._errors import AddressMismatch, FrameError
 from .model import RULES, SIGNALS, Frame, ProtocolViolation
 
-__all__ = ["Bridge", "frame_log", "python_hal", "register", "STATUS", "twin_trace",
-           "twin_violation"]
+__all__ = [
+    "STATUS",
+    "Bridge",
+    "frame_log",
+    "python_hal",
+    "register",
+    "twin_trace",
+    "twin_violation",
+]
 
 _registered: set[str] = set()
 

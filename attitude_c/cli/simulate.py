@@ -199,6 +199,7 @@ class _Progress:
 
 def build_config(args: argparse.Namespace) -> Any:
     from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
+    from ..sim.adc import AdcBackend
 
     given = getattr(args, "trajectory", None)
     trajectory = given or ("csv" if args.trajectory_file else "paper")
@@ -235,7 +236,7 @@ def build_config(args: argparse.Namespace) -> Any:
         traj = make_trajectory("constant-rate", rate=[math.radians(v) for v in args.rate])
     else:
         traj = make_trajectory("static")
-    adc = "tlc2543" if args.adc == "auto" else args.adc
+    adc: AdcBackend = "tlc2543" if args.adc == "auto" else args.adc
     return SimConfig(trajectory=traj, duration=duration or DEFAULT_DURATION_S, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),

@@ -90,11 +90,11 @@ class HostDecoder:
             if rec is None or span is None:
                 continue  # no place in the numbering (a record that breaks the format)
             if rec.kind == "sample" and st == 0:
-                number = span.first
+                k = span.first
                 if stream_sample is not None and delivered.source is not None:
-                    number = int(stream_sample[delivered.source[j]])
+                    k = int(stream_sample[delivered.source[j]])
                 last = (tr.oversample, rec.codes)
-                rows.append((number, last[0], last[1], False))
+                rows.append((k, last[0], last[1], False))
                 continue
             if rec.kind != "sample":
                 reports.append(rec.kind)

@@ -33,8 +33,16 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from ..errors import InvalidArgument, NonFiniteError
+
 # truth-side rotation math: the NumPy reference, independent of the C library the chain tests
-from ..reference import euler_to_quat, quat_conj, quat_multiply, quat_to_euler, quat_to_rotvec, rotvec_to_quat
+from ..reference import (
+    euler_to_quat,
+    quat_conj,
+    quat_multiply,
+    quat_to_euler,
+    quat_to_rotvec,
+    rotvec_to_quat,
+)
 
 __all__ = [
     "TRAJECTORIES",
