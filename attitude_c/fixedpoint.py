@@ -31,6 +31,7 @@ from .core import INCREMENT_METHODS
 from .core import Integrator as _Integrator
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 from .names import C, samples_per_update
+from .sensor import adc_words
 
 if TYPE_CHECKING:
     from .core import Method
@@ -405,16 +406,9 @@ class AdcConverter:
 
     def convert_q30(self, codes: ArrayLike) -> NDArray[np.int32]:
         """Codes (N, 3) → Q2.30 increments (N, 3); RangeError names the sample."""
-        c = np.asarray(codes)
-        if c.dtype.kind not in "iu":
-            raise InvalidType(f"codes: expected integer ADC codes, got dtype {c.dtype}")
-        if c.ndim != 2 or c.shape[1] != 3:
-            raise InvalidArgument(f"codes: expected shape (N, 3), got {c.shape}")
-        if np.any(c < 0) or np.any(c > 65535):
-            raise InvalidArgument("codes: ADC codes must lie in [0, 65535]")
-        cc = np.ascontiguousarray(c.astype(np.uint16))
-        out = np.empty(c.shape, dtype=np.int32)
-        for i in range(c.shape[0]):
+        cc = adc_words(codes, "codes")
+        out = np.empty(cc.shape, dtype=np.int32)
+        for i in range(cc.shape[0]):
             st = self._lib_.att_fx_adc_convert(self._a, _ptr(self._ffi, cc, i, 3, "uint16_t *"),
                                                _ptr(self._ffi, out, i, 3))
             _check(st, f"codes: sample {i}")

@@ -23,7 +23,7 @@ from ._lib import ffi_lib
 from .core import FloatPrecision
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
-__all__ = ["Sensor"]
+__all__ = ["Sensor", "adc_words"]
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
@@ -40,6 +40,20 @@ def _triple(x: ArrayLike, name: str) -> NDArray[np.float64]:
     if not np.isfinite(a).all():
         raise NonFiniteError(f"{name} holds NaN or Inf: {a.tolist()}")
     return a
+
+
+def adc_words(words: ArrayLike, name: str = "words") -> NDArray[np.uint16]:
+    """Check ADC words (M, 3) (integer dtype, 0..65535) and return them as a C-contiguous
+    uint16 array; InvalidType, InvalidArgument (shape) or RangeError naming the sample."""
+    w = np.asarray(words)
+    if w.dtype.kind not in "iu":
+        raise InvalidType(f"{name} must be integer ADC words, got dtype {w.dtype}")
+    if w.ndim != 2 or w.shape[1] != 3:
+        raise InvalidArgument(f"{name} must have shape (M, 3), got {w.shape}")
+    if w.size and (w.min() < 0 or w.max() > 0xFFFF):
+        i = int(np.argmax(((w < 0) | (w > 0xFFFF)).any(axis=1)))
+        raise RangeError(f"{name}: sample {i} = {w[i].tolist()} is not a 16-bit word")
+    return np.ascontiguousarray(w, dtype=np.uint16)
 
 
 class Sensor:
@@ -74,24 +88,13 @@ class Sensor:
                                   f"scale {self.scale.tolist()}")
         raise_for_status(st, "Sensor(zero, scale)")
 
-    def _words(self, words: ArrayLike) -> NDArray[np.uint16]:
-        w = np.asarray(words)
-        if w.dtype.kind not in "iu":
-            raise InvalidType(f"words must be integer ADC words, got dtype {w.dtype}")
-        if w.ndim != 2 or w.shape[1] != 3:
-            raise InvalidArgument(f"words must have shape (M, 3), got {w.shape}")
-        if w.size and (w.min() < 0 or w.max() > 0xFFFF):
-            i = int(np.argmax(((w < 0) | (w > 0xFFFF)).any(axis=1)))
-            raise RangeError(f"words: sample {i} = {w[i].tolist()} is not a 16-bit word")
-        return np.ascontiguousarray(w, dtype=np.uint16)
-
     def increments(self, words: ArrayLike, n: int = 1, period: float = 1.0) -> NDArray[Any]:
         """Words (M, 3) of ``n`` conversions each, sampled every ``period`` s → values
         × period (M, 3) (a gyro: angle increments, rad), in the precision's dtype.
         A word above n × 4095 raises :class:`RangeError` naming the sample."""
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
             raise InvalidType(f"n must be an integer, got {type(n).__name__}")
-        w = self._words(words)
+        w = adc_words(words)
         out = np.empty(w.shape, dtype=_DTYPES[self.precision])
         ffi, lib = self._ffi, self._lib
         err = ffi.new("size_t *")
