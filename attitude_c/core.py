@@ -2,9 +2,9 @@
 
 Rotation math (vectorized over leading axes) and the rotation-vector
 attitude integrator of docs/integrator.md, in two builds of the same C
-source: ``precision="f64"`` (double) and ``precision="f32"`` (float).
-``integrate(..., precision="fixed")`` dispatches to
-:mod:`attitude_c.fixedpoint` (the Q-format port).
+source: ``precision="f64"`` (double) and ``precision="f32"`` (float); the
+integrator also in the Q-format port, ``precision="fixed"``
+(:mod:`attitude_c.fixedpoint`), with the same contract.
 
 Conventions (docs/conventions.md): quaternions ``[λ, p1, p2, p3]`` scalar
 first, rotating body vectors into the ENU navigation frame; attitude
@@ -16,7 +16,12 @@ returns float64 arrays; with ``precision="f32"`` float32 arrays (the float
 build's own results, not widened); ``integrate(..., precision="fixed")``
 returns float64 (the Q2.30 results converted exactly: float32 cannot hold
 their 30 fraction bits). ``quat_conj`` returns float64. ``Integrator.q``
-and ``Integrator.update`` follow the integrator's precision.
+and ``Integrator.update`` follow the integrator's precision (float64 for
+"fixed").
+
+Method names, their numbers and the samples each consumes per update come
+from the library (:mod:`attitude_c.names`); :data:`Method` spells the names
+out for type checkers (tests/test_names.py proves they are the library's).
 """
 
 from __future__ import annotations
@@ -27,8 +32,9 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import names
 from ._lib import ffi_lib
-from .errors import AttitudeError, InvalidArgument, InvalidType, NonFiniteError, RangeError
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = [
     "INCREMENT_METHODS",
@@ -62,22 +68,13 @@ Method = Literal["rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly
 METHODS: tuple[Method, ...] = get_args(Method)
 #: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
 INCREMENT_METHODS: tuple[Method, ...] = tuple(m for m in METHODS if m != "rk4")
-#: Increments consumed per attitude update, per method.
-FRAME: dict[str, int] = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1,
-                         "rv3-reuse-poly": 1}
 #: Numeric precisions: the two float builds and the fixed-point port.
 Precision = Literal["f64", "f32", "fixed"]
 PRECISIONS: tuple[Precision, ...] = get_args(Precision)
-#: The precisions of the float builds (rotation functions, ``Integrator``).
+#: The precisions of the float builds (the rotation functions).
 FloatPrecision = Literal["f64", "f32"]
 
-_DTYPES = {"f64": np.float64, "f32": np.float32}
-
-# Integrator-specific C status codes (csrc/include/attitude/integrator.h).
-_INTEG_STATUS = {
-    -20: (InvalidArgument, "unknown method, or a call not valid for this method"),
-    -21: (RangeError, "increment too large: the attitude update is not finite"),
-}
+_DTYPES = {"f64": np.float64, "f32": np.float32, "fixed": np.float64}
 
 #: float64, or float32 for ``precision="f32"`` (see the module docstring).
 FloatArray = NDArray[np.floating[Any]]
@@ -106,12 +103,12 @@ def _check_method(method: Any, allowed: tuple[str, ...] = METHODS) -> Any:
 
 
 def method_code(method: str, lib: Any = None) -> int:
-    """The ``att_method`` value of ``method`` ("rv3-reuse" → ``lib.ATT_METHOD_RV3_REUSE``),
-    read from the compiled library (``lib``: the f64 one by default)."""
+    """The ``att_method`` value of ``method`` ("rv3-reuse" → ``ATT_METHOD_RV3_REUSE``),
+    read from the compiled library (``lib``: a build to read it from; the
+    table of :mod:`attitude_c.names` by default)."""
     _check_method(method)
-    if lib is None:
-        lib = ffi_lib("f64")[1]
-    return int(getattr(lib, "ATT_METHOD_" + method.upper().replace("-", "_")))
+    name = "ATT_METHOD_" + method.upper().replace("-", "_")
+    return int(getattr(lib, name)) if lib is not None else names.C[name]
 
 
 def _as_real(x: ArrayLike, name: str) -> NDArray[Any]:
@@ -181,23 +178,7 @@ def _ptr(ffi: Any, a: NDArray[Any]) -> Any:
 
 
 def _raise(status: int, what: str, index: int | None = None) -> None:
-    if status >= 0:
-        return
-    cls, text = _INTEG_STATUS.get(status, (None, None))
-    if cls is None:
-        from .errors import raise_for_status
-
-        try:
-            raise_for_status(status, what)
-        except NonFiniteError as exc:
-            raise NonFiniteError(f"{exc} at sample {index}", index=index) from None
-        except AttitudeError as exc:
-            if index is not None:
-                raise type(exc)(f"{exc} at sample {index}") from None
-            raise
-        return
-    where = f" at sample {index}" if index is not None else ""
-    raise cls(f"{what}: {text}{where} (status {status})")
+    raise_for_status(status, what, index=index)
 
 
 # --------------------------------------------------------------------------
@@ -328,30 +309,46 @@ def _check_q0(q0: ArrayLike | None) -> NDArray[np.float64] | None:
 
 
 class Integrator:
-    """Streaming attitude integrator (one C ``att_integ`` state).
+    """Streaming attitude integrator: one C state, of any precision.
 
     ``Integrator(method="rv3", q0=None, precision="f64")``. Feed angle
     increments (increment methods) or rate samples (``rk4``, with ``dt``)
     to :meth:`update`; it returns the attitude after every update completed
     by these samples, as an (M, 4) array, float64 or float32 after the
     precision (M may be 0: rv2/rv3 buffer increments until their frame is
-    full, rk4 rows until a step ends).
+    full, rk4 rows until a step ends). ``precision="fixed"`` runs the
+    Q2.30 port (``att_fx_integ``, every increment method; float64 in and
+    out, increments limited to ``fixedpoint.DTHETA_MAX``); "f64"/"f32" the
+    float builds (``att_integ``).
     """
 
     def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None,
-                 precision: FloatPrecision = "f64") -> None:
+                 precision: Precision = "f64") -> None:
         self.method: Method = _check_method(method)
-        self.precision: FloatPrecision = _check_precision(precision)
-        self._ffi, self._lib = ffi_lib(self.precision)
+        self.precision: Precision = _check_precision(precision, allow_fixed=True)
         self._dtype = _DTYPES[self.precision]
+        self._pending_dt: NDArray[np.float64] = np.empty(0)
+        if self.precision == "fixed":
+            if self.method == "rk4":
+                raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
+            from .fixedpoint import _Stream
+
+            _check_q0(q0)  # the float builds' checks first: the same errors in every precision
+            self._fx: Any = _Stream(self.method, q0)
+            return
+        self._fx = None
+        self._ffi, self._lib = ffi_lib(self.precision)
         self._state = self._ffi.new("att_integ *")
         self._one_in = self._ffi.new("att_real[3]")
         self._one_out = self._ffi.new("att_real[4]")
-        self._pending_dt: NDArray[np.float64] = np.empty(0)
         self.reset(q0)
 
     def reset(self, q0: ArrayLike | None = None) -> None:
         """Back to attitude ``q0`` (None = identity), buffered samples dropped."""
+        if self._fx is not None:
+            _check_q0(q0)
+            self._fx.reset(q0)
+            return
         q = _check_q0(q0)
         qp = self._ffi.NULL
         if q is not None:
@@ -366,20 +363,26 @@ class Integrator:
     @property
     def q(self) -> FloatArray:
         """Current attitude quaternion (4,), float64 or float32 after the precision."""
+        if self._fx is not None:
+            from .fixedpoint import from_q30
+
+            return from_q30(self._fx.q_q30)
         return np.array([float(self._state.q[i]) for i in range(4)], dtype=self._dtype)
 
     @property
     def pending(self) -> int:
         """Samples buffered in the state (rv2/rv3 frame, rv3-reuse history, rk4 rows)."""
-        return int(self._state.nbuf)
+        return int(self._fx.pending if self._fx is not None else self._state.nbuf)
 
     @property
     def updates(self) -> int:
         """Attitude updates since construction or reset (C counter, wraps)."""
-        return int(self._state.updates)
+        return int(self._fx.updates if self._fx is not None else self._state.updates)
 
     def outputs(self, n: int) -> int:
         """How many updates ``n`` more samples would complete."""
+        if self._fx is not None:
+            return self._fx.outputs(n)
         return int(self._lib.att_integ_outputs(self._state, int(n)))
 
     def update(self, x: ArrayLike, dt: ArrayLike | None = None) -> FloatArray:
@@ -392,7 +395,7 @@ class Integrator:
         alternate step start/end and midpoint; the step of an update is
         h = dt[start] + dt[midpoint].
         """
-        if (self.method != "rk4" and dt is None and isinstance(x, np.ndarray)
+        if (self.method != "rk4" and dt is None and self._fx is None and isinstance(x, np.ndarray)
                 and x.shape == (3,) and x.dtype.kind == "f"):
             return self._update_one(x)
         if self.method == "rk4":
@@ -405,7 +408,9 @@ class Integrator:
 
     def _update_increments(self, a: NDArray[Any], lead: tuple[int, ...],
                            out: NDArray[Any] | None = None) -> FloatArray:
-        """``att_integ_batch`` on records ``a`` (n, 3) of any real dtype."""
+        """``att_integ_batch`` (``att_fx_integ_batch``) on records ``a`` (n, 3) of any real dtype."""
+        if self._fx is not None:
+            return self._fx.update(_records(a, "dtheta", (3,), "angle increment"), out)
         return self._batch(a, lead, "dtheta", None, out)
 
     def _batch(self, a: NDArray[Any], lead: tuple[int, ...], name: str,
@@ -502,24 +507,6 @@ class Integrator:
                 f"q={self.q.tolist()!r}, pending={self.pending})")
 
 
-def _fixedpoint() -> Any:
-    try:
-        from . import fixedpoint  # type: ignore[attr-defined]
-    except ImportError as exc:
-        raise InvalidArgument(
-            "precision='fixed' needs attitude_c.fixedpoint (the Q-format integrator), "
-            f"which is not available here: {exc}") from exc
-    return fixedpoint
-
-
-def _n_outputs(method: str, n: int) -> int:
-    """Attitude updates that n samples complete from a fresh state (C count)."""
-    ffi, lib = ffi_lib("f64")
-    s = ffi.new("att_integ *")
-    lib.att_integ_init(s, method_code(method, lib), ffi.NULL)
-    return int(lib.att_integ_outputs(s, n))
-
-
 def _check_out(out: Any, m: int, precision: str, source: NDArray[Any], source_name: str) -> NDArray[Any]:
     """Validate a caller's ``out`` buffer: an ndarray of shape (m, 4), the
     precision's dtype, C-contiguous, writeable, not sharing memory with the
@@ -569,18 +556,11 @@ def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = 
     a, lead = _shaped(dtheta, "dtheta", (3,), "angle increment", allow_empty=False)
     if len(lead) != 1:
         raise InvalidArgument(f"dtheta must have shape (N, 3), got {np.shape(dtheta)}")
-    if a.shape[0] < FRAME[method]:
-        raise InvalidArgument(f"method {method!r} needs at least {FRAME[method]} increments "
+    k = names.samples_per_update(method)
+    if a.shape[0] < k:
+        raise InvalidArgument(f"method {method!r} needs at least {k} increments "
                               f"per update, got {a.shape[0]}")
     q = _check_q0(q0)
-    if precision == "fixed":
-        if out is not None:
-            _check_out(out, _n_outputs(method, a.shape[0]), precision, a, "dtheta")
-        res = _fixedpoint().integrate(_records(a, "dtheta", (3,), "angle increment"), method, q)
-        if out is None:
-            return np.asarray(res, dtype=np.float64)
-        out[...] = res
-        return out
     it = Integrator(method, q, precision)
     if out is not None:
         _check_out(out, it.outputs(a.shape[0]), precision, a, "dtheta")
@@ -605,9 +585,10 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "r
     if len(lead) != 1:
         raise InvalidArgument(f"omega must have shape (N, 3), got {np.shape(omega)}")
     q = _check_q0(q0)
-    if method != "rk4" or precision == "fixed":
-        a = _records(a, "omega", (3,), "rate sample")  # checked here: not by the C rk4 call
+    if method == "rk4" and precision == "fixed":
+        raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
     if method != "rk4":
+        a = _records(a, "omega", (3,), "rate sample")  # checked here: not by the C rk4 call
         d = _as_real(dt, "dt").astype(np.float64)
         if d.ndim == 0:
             d = np.full(a.shape[0], float(d))
@@ -624,17 +605,6 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "r
     if a.shape[0] < 3:
         raise InvalidArgument(f"method 'rk4' needs at least 3 rate rows (t, t+h/2, t+h), "
                               f"got {a.shape[0]}")
-    if precision == "fixed":
-        fx = _fixedpoint()
-        if not hasattr(fx, "integrate_rates"):
-            raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
-        if out is not None:
-            _check_out(out, _n_outputs("rk4", a.shape[0]), precision, a, "omega")
-        res = fx.integrate_rates(a, dt, method, q)
-        if out is None:
-            return np.asarray(res, dtype=np.float64)
-        out[...] = res
-        return out
     it = Integrator("rk4", q, precision)
     if out is not None:
         _check_out(out, it.outputs(a.shape[0]), precision, a, "omega")

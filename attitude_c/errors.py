@@ -47,6 +47,10 @@ class LinkError(AttitudeError, OSError):
     """The serial link failed (port missing, dead line, gave up)."""
 
 
+class LinkBusy(LinkError):
+    """A link sender was given a block while the previous one is still in progress."""
+
+
 class BlockFormatError(InvalidArgument):
     """A record breaks the block format (csrc/include/attitude/block.h).
 
@@ -60,28 +64,17 @@ class BlockFormatError(InvalidArgument):
         self.index = index
 
 
-# C status codes of csrc/include/attitude/common.h (generic range).
-_GENERIC = {
-    -1: (InvalidArgument, "NULL pointer argument"),
-    -2: (InvalidArgument, "argument out of range"),
-    -3: (NonFiniteError, "non-finite input (NaN or Inf)"),
-    -4: (RangeError, "value outside representable range"),
-    -5: (AttitudeError, "call not valid in current state"),
-    -6: (DeviceTimeout, "timeout"),
-    -7: (InvalidArgument, "buffer too small"),
-}
+def raise_for_status(status: int, what: str, extra: Mapping[str, tuple[type[Exception], str]] | None = None,
+                     index: int | None = None) -> None:
+    """Raise the exception matching C status ``status`` (no-op for ``ATT_OK``).
 
-
-def raise_for_status(status: int, what: str, extra: Mapping[int, tuple[type[Exception], str]] | None = None) -> None:
-    """Raise the exception matching C status ``status`` (no-op for ATT_OK).
-
-    ``what`` names the call or argument, so the message says what failed.
-    ``extra`` maps module-specific codes to (exception class, text).
+    ``what`` names the call or argument, so the message says what failed;
+    ``index`` the sample, when there is one. The meaning of every code comes
+    from :data:`attitude_c.names.STATUS`, keyed by the codes' C names;
+    ``extra`` adds a module's own meanings (C name -> (exception class, text)).
     """
     if status >= 0:
         return
-    table: dict[int, tuple[type[Exception], str]] = dict(_GENERIC)
-    if extra:
-        table.update(extra)
-    cls, text = table.get(status, (AttitudeError, f"unknown status {status}"))
-    raise cls(f"{what}: {text} (status {status})")
+    from . import names
+
+    names.raise_for_status(status, what, extra, index)

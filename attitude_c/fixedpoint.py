@@ -12,8 +12,11 @@ computation in integer arithmetic. This wrapper converts at the boundary:
 
 So ``integrate(dtheta, "rv3")`` here and ``attitude_c.core.integrate(...,
 precision="fixed")`` answer the same question as the float builds, with the
-accuracy of the Q formats (docs/fixed-point.md). The ``*_q30`` functions take
-and return the raw integers for bit-exact work (tests, firmware vectors).
+accuracy of the Q formats (docs/fixed-point.md); :class:`Integrator` is
+``attitude_c.core.Integrator(..., precision="fixed")`` (one contract for
+every precision). The ``*_q30`` functions take and return the raw integers
+for bit-exact work (tests, firmware vectors). The formats' constants and
+limits come from the library (:data:`attitude_c.names.C`).
 """
 
 from __future__ import annotations
@@ -25,10 +28,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
 from .core import INCREMENT_METHODS
+from .core import Integrator as _Integrator
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from .names import C, samples_per_update
+from .sensor import adc_words
 
 if TYPE_CHECKING:
     from .core import Method
-from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = [
     "DTHETA_MAX",
@@ -44,32 +50,27 @@ __all__ = [
     "heading",
     "integrate",
     "integrate_q30",
-    "quat_mul",
+    "quat_multiply",
     "quat_normalize",
     "quat_to_dcm",
     "quat_to_euler",
-    "rotation_vector",
+    "rotation_vectors",
     "rotvec_to_quat",
     "to_q30",
 ]
 
-Q30_ONE = 1 << 30
-Q28_ONE = 1 << 28
+#: 1.0 in Q2.30 and in Q4.28 (ATT_FX_Q30_ONE, ATT_FX_Q28_ONE).
+Q30_ONE = C["ATT_FX_Q30_ONE"]
+Q28_ONE = C["ATT_FX_Q28_ONE"]
+_DTHETA_MAX_Q30 = C["ATT_FX_DTHETA_MAX"]
+_QUAT_MAX_Q30 = C["ATT_FX_QUAT_MAX"]
 #: Largest accepted |Δθ| component (rad): ATT_FX_DTHETA_MAX / 2^30 ≈ 0.4.
-DTHETA_MAX = 429496730 / Q30_ONE
-_DTHETA_MAX_Q30 = 429496730
-_QUAT_MAX_Q30 = 1342177280
+DTHETA_MAX = _DTHETA_MAX_Q30 / Q30_ONE
 
 #: Methods with a fixed-point port: every increment method of the float
-#: integrator (the att_fx_method value of each is lib.ATT_FX_<NAME>, equal to
-#: its att_method value).
+#: integrator (the att_fx_method value of each is ATT_FX_<NAME>, equal to
+#: its att_method value; tests/test_names.py checks both).
 METHODS: tuple[str, ...] = INCREMENT_METHODS
-
-_FX_STATUS = {
-    -80: (RangeError, "value outside its fixed-point format's range"),
-    -81: (InvalidArgument, "unknown fixed-point method"),
-    -82: (InvalidArgument, "zero quaternion"),
-}
 
 
 def _lib() -> tuple[Any, Any]:
@@ -78,7 +79,7 @@ def _lib() -> tuple[Any, Any]:
 
 
 def _check(status: int, what: str) -> None:
-    raise_for_status(status, what, _FX_STATUS)
+    raise_for_status(status, what)
 
 
 def _as_float(x: ArrayLike, name: str, last: tuple[int, ...] | None = None) -> NDArray[np.float64]:
@@ -126,7 +127,7 @@ def _method(method: str) -> int:
     if method not in METHODS:
         raise InvalidArgument(
             f"method: {method!r} is not available in fixed point; choose one of {sorted(METHODS)}")
-    return int(getattr(_lib()[1], "ATT_FX_" + method.upper().replace("-", "_")))
+    return C["ATT_FX_" + method.upper().replace("-", "_")]
 
 
 def _dtheta_q30(dtheta: ArrayLike, name: str = "dtheta") -> NDArray[np.int32]:
@@ -197,46 +198,67 @@ def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = 
     return from_q30(integrate_q30(d, method, q0i))
 
 
-class Integrator:
-    """Streaming fixed-point integrator (one increment at a time)."""
+class _Stream:
+    """One ``att_fx_integ`` state: the fixed-point backend of
+    ``core.Integrator(..., precision="fixed")`` (use that class, or :class:`Integrator`)."""
 
-    def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None) -> None:
+    def __init__(self, method: Method, q0: ArrayLike | None) -> None:
         self._ffi, self._lib_ = _lib()
-        self.method = method
         self._m = _method(method)
         self._s = self._ffi.new("att_fx_integ *")
+        self.updates = 0
         self.reset(q0)
 
     def reset(self, q0: ArrayLike | None = None) -> None:
-        """Back to attitude ``q0`` (identity if None), buffers cleared."""
         q = _q0_q30(q0)
-        if q is None:
-            st = self._lib_.att_fx_integ_init(self._s, self._m, self._ffi.NULL)
-        else:
-            self._q0 = q
-            st = self._lib_.att_fx_integ_init(self._s, self._m, self._ffi.cast("int32_t *", q.ctypes.data))
-        _check(st, "q0")
+        ptr = self._ffi.NULL if q is None else self._ffi.cast("int32_t *", q.ctypes.data)
+        _check(self._lib_.att_fx_integ_init(self._s, self._m, ptr), "q0")
+        self.updates = 0
 
-    def update(self, dtheta: ArrayLike) -> NDArray[np.float64] | None:
-        """Feed one increment (rad, shape (3,)); the new attitude, or None if buffered."""
-        d = _dtheta_q30(np.asarray(dtheta, dtype=np.float64).reshape(1, 3) if np.ndim(dtheta) == 1
-                        else dtheta)
-        if d.shape != (1, 3):
-            raise InvalidArgument(f"dtheta: expected shape (3,), got {np.shape(dtheta)}")
-        out = self._ffi.new("int32_t[4]")
-        r = self._lib_.att_fx_integ_update(self._s, self._ffi.cast("int32_t *", d.ctypes.data), out)
-        _check(r, "dtheta")
-        return from_q30(list(out)) if r == 1 else None
+    def outputs(self, n: int) -> int:
+        return int(self._lib_.att_fx_integ_outputs(self._s, int(n)))
 
     @property
-    def q(self) -> NDArray[np.float64]:
-        """Current attitude quaternion (float64)."""
-        return from_q30(list(self._s.q))
+    def pending(self) -> int:
+        return int(self._s.nbuf)
+
+    @property
+    def q_q30(self) -> NDArray[np.int32]:
+        return np.array(list(self._s.q), dtype=np.int32)
+
+    def update(self, dtheta: NDArray[np.float64], out: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+        """(n, 3) float64 increments (checked finite) -> the (M, 4) attitudes they complete;
+        on an error nothing is consumed (the C batch leaves the state as it was)."""
+        d = _dtheta_q30(dtheta)
+        n = d.shape[0]
+        qo = np.empty((max(self.outputs(n), 1), 4), dtype=np.int32)
+        n_out = self._ffi.new("size_t *")
+        err = self._ffi.new("size_t *")
+        if n:
+            st = self._lib_.att_fx_integ_batch(self._s, self._ffi.cast("int32_t *", d.ctypes.data), n,
+                                               self._ffi.cast("int32_t *", qo.ctypes.data), n_out, err)
+            _check(st, f"dtheta: increment {int(err[0])}")
+        m = int(n_out[0]) if n else 0
+        self.updates += m
+        res = from_q30(qo[:m])
+        if out is None:
+            return res
+        out[...] = res
+        return out
+
+
+class Integrator(_Integrator):
+    """Streaming fixed-point integrator: ``attitude_c.core.Integrator(method, q0,
+    precision="fixed")`` (same contract: :meth:`update` returns the (M, 4)
+    attitudes, float64), plus the raw Q2.30 attitude :attr:`q_q30`."""
+
+    def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None) -> None:
+        super().__init__(method, q0, precision="fixed")
 
     @property
     def q_q30(self) -> NDArray[np.int32]:
         """Current attitude quaternion (raw Q2.30)."""
-        return np.array(list(self._s.q), dtype=np.int32)
+        return self._fx.q_q30
 
 
 # -- primitives (vectorized over leading axes by a loop over records) -------
@@ -250,15 +272,25 @@ def _ptr(ffi: Any, a: NDArray[Any], i: int, width: int, ctype: str = "int32_t *"
     return ffi.cast(ctype, a.ctypes.data + a.itemsize * width * i)
 
 
-def rotation_vector(dtheta: ArrayLike, method: Method = "rv3") -> NDArray[np.float64]:
-    """Φ of one update from the increments of that update (shape (n, 3), oldest
-    first; n = 1 rv1, 2 rv2, 3 rv3/rv3-coning, 1–3 rv3-reuse/rv3-reuse-poly)."""
+def rotation_vectors(dtheta: ArrayLike, method: Method = "rv3") -> NDArray[np.float64]:
+    """Φ of every update of ``method`` (M, 3) from increments (N, 3), oldest first,
+    from a fresh state (the reuse forms' first two updates use their start-up
+    forms), each computed in Q2.30 by ``att_fx_phi`` (round to nearest: the
+    integrator itself dithers, docs/fixed-point.md)."""
     ffi, lib = _lib()
     m = _method(method)
     d = _dtheta_q30(dtheta)
-    out = ffi.new("int32_t[3]")
-    _check(lib.att_fx_phi(m, ffi.cast("int32_t *", d.ctypes.data), d.shape[0], out), "dtheta")
-    return from_q30(list(out))
+    if method in ("rv3-reuse", "rv3-reuse-poly"):
+        windows = [(max(0, k - 2), k + 1) for k in range(d.shape[0])]
+    else:
+        frame = samples_per_update(method)
+        windows = [(k, k + frame) for k in range(0, d.shape[0] - frame + 1, frame)]
+    out = np.empty((len(windows), 3), dtype=np.int32)
+    for j, (a, b) in enumerate(windows):
+        w = np.ascontiguousarray(d[a:b])
+        _check(lib.att_fx_phi(m, ffi.cast("int32_t *", w.ctypes.data), b - a,
+                              ffi.cast("int32_t *", out[j:].ctypes.data)), f"dtheta: update {j}")
+    return from_q30(out)
 
 
 def rotvec_to_quat(phi: ArrayLike) -> NDArray[np.float64]:
@@ -275,7 +307,7 @@ def _quat_q30(q: ArrayLike, name: str) -> NDArray[np.int32]:
     return to_q30(_as_float(q, name, (4,)), name, _QUAT_MAX_Q30 / Q30_ONE)
 
 
-def quat_mul(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
+def quat_multiply(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     """a ⊗ b in Q2.30 (components |x| ≤ 1.25), broadcast over leading axes."""
     ffi, lib = _lib()
     qa, qb = np.broadcast_arrays(_quat_q30(a, "a"), _quat_q30(b, "b"))
@@ -284,7 +316,7 @@ def quat_mul(a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
     out = np.empty_like(ra)
     for i in range(ra.shape[0]):
         _check(lib.att_fx_quat_mul(_ptr(ffi, ra, i, 4), _ptr(ffi, rb, i, 4), _ptr(ffi, out, i, 4)),
-               f"quat_mul record {i}")
+               f"quat_multiply record {i}")
     return from_q30(out).reshape(*lead, 4)
 
 
@@ -374,16 +406,9 @@ class AdcConverter:
 
     def convert_q30(self, codes: ArrayLike) -> NDArray[np.int32]:
         """Codes (N, 3) → Q2.30 increments (N, 3); RangeError names the sample."""
-        c = np.asarray(codes)
-        if c.dtype.kind not in "iu":
-            raise InvalidType(f"codes: expected integer ADC codes, got dtype {c.dtype}")
-        if c.ndim != 2 or c.shape[1] != 3:
-            raise InvalidArgument(f"codes: expected shape (N, 3), got {c.shape}")
-        if np.any(c < 0) or np.any(c > 65535):
-            raise InvalidArgument("codes: ADC codes must lie in [0, 65535]")
-        cc = np.ascontiguousarray(c.astype(np.uint16))
-        out = np.empty(c.shape, dtype=np.int32)
-        for i in range(c.shape[0]):
+        cc = adc_words(codes, "codes")
+        out = np.empty(cc.shape, dtype=np.int32)
+        for i in range(cc.shape[0]):
             st = self._lib_.att_fx_adc_convert(self._a, _ptr(self._ffi, cc, i, 3, "uint16_t *"),
                                                _ptr(self._ffi, out, i, 3))
             _check(st, f"codes: sample {i}")

@@ -33,6 +33,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .core import METHODS  # the names only (importing core loads no C extension)
+
 if TYPE_CHECKING:  # types only: the reference runs without the C library
     from .core import FloatPrecision, Method
 
@@ -57,6 +59,7 @@ __all__ = [
     "heading",
     "integrate",
     "integrate_rates",
+    "quat_angle",
     "quat_conj",
     "quat_multiply",
     "quat_normalize",
@@ -65,11 +68,10 @@ __all__ = [
     "quat_to_rotvec",
     "rotation_vectors",
     "rotvec_to_quat",
+    "sensor_values",
 ]
 
 F = NDArray[np.float64]
-
-METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4")
 
 #: Gimbal-lock threshold on cos θ (docs/integrator.md): sqrt(eps) of the build.
 GIMBAL_COS = {"f64": 2.0 ** -26, "f32": 2.0 ** -12}
@@ -511,6 +513,13 @@ def rotvec_to_quat(phi: ArrayLike) -> F:
     return np.concatenate([np.cos(n / 2), 0.5 * np.sinc(n / (2 * np.pi)) * p], axis=-1)
 
 
+def quat_angle(qa: ArrayLike, qb: ArrayLike) -> F:
+    """Angle (rad, [0, π]) of the rotation taking attitude qa to qb: 2 atan2(|v|, |w|)
+    of qa* ⊗ qb (the sign of the quaternion does not matter)."""
+    d = quat_multiply(quat_conj(qa), qb)
+    return 2 * np.arctan2(np.linalg.norm(d[..., 1:], axis=-1), np.abs(d[..., 0]))
+
+
 def quat_to_rotvec(q: ArrayLike) -> F:
     u = quat_normalize(q)
     u = np.where(u[..., :1] < 0, -u, u)
@@ -598,3 +607,20 @@ def integrate_rates(omega: ArrayLike, dt: ArrayLike, method: Method = "rk4",
     steps = _rk4_step_quats(w[0:2 * m:2], w[1:2 * m:2], w[2:2 * m + 1:2], h)
     q = np.array([1.0, 0, 0, 0]) if q0 is None else quat_normalize(q0)
     return _prefix_product(q, steps)
+
+
+# ---------------------------------------------------------------------------
+# sensor words -> body values (attitude/sensor.h)
+# ---------------------------------------------------------------------------
+
+def sensor_values(words: ArrayLike, zero: ArrayLike, scale: ArrayLike, n: int = 1,
+                  axes: ArrayLike = (0, 1, 2), signs: ArrayLike = (1, 1, 1)) -> F:
+    """Body-frame values (M, 3) of sample words (M, 3), each the sum of ``n``
+    conversions: body axis i reads channel ``axes[i]`` with sign ``signs[i]``,
+    value = sign · (mean code − zero) · scale (the mean code of the channel is
+    word / n; zero in codes of one conversion, scale in units per code)."""
+    w = np.asarray(words, dtype=np.float64).reshape(-1, 3)
+    mean = w / float(n)
+    chan = (mean - np.asarray(zero, dtype=np.float64)) * np.asarray(scale, dtype=np.float64)
+    return chan[:, np.asarray(axes, dtype=np.intp)] * np.asarray(signs, dtype=np.float64)
+

@@ -14,18 +14,17 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from attitude_c.core import METHODS
+from attitude_c.names import samples_per_update
 
-from attitude_c.core import FRAME, METHODS
+ROOT = Path(__file__).resolve().parents[1]
 from toolchain import targets as T
 from toolchain.qemu_count import per_iteration
 
 TITLE = "ARMv4T (ARM920T) integrator cost and attitude-rx load"
 
 #: increments (rate samples for rk4) consumed per attitude update
-PER_UPDATE = {**FRAME, "rk4": 2}
+PER_UPDATE = {m: samples_per_update(m) for m in METHODS}  # rk4: 2 rate rows per step
 CLOCK_HZ = 400e6
 #: assumed cycles per instruction of the ARM920T on this code (1-cycle ALU
 #: and cached loads, 3-cycle taken branches, 2-4 cycle multiplies; soft-float

@@ -3,7 +3,7 @@
 Method: the ``bench`` image (production code, pins and RAM layout; cycle
 counters kept in unused SFR cells, Timer 0 as the cycle clock) runs in
 ``s51 -t C51`` against libattitude's C receiver on a pty pair
-(firmware/tool.py). In s51 nothing drives P1, so EOC reads "done" at once:
+(toolchain/firmware.py). In s51 nothing drives P1, so EOC reads "done" at once:
 the scan figure is the driver's own cost (on hardware each of the 4 I/O
 cycles also waits up to 10 us for the conversion). The host answers in wall
 time while s51 runs slower than real time, so the measured exchange includes
@@ -14,7 +14,6 @@ byte times each).
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -41,8 +40,7 @@ def _measure(tool, build_dir: Path, baud: int, blocks: int) -> dict[str, float]:
 
 
 def run(quick: bool) -> str:
-    sys.path.insert(0, str(ROOT))
-    from firmware import tool
+    from toolchain import firmware as tool
 
     build_dir = ROOT / "build" / "bench_firmware"
     blocks = 12 if quick else 60

@@ -11,7 +11,7 @@ figure is the difference between K and 2K updates, so start-up cancels.
 8051: tests/s51/fixed_kernel.c (att_fx_update_rv3, att_fx_update_reuse) in
 s51 on the C51 core (AT89S51 configuration of toolchain/mcs51.toml: small
 model, 128 B internal RAM, no external RAM, 4 KB code), built and run by
-tests/test_fixed_targets.py's s51_kernel_run, Timer 0 + overflow interrupt
+toolchain/fixed_harness.py's s51_kernel_run, Timer 0 + overflow interrupt
 around one update; sizes from SDCC's .sym area tables, from two linked
 images (with and without the call) and from the linker's internal RAM map
 (free stack).
@@ -20,14 +20,11 @@ images (with and without the call) and from the linker's internal RAM map
 from __future__ import annotations
 
 import re
-import sys
 import tempfile
 from pathlib import Path
 from typing import Callable
 
 ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
 
 TITLE = "Fixed-point core (ARMv4T instructions, 8051 cycles and flash, accuracy)"
 
@@ -50,7 +47,7 @@ ARM_ROWS = [
     ("float rv3-reuse-poly, att_integ_update", "fl-reuse-poly", "f32", 1),
     ("double rv3-reuse-poly, att_integ_update", "fl-reuse-poly", "f64", 1),
 ]
-#: the 8051 update kernels (tests/test_fixed_targets.py KERNELS)
+#: the 8051 update kernels (toolchain/fixed_harness.py KERNELS)
 KERNELS = ("rv3", "rv3-reuse", "rv3-reuse-poly")
 
 
@@ -86,10 +83,8 @@ def _s51(tmp: Path) -> dict[str, dict[str, object]]:
     import subprocess
 
     from toolchain import targets as T
-
-    sys.path.insert(0, str(ROOT / "tests"))
-    from test_fixed_targets import KERNELS as DEFS  # type: ignore
-    from test_fixed_targets import s51_kernel_run  # type: ignore
+    from toolchain.fixed_harness import KERNELS as DEFS
+    from toolchain.fixed_harness import s51_kernel_run
 
     t = T.load("mcs51")
     out: dict[str, dict[str, object]] = {}
@@ -127,12 +122,11 @@ def _s51(tmp: Path) -> dict[str, dict[str, object]]:
 
 
 def _accuracy(quick: bool) -> list[tuple[str, int, float, float, float]]:
-    sys.path.insert(0, str(ROOT / "tests"))
     import numpy as np
-    from test_fixed import MOTIONS, angle_error, noise_limit, quantize  # type: ignore
 
     from attitude_c import core
     from attitude_c import fixedpoint as fx
+    from toolchain.fixed_harness import MOTIONS, angle_error, noise_limit, quantize
 
     n_upd = 100_000 if quick else 1_000_000
     rows = []

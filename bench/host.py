@@ -12,12 +12,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from attitude_c import core
+from attitude_c.names import samples_per_update
 
 TITLE = "Host integrator throughput (C batch call vs NumPy, Python loops, imufusion)"
 
-#: samples per update (rk4: two rate rows per step)
-FRAME = {**core.FRAME, "rk4": 2}
 
 
 def _best(fn: Callable[[], Any], repeat: int) -> float:
@@ -146,7 +144,7 @@ def numpy_rate(method: str, n: int, repeat: int) -> float:
         sec = _best(lambda: ref.integrate_rates(d * 1e3, 1e-3), repeat)
     else:
         sec = _best(lambda: ref.integrate(d, method), repeat)
-    return (n // FRAME[method]) / sec
+    return (n // samples_per_update(method)) / sec
 
 
 def python_loop_rate(method: str, n: int) -> float:
@@ -165,7 +163,7 @@ def python_loop_rate(method: str, n: int) -> float:
         for r in rows:
             it.update(r)
     sec = time.perf_counter() - t0
-    return (n // FRAME[method]) / sec
+    return (n // samples_per_update(method)) / sec
 
 
 def imufusion_rate(n: int) -> float | None:
@@ -203,7 +201,7 @@ def run(quick: bool = False) -> str:
         npy = numpy_rate(m, n // 10, max(1, repeat // 2))
         loop = python_loop_rate(m, n_loop)
         rates[m, "f64"], rates[m, "numpy"], rates[m, "loop"] = f64, npy, loop
-        gyro = f64 * FRAME[m]
+        gyro = f64 * samples_per_update(m)
         rows.append(f"| {m} | {_fmt(f64)} | {_fmt(gyro)} | {_fmt(f32)} | {_fmt(npy)} | "
                     f"{f64 / npy:.0f}× | {_fmt(loop)} |")
     fus = imufusion_rate(n_loop)

@@ -30,9 +30,6 @@ def _sizes(objs: Path) -> tuple[int, int, int]:
 
 
 def run(quick: bool) -> str:
-    import sys
-
-    sys.path.insert(0, str(ROOT))
     from toolchain import s51
 
     lines = []

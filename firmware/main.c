@@ -41,19 +41,6 @@
  * firmware's tick must be that unit (it is at 11.0592 MHz). */
 typedef char fw_tick_is_the_boot_period_unit[(FW_TICK_HZ == (long)ATT_BLOCK_TICK_HZ) ? 1 : -1];
 
-#if defined(FW_SIM)
-/* Simulation image: text output and stop through the uCsim simulator
- * interface (sim/sim_io.c); stops after FW_SIM_BLOCKS accepted blocks and
- * prints the link statistics. */
-#include "sim/sim_io.h"
-#ifndef FW_SIM_BLOCKS
-#define FW_SIM_BLOCKS 0 /* 0: run until the simulator is stopped */
-#endif
-#endif
-#if defined(FW_SIM_MODEL)
-#include "sim/fw_sim.h" /* ADC inputs from the TLC2543 + gyro model */
-#endif
-
 /* ---- time base: Timer 0 ---------------------------------------------- */
 
 /* Timer 0 runs free in mode 1 (16 bits) and counts machine cycles, so TH0
@@ -71,20 +58,6 @@ static uint16_t tick_now(void)
     fw_ticks += d;
     return fw_ticks;
 }
-
-#if defined(FW_BENCH)
-/* Machine-cycle timestamp (16 bits, wraps every 65536 cycles = 71 ms):
- * TH0:TL0, read high-low-high so a carry between the reads is seen. */
-static uint16_t cycles_now(void)
-{
-    uint8_t h, l;
-    do {
-        h = TH0;
-        l = TL0;
-    } while (h != TH0);
-    return (uint16_t)(((uint16_t)h << 8) | l);
-}
-#endif
 
 /* ---- UART: mode 1, Timer 1 mode 2 ----------------------------------- */
 
@@ -169,6 +142,11 @@ static void flush_overrun(void)
     }
 }
 
+/* Hooks of the build variants (firmware/hooks.h): empty in the production
+ * image; the simulation and bench images' instrumentation (firmware/sim/hooks.h)
+ * sees the state above. */
+#include "hooks.h"
+
 /* ---- ADC ------------------------------------------------------------- */
 
 /* X, Y, Z in one scan, then power-down (address 14): the three channels
@@ -226,14 +204,7 @@ static uint8_t self_test_done(int st)
         }
         (void)att_block_encode_selftest(wp, (int8_t)st, bad, (uint8_t)seq); /* attempt, mod 256 */
         P3_5 = 0;                                                           /* fault LED on */
-#if defined(FW_BENCH)
-        /* s51's port pins read 1: the test fails, but it ran (its stack
-         * depth is measured); the bench goes on to sample. */
-        q_unpush();
-        return 1;
-#else
-        return 0;
-#endif
+        return FW_HOOK_SELFTEST_FAILED(); /* 0: retried after FW_SELFTEST_RETRY_TICKS */
     }
     q_unpush(); /* passed: the slot is not needed */
     P3_5 = 1;   /* fault LED off */
@@ -241,165 +212,6 @@ static uint8_t self_test_done(int st)
 }
 
 /* ---- link events ------------------------------------------------------ */
-
-#if defined(FW_BENCH)
-/* Bench counters (machine cycles from cycles_now()). They live in SFR cells
- * the C51 core does not implement (uCsim keeps them as memory), so the
- * bench image has the production image's RAM use; the helpers are called
- * where main has no live locals. */
-__sfr16 __at(0xD2D1) bench_scan_min;
-__sfr16 __at(0xD4D3) bench_scan_max;
-__sfr16 __at(0xD6D5) bench_scans;
-__sfr32 __at(0xDCDBDAD9) bench_scan_sum;
-__sfr16 __at(0xDEDD) bench_blocks;
-__sfr16 __at(0xE2E1) bench_busy_block; /* CPU cycles of link handling, block in progress */
-__sfr16 __at(0xE4E3) bench_busy_max;
-__sfr16 __at(0xE6E5) bench_t_start; /* block started */
-__sfr16 __at(0xE9E8) bench_t_syn;   /* 0xAA handed out */
-__sfr16 __at(0xEBEA) bench_t_sum;   /* checksum handed out */
-__sfr16 __at(0xEDEC) bench_sent;    /* tx.stats.blocks_sent seen last */
-__sfr16 __at(0xEFEE) bench_t_loop;  /* start of this loop iteration */
-__sfr16 __at(0xD8D7) bench_t_scan;
-__sfr __at(0xBE) bench_busy; /* this iteration did link work */
-__sfr32 __at(0xF4F3F2F1) bench_busy_sum;
-__sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
-__sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
-__sfr32 __at(0xFDFCFBFA) bench_ans_wait_sum; /* checksum handed out -> answer received */
-
-static void bench_init(void)
-{
-    bench_scan_min = 0xFFFFu;
-    bench_scan_max = 0;
-    bench_scans = 0;
-    bench_scan_sum = 0;
-    bench_blocks = 0;
-    bench_busy_block = 0;
-    bench_busy_max = 0;
-    bench_sent = 0;
-    bench_busy_sum = 0;
-    bench_exch_sum = 0;
-    bench_syn_wait_sum = 0;
-    bench_ans_wait_sum = 0;
-}
-
-static void bench_loop_start(void)
-{
-    bench_t_loop = cycles_now();
-    bench_busy = 0;
-}
-
-static void bench_loop_end(void)
-{
-    if (bench_busy) {
-        bench_busy_block += (uint16_t)(cycles_now() - bench_t_loop);
-    }
-}
-
-static void bench_rx(uint8_t b)
-{
-    bench_busy = 1;
-    if (b == (uint8_t)ATT_LINK_SYN_ACK) {
-        bench_syn_wait_sum += (uint16_t)(bench_t_loop - bench_t_syn);
-    } else if (b == (uint8_t)ATT_LINK_ACK || b == (uint8_t)ATT_LINK_NAK) {
-        bench_ans_wait_sum += (uint16_t)(bench_t_loop - bench_t_sum);
-    }
-}
-
-static void bench_tx(void)
-{
-    bench_busy = 1;
-    if (tx.stats.blocks_sent != bench_sent) { /* the checksum was handed out */
-        bench_sent = tx.stats.blocks_sent;
-        bench_t_sum = bench_t_loop;
-    } else if (txb == (uint8_t)ATT_LINK_SYN && tx.index == 0u) {
-        bench_t_syn = bench_t_loop;
-    }
-}
-
-static void bench_block_start(void)
-{
-    bench_busy = 1;
-    bench_t_start = bench_t_loop;
-    bench_busy_block = 0;
-}
-
-static void bench_scan_begin(void)
-{
-    bench_t_scan = cycles_now();
-}
-
-static void bench_scan_end(void)
-{
-    uint16_t c = (uint16_t)(cycles_now() - bench_t_scan);
-    if (c < bench_scan_min) {
-        bench_scan_min = c;
-    }
-    if (c > bench_scan_max) {
-        bench_scan_max = c;
-    }
-    bench_scan_sum += c;
-    bench_scans++;
-}
-#endif
-
-#if defined(FW_SIM)
-/* Instrumentation lives in SFR cells the C51 core does not implement
- * (uCsim keeps them as memory), so it takes none of the 128 bytes of RAM. */
-__sfr16 __at(0xCECD) sim_accepted;
-
-static void put_stat(const char *name)
-{
-    fw_sim_putc(' ');
-    fw_sim_puts(name);
-    fw_sim_putc('=');
-}
-#define STAT(name, v)                 \
-    do {                              \
-        put_stat(name);               \
-        fw_sim_puthex((uint16_t)(v)); \
-    } while (0)
-#define STAT32(name, v)                       \
-    do {                                      \
-        put_stat(name);                       \
-        fw_sim_puthex((uint16_t)((v) >> 16)); \
-        fw_sim_puthex((uint16_t)(v));         \
-    } while (0)
-
-/* Final report of a simulation run (hex values), then stop. */
-static void sim_finish(void)
-{
-    fw_sim_puts("STATS");
-    STAT("accepted", tx.stats.blocks_accepted);
-    STAT("sent", tx.stats.blocks_sent);
-    STAT("naks", tx.stats.naks);
-    STAT("timeouts", tx.stats.timeouts);
-    STAT("gave_up", tx.stats.gave_up);
-    STAT("discarded", tx.stats.bytes_discarded);
-    STAT("samples", seq);
-    STAT("queued", (uint8_t)q_any + (uint8_t)q_full);
-    STAT("overrun_pending", ovr_count);
-    STAT("ticks", fw_ticks);
-#if defined(FW_SIM_MODEL)
-    STAT("conversions", fw_sim_conversions());
-#endif
-    fw_sim_putc('\n');
-#if defined(FW_BENCH)
-    fw_sim_puts("BENCH");
-    STAT("scans", bench_scans);
-    STAT("scan_min", bench_scan_min);
-    STAT("scan_max", bench_scan_max);
-    STAT32("scan_sum", bench_scan_sum);
-    STAT("blocks", bench_blocks);
-    STAT32("busy_sum", bench_busy_sum);
-    STAT("busy_max", bench_busy_max);
-    STAT32("exch_sum", bench_exch_sum);
-    STAT32("syn_wait_sum", bench_syn_wait_sum);
-    STAT32("ans_wait_sum", bench_ans_wait_sum);
-    fw_sim_putc('\n');
-#endif
-    fw_sim_stop(0);
-}
-#endif
 
 /* The head block was accepted by the receiver: drop it from the queue. */
 static void block_accepted(void)
@@ -409,21 +221,7 @@ static void block_accepted(void)
     }
     q_head = !q_head;
     q_unpush();
-#if defined(FW_BENCH)
-    bench_exch_sum += (uint16_t)(cycles_now() - bench_t_start);
-    bench_busy_sum += bench_busy_block;
-    if (bench_busy_block > bench_busy_max) {
-        bench_busy_max = bench_busy_block;
-    }
-    bench_blocks++;
-#endif
-#if defined(FW_SIM)
-#if FW_SIM_BLOCKS != 0
-    if (++sim_accepted >= (uint16_t)FW_SIM_BLOCKS) {
-        sim_finish();
-    }
-#endif
-#endif
+    FW_HOOK_ACCEPTED(); /* the accepted block is queue[!q_head] */
 }
 
 /* The link gave up on the head block. A sample is replaced in place by a
@@ -454,16 +252,8 @@ void main(void)
     P1 = 0xFD; /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released */
     timer0_init();
     uart_init();
-#if defined(FW_SIM)
-    sim_accepted = 0;
-#endif
-#if defined(FW_BENCH)
-    bench_init();
-#endif
+    FW_HOOK_INIT();
     (void)att_link_sender_init(&tx, &link_cfg);
-#if defined(FW_SIM_MODEL)
-    fw_sim_model_init();
-#endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push();                 /* the queue is empty: BOOT report first */
     (void)att_block_encode_boot(wp, FW_PERIOD_TICKS, (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT));
@@ -472,23 +262,12 @@ void main(void)
 
     for (;;) {
         (void)tick_now(); /* fw_ticks = now */
-#if defined(FW_BENCH)
-        bench_loop_start();
-#endif
+        FW_HOOK_LOOP_START();
 
         /* 1. a byte from the receiver */
         if (RI) {
             RI = 0;
-#if defined(FW_BENCH)
-            bench_rx(SBUF);
-#endif
-#if defined(FW_SIM_TRACE)
-            fw_sim_putc('r');
-            fw_sim_puthex(SBUF);
-            fw_sim_putc('@');
-            fw_sim_puthex(fw_ticks);
-            fw_sim_putc('\n');
-#endif
+            FW_HOOK_RX(SBUF);
             if (att_link_sender_sink(&tx, SBUF, fw_ticks) == ATT_LINK_ACCEPTED) {
                 block_accepted();
             }
@@ -497,29 +276,15 @@ void main(void)
         /* 2. the transmitter is free: what does the sender want? */
         if (TI) {
             st = att_link_sender_poll(&tx, fw_ticks, &txb);
-#if defined(FW_SIM_TRACE)
-            if (st != ATT_LINK_NONE && st != ATT_LINK_IDLE) {
-                fw_sim_putc('p');
-                fw_sim_puthex((uint16_t)st);
-                fw_sim_putc(' ');
-                fw_sim_puthex(txb);
-                fw_sim_putc('@');
-                fw_sim_puthex(fw_ticks);
-                fw_sim_putc('\n');
-            }
-#endif
+            FW_HOOK_POLL(st);
             if (st == ATT_LINK_SEND) {
                 TI = 0;
                 SBUF = txb;
-#if defined(FW_BENCH)
-                bench_tx();
-#endif
+                FW_HOOK_TX();
             } else if (st == ATT_LINK_IDLE) {
                 if (q_any) {
                     (void)att_link_sender_start(&tx, queue[q_head], fw_ticks);
-#if defined(FW_BENCH)
-                    bench_block_start();
-#endif
+                    FW_HOOK_BLOCK_START();
                 }
             } else if (st == ATT_LINK_GAVE_UP) {
                 block_given_up();
@@ -527,9 +292,7 @@ void main(void)
                 att_link_sender_reset(&tx); /* corrupted state: resend the head block */
             }
         }
-#if defined(FW_BENCH)
-        bench_loop_end();
-#endif
+        FW_HOOK_LOOP_END();
 
         /* 3. the sampling clock (or the self-test retry clock) */
         if (ovr_count != 0u) {
@@ -539,19 +302,9 @@ void main(void)
             if (sampling) {
                 next_sample += (uint16_t)FW_PERIOD_TICKS;
                 if (sample_slot()) {
-#if defined(FW_SIM_MODEL)
-                    fw_sim_model_step();
-#endif
-#if defined(FW_BENCH)
-                    bench_scan_begin();
-#endif
+                    FW_HOOK_SCAN_BEGIN();
                     st = tlc2543_scan(&adc, xyz, 3, (uint16_t __data *)wp, TLC2543_POWER_DOWN);
-#if defined(FW_BENCH)
-                    bench_scan_end();
-#endif
-#if defined(FW_SIM_MODEL)
-                    fw_sim_model_check();
-#endif
+                    FW_HOOK_SCAN_END();
                     sample_store(st);
                 }
                 seq++;
@@ -559,9 +312,7 @@ void main(void)
                 if (q_push()) { /* the report slot, also where the codes land */
                     seq++;      /* until sampling starts, seq counts the self-test attempts */
                     st = tlc2543_self_test_codes(&adc, (uint16_t __data *)wp);
-#if defined(FW_SIM_MODEL)
-                    fw_sim_model_check();
-#endif
+                    FW_HOOK_SELFTEST_END();
                     if (self_test_done(st)) {
                         sampling = 1;
                         seq = 0;

@@ -1,5 +1,10 @@
 """Shared pytest fixtures and helpers.
 
+Run the suite from the checkout's root with ``python -m pytest`` (``invoke
+test`` does): the root is then on sys.path, so the tests import the tooling
+layer (``toolchain``) as a package; ``attitude_c`` is the installed (``pip
+install -e .``) package. Nothing here edits sys.path.
+
 Toolchain rule: a test that needs a toolchain calls ``require_target(name)``
 (or ``require_tools``). Locally a missing tool skips the test with a
 message saying what to install; in CI (``CI`` set in the environment) it
@@ -11,16 +16,15 @@ from __future__ import annotations
 import os
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from toolchain import (
+    targets as _targets,  # the checkout's root is on sys.path: python -m pytest from it
+)
 
-from toolchain import targets as _targets
+ROOT = Path(__file__).resolve().parents[1]
 
 IN_CI = bool(os.environ.get("CI"))
 

@@ -22,10 +22,6 @@ SCALE = (90.0 * math.pi / 180.0) / 2048.0  # the app's default rad/s per code
 PERIOD = 0.01
 
 
-# The Python link ends (issue 4) feed the app; until they are in the tree these tests cannot run.
-pytest.importorskip("attitude_c.link", reason="attitude_c.link (issue 4) not in this tree yet")
-
-
 @pytest.fixture(autouse=True)
 def _no_leftover_processes():
     """Whatever a test does (fail, skip), no attitude-rx it started survives it."""

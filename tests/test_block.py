@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from attitude_c.errors import BlockFormatError, InvalidArgument, InvalidType
 from attitude_c.link import block
 
-KINDS = ["boot", "selftest", "gave_up", "overrun", "adc_error"]
+KINDS = ["boot", "selftest", "gave_up", "overrun", "adc_error", "oversample"]
 
 
 def _spec(raw: bytes) -> tuple[str, bool]:
@@ -36,7 +36,8 @@ def _spec(raw: bytes) -> tuple[str, bool]:
     ok = {"boot": raw[2] == 1 and 1 <= w34 <= 32767 and raw[5] != 0,
           "selftest": raw[2] >= 0x80 and w34 <= 4095,
           "gave_up": w45 != 0, "overrun": w45 != 0,
-          "adc_error": raw[4] >= 0x80 and raw[5] == 0}[kind]
+          "adc_error": raw[4] >= 0x80 and raw[5] == 0,
+          "oversample": 1 <= raw[2] <= 16 and raw[3:] == b"\0\0\0"}[kind]
     return kind, ok
 
 
@@ -100,7 +101,8 @@ def test_encoders_check_their_arguments() -> None:
 
 @settings(max_examples=3000, deadline=None)
 @given(st.binary(min_size=6, max_size=6) | st.builds(lambda k, t: bytes([0xFE, k]) + t,
-                                                     st.integers(0, 6), st.binary(min_size=4, max_size=4)))
+                                                     st.integers(0, 7), st.binary(min_size=4, max_size=4))
+       | st.builds(lambda n: bytes([0xFE, 5, n, 0, 0, 0]), st.integers(0, 20)))
 def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
     kind, ok = _spec(raw)
     rec, status = block.try_decode(raw)
@@ -116,7 +118,8 @@ def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
                  "selftest": lambda: block.encode_selftest(rec.status, rec.bad_code, rec.attempt),
                  "gave_up": lambda: block.encode_loss("gave_up", rec.first, rec.count),
                  "overrun": lambda: block.encode_loss("overrun", rec.first, rec.count),
-                 "adc_error": lambda: block.encode_adc_error(rec.first, rec.status)}[rec.kind]()
+                 "adc_error": lambda: block.encode_adc_error(rec.first, rec.status),
+                 "oversample": lambda: block.encode_oversample(rec.oversample)}[rec.kind]()
         assert again == raw
 
 
@@ -144,6 +147,40 @@ def test_number_stream_accounts_for_every_sample() -> None:
     assert [(r.kind, sp.first) for r, sp in out] == [("boot", 0), ("sample", 0), ("sample", 1)]
 
 
+def test_oversampled_stream_keeps_the_sums() -> None:
+    """A board that sums n conversions announces n (OVERSAMPLE, right after BOOT); its
+    sample records carry the sums, up to min(n × 4095, 0xFDFF) (block.h: byte 0 of a
+    sample stays below the report mark), and the stream's tracker checks that limit."""
+    assert block.encode_oversample(16) == bytes.fromhex("fe0510000000")
+    assert block.decode(block.encode_oversample(3)).as_dict() == {"report": "OVERSAMPLE", "n": 3}
+    assert block.encode_sums([0x8000, 0xFDFF, 0], 16) == bytes.fromhex("8000fdff0000")
+    assert block.encode_sums([1, 2, 3], 1) == block.encode_sample([1, 2, 3])
+    assert [block.sum_limit(n) for n in (1, 2, 15, 16)] == [4095, 8190, 61425, 0xFDFF]
+    with pytest.raises(InvalidArgument, match=r"sums\[1\] must be 0..65023, got 65024"):
+        block.encode_sums([0, 0xFE00, 0], 16)
+    with pytest.raises(InvalidArgument, match="n must be 1..16, got 17"):
+        block.encode_oversample(17)
+    boot = block.encode_boot(72, 9600)
+    sums = [block.encode_sums([16 * 2048 + k, 5, 65000], 16) for k in range(3)]
+    out = block.number_stream([boot, block.encode_oversample(16), *sums])
+    assert [(r.kind, sp.first, sp.count) for r, sp in out] == [
+        ("boot", 0, 0), ("oversample", 0, 0), ("sample", 0, 1), ("sample", 1, 1), ("sample", 2, 1)]
+    assert out[3][0].codes == (32769, 5, 65000)
+    # the same records in a plain stream (no OVERSAMPLE) are codes above 4095: rejected
+    with pytest.raises(BlockFormatError, match="record 1 .*sample code above 4095"):
+        block.number_stream([boot, *sums])
+    tr = block.SeqTracker()
+    for raw in (boot, block.encode_oversample(2)):
+        tr.decode(raw)
+    assert (tr.oversample, tr.code_limit) == (2, 8190)
+    _, span, st = tr.decode(block.encode_sums([8191 - 1, 0, 0], 16))
+    assert st == 0 and span is not None and span.first == 0
+    _, span, st = tr.decode(bytes([0x20, 0, 0, 0, 0, 0]))  # 8192 > 2 × 4095
+    assert tr.error(st) == "sample code above 8190" and span is not None and span.first == 1
+    tr.decode(boot)  # a new stream is plain
+    assert tr.oversample == 1
+
+
 # -- the 8051 side ------------------------------------------------------------------
 
 SDCC = ["sdcc", "-mmcs51", "--model-small", "--iram-size", "128", "--xram-size", "0", "--std-c99", "--Werror",
@@ -151,12 +188,12 @@ SDCC = ["sdcc", "-mmcs51", "--model-small", "--iram-size", "128", "--xram-size",
 
 
 def test_block_sources_compile_for_the_8051_and_the_encoders_stay_small(tmp_path: Path) -> None:
-    """block.c (what the firmware links) and block_decode.c compile warning-free with SDCC;
+    """block.c (what the firmware links), block_decode.c and block_sums.c compile warning-free with SDCC;
     the encoders are leaf functions whose parameters SDCC overlays: no RAM of their own,
     and code small enough for the 4 KB image (294 bytes when written)."""
     require_tools("sdcc", apt="sdcc")
     segs = {}
-    for src in ("block.c", "block_decode.c"):
+    for src in ("block.c", "block_decode.c", "block_sums.c"):
         rel = tmp_path / src.replace(".c", ".rel")
         proc = subprocess.run([*SDCC, "-c", str(ROOT / "csrc" / "src" / src), "-o", str(rel)],
                               capture_output=True, text=True, timeout=120, check=False)

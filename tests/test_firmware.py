@@ -2,11 +2,11 @@
 
 Every run is ``s51 -t C51 -R 1`` with the UART on a ``socat`` pty pair and
 libattitude's C receiver B (through CFFI) on the other end
-(:class:`firmware.tool.LinkHost`); the firmware stops itself through the
+(:class:`toolchain.firmware.LinkHost`); the firmware stops itself through the
 simulator interface after a given number of accepted blocks, and every
 s51/socat process is killed in a ``finally`` (wall-clock timeouts on all).
 
-Images (firmware/tool.py): ``production`` (what goes into the chip),
+Images (toolchain/firmware.py): ``production`` (what goes into the chip),
 ``bench`` (production pins and RAM layout, cycle counters in unused SFR
 cells) and ``sim`` (the production driver and HAL with the pins pointed at
 a TLC2543 + gyro model kept in unused SFR cells: same RAM layout again).
@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 from conftest import require_target, require_tools
 
-from firmware import tool
+from toolchain import firmware as tool
 
 #: Stack margin we require in the production RAM layout: the highest SP
 #: s51 sees running the bench image (production code, RAM layout and call
@@ -117,19 +117,20 @@ def test_stack_in_the_production_layout(out: Path) -> None:
 def test_200_samples_match_the_analog_inputs(out: Path, impl: str, n: int) -> None:
     """At least 200 samples, in order, every loss reported in place, each within 1 LSB of its input.
 
-    The run asks for n + 20 blocks: normally all are samples (after BOOT)
-    and none is lost. s51 runs in simulated time, at up to twice real time
-    on a fast machine, while the host answers over a pty in wall time: on a
-    loaded machine (load average 5 on 2 cores) it stalls long enough for
-    the two-slot queue to overflow; the firmware then reports the loss in
-    place (OVERRUN), which decode_stream checks against the numbering. The
-    test requires n samples and at most 10 % of the periods lost (every
-    one reported), and prints the longest unbroken run. The Python
-    receiver runs a shorter interoperability check (n = 50).
+    The run stops after n + 20 accepted sample records (a count of samples, not of
+    blocks: a loss report takes no sample's place in the count), normally with no
+    loss. s51 runs in simulated time while the host answers over a pty in wall
+    time: a host that stalls long enough lets the two-slot queue overflow; the
+    firmware then reports the loss in place (OVERRUN), which decode_stream checks
+    against the numbering (s51 runs niced under the host, toolchain/firmware.py,
+    so that a loaded machine slows the simulation down instead). The test
+    requires n samples and at most 10 % of the periods lost (every one reported),
+    and prints the longest unbroken run. The Python receiver runs a shorter
+    interoperability check (n = 50).
     """
     _need()
     cfg = tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
-    img = tool.build(out, cfg, kind="sim", sim_blocks=n + 21, name=f"fw_{n}_{impl}")
+    img = tool.build(out, cfg, kind="sim", sim_samples=n + 20, name=f"fw_{n}_{impl}")
     res = tool.run(img, tool.LinkHost(impl), timeout=180)
     print(f"{img.size_report()}; {res.sim_seconds:.2f} s simulated in {res.wall_seconds:.1f} s, "
           f"max SP 0x{res.max_sp:02X}; host {res.host.stats()}")

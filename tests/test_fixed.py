@@ -18,6 +18,7 @@ import pytest
 from attitude_c import core
 from attitude_c import fixedpoint as fx
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from toolchain.fixed_harness import MOTIONS, angle_error, noise_limit, quantize, random_motion
 
 LSB = 2.0**-30
 LSB28 = 2.0**-28
@@ -55,19 +56,6 @@ def euler(C: np.ndarray) -> np.ndarray:
     return np.stack([psi, th, ga], -1)
 
 
-def angle_error(qa: np.ndarray, qb: np.ndarray) -> np.ndarray:
-    """Rotation angle between attitudes qa and qb (rad), 2·|vec(qa* ⊗ qb)|."""
-    w1, v1 = qa[..., 0], qa[..., 1:]
-    w2, v2 = qb[..., 0], qb[..., 1:]
-    v = w1[..., None] * v2 - w2[..., None] * v1 - np.cross(v1, v2)
-    return 2 * np.linalg.norm(v, axis=-1)
-
-
-def quantize(x: np.ndarray) -> np.ndarray:
-    """The values the fixed-point side really sees (rounded to Q2.30)."""
-    return fx.from_q30(fx.to_q30(x))
-
-
 def unit_quats(rng: np.random.Generator, n: int) -> np.ndarray:
     q = rng.normal(size=(n, 4))
     return q / np.linalg.norm(q, axis=1, keepdims=True)
@@ -78,7 +66,7 @@ def unit_quats(rng: np.random.Generator, n: int) -> np.ndarray:
 def test_quat_mul_one_rounding() -> None:
     rng = np.random.default_rng(1)
     a, b = quantize(unit_quats(rng, 2000)), quantize(unit_quats(rng, 2000))
-    err = np.abs(fx.quat_mul(a, b) - qmul(a, b)) / LSB
+    err = np.abs(fx.quat_multiply(a, b) - qmul(a, b)) / LSB
     # exact 64-bit sum rounded once: ≤ 0.5 LSB (+1e-6 for the float64 reference)
     assert err.max() <= 0.5 + 1e-6
 
@@ -212,8 +200,8 @@ def test_streaming_equals_batch() -> None:
     for method in METHODS:
         batch = fx.integrate(d, method)
         it = fx.Integrator(method)
-        outs = [o for o in (it.update(x) for x in d) if o is not None]
-        assert np.array_equal(np.array(outs), batch)
+        outs = np.concatenate([it.update(x) for x in d])  # (M, 4) per call, as every precision
+        assert np.array_equal(outs, batch)
 
 
 def test_bad_input() -> None:
@@ -239,64 +227,7 @@ def test_bad_input() -> None:
         core.integrate(np.full((3, 3), 0.5), "rv1", precision="fixed")
 
 
-# -- long runs against f64 fed the same increments ---------------------------
-
-def paper_sinusoid(n: int, rate: float = 100.0) -> np.ndarray:
-    """Increments of the paper's sec. 4 test: attitude angles varying as sines
-    (yaw 0.5 sin(0.2πt), pitch 0.3 sin(0.3πt), roll 0.4 sin(0.25πt)); body
-    rate of the z-x-y sequence at mid-interval times the period."""
-    dt = 1.0 / rate
-    t = (np.arange(n) + 0.5) * dt
-    A = np.array([0.5, 0.3, 0.4])
-    W = np.array([0.2, 0.3, 0.25]) * np.pi
-    ang = A * np.sin(np.outer(t, W))
-    dang = A * W * np.cos(np.outer(t, W))
-    th, ga = ang[:, 1], ang[:, 2]
-    dpsi, dth, dga = dang[:, 0], dang[:, 1], dang[:, 2]
-    # C = Rz(ψ) Rx(θ) Ry(γ): ω_b = Ry(γ)^T [ (dθ, 0, 0) + Rx(θ)^T (0, 0, dψ) ] + (0, dγ, 0)
-    wx = dth * np.cos(ga) - dpsi * np.cos(th) * np.sin(ga)
-    wy = dga + dpsi * np.sin(th)
-    wz = dth * np.sin(ga) + dpsi * np.cos(th) * np.cos(ga)
-    return np.stack([wx, wy, wz], 1) * dt
-
-
-def coning(n: int, rate: float = 1000.0, half_angle: float = 0.05, freq: float = 2.0) -> np.ndarray:
-    """Exact increments of classical coning (Ignagni 1990): ω = [−aΩ sinΩt, aΩ cosΩt, ...] form
-    integrated in closed form; a = 2 sin(α/2) Ω sin(α/2)... (increments only need to be realistic:
-    both sides get the same ones)."""
-    dt = 1.0 / rate
-    Om = 2 * np.pi * freq
-    a = half_angle
-    t0 = np.arange(n) * dt
-    t1 = t0 + dt
-    c = 2 * np.sin(a / 2)
-    ix = c * (np.cos(Om * t1) - np.cos(Om * t0))
-    iy = c * (np.sin(Om * t1) - np.sin(Om * t0))
-    iz = -2 * np.sin(a / 2) ** 2 * Om * dt * np.ones(n)
-    return np.stack([ix, iy, iz], 1)
-
-
-def random_motion(n: int, rate: float = 1000.0, seed: int = 8) -> np.ndarray:
-    """Smooth random body rate with ≈ 1 rad/s rms per axis, sampled at 1 kHz."""
-    rng = np.random.default_rng(seed)
-    k = 64
-    w = np.cumsum(rng.normal(size=(n // k + 2, 3)), axis=0)
-    w = (w - w.mean(0)) / w.std(0)
-    tt = np.arange(n) / k
-    wi = np.stack([np.interp(tt, np.arange(w.shape[0]), w[:, i]) for i in range(3)], 1)
-    return wi / rate
-
-
-def noise_limit(n_updates: int) -> float:
-    """Rounding-noise limit of the Q2.30 quaternion (docs/fixed-point.md): per
-    update the 4 components are rounded (uniform, var LSB²/12); the 3 of them
-    orthogonal to Q turn the attitude by 2δ: angle variance 4·3/12 = 1 LSB²
-    per update, rms angle after N updates = LSB·√N."""
-    return LSB * float(np.sqrt(n_updates))
-
-
-MOTIONS = {"paper-sinusoid": paper_sinusoid, "coning": coning, "random-1rad/s": random_motion}
-
+# -- long runs against f64 fed the same increments (motions: toolchain/fixed_harness.py) --
 
 @pytest.mark.parametrize("motion", sorted(MOTIONS))
 def test_long_run_rv3(motion: str) -> None:

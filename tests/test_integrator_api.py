@@ -125,26 +125,34 @@ def test_rates_interfaces() -> None:
         ac.integrate_rates(om, np.full(21, np.nan))
 
 
-def test_fixed_precision_dispatch(monkeypatch: pytest.MonkeyPatch) -> None:
-    import sys
-    import types
+def test_fixed_precision_is_the_same_contract() -> None:
+    """precision="fixed" everywhere the integrator is: integrate(), integrate_rates() of
+    increment methods and Integrator, with the float builds' shapes (float64 out)."""
+    from attitude_c import fixedpoint
 
-    calls = []
-    fake = types.ModuleType("attitude_c.fixedpoint")
-
-    def integrate(dtheta: np.ndarray, method: str, q0: object) -> np.ndarray:
-        calls.append((dtheta.shape, method, q0))
-        return np.zeros((1, 4))
-
-    fake.integrate = integrate  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "attitude_c.fixedpoint", fake)
-    monkeypatch.setattr(ac, "fixedpoint", fake, raising=False)
-    out = ac.integrate(D[:3], "rv3", precision="fixed")
-    assert out.shape == (1, 4) and calls == [((3, 3), "rv3", None)]
+    d = D[:12] * 0.1
+    out = ac.integrate(d, "rv3", precision="fixed")
+    assert out.shape == (4, 4) and out.dtype == np.float64
+    np.testing.assert_array_equal(out, fixedpoint.integrate(d, "rv3"))
+    it = ac.Integrator("rv3", precision="fixed")
+    parts = [it.update(d[a:b]) for a, b in ((0, 2), (2, 7), (7, 12))]
+    assert [p.shape for p in parts] == [(0, 4), (2, 4), (2, 4)] and it.pending == 0 and it.updates == 4
+    np.testing.assert_array_equal(np.concatenate(parts), out)
+    np.testing.assert_array_equal(it.q, out[-1])
+    assert it.outputs(7) == 2
+    one = it.update(d[0])  # one increment: (M, 4) too, M = 0 here
+    assert one.shape == (0, 4) and it.pending == 1
+    it.reset()
+    assert it.pending == 0 and it.updates == 0
+    np.testing.assert_array_equal(fixedpoint.Integrator("rv3").update(d), out)
+    np.testing.assert_array_equal(ac.integrate_rates(d / 0.01, 0.01, "rv3", precision="fixed"),
+                                  ac.integrate(d / 0.01 * 0.01, "rv3", precision="fixed"))
     with pytest.raises(InvalidArgument, match="rk4"):
         ac.integrate_rates(np.zeros((3, 3)), 0.01, precision="fixed")
-    with pytest.raises(InvalidArgument, match="precision"):
-        ac.Integrator("rv3", precision="fixed")
+    with pytest.raises(InvalidArgument, match="rk4"):
+        ac.Integrator("rk4", precision="fixed")
+    with pytest.raises(InvalidArgument, match="zero quaternion"):
+        ac.Integrator("rv3", q0=[0, 0, 0, 0], precision="fixed")
 
 
 def test_methods_constant() -> None:
@@ -167,11 +175,10 @@ def test_methods_constant() -> None:
             == {m: m for m in codes}
     with pytest.raises(InvalidArgument, match="method"):
         ac.method_code("rv3-reuse-old")
-    # the simulator and the simulate command offer exactly these methods
+    # the simulate command offers exactly these methods
     from attitude_c.cli import simulate
-    from attitude_c.sim import _integ
 
-    assert _integ.METHODS == simulate._METHODS == ac.METHODS
+    assert simulate._METHODS == ac.METHODS
 
 
 def test_demo_command(capsys: pytest.CaptureFixture[str]) -> None:
@@ -263,7 +270,8 @@ def test_method_and_precision_are_literal_types() -> None:
     hints = typing.get_type_hints(ac.integrate)
     assert typing.get_args(hints["method"]) == ac.METHODS
     assert typing.get_args(hints["precision"]) == ac.PRECISIONS
-    assert set(typing.get_args(typing.get_type_hints(ac.Integrator.__init__)["precision"])) == {"f64", "f32"}
+    # one Integrator contract for every precision (the fixed-point port included)
+    assert typing.get_args(typing.get_type_hints(ac.Integrator.__init__)["precision"]) == ac.PRECISIONS
     assert typing.get_args(typing.get_type_hints(ac.quat_to_dcm)["precision"]) == ("f64", "f32")
 
 

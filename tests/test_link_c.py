@@ -79,9 +79,6 @@ def test_sender_fits_8051_ram_budget(tmp_path: Path):
 @pytest.mark.parametrize("target", ["link", "block"])
 def test_fuzz_smoke_run(tmp_path: Path, target: str):
     require_tools("clang", "llvm-profdata", "llvm-cov", apt="clang libclang-rt-14-dev llvm")
-    import sys
-
-    sys.path.insert(0, str(ROOT))
     from toolchain.tasks.link import COVERS, build_fuzzer, line_coverage, run_fuzzer
 
     exe = build_fuzzer(tmp_path / "fuzz", target)

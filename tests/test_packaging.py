@@ -92,8 +92,9 @@ def test_sdist_wheel_fresh_venv_smoke(tmp_path: Path) -> None:
     out = json.loads(_run([py, "-c", _IMPORT_ALL], cwd=work, env=_clean_env(), timeout=120).stdout)
     assert Path(out["file"]).is_relative_to(env_dir), out["file"]  # the wheel, not the checkout
     assert all(Path(e).is_relative_to(env_dir) and e.endswith(".abi3.so") for e in out["ext"]), out["ext"]
-    for m in ("attitude_c.core", "attitude_c.cli.simulate", "attitude_c.link.transport",
-              "attitude_c.sim.chain", "attitude_c.tlc2543.model", "attitude_c.reference"):
+    for m in ("attitude_c.core", "attitude_c.cli.simulate", "attitude_c.link.transport", "attitude_c.names",
+              "attitude_c.sensor", "attitude_c.sim.chain", "attitude_c.sim.host", "attitude_c.sim.board",
+              "attitude_c.tlc2543.model", "attitude_c.reference"):
         assert m in out["modules"]
     assert out["f32_dtype"] == "float32"
 
@@ -120,3 +121,38 @@ def test_invoke_build_isolates_only_when_needed() -> None:
 
     have = metadata.version("setuptools")
     assert build_requirements_met([f"setuptools>={have}"])
+
+
+#: Distributions the package's dependencies install, by their import name
+#: (pyproject.toml [project] dependencies), and what only one function imports
+#: on demand with a message naming what to install (scipy: attitude_c.broad's .mat reader).
+_DEPENDENCIES = {"cffi", "numpy", "serial", "matplotlib", "tqdm"}
+_ON_DEMAND = {"scipy"}
+
+
+def test_the_package_imports_nothing_outside_itself() -> None:
+    """attitude_c imports the standard library, its dependencies and itself, also inside
+    functions (the wheel test above imports every module, but not every function's
+    imports); and no file of the project edits sys.path."""
+    import ast
+
+    from conftest import ROOT
+
+    bad = []
+    for f in sorted((ROOT / "attitude_c").rglob("*.py")):
+        for node in ast.walk(ast.parse(f.read_text())):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module] if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module else [])
+            for n in names:
+                top = n.split(".")[0]
+                if top not in sys.stdlib_module_names and top not in _DEPENDENCIES | _ON_DEMAND | {"attitude_c"}:
+                    bad.append(f"{f.relative_to(ROOT)}:{node.lineno}: import {n}")
+    assert not bad, "\n".join(bad)
+    import re
+
+    edit = re.compile(r"\bsys\.path\s*(\.\s*(insert|append|extend|remove)\s*\(|\+?=|\[)")
+    files = [ROOT / "tasks.py", ROOT / "setup.py"] + [f for d in ("attitude_c", "tests", "toolchain", "bench")
+                                                      for f in sorted((ROOT / d).rglob("*.py"))]
+    edits = [f"{f.relative_to(ROOT)}:{i}" for f in files for i, line in enumerate(f.read_text().splitlines(), 1)
+             if edit.search(line)]
+    assert not edits, edits

@@ -20,10 +20,9 @@ from attitude_c.sim import (
     run_budget,
     simulate,
 )
-from attitude_c.sim._tlc import available as tlc_available
 
 PAPER_HEADING, PAPER_PITCH = 0.12, 0.15  # sec. 4 of the paper, rad
-ADC = "tlc2543" if tlc_available() else "ideal"
+ADC = "tlc2543"
 
 
 def _max(res, key: str) -> float:

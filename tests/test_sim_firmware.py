@@ -1,17 +1,19 @@
-"""`attitude simulate --firmware s51`: the acquisition side as the real AT89S51
-firmware in s51 (TLC2543 driver, sampling loop and link sender unchanged)."""
+"""`python -m toolchain.simulate --firmware s51` (`attitude simulate` with the
+tooling layer's source): the acquisition side as the real AT89S51 firmware in
+s51 (TLC2543 driver, sampling loop and link sender unchanged)."""
 
 from __future__ import annotations
 
 import json
 
 import numpy as np
+from conftest import require_tools
 
-from attitude_c.cli import main
 from attitude_c.sim import SimConfig, simulate
-from attitude_c.sim.firmware import FirmwareTrajectory, _tool
 from attitude_c.sim.sensors import DEG
-from tests.conftest import require_tools
+from toolchain import firmware as tool  # registers the "s51" source
+from toolchain.firmware import FirmwareTrajectory
+from toolchain.simulate import main
 
 # cg-l53 through the default conditioning: 90 °/s ↔ 0.9 · 2048 codes
 K = 90.0 * DEG / (0.9 * 2048)
@@ -35,7 +37,6 @@ def test_firmware_chain_delivers_every_sample_and_tracks_the_truth() -> None:
     held = set(s["held"])
     assert len(held) <= s["lost"] and set(idx) >= held and list(idx) == sorted(set(idx))
     # the words the firmware sent are the model's codes at the sampling instants
-    tool = _tool()
     good = np.array([i not in held for i in idx])
     want = np.array([[int(tool.Gyro(*g).lsb(int(i))) for g in tr.gyros] for i in idx[good]])
     got = np.rint(res.increments[good] / (K * h) + 2047.5).astype(int)
@@ -54,7 +55,7 @@ def test_firmware_chain_delivers_every_sample_and_tracks_the_truth() -> None:
 def test_firmware_cli_option(tmp_path) -> None:
     require_tools("sdcc", "s51", "socat", apt="sdcc sdcc-ucsim socat")
     out = tmp_path / "fw"
-    assert main(["simulate", "--firmware", "s51", "--duration", "2", "--no-plots",
+    assert main(["--firmware", "s51", "--duration", "2", "--no-plots",
                  "--no-progress", "--out", str(out)]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["parameters"]["firmware"] == "s51"

@@ -12,14 +12,9 @@ import numpy as np
 import pytest
 
 from attitude_c.errors import InvalidArgument, NonFiniteError
-from attitude_c.sim._rot import (
-    euler_to_quat,
-    quat_angle_between,
-    quat_conj,
-    quat_mul,
-    quat_to_euler,
-    rotvec_to_quat,
-)
+from attitude_c.reference import euler_to_quat, quat_conj, quat_to_euler, rotvec_to_quat
+from attitude_c.reference import quat_angle as quat_angle_between
+from attitude_c.reference import quat_multiply as quat_mul
 from attitude_c.sim.trajectory import (
     ConingTrajectory,
     ConstantRateTrajectory,
@@ -181,8 +176,9 @@ def test_firmware_trajectory_truth() -> None:
     rates at 200 Hz (RK4's error ~(ωdt)^4/120 per step: ~1e-12 rad over 6 s), its
     closed-form increments against the base class's Gauss-Legendre quadrature,
     and the gyro parameters it accepts."""
-    from attitude_c.sim.firmware import FirmwareTrajectory
     from attitude_c.sim.trajectory import Trajectory
+    from toolchain import firmware as tool
+    from toolchain.firmware import FirmwareTrajectory
 
     tr = FirmwareTrajectory(period=0.08, rad_per_s_per_code=8.5e-4, duration=7.0)
     assert quat_angle_between(_rk4_attitude(tr, 6.0, 0.005), tr.quat(6.0)) < 1e-9
@@ -191,8 +187,6 @@ def test_firmware_trajectory_truth() -> None:
                                atol=1e-15)  # 8-node Gauss-Legendre is exact to rounding here
     # the model's sample k is the rate at the midpoint of period k
     k = 17
-    from firmware import tool
-
     want = [4096 * tool.Gyro(*g).fraction(k) - 2048 for g in tr.gyros]
     np.testing.assert_allclose(tr.omega((k + 0.5) * 0.08) / 8.5e-4, want, atol=1e-9)
     with pytest.raises(InvalidArgument, match="quadrature pair"):

@@ -9,7 +9,7 @@ with BOOT, loses one sample to a forced ADC failure (sim fault
 through the handshake protocol to attitude-rx, which takes the sample period
 from BOOT, holds the rate over the lost sample and integrates with rv3. Its
 attitude is compared, at every update, with the closed-form attitude of the
-firmware's motion (``attitude_c.sim.firmware.FirmwareTrajectory``: no
+firmware's motion (``toolchain.firmware.FirmwareTrajectory``: no
 integrator behind it) within a bound derived below from quantization.
 """
 
@@ -26,9 +26,9 @@ import numpy as np
 import pytest
 from conftest import require_target, require_tools
 
-from attitude_c.sim._rot import quat_angle_between
-from attitude_c.sim.firmware import FirmwareTrajectory
-from firmware import tool
+from attitude_c.reference import quat_angle as quat_angle_between
+from toolchain import firmware as tool
+from toolchain.firmware import FirmwareTrajectory
 
 H_TICKS = 72  # the firmware's default sampling period: 20 ms
 H = H_TICKS / tool.TICK_HZ

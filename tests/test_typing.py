@@ -19,9 +19,10 @@ from attitude_c.sim import SimConfig
 x = np.zeros((3, 3))
 ac.integrate(x, method="rv4")                          # line 7: bad
 ac.integrate(x, precision="f16")                       # line 8: bad
-ac.Integrator("rv3", precision="fixed")                # line 9: bad (float builds only)
+ac.Integrator("rv3", precision="f16")                  # line 9: bad
 SimConfig(sensors="perfect")                           # line 10: bad
 run_sender(None, [], impl="rust")                      # line 11: bad
+ac.Integrator("rv3", precision="fixed")                # fine: one contract for every precision
 ac.integrate(x, method="rv3-reuse", precision="f32")   # fine
 ac.Integrator("rk4", precision="f64")                  # fine
 SimConfig(method="rv1", precision="fixed", sensors="ideal", link="none")  # fine

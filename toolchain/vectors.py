@@ -34,6 +34,8 @@ from typing import Any
 
 import numpy as np
 
+from attitude_c import core
+
 ROOT = Path(__file__).resolve().parents[1]
 RUNNER_SRC = ROOT / "csrc" / "vectors" / "run_vectors.c"
 
@@ -42,7 +44,8 @@ EPS32 = 2.0 ** -24
 #: float64 unit roundoff (2^-53).
 EPS64 = 2.0 ** -53
 
-INCREMENT_METHODS = ("rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly")
+#: The methods whose increments the vectors integrate (every one but rk4: the library's list).
+INCREMENT_METHODS = core.INCREMENT_METHODS
 
 
 @dataclass
@@ -186,7 +189,39 @@ def generate(seed: int = 20100601, n: int = 64) -> list[Case]:
     for c in denoise_cases(rng):
         c.id = f"{c.id}.{len(cases)}"
         cases.append(c)
+    for c in sensor_cases(rng):
+        c.id = f"{c.id}.{len(cases)}"
+        cases.append(c)
     return cases
+
+
+def sensor_cases(rng: np.random.Generator) -> list[Case]:
+    """Sensor words to increments (att_sensor_increments) against reference.sensor_values:
+    plain codes and sums of 16 and of 3 conversions, permuted and signed axes, and a word
+    above its limit (the error names the sample, nothing is written)."""
+    ref = _ref()
+    out: list[Case] = []
+    for n_conv, period in ((1, 0.02), (16, 0.08), (3, 0.005)):
+        m = 40
+        words = rng.integers(0, n_conv * 4095 + 1, size=(m, 3)).astype(np.float64)
+        words[0] = 0
+        words[1] = n_conv * 4095
+        zero = _f32(rng.uniform(1800, 2300, size=3))
+        scale = _f32(rng.uniform(2e-4, 2e-3, size=3) * rng.choice([-1.0, 1.0], size=3))
+        axes = rng.permutation(3)
+        signs = rng.choice([-1, 1], size=3)
+        per = float(_f32(np.array([period]))[0])
+        params = [str(n_conv), repr(per), *(repr(float(v)) for v in (*zero, *scale)),
+                  *(str(int(v)) for v in (*axes, *signs))]
+        exp = ref.sensor_values(words, zero, scale, n_conv, axes, signs) * per
+        # the terms before the subtraction are ~4096 codes × |scale| × period: the roundings'
+        # size (the difference itself may be much smaller)
+        big = 4096 * float(np.max(np.abs(scale))) * per
+        out.append(Case(f"sensor.n{n_conv}", "sensor", words, params=params, expected=exp, ops=8, scale=big))
+        bad = words.copy()
+        bad[7, 2] = n_conv * 4095 + 1
+        out.append(Case(f"sensor.bad.n{n_conv}", "sensor", bad, params=params, status_ok=False, err_index=7))
+    return out
 
 
 def _wden_ops(wavelet: str, levels: int, block: int | None = None) -> int:

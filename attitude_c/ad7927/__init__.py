@@ -195,7 +195,6 @@ class Ad7927:
             self._hal = self.model.hal(hal)
         else:
             raise InvalidType(f"model must be an Ad7927Model or CTwin, got {type(model).__name__}")
-        self._status = _capi.status_table(lib)
         self._dev = ffi.new("ad7927 *")
         self._settings = ffi.new("ad7927_settings *")
         self._fill(range_double, twos_complement)
@@ -220,7 +219,7 @@ class Ad7927:
             name = "its leading bit is 1" if cls is FrameError else f"it names VIN{(word >> 12) & 7}"
             want = "" if exp >= 8 else f", expected VIN{exp}"
             raise cls(f"{what}: output word 0x{word:04X}: {name}{want} (status {status})", word, exp)
-        raise_for_status(status, what, self._status)
+        raise_for_status(status, what, _capi.STATUS)
 
     # -- API ------------------------------------------------------------------
     @property

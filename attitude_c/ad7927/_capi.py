@@ -13,8 +13,15 @@ from ..errors import DeviceError
 from ._errors import AddressMismatch, FrameError
 from .model import RULES, SIGNALS, Frame, ProtocolViolation
 
-__all__ = ["Bridge", "frame_log", "python_hal", "register", "status_table", "twin_trace",
-           "twin_violation"]
+__all__ = [
+    "STATUS",
+    "Bridge",
+    "frame_log",
+    "python_hal",
+    "register",
+    "twin_trace",
+    "twin_violation",
+]
 
 _registered: set[str] = set()
 
@@ -81,16 +88,16 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge, frames: bool) -> tuple[Any, A
     return hal, pins, handle
 
 
-def status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
-    """The module's C status codes (read from the library) -> (class, text)."""
-    return {
-        int(lib.AD7927_E_CHANNEL): (AddressMismatch, ("an output word names another channel "
-                                                      "than the one written for that frame")),
-        int(lib.AD7927_E_FRAME): (FrameError, ("an output word's leading bit is 1 (DOUT stuck "
-                                               "high or no part on the bus?)")),
-        int(lib.AD7927_E_TRANSFER): (DeviceError, "the frame-transfer HAL failed"),
-        int(lib.AD7927M_E_VIOLATION): (ProtocolViolation, "protocol violation"),
-    }
+#: The driver's and its model's status codes (attitude/ad7927.h, csrc/host/ad7927_model.h),
+#: keyed by C name (attitude_c.names) -> (class, text).
+STATUS: dict[str, tuple[type[Exception], str]] = {
+    "AD7927_E_CHANNEL": (AddressMismatch, ("an output word names another channel "
+                                           "than the one written for that frame")),
+    "AD7927_E_FRAME": (FrameError, ("an output word's leading bit is 1 (DOUT stuck "
+                                    "high or no part on the bus?)")),
+    "AD7927_E_TRANSFER": (DeviceError, "the frame-transfer HAL failed"),
+    "AD7927M_E_VIOLATION": (ProtocolViolation, "protocol violation"),
+}
 
 
 def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:

@@ -3,15 +3,16 @@
 Subcommands live in modules of this package; each module defines
 ``register(subparsers)`` that adds its parsers and sets ``func`` (a
 callable taking the parsed ``argparse.Namespace`` and returning an exit
-code). Add a module name to ``_MODULES`` to add its subcommands.
+code). Add the module to ``_MODULES`` to add its subcommands.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from collections.abc import Sequence
+
+from . import demo, link, simulate
 
 
 class _VersionAction(argparse.Action):
@@ -27,8 +28,8 @@ class _VersionAction(argparse.Action):
 
         parser.exit(message=f"{parser.prog} {attitude_c.__version__}\n")
 
-# Module names under attitude_c.cli, in the order their commands are listed.
-_MODULES = ("simulate", "link", "demo")
+# The subcommand modules, in the order their commands are listed.
+_MODULES = (simulate, link, demo)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -39,13 +40,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action=_VersionAction)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for name in _MODULES:
-        try:
-            mod = importlib.import_module(f"{__name__}.{name}")
-        except ModuleNotFoundError as exc:
-            if exc.name == f"{__name__}.{name}":
-                continue  # subcommand module not present in this tree
-            raise
+    for mod in _MODULES:
         mod.register(sub)
     return parser
 

@@ -43,7 +43,7 @@ def coning_drifts(beta: float, omega: float, T: float, seconds: float,
     component of the navigation-frame error, divided by cos β (the cone
     axis seen from the navigation frame); increment methods get the exact
     increments, rk4 the exact rates at every T (steps of 2T)."""
-    from .. import core
+    from .. import core, names
     from .. import reference as ref
 
     n = round(seconds / T)
@@ -54,10 +54,9 @@ def coning_drifts(beta: float, omega: float, T: float, seconds: float,
         if m == "rk4":
             q = core.integrate_rates(ref.coning_rates(beta, omega, t), T, "rk4", q0=q0,
                                      precision=precision)
-            per = 2
         else:
             q = core.integrate(d, m, q0=q0, precision=precision)
-            per = core.FRAME[m]
+        per = names.samples_per_update(m)
         tt = t[per::per][: len(q)]
         e = ref.quat_to_rotvec(ref.quat_multiply(q, ref.quat_conj(ref.coning_attitude(beta, omega, tt))))
         slope = float(np.polyfit(tt, e[:, 0], 1)[0] / np.cos(beta))
@@ -66,7 +65,7 @@ def coning_drifts(beta: float, omega: float, T: float, seconds: float,
 
 
 def main(args: argparse.Namespace) -> int:
-    from .. import core
+    from .. import core, names
     from .. import reference as ref
     from ..errors import AttitudeError, InvalidArgument
 
@@ -91,7 +90,7 @@ def main(args: argparse.Namespace) -> int:
         print(f"\nconstant rate {w.tolist()} rad/s for {args.seconds:g} s (every increment method exact):")
         for m in core.INCREMENT_METHODS:
             q = core.integrate(dc, m, precision=args.precision)
-            exact = ref.rotvec_to_quat(w * T * core.FRAME[m] * len(q))
+            exact = ref.rotvec_to_quat(w * T * names.samples_per_update(m) * len(q))
             err = np.linalg.norm(ref.quat_to_rotvec(ref.quat_multiply(q[-1], ref.quat_conj(exact))))
             print(f"{m:<15} final error {err:.3e} rad")
     except AttitudeError as exc:

@@ -133,16 +133,15 @@ def _block_printer() -> Any:
     def show(b: bytes) -> None:
         for k in range(0, len(b), size):
             raw = b[k:k + size]
-            rec, st = block.try_decode(raw)
-            if rec is None or (st != 0 and rec.kind != "sample"):  # no place in the numbering
-                print(json.dumps({"error": block.fmt().errors[st], "raw": raw.hex()}), flush=True)
+            rec, span, st = tracker.decode(raw)  # a slip shows in the loss report's "slip"
+            if rec is None or span is None:  # no place in the numbering
+                print(json.dumps({"error": tracker.error(st), "raw": raw.hex()}), flush=True)
                 continue
-            span, _ = tracker.feed(rec)  # a slip shows in the loss report's "slip"
             out: dict[str, Any]
             if rec.kind == "sample":
                 out = {"n": span.first, "codes": list(rec.codes)}
                 if st != 0:
-                    out["error"] = block.fmt().errors[st]  # never a sample to integrate
+                    out["error"] = tracker.error(st)  # never a sample to integrate
             else:
                 out = rec.as_dict()
                 if rec.is_loss:

@@ -144,11 +144,11 @@ def register(subparsers: Any) -> None:
                    help="static zero-rate calibration before the run (s)")
     g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ideal"),
                    help="tlc2543: C driver against the device model; ideal: vectorized quantizer; "
-                   "auto: tlc2543 when built")
+                   "auto: tlc2543")
     g.add_argument("--firmware", choices=("none", "s51"), default="none",
                    help="s51: the acquisition side is the real AT89S51 firmware running in s51 "
-                   "(needs sdcc, s51, socat and a source checkout); the motion is then the "
-                   "firmware's own sinusoidal body rates")
+                   "(a source checkout with sdcc, s51 and socat: run it as python -m toolchain.simulate "
+                   "--firmware s51 ...); the motion is then the firmware's own sinusoidal body rates")
     g.add_argument("--link", default="c", choices=("c", "none"),
                    help="c: every sample through the C link sender and receiver; none: direct")
     g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
@@ -199,21 +199,19 @@ class _Progress:
 
 def build_config(args: argparse.Namespace) -> Any:
     from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
+    from ..sim.adc import AdcBackend
 
     given = getattr(args, "trajectory", None)
     trajectory = given or ("csv" if args.trajectory_file else "paper")
     duration: float | None = getattr(args, "duration", None)
-    if args.firmware == "s51":
-        from ..sim.firmware import FirmwareTrajectory
-        from ..sim.sensors import DEG, Conditioning
+    if args.firmware != "none":
+        from ..sim import Conditioning, source
 
         if given or args.trajectory_file:
-            raise ValueError("--firmware s51 uses the firmware's own motion: drop --trajectory")
-        gyro = gyro_preset(args.gyro)
-        cond = Conditioning()
-        k = cond.vref / 4096 / (gyro.scale_v_per_dps / DEG * cond.gain(gyro))
-        traj: Any = FirmwareTrajectory(period=args.period, rad_per_s_per_code=k,
-                                       duration=duration or DEFAULT_DURATION_S)
+            raise ValueError(f"--firmware {args.firmware} uses the firmware's own motion: drop --trajectory")
+        # a source registered by the tooling layer (toolchain/firmware.py): its own motion
+        traj: Any = source(args.firmware).trajectory(args.period, gyro_preset(args.gyro), Conditioning(),
+                                                     duration or DEFAULT_DURATION_S)
     elif trajectory == "csv":
         if not args.trajectory_file:
             raise ValueError("--trajectory csv needs --trajectory-file CSV")
@@ -238,11 +236,7 @@ def build_config(args: argparse.Namespace) -> Any:
         traj = make_trajectory("constant-rate", rate=[math.radians(v) for v in args.rate])
     else:
         traj = make_trajectory("static")
-    adc = args.adc
-    if adc == "auto":
-        from ..sim._tlc import available
-
-        adc = "tlc2543" if available() else "ideal"
+    adc: AdcBackend = "tlc2543" if args.adc == "auto" else args.adc
     return SimConfig(trajectory=traj, duration=duration or DEFAULT_DURATION_S, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
@@ -256,7 +250,7 @@ def run(args: argparse.Namespace) -> int:
 
     try:
         return _run(args)
-    except (AttitudeError, ValueError, TypeError, ImportError) as exc:
+    except (AttitudeError, ValueError, TypeError) as exc:
         print(f"attitude simulate: error: {exc}", file=sys.stderr)
         return 2
 

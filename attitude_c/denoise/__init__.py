@@ -68,16 +68,17 @@ def _mode_code(lib: Any, name: str) -> int:
     return {"soft": lib.ATT_WDEN_SOFT, "hard": lib.ATT_WDEN_HARD}[name]
 
 
-def _status_table(lib: Any) -> dict[int, tuple[type[Exception], str]]:
+def _status_table(lib: Any) -> dict[str, tuple[type[Exception], str]]:
+    """The denoiser's status codes (attitude/denoise.h), keyed by C name (attitude_c.names)."""
     return {
-        lib.ATT_E_WDEN_WAVELET: (InvalidArgument, f"wavelet must be one of {WAVELETS}"),
-        lib.ATT_E_WDEN_MODE: (InvalidArgument, f"threshold must be one of {THRESHOLDS}"),
-        lib.ATT_E_WDEN_LEVELS: (InvalidArgument, f"levels must be 1..{lib.ATT_WDEN_MAX_LEVELS}"),
-        lib.ATT_E_WDEN_BLOCK: (InvalidArgument, (f"the block length must be 2..{lib.ATT_WDEN_MAX_BLOCK} "
-                                                 "and a multiple of 2**levels")),
-        lib.ATT_E_WDEN_EDGE: (InvalidArgument, "edge_start + edge_end must be smaller than the block"),
-        lib.ATT_E_WDEN_SHORT: (InvalidArgument, "fewer samples than one block were received"),
-        lib.ATT_E_WDEN_OVERFLOW: (RangeError, "finite input, but the result overflows"),
+        "ATT_E_WDEN_WAVELET": (InvalidArgument, f"wavelet must be one of {WAVELETS}"),
+        "ATT_E_WDEN_MODE": (InvalidArgument, f"threshold must be one of {THRESHOLDS}"),
+        "ATT_E_WDEN_LEVELS": (InvalidArgument, f"levels must be 1..{lib.ATT_WDEN_MAX_LEVELS}"),
+        "ATT_E_WDEN_BLOCK": (InvalidArgument, (f"the block length must be 2..{lib.ATT_WDEN_MAX_BLOCK} "
+                                               "and a multiple of 2**levels")),
+        "ATT_E_WDEN_EDGE": (InvalidArgument, "edge_start + edge_end must be smaller than the block"),
+        "ATT_E_WDEN_SHORT": (InvalidArgument, "fewer samples than one block were received"),
+        "ATT_E_WDEN_OVERFLOW": (RangeError, "finite input, but the result overflows"),
     }
 
 

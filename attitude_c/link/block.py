@@ -6,11 +6,13 @@ constants, record kinds and every range check come from the compiled
 library (``lib.ATT_BLOCK_*``); nothing of the format is written again here.
 
 - :func:`decode` (raises :class:`~attitude_c.errors.BlockFormatError`) and
-  :func:`try_decode` (returns the C status) turn 6 bytes into a :class:`Record`;
-- ``encode_*`` build records (what the firmware sends);
-- :class:`SeqTracker` numbers the samples of a stream and places every loss
-  report (``att_block_seq_*``); :func:`number_stream` does both for a list of
-  blocks.
+  :func:`try_decode` (returns the C status) turn 6 bytes read alone into a
+  :class:`Record`;
+- ``encode_*`` build records (what the firmware sends; ``encode_oversample``
+  and ``encode_sums``: a board that sends sums of n conversions);
+- :class:`SeqTracker` decodes the records of one stream (its limit for sample
+  words included), numbers the samples and places every loss report
+  (``att_block_seq_*``); :func:`number_stream` does that for a list of blocks.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from typing import Any, Literal, Union
 from .._lib import ffi_lib
 from ..errors import BlockFormatError, InvalidArgument, InvalidType, raise_for_status
 
-Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error"]
+Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error", "oversample"]
 LossKind = Literal["gave_up", "overrun"]
 Bytes = Union[bytes, bytearray, memoryview]
 
@@ -37,8 +39,10 @@ __all__ = [
     "encode_adc_error",
     "encode_boot",
     "encode_loss",
+    "encode_oversample",
     "encode_sample",
     "encode_selftest",
+    "encode_sums",
     "fmt",
     "number_stream",
     "try_decode",
@@ -56,6 +60,8 @@ class Format:
     tick_hz: int       #: BOOT period unit (ticks per second)
     period_max: int    #: largest BOOT period (ticks)
     baud_unit: int     #: BOOT baud_div unit
+    oversample_max: int  #: largest OVERSAMPLE n
+    sum_max: int       #: largest word of an oversampled sample
     kinds: dict[int, Kind] = field(repr=False)  #: C kind value -> name
     errors: dict[int, str] = field(repr=False)  #: C status -> what it means
 
@@ -74,13 +80,14 @@ def fmt() -> Format:
         ffi, lib = _c()
         kinds: dict[int, Kind] = {v: n[len("ATT_BLOCK_"):].lower()  # type: ignore[misc]
                                   for v, n in ffi.typeof("att_block_kind").elements.items()}
-        errors = {lib.ATT_BLOCK_E_CODE: f"sample code above {lib.ATT_BLOCK_CODE_MAX}",
+        errors = {lib.ATT_BLOCK_E_CODE: f"sample code above {lib.ATT_BLOCK_CODE_MAX}",  # plain streams
                   lib.ATT_BLOCK_E_KIND: "unknown report kind",
                   lib.ATT_BLOCK_E_FIELD: "report field out of range",
                   lib.ATT_BLOCK_E_SEQ: "loss report disagrees with the sample count"}
         _fmt = Format(size=lib.ATT_BLOCK_SIZE, code_max=lib.ATT_BLOCK_CODE_MAX, mark=lib.ATT_BLOCK_MARK,
                       version=lib.ATT_BLOCK_VERSION, tick_hz=lib.ATT_BLOCK_TICK_HZ,
                       period_max=lib.ATT_BLOCK_PERIOD_MAX, baud_unit=lib.ATT_BLOCK_BAUD_UNIT,
+                      oversample_max=lib.ATT_BLOCK_OVERSAMPLE_MAX, sum_max=lib.ATT_BLOCK_SUM_MAX,
                       kinds=kinds, errors=errors)
     return _fmt
 
@@ -107,6 +114,7 @@ class Record:
     status: int = 0        #: selftest, adc_error: the failure's att_status
     bad_code: int = 0      #: selftest: code read from the failed test input
     attempt: int = 0       #: selftest: attempt number
+    oversample: int = 0    #: oversample: conversions summed per word of the samples that follow
 
     @property
     def is_report(self) -> bool:
@@ -131,6 +139,8 @@ class Record:
                        baud=self.baud)
         elif self.kind == "selftest":
             out.update(status=self.status, bad_code=self.bad_code, attempt=self.attempt)
+        elif self.kind == "oversample":
+            out["n"] = self.oversample
         else:
             out.update(first=self.first, count=self.count)
             if self.kind == "adc_error":
@@ -165,13 +175,18 @@ def try_decode(raw: Bytes, index: int | None = None) -> tuple[Record | None, int
     st = lib.att_block_decode(b, out)
     if st < 0 and st not in fmt().errors:
         raise_for_status(st, "att_block_decode")
+    return _record(b, out), st
+
+
+def _record(b: bytes, out: Any) -> Record | None:
+    """The Record of a decoded ``att_block`` (None for an unknown kind)."""
     kind = fmt().kinds.get(out.kind)
     if kind is None:
-        return None, st
-    rec = Record(kind=kind, raw=b, codes=(out.code[0], out.code[1], out.code[2]), first=out.first,
-                 count=out.count, period_ticks=out.period_ticks, baud=out.baud_div * fmt().baud_unit,
-                 version=out.version, status=out.status, bad_code=out.bad_code, attempt=out.attempt)
-    return rec, st
+        return None
+    return Record(kind=kind, raw=b, codes=(out.code[0], out.code[1], out.code[2]), first=out.first,
+                  count=out.count, period_ticks=out.period_ticks, baud=out.baud_div * fmt().baud_unit,
+                  version=out.version, status=out.status, bad_code=out.bad_code, attempt=out.attempt,
+                  oversample=out.oversample)
 
 
 def decode(raw: Bytes, index: int | None = None) -> Record:
@@ -251,6 +266,29 @@ def encode_adc_error(first: int, status: int) -> bytes:
     return _encode("att_block_encode_adc_error", first, status)
 
 
+def encode_oversample(n: int) -> bytes:
+    """OVERSAMPLE: the sample records that follow carry sums of ``n`` conversions (1..16)."""
+    _check("n", n, 1, fmt().oversample_max)
+    return _encode("att_block_encode_oversample", n)
+
+
+def sum_limit(n: int) -> int:
+    """Largest word of a sample record of sums of ``n`` conversions: min(n × 4095, 0xFDFF)."""
+    _check("n", n, 1, fmt().oversample_max)
+    return min(n * fmt().code_max, fmt().sum_max)
+
+
+def encode_sums(sums: Sequence[int], n: int) -> bytes:
+    """A sample record of an oversampled stream: X, Y, Z, each the sum of ``n`` codes
+    (0..:func:`sum_limit`); ``n = 1`` gives :func:`encode_sample`'s bytes."""
+    if len(sums) != 3:
+        raise InvalidArgument(f"sums must hold 3 values (X, Y, Z), got {len(sums)}")
+    hi = sum_limit(n)
+    c = [_check(f"sums[{i}]", v, 0, hi) for i, v in enumerate(sums)]
+    ffi, _ = _c()
+    return _encode("att_block_encode_sums", ffi.new("uint16_t[3]", c), n)
+
+
 @dataclass(frozen=True)
 class Span:
     """Where a record falls in the numbering (``att_block_span``)."""
@@ -261,7 +299,8 @@ class Span:
 
 
 class SeqTracker:
-    """Numbers the samples of a stream and places each loss report (``att_block_seq``)."""
+    """One stream's decoder: numbers its samples, places each loss report and
+    knows its limit for sample words (``att_block_seq``)."""
 
     def __init__(self) -> None:
         self._ffi, self._lib = _c()
@@ -275,30 +314,58 @@ class SeqTracker:
         """Number of the next sample expected."""
         return int(self._s.next)
 
+    @property
+    def oversample(self) -> int:
+        """Conversions per sample word: 1, or the stream's OVERSAMPLE n."""
+        return max(1, int(self._s.oversample))
+
+    @property
+    def code_limit(self) -> int:
+        """Largest sample word of this stream (4095, or min(n × 4095, 0xFDFF))."""
+        return min(self.oversample * fmt().code_max, fmt().sum_max)
+
+    def error(self, status: int) -> str:
+        """What a ``lib.ATT_BLOCK_E_*`` status means in this stream."""
+        if status == self._lib.ATT_BLOCK_E_CODE:
+            return f"sample code above {self.code_limit}"
+        return fmt().errors.get(status, f"status {status}")
+
+    def decode(self, raw: Bytes, index: int | None = None) -> tuple[Record | None, Span | None, int]:
+        """Decode and place one record of the stream (``att_block_seq_decode``):
+        ``(record, span, status)``. status 0; ``lib.ATT_BLOCK_E_CODE`` (a sample
+        above the stream's limit: numbered, never integrate it);
+        ``lib.ATT_BLOCK_E_KIND`` / ``E_FIELD`` (span None: no place in the
+        numbering; record None for an unknown kind); ``lib.ATT_BLOCK_E_SEQ``
+        (a loss report after a slip: the numbering follows it from now on)."""
+        b = _raw(raw, _where(index))
+        st = self._lib.att_block_seq_decode(self._s, b, self._b, self._span)
+        if st < 0 and st not in fmt().errors:
+            raise_for_status(st, "att_block_seq_decode")
+        rec = _record(b, self._b)
+        placed = st in (0, self._lib.ATT_BLOCK_E_CODE, self._lib.ATT_BLOCK_E_SEQ)
+        span = Span(int(self._span.first), int(self._span.count), int(self._span.slip)) if placed else None
+        return rec, span, st
+
     def feed(self, rec: Record) -> tuple[Span, int]:
-        """Place ``rec`` (a sample, also one that failed ``E_CODE``, or a report):
-        ``(span, status)`` with status 0 or ``lib.ATT_BLOCK_E_SEQ`` (the numbering
-        slipped; it follows the report from now on)."""
-        lib = self._lib
-        st = lib.att_block_decode(rec.raw, self._b)
-        if rec.kind == "sample":  # a sample with a bad code still takes its number
-            self._b.kind = lib.ATT_BLOCK_SAMPLE
-        elif st < 0:
-            raise BlockFormatError(f"record {rec.raw.hex(' ')}: {fmt().errors.get(st, st)}: it has "
-                                   "no place in the numbering", st)
-        st = lib.att_block_seq_feed(self._s, self._b, self._span)
-        if st < 0 and st != lib.ATT_BLOCK_E_SEQ:
-            raise BlockFormatError(f"record {rec.raw.hex(' ')}: {fmt().errors.get(st, st)}", st)
-        return Span(int(self._span.first), int(self._span.count), int(self._span.slip)), st
+        """Place an already decoded ``rec``: ``(span, status)`` as :meth:`decode`;
+        a record with no place in the numbering raises :class:`BlockFormatError`."""
+        _, span, st = self.decode(rec.raw)
+        if span is None:
+            raise BlockFormatError(f"record {rec.raw.hex(' ')}: {self.error(st)}: it has no place in "
+                                   "the numbering", st)
+        return span, st
 
 
 def number_stream(blocks: Iterable[Bytes], *, strict: bool = True) -> list[tuple[Record, Span]]:
-    """Decode and number a stream of records (each link block may hold several).
+    """Decode and number a stream of records (each link block may hold several),
+    with one :class:`SeqTracker`.
 
-    ``strict``: a record that breaks the format or a loss report that
-    disagrees with the count raises :class:`BlockFormatError` naming the
-    record's index; otherwise bad records are skipped (a bad-code sample
-    still takes its number) and slips are followed.
+    ``strict``: a record that breaks the format (for this stream: a sample
+    above its limit) or a loss report that disagrees with the count raises
+    :class:`BlockFormatError` naming the record's index; otherwise records
+    with no place in the numbering are skipped, a bad sample keeps its
+    number (and its status is dropped: check ``rec.codes`` against
+    :attr:`SeqTracker.code_limit` before integrating) and slips are followed.
     """
     n = fmt().size
     tr = SeqTracker()
@@ -309,18 +376,14 @@ def number_stream(blocks: Iterable[Bytes], *, strict: bool = True) -> list[tuple
         if len(b) % n:
             raise InvalidArgument(f"block {len(out)} has {len(b)} bytes, not a multiple of {n}")
         for k in range(0, len(b), n):
-            rec, st = try_decode(b[k:k + n], i)
-            if st != 0 and (strict or rec is None or rec.kind != "sample"):
-                if strict:
-                    raise BlockFormatError(f"record {i} {b[k:k + n].hex(' ')}: {fmt().errors[st]}", st, i)
-                i += 1
-                continue
-            assert rec is not None
             expected = tr.next
-            span, st = tr.feed(rec)
+            rec, span, st = tr.decode(b[k:k + n], i)
             if st != 0 and strict:
-                raise BlockFormatError(f"record {i} {rec.raw.hex(' ')}: {fmt().errors[st]} (its first "
-                                       f"sample is {rec.first}, expected {expected & 0xFFFF})", st, i)
-            out.append((rec, span))
+                what = tr.error(st)
+                if st == tr._lib.ATT_BLOCK_E_SEQ and rec is not None:
+                    what += f" (its first sample is {rec.first}, expected {expected & 0xFFFF})"
+                raise BlockFormatError(f"record {i} {b[k:k + n].hex(' ')}: {what}", st, i)
+            if rec is not None and span is not None:
+                out.append((rec, span))
             i += 1
     return out

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any, Literal
 
 from .._lib import ffi_lib
-from ..errors import InvalidArgument, LinkError, raise_for_status
+from ..errors import InvalidArgument, raise_for_status
 from .protocol import (
     BLOCK_DEFAULT,
     DEFAULT_ANSWER_TIMEOUT_MS,
@@ -22,14 +22,6 @@ from .protocol import (
     _check_int,
 )
 
-#: C status codes of attitude/link.h, for raise_for_status.
-LINK_ERRORS: dict[int, tuple[type, str]] = {
-    -60: (InvalidArgument, "NULL pointer"),
-    -61: (InvalidArgument, "link configuration out of range"),
-    -62: (LinkBusy, "sender busy with the previous block"),
-    -63: (LinkError, "link state corrupted"),
-}
-
 #: Which implementation of an end: the C machine or the Python one.
 Impl = Literal["c", "python"]
 
@@ -40,7 +32,7 @@ _NO_TIMER = 0xFFFF
 
 def _result(code: int, what: str) -> Result:
     if code < 0:
-        raise_for_status(code, what, LINK_ERRORS)
+        raise_for_status(code, what)
     return Result(code)
 
 
@@ -63,7 +55,7 @@ class CSender:
         cfg.syn_timeout = syn_timeout
         cfg.answer_timeout = answer_timeout
         cfg.max_attempts = max_attempts
-        raise_for_status(lib.att_link_sender_init(self._s, cfg), "att_link_sender_init", LINK_ERRORS)
+        raise_for_status(lib.att_link_sender_init(self._s, cfg), "att_link_sender_init")
         self.block_size = block_size
         self.syn_timeout, self.answer_timeout, self.max_attempts = syn_timeout, answer_timeout, max_attempts
         self._block: Any = ffi.new("uint8_t[]", block_size)
@@ -96,7 +88,7 @@ class CSender:
             raise LinkBusy("CSender.start: the previous block is still in progress")
         self._ffi.memmove(self._block, block, self.block_size)
         raise_for_status(self._lib.att_link_sender_start(self._s, self._block, tick & 0xFFFF),
-                         "att_link_sender_start", LINK_ERRORS)
+                         "att_link_sender_start")
 
     def sink(self, byte: int, tick: int) -> Result:
         r = _result(self._lib.att_link_sender_sink(self._s, _byte(byte), tick & 0xFFFF),
@@ -132,7 +124,7 @@ class CReceiver:
         lib.att_link_receiver_config_init(cfg, block_size)
         cfg.gap_timeout = gap_timeout
         raise_for_status(lib.att_link_receiver_init(self._r, cfg, self._buf),
-                         "att_link_receiver_init", LINK_ERRORS)
+                         "att_link_receiver_init")
         self.block_size = block_size
         self.gap_timeout = gap_timeout
         self.block = b""

@@ -14,7 +14,7 @@ from __future__ import annotations
 import enum
 from dataclasses import asdict, dataclass
 
-from ..errors import InvalidArgument, InvalidType, LinkError
+from ..errors import InvalidArgument, InvalidType, LinkBusy
 
 SYN = 0xAA  # A -> B: may I send?
 SYN_ACK = 0xBB  # B -> A: go ahead
@@ -45,10 +45,6 @@ class Result(enum.IntEnum):
     REJECTED = 7
     TIMEOUT = 8
     GAVE_UP = 9
-
-
-class LinkBusy(LinkError):
-    """``Sender.start`` while a block is still in progress."""
 
 
 @dataclass

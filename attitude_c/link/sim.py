@@ -23,7 +23,7 @@ import numpy as np
 
 from .._lib import ffi_lib
 from ..errors import InvalidArgument, InvalidType, raise_for_status
-from .cends import LINK_ERRORS, Impl, make_receiver, make_sender
+from .cends import Impl, make_receiver, make_sender
 from .protocol import (
     BLOCK_MAX,
     DEFAULT_ANSWER_TIMEOUT_MS,
@@ -315,7 +315,7 @@ def _run_c(arr: np.ndarray, chan_cfg: ChannelConfig, baud: int, timing: dict[str
             ffi.from_buffer("uint8_t[]", acc), ffi.from_buffer("int64_t[]", acc_index),
             ffi.from_buffer("uint64_t[]", acc_tick), cap,
             ffi.from_buffer("uint8_t[]", outcome), res)
-        raise_for_status(rc, "att_link_sim_run", LINK_ERRORS)
+        raise_for_status(rc, "att_link_sim_run")
         if res.n_accepted <= cap:
             break
         cap = int(res.n_accepted) + 64

@@ -1,25 +1,40 @@
-"""Full-system simulation of the paper's attitude measurement system.
+"""Full-system simulation of the paper's attitude measurement system, as a
+pipeline of stages (docs/architecture.md, docs/simulation.md):
 
-trajectory → gyros → analog conditioning → TLC2543 ADC (C driver + device
-model) → acquisition-board increment formation → serial link (C sender and
-receiver, optional channel errors) → integrator (any method, f64/f32/fixed)
-→ attitude → errors against the truth. See docs/simulation.md.
+    trajectory → sensors → conditioning → ADC → board → link → host → estimator → outputs
+
+one module each (:mod:`.trajectory`, :mod:`.sensors`, :mod:`.conditioning`,
+:mod:`.adc`, :mod:`.board`, :mod:`.link`, :mod:`.host`, :mod:`.estimator`,
+:mod:`.outputs`); :mod:`.chain` composes them (``simulate``, ``acquire``),
+:mod:`.budget` switches the error sources on one at a time, :mod:`.report`
+writes a run's plots and files.
 """
 
 from __future__ import annotations
 
+from .adc import AdcModel, quantize_ideal
+from .board import Board, BoardStream
 from .budget import STAGES, BudgetResult, format_budget, plot_budget, run_budget
-from .chain import PAPER_MAXIMA, Acquired, SimConfig, SimResult, acquire, simulate
-from .report import format_table, plot_attitude, plot_errors, write_run
-from .sensors import (
-    GYRO_PRESETS,
-    AdcModel,
-    Board,
-    Calibration,
-    Conditioning,
-    GyroModel,
-    gyro_preset,
+from .chain import (
+    PAPER_MAXIMA,
+    SENSOR_MODES,
+    Acquired,
+    SimConfig,
+    SimResult,
+    Source,
+    SourceOutput,
+    acquire,
+    register_source,
+    simulate,
+    source,
 )
+from .conditioning import Conditioning
+from .estimator import Estimate, Integrate
+from .host import Calibration, Decoded, HostDecoder
+from .link import Delivered, Link
+from .outputs import Errors, attitude_angle, compare, wrap_angle
+from .report import format_table, plot_attitude, plot_errors, write_run
+from .sensors import GYRO_PRESETS, Gyro, GyroModel, gyro_preset
 from .trajectory import (
     TRAJECTORIES,
     ConingTrajectory,
@@ -35,24 +50,38 @@ from .trajectory import (
 __all__ = [
     "GYRO_PRESETS",
     "PAPER_MAXIMA",
+    "SENSOR_MODES",
     "STAGES",
     "TRAJECTORIES",
     "Acquired",
     "AdcModel",
     "Board",
+    "BoardStream",
     "BudgetResult",
     "Calibration",
     "Conditioning",
     "ConingTrajectory",
     "ConstantRateTrajectory",
     "CsvTrajectory",
+    "Decoded",
+    "Delivered",
+    "Errors",
+    "Estimate",
+    "Gyro",
     "GyroModel",
+    "HostDecoder",
+    "Integrate",
+    "Link",
     "PaperTrajectory",
     "SimConfig",
     "SimResult",
+    "Source",
+    "SourceOutput",
     "StaticTrajectory",
     "Trajectory",
     "acquire",
+    "attitude_angle",
+    "compare",
     "euler_rates_to_body",
     "format_budget",
     "format_table",
@@ -61,7 +90,11 @@ __all__ = [
     "plot_attitude",
     "plot_budget",
     "plot_errors",
+    "quantize_ideal",
+    "register_source",
     "run_budget",
     "simulate",
+    "source",
+    "wrap_angle",
     "write_run",
 ]

@@ -9,8 +9,7 @@ Stages (each adds one source to its *base* stage):
 3. ``+ gyro noise/bias`` (base 2) — the gyro model's noise, turn-on bias
    (calibrated out up to noise), filter and saturation: the full sensor chain;
 4. ``+ float32`` (base 3) — the float32 build of the integrator;
-5. ``+ fixed-point`` (base 3) — the Q-format integrator (when the installed
-   core has it);
+5. ``+ fixed-point`` (base 3) — the Q-format integrator;
 6. ``+ link errors`` (base 3) — every sample through the C sender, the
    channel simulator at the budget BER and the C receiver, float64.
 
@@ -31,11 +30,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ..core import Method
+from ..core import METHODS, Method
 from ..errors import InvalidArgument
-from . import _integ
-from ._rot import quat_angle_between
 from .chain import Acquired, SimConfig, acquire, simulate
+from .outputs import attitude_angle
 
 __all__ = ["STAGES", "BudgetResult", "format_budget", "plot_budget", "run_budget"]
 
@@ -86,19 +84,11 @@ def _stage_configs(base: SimConfig, ber: float) -> list[tuple[str, SimConfig]]:
     ]
 
 
-def run_budget(base: SimConfig, methods: tuple[Method, ...] = _integ.METHODS, ber: float = 1e-3,
+def run_budget(base: SimConfig, methods: tuple[Method, ...] = METHODS, ber: float = 1e-3,
                progress: Callable[[str, int, int], None] | None = None) -> BudgetResult:
     """Run every stage for every method on the scenario of ``base``."""
     stages = _stage_configs(base, ber)
     skipped: dict[str, str] = {}
-    try:
-        from .. import link as _link  # noqa: F401
-    except ImportError:
-        skipped["+ link errors"] = "attitude_c.link is not built"
-        stages = [s for s in stages if s[0] != "+ link errors"]
-    if not _integ.precision_available("fixed"):
-        skipped["+ fixed-point"] = "precision='fixed' is not available in the installed core"
-        stages = [s for s in stages if s[0] != "+ fixed-point"]
     names = [s[0] for s in stages]
     cache: dict[tuple[Any, ...], Acquired] = {}
     rms = np.full((len(stages), len(methods)), np.nan)
@@ -131,7 +121,7 @@ def run_budget(base: SimConfig, methods: tuple[Method, ...] = _integ.METHODS, be
             if name == "algorithm":
                 contrib[i, j] = e["rms"]
             elif name in _DIRECT and (_BASE[name], m) in q_of:
-                d = quat_angle_between(q_of[(_BASE[name], m)], res.q_est)
+                d = attitude_angle(q_of[(_BASE[name], m)], res.q_est)
                 contrib[i, j] = float(np.sqrt(np.mean(d * d)))
             else:
                 r0 = rms[names.index(_BASE[name]), j]

@@ -1,7 +1,20 @@
-"""The whole system in simulation: trajectory → gyros → ADC → link → integrator.
+"""The whole system in simulation: this module only composes the stages.
+
+    trajectory → sensors → conditioning → ADC → board → link → host → estimator → outputs
+    (trajectory.py, sensors.py, conditioning.py, adc.py, board.py, link.py, host.py,
+     estimator.py, outputs.py: one stage each; docs/architecture.md)
 
 ``simulate(SimConfig(...))`` runs one scenario and returns a
-:class:`SimResult` (time series and a JSON-ready summary).
+:class:`SimResult` (time series and a JSON-ready summary); ``acquire(cfg)``
+runs the acquisition side alone (everything before the estimator).
+
+Acquisition sources. The modeled board (sensors → conditioning → ADC →
+board → link) is the default source; the sensors="ideal" mode hands the
+trajectory's exact increments to the estimator. Another source replaces the
+acquisition side and delivers records to the same host stage: the AT89S51
+firmware in s51 is one, registered from the tooling layer
+(``toolchain/firmware.py``: ``python -m toolchain.simulate --firmware s51``),
+never imported by this package; :func:`register_source` is how.
 """
 
 from __future__ import annotations
@@ -13,25 +26,20 @@ from typing import Any, Callable, Literal, get_args
 
 import numpy as np
 
-from ..core import Method, Precision
+from ..core import METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
-from . import _integ
-from ._rot import quat_angle_between, quat_to_euler, wrap_angle
-from .sensors import (
-    DEG,
-    AdcModel,
-    Board,
-    Calibration,
-    Conditioning,
-    GyroModel,
-    filtered_rate,
-    gyro_preset,
-    gyro_volts,
-    rate_noise,
-)
+from .adc import AdcModel
+from .board import Board
+from .conditioning import Conditioning
+from .estimator import Integrate
+from .host import Calibration, Decoded, HostDecoder
+from .link import Delivered, Link
+from .outputs import compare
+from .sensors import DEG, Gyro, GyroModel, gyro_preset
 from .trajectory import PaperTrajectory, Trajectory
 
-__all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "acquire", "simulate"]
+__all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "Source", "acquire",
+           "register_source", "simulate", "source"]
 
 
 def _package_version() -> str:
@@ -60,7 +68,9 @@ class SimConfig:
     with a perfect gyro; ``"full"`` adds the gyro's noise, bias, filter and
     saturation. ``link``: ``"c"`` sends every sample through the C sender and
     receiver (with the channel simulator when ``ber`` > 0), ``"none"`` hands
-    the words over directly.
+    the records over directly. ``firmware``: the name of a registered
+    acquisition source that replaces the modeled board (``"s51"``, from the
+    tooling layer), or None.
     """
 
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
@@ -81,8 +91,10 @@ class SimConfig:
     firmware: str | None = None
 
     def validate(self) -> None:
-        _integ.check_method(self.method)
-        _integ.check_precision(self.precision)
+        if self.method not in METHODS:
+            raise InvalidArgument(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.precision not in PRECISIONS:
+            raise InvalidArgument(f"precision must be one of {PRECISIONS}, got {self.precision!r}")
         for name in ("duration", "period"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
@@ -110,17 +122,8 @@ class SimConfig:
         if not (math.isfinite(self.calibration_s) and self.calibration_s >= 0):
             raise InvalidArgument(f"calibration_s must be >= 0, got {self.calibration_s!r}")
         self.board.check(self.adc.bits)
-        if self.firmware not in (None, "s51"):
-            raise InvalidArgument(f"firmware must be None or 's51', got {self.firmware!r}")
-        if self.firmware == "s51":
-            from .firmware import FirmwareTrajectory
-
-            if not isinstance(self.trajectory, FirmwareTrajectory):
-                raise InvalidArgument("firmware='s51' runs the firmware's own gyro model: use a "
-                                      "FirmwareTrajectory (attitude simulate --firmware s51 does)")
-            if self.sensors == "ideal" or self.ber > 0:
-                raise InvalidArgument("firmware='s51' takes the firmware's codes: sensors must "
-                                      "not be 'ideal' and ber must be 0 (the pty link is clean)")
+        if self.firmware is not None:
+            source(self.firmware).check(self)
 
     def params(self) -> dict[str, Any]:
         return {
@@ -144,6 +147,12 @@ class SimConfig:
             "firmware": self.firmware,
         }
 
+    def rad_per_s_per_code(self) -> float:
+        """The nominal rad/s per code of one conversion through the gyro's scale,
+        the conditioning gain and the ADC (what the host's calibration assumes)."""
+        full = 1 << self.adc.bits
+        return 1.0 / (self.gyro.volts_per_rad_s * self.conditioning.gain(self.gyro) * full / self.adc.vref)
+
 
 @dataclass
 class SimResult:
@@ -166,12 +175,64 @@ class SimResult:
         return -self.err[:, 0]
 
 
-def _stats(e: np.ndarray) -> dict[str, float]:
-    if e.size == 0:
-        return {"max": 0.0, "min": 0.0, "rms": 0.0, "max_abs": 0.0}
-    return {"max": float(np.max(e)), "min": float(np.min(e)),
-            "rms": float(np.sqrt(np.mean(e * e))), "max_abs": float(np.max(np.abs(e)))}
+# ---------------------------------------------------------------------------
+# acquisition sources
+# ---------------------------------------------------------------------------
 
+@dataclass
+class SourceOutput:
+    """What an acquisition source hands the host: the ``delivered`` records, the
+    ``calibration`` to convert them with, the ``backends`` it ran (for the
+    summary) and, when the simulator knows it, the sent stream's record → sample
+    map (``stream_sample``; None: the stream's own numbering is the truth)."""
+
+    delivered: Delivered
+    calibration: Calibration
+    backends: dict[str, Any]
+    stream_sample: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Source:
+    """An acquisition source that replaces the modeled board (SimConfig.firmware).
+
+    ``acquire(cfg, n, progress)`` delivers the records of n samples;
+    ``check(cfg)`` refuses configurations it cannot run (InvalidArgument);
+    ``trajectory(cfg_period, gyro, conditioning, duration)`` is the motion the
+    source produces (the CLI builds its truth with it); ``description`` says
+    what runs."""
+
+    name: str
+    description: str
+    acquire: Callable[[SimConfig, int, Progress | None], SourceOutput]
+    check: Callable[[SimConfig], None]
+    trajectory: Callable[[float, GyroModel, Conditioning, float], Trajectory]
+
+
+_SOURCES: dict[str, Source] = {}
+
+#: Sources this package knows by name but does not contain: where they come from.
+KNOWN_SOURCES = {"s51": "the AT89S51 firmware in s51 runs from a source checkout: "
+                        "python -m toolchain.simulate --firmware s51 ... (docs/firmware.md)"}
+
+
+def register_source(src: Source) -> None:
+    """Make ``src`` available as ``SimConfig(firmware=src.name)``."""
+    _SOURCES[src.name] = src
+
+
+def source(name: str) -> Source:
+    """The registered source ``name`` (InvalidArgument saying where it comes from if absent)."""
+    try:
+        return _SOURCES[name]
+    except KeyError:
+        hint = KNOWN_SOURCES.get(name, f"registered: {sorted(_SOURCES) or 'none'}")
+        raise InvalidArgument(f"firmware source {name!r} is not available here: {hint}") from None
+
+
+# ---------------------------------------------------------------------------
+# the modeled acquisition: sensors → conditioning → ADC → board → link
+# ---------------------------------------------------------------------------
 
 def _spawn(seed: int) -> dict[str, np.random.Generator]:
     # independent streams per error source, so that switching one source off
@@ -181,53 +242,49 @@ def _spawn(seed: int) -> dict[str, np.random.Generator]:
     return {n: np.random.default_rng(s) for n, s in zip(names, ss.spawn(len(names)))}
 
 
-def _acquire(cfg: SimConfig, gyro: GyroModel, t0: float, n: int, rngs: dict[str, np.random.Generator],
-             static: bool, bias: np.ndarray, progress: Progress | None, label: str) -> np.ndarray:
-    """Board output words (n, 3) for n sample periods from t0."""
-    h = cfg.period
-    m = cfg.board.oversample
-    dt = h / m
-    delay = gyro.tau if cfg.board.delay_comp else 0.0
-    frac = 0.5 if cfg.board.sample_at == "mid" else 0.0
-    ti = t0 + (np.arange(n * m) + frac) * dt + delay
-    if static:
-        rate = np.zeros((n * m, 3))
-    else:
-        rate = filtered_rate(cfg.trajectory, ti, gyro.tau)
-    rate = rate + rate_noise(n * m, dt, gyro, rngs["noise_cal" if static else "noise_run"])
-    v = gyro_volts(rate, gyro, bias)
-    g = cfg.conditioning.gain(gyro)
-    v_adc = cfg.conditioning.vref / 2 + g * (v - gyro.null_v)
+def _words(cfg: SimConfig, gyro: Gyro, t0: float, n: int, rng: np.random.Generator, static: bool,
+           progress: Progress | None, label: str) -> np.ndarray:
+    """The board's words (n, 3) of n periods from t0: gyro → conditioning → ADC → board sums."""
+    board = cfg.board
+    ti = board.instants(t0, n, cfg.period, gyro.model.tau)
+    volts = gyro.volts(cfg.trajectory, ti, cfg.period / board.oversample, rng, static)
+    v_adc = cfg.conditioning.apply(volts, gyro.model)
     cb = None
     if progress is not None:
-        total = n * m
+        total = len(ti)
 
         def cb(done: int) -> None:
             progress(label, done, total)
-    codes = cfg.adc.convert(v_adc, cb)
-    return codes.reshape(n, m, 3).sum(axis=1)
+    return board.sums(cfg.adc.convert(v_adc, cb))
 
 
-def _calibrate(cfg: SimConfig, gyro: GyroModel, rngs: dict[str, np.random.Generator],
-               bias: np.ndarray, progress: Progress | None) -> Calibration:
+def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
+           progress: Progress | None) -> SourceOutput:
+    model = cfg.gyro if cfg.sensors == "full" else cfg.gyro.without(
+        noise=True, bias=True, bandwidth=True, scale=True)
+    gyro = Gyro(model, rngs["bias"].standard_normal(3) * model.bias_dps * DEG)
     m = cfg.board.oversample
-    full = 1 << cfg.adc.bits
-    g = cfg.conditioning.gain(gyro)
-    # codes per rad/s through gyro scale, conditioning gain and ADC
-    codes_per_rad_s = gyro.scale_v_per_dps / DEG * g * full / cfg.adc.vref
+    k = cfg.rad_per_s_per_code()  # nominal: the error sources switched off keep range and scale
+    # host calibration: the gyros sit still for calibration_s before the run
     n_cal = round(cfg.calibration_s / cfg.period)
+    t0 = cfg.trajectory.t_start
     if n_cal > 0:
-        words = _acquire(cfg, gyro, cfg.trajectory.t_start - cfg.calibration_s, n_cal, rngs,
-                         True, bias, progress, "calibration")
-        zero = words.mean(axis=0)
+        calib = Calibration.from_static(_words(cfg, gyro, t0 - cfg.calibration_s, n_cal, rngs["noise_cal"], True,
+                                               progress, "calibration"), m, k)
     else:  # nominal zero: mid-scale
-        zero = np.full(3, m * cfg.adc.vref / 2 * full / cfg.adc.vref)
-    return Calibration(zero_sum=zero, rad_per_s_per_code=1.0 / codes_per_rad_s, oversample=m)
+        calib = Calibration(np.full(3, cfg.adc.vref / 2 * (1 << cfg.adc.bits) / cfg.adc.vref), k, m)
+    words = _words(cfg, gyro, t0, n, rngs["noise_run"], False, progress, "adc")
+    stream = cfg.board.stream(words, cfg.period)
+    delivered = Link(cfg.link, cfg.ber, cfg.link_attempts).carry(stream, rngs["link"], cfg.period)
+    backends: dict[str, Any] = {"adc": cfg.adc.backend}
+    if cfg.link == "c":
+        backends["link"] = delivered.stats.get("backend", "c")
+    return SourceOutput(delivered, calib, backends, stream.sample)
 
 
 @dataclass
 class Acquired:
-    """Increments as the host's integrator receives them, and their origin."""
+    """Increments as the host's estimator receives them, and their origin."""
 
     increments: np.ndarray  # (m, 3) rad
     sample_index: np.ndarray  # (m,) true sample index of each increment
@@ -235,108 +292,68 @@ class Acquired:
     calibration: Calibration | None
     backends: dict[str, Any]
     samples: int
+    decoded: Decoded | None = None
 
 
 def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
-    """The sensor side of the chain: trajectory → gyros → ADC → board → link →
-    calibrated increments (everything before the integrator)."""
+    """The acquisition side: a source (the modeled board and link, or a registered
+    one) → the host's decoding; or the exact increments with ``sensors="ideal"``."""
     cfg.validate()
-    h = cfg.period
-    n = math.floor(cfg.duration / h + 1e-9)
-    t0 = cfg.trajectory.t_start
-    rngs = _spawn(cfg.seed)
-    backends: dict[str, Any] = {}
-    link_stats: dict[str, Any] = {"link": "none"}
-    calib = None
-    if cfg.firmware == "s51":
-        from .firmware import run_firmware
-
-        codes, idx, link_stats = run_firmware(n, h, cfg.trajectory,  # type: ignore[arg-type]
-                                              cfg.link_attempts, progress)
-        # one truncating conversion per period (the in-image model: code = v >> 4)
-        calib = Calibration(zero_sum=np.full(3, 2047.5),
-                            rad_per_s_per_code=cfg.trajectory.rad_per_s_per_code,  # type: ignore[attr-defined]
-                            oversample=1)
-        inc = calib.increments(codes, h)
-        backends["sensors"] = "AT89S51 firmware in s51 (TLC2543 + gyro model in the image)"
-        backends["link"] = "firmware link sender → pty → C receiver"
-    elif cfg.sensors == "ideal":
-        inc = cfg.trajectory.increments(t0, h, n)
+    n = math.floor(cfg.duration / cfg.period + 1e-9)
+    if cfg.sensors == "ideal" and cfg.firmware is None:
+        inc = cfg.trajectory.increments(cfg.trajectory.t_start, cfg.period, n)
         idx = np.arange(n)
-        backends["sensors"] = "exact increments"
+        return Acquired(inc, idx, {"link": "none"}, None, {"sensors": "exact increments"}, n,
+                        Decoded(inc, idx, np.zeros((n, 3), dtype=np.int64)))
+    if cfg.firmware is not None:
+        out = source(cfg.firmware).acquire(cfg, n, progress)
     else:
-        gyro = cfg.gyro if cfg.sensors == "full" else cfg.gyro.without(
-            noise=True, bias=True, bandwidth=True, scale=True)
-        bias = rngs["bias"].standard_normal(3) * gyro.bias_dps * DEG
-        calib = _calibrate(cfg, gyro, rngs, bias, progress)
-        words = _acquire(cfg, gyro, t0, n, rngs, False, bias, progress, "adc")
-        backends["adc"] = cfg.adc.backend
-        if cfg.link == "c":
-            from ._link import send_words
-
-            delivered, idx, link_stats = send_words(
-                words, ber=cfg.ber, rng=rngs["link"], attempts=cfg.link_attempts,
-                period=h, progress=progress)
-            backends["link"] = link_stats.get("backend", "c")
-        else:
-            delivered, idx = words, np.arange(n)
-            link_stats = {"link": "none", "sent": n, "delivered": n, "lost": 0, "duplicated": 0,
-                          "corrupted_undetected": 0}
-        inc = calib.increments(delivered, h)
-    return Acquired(inc, idx, link_stats, calib, backends, n)
+        out = _model(cfg, n, _spawn(cfg.seed), progress)
+    dec = HostDecoder(out.calibration, cfg.period).decode(out.delivered, out.stream_sample)
+    keep = dec.sample_index < n  # a source may deliver past the run (the firmware stops on blocks)
+    dec = Decoded(dec.increments[keep], dec.sample_index[keep], dec.words[keep],
+                  [k for k in dec.held if k < n], dec.reports)
+    stats = dict(out.delivered.stats)
+    if out.stream_sample is None:  # the stream's own numbering: count what it says
+        good = len(dec.sample_index) - len(dec.held)
+        stats.update(delivered=good, delivered_ok=good, lost=n - good, held=dec.held, reports=dec.reports)
+    return Acquired(dec.increments, dec.sample_index, stats, out.calibration, out.backends, n, dec)
 
 
 def simulate(cfg: SimConfig, progress: Progress | None = None,
              acquired: Acquired | None = None) -> SimResult:
     """Run one scenario end to end. ``progress(stage, done, total)`` is called
     during the long stages (ADC conversions, link blocks). ``acquired``
-    reuses the sensor side of an earlier run (same sensors, link and seed)."""
+    reuses the acquisition side of an earlier run (same sensors, link and seed)."""
     t_wall = time.perf_counter()
     cfg.validate()
     acq = acquired if acquired is not None else acquire(cfg, progress)
-    h = cfg.period
-    t0 = cfg.trajectory.t_start
-    n = acq.samples
-    inc, idx, link_stats, calib = acq.increments, acq.sample_index, acq.link_stats, acq.calibration
+    estimator = Integrate(cfg.method, cfg.precision)
+    dec = acq.decoded if acq.decoded is not None else Decoded(acq.increments, acq.sample_index,
+                                                              np.zeros((len(acq.increments), 3), dtype=np.int64))
+    est = estimator.run(dec, cfg.trajectory.quat, cfg.trajectory.t_start, cfg.period)
+    res = compare(est, cfg.trajectory)
     backends = dict(acq.backends)
-    backends["integrator"] = f"attitude_c.integrate ({cfg.precision})"
-    first = int(idx[0]) if len(idx) else 0
-
-    def q0_at(offset: float) -> np.ndarray:
-        return cfg.trajectory.quat(t0 + (first + offset) * h)
-
-    q_est, last, offset = _integ.run_integrator(inc, cfg.method, q0_at, cfg.precision, h)
-    sample_idx = idx[last] if len(last) else np.zeros(0, dtype=int)
-    t_out = t0 + (sample_idx + offset) * h
-    q_true = cfg.trajectory.quat(t_out)
-    e_est = quat_to_euler(q_est) if len(q_est) else np.zeros((0, 3))
-    e_true = cfg.trajectory.euler(t_out) if len(t_out) else np.zeros((0, 3))
-    err = wrap_angle(e_est - e_true)
-    err_angle = quat_angle_between(q_true, q_est) if len(q_est) else np.zeros(0)
+    backends["integrator"] = estimator.backend
+    errors = res.summary()
     summary: dict[str, Any] = {
         "attitude_c_version": _package_version(),
         "parameters": cfg.params(),
-        "updates": len(t_out),
-        "samples": int(n),
-        "errors_rad": {
-            "heading": _stats(-err[:, 0]),
-            "yaw": _stats(err[:, 0]),
-            "pitch": _stats(err[:, 1]),
-            "roll": _stats(err[:, 2]),
-            "attitude_angle": _stats(err_angle),
-        },
+        "updates": len(res.t),
+        "samples": int(acq.samples),
+        "errors_rad": errors,
         "paper_maxima_rad": {"heading": PAPER_MAXIMA["heading"][1], "pitch": PAPER_MAXIMA["pitch"][1]},
-        "link": link_stats,
+        "link": acq.link_stats,
         "backends": backends,
     }
-    eh = summary["errors_rad"]
     summary["times_better_than_paper"] = {
-        "heading": PAPER_MAXIMA["heading"][1] / max(eh["heading"]["max_abs"], 1e-300),
-        "pitch": PAPER_MAXIMA["pitch"][1] / max(eh["pitch"]["max_abs"], 1e-300),
+        "heading": PAPER_MAXIMA["heading"][1] / max(errors["heading"]["max_abs"], 1e-300),
+        "pitch": PAPER_MAXIMA["pitch"][1] / max(errors["pitch"]["max_abs"], 1e-300),
     }
-    if calib is not None:
-        summary["calibration"] = calib.to_dict()
+    if acq.calibration is not None:
+        summary["calibration"] = acq.calibration.to_dict()
     summary["elapsed_s"] = time.perf_counter() - t_wall
-    return SimResult(config=cfg, t=t_out, q_est=q_est, q_true=q_true, euler_est=e_est,
-                     euler_true=e_true, err=err, err_angle=err_angle, increments=inc,
-                     sample_index=idx, link_stats=link_stats, summary=summary)
+    return SimResult(config=cfg, t=res.t, q_est=res.q_est, q_true=res.q_true, euler_est=res.euler_est,
+                     euler_true=res.euler_true, err=res.err, err_angle=res.err_angle,
+                     increments=acq.increments, sample_index=acq.sample_index, link_stats=acq.link_stats,
+                     summary=summary)

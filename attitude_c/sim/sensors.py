@@ -1,19 +1,24 @@
-"""Gyro, analog conditioning, ADC and increment-formation models.
+"""Stage 2 of the simulator (docs/architecture.md): the sensors.
 
-The signal path of one axis, as on the paper's acquisition board (sec. 2,
-Fig. 1–3): gyro (rate → voltage) → analog conditioning (offset and gain to
-the ADC input range) → TLC2543 12-bit ADC → the AT89S51 sums ``oversample``
-conversions per sample period and sends the sum (one 16-bit word per axis) →
-the host subtracts the calibrated zero-rate sum and scales to an angle
-increment. Every figure below that comes from a paper says which; the
-others are marked as assumptions in docs/simulation.md.
+A sensor stage maps the truth (a :class:`~attitude_c.sim.trajectory.Trajectory`)
+at the conversion instants to the sensor's output voltages, (k, 3) for the
+three axes. The gyro is :class:`Gyro` (a :class:`GyroModel` from the paper's
+and the thesis's figures, its turn-on bias and its noise stream); sensors of
+other quantities (accelerometer, magnetometer) are stages of the same shape
+beside it, each reading its own truth method of the trajectory.
+
+Per conversion instant: the true rate through the gyro's first-order
+low-pass, the white noise through the same filter, the scale-factor error and
+the turn-on bias, clipped at the range, to volts (``v = null + scale ·
+rate``). Every figure that comes from a paper says which; the others are
+marked as assumptions in docs/simulation.md.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, replace
-from typing import Any, Callable, Literal
+from typing import Any
 
 import numpy as np
 
@@ -21,14 +26,14 @@ from ..errors import InvalidArgument
 from .trajectory import Trajectory
 
 __all__ = [
+    "DEG",
     "GYRO_PRESETS",
-    "AdcModel",
-    "Board",
-    "Calibration",
-    "Conditioning",
+    "Gyro",
     "GyroModel",
+    "filtered_rate",
     "gyro_preset",
-    "quantize_ideal",
+    "gyro_volts",
+    "rate_noise",
 ]
 
 DEG = math.pi / 180.0
@@ -75,6 +80,11 @@ class GyroModel:
         """Time constant of the output filter (s); 0 without one."""
         return 0.0 if not self.bandwidth_hz else 1.0 / (2 * math.pi * self.bandwidth_hz)
 
+    @property
+    def volts_per_rad_s(self) -> float:
+        """Nominal output change per rad/s (V)."""
+        return self.scale_v_per_dps / DEG
+
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
@@ -103,75 +113,6 @@ def gyro_preset(name: str) -> GyroModel:
         return GYRO_PRESETS[name]
     except KeyError:
         raise InvalidArgument(f"gyro must be one of {sorted(GYRO_PRESETS)}, got {name!r}") from None
-
-
-@dataclass(frozen=True)
-class Conditioning:
-    """Analog conditioning between gyro and ADC (the paper's "signal
-    processing" of Fig. 2 and the thesis's AD623 follower, sec. 4.4).
-
-    ``v_adc = vref/2 + gain · (v_gyro − null_v)`` with the gain chosen so that
-    the gyro's full range uses ``span`` of the ADC half-range (default 0.9:
-    10 % headroom before the ADC clips). ``vref`` = TLC2543 REF+ (V), REF− = 0.
-    """
-
-    vref: float = 5.0
-    span: float = 0.9
-
-    def gain(self, gyro: GyroModel) -> float:
-        return self.span * (self.vref / 2) / (gyro.range_dps * gyro.scale_v_per_dps)
-
-
-def quantize_ideal(v: np.ndarray, vref: float, bits: int = 12) -> np.ndarray:
-    """Ideal unipolar ADC: code = round(v / vref · 2^bits) clipped to the code
-    range (TLC2543 straight binary; beyond the rails it clips)."""
-    full = 1 << bits
-    c = np.floor(np.asarray(v, dtype=float) / vref * full + 0.5)
-    return np.clip(c, 0, full - 1).astype(np.int64)
-
-
-@dataclass
-class AdcModel:
-    """The ADC stage: ``backend`` ``"tlc2543"`` converts through the C TLC2543
-    driver against its device model (attitude_c.tlc2543); ``"ideal"`` is the
-    vectorized quantizer above (same transfer, no protocol)."""
-
-    vref: float = 5.0
-    bits: int = 12
-    backend: Literal["tlc2543", "ideal"] = "tlc2543"
-
-    def convert(self, volts: np.ndarray, progress: Callable[[int], None] | None = None) -> np.ndarray:
-        """(n, 3) voltages of channels X, Y, Z → (n, 3) integer codes."""
-        volts = np.asarray(volts, dtype=float)
-        if self.backend == "ideal":
-            return quantize_ideal(volts, self.vref, self.bits)
-        if self.backend == "tlc2543":
-            from ._tlc import convert_tlc2543
-
-            return convert_tlc2543(volts, self.vref, self.bits, progress)
-        raise InvalidArgument(f"adc backend must be 'tlc2543' or 'ideal', got {self.backend!r}")
-
-
-@dataclass(frozen=True)
-class Board:
-    """Increment formation on the acquisition board: ``oversample``
-    conversions per axis per sample period at the midpoints of equal
-    sub-intervals (delayed by the gyro filter's group delay when
-    ``delay_comp``), summed into one 16-bit word per axis."""
-
-    oversample: int = 16
-    delay_comp: bool = True
-    sample_at: Literal["mid", "start"] = "mid"  # "mid": sub-interval midpoints; "start": their starts
-
-    def check(self, bits: int) -> None:
-        if self.sample_at not in ("mid", "start"):
-            raise InvalidArgument(f"sample_at must be 'mid' or 'start', got {self.sample_at!r}")
-        if not (isinstance(bits, int) and 1 <= bits <= 16):
-            raise InvalidArgument(f"ADC bits must be 1..16 (16-bit link words), got {bits!r}")
-        if not 1 <= self.oversample <= (1 << (16 - bits)):
-            raise InvalidArgument(
-                f"oversample must be 1..{1 << (16 - bits)} so that the sum of {bits}-bit codes "
-                f"fits the link's 16-bit word, got {self.oversample}")
 
 
 # Gauss–Laguerre nodes for the first-order filter y(t) = ∫ ω(t−s) e^{−s/τ}/τ ds:
@@ -219,19 +160,22 @@ def gyro_volts(rate: np.ndarray, gyro: GyroModel, bias: np.ndarray) -> np.ndarra
     return gyro.null_v + gyro.scale_v_per_dps * dps
 
 
-@dataclass
-class Calibration:
-    """What the host knows: zero-rate code sum per axis and rad/s per code."""
+@dataclass(frozen=True)
+class Gyro:
+    """The gyro stage: three gyros of one :class:`GyroModel` with their turn-on
+    ``bias`` (rad/s, (3,), drawn once per run).
 
-    zero_sum: np.ndarray  # (3,) expected word at zero rate (oversample codes summed)
-    rad_per_s_per_code: float
-    oversample: int
+    :meth:`volts` takes the conversion instants (s, (k,), spaced ``dt``) and a
+    noise stream and returns the output voltages (k, 3); ``static`` feeds a
+    zero true rate (the calibration's still gyros) instead of the trajectory's.
+    """
 
-    def increments(self, words: np.ndarray, h: float) -> np.ndarray:
-        """(n, 3) words → (n, 3) angle increments (rad)."""
-        w = np.asarray(words, dtype=float)
-        return (w - self.zero_sum) * self.rad_per_s_per_code * (h / self.oversample)
+    model: GyroModel
+    bias: np.ndarray
 
-    def to_dict(self) -> dict[str, Any]:
-        return {"zero_code": (self.zero_sum / self.oversample).tolist(),
-                "rad_per_s_per_code": self.rad_per_s_per_code, "oversample": self.oversample}
+    def volts(self, traj: Trajectory, instants: np.ndarray, dt: float, rng: np.random.Generator,
+              static: bool = False) -> np.ndarray:
+        k = len(instants)
+        rate = np.zeros((k, 3)) if static else filtered_rate(traj, instants, self.model.tau)
+        rate = rate + rate_noise(k, dt, self.model, rng)
+        return gyro_volts(rate, self.model, self.bias)

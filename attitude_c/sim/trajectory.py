@@ -1,5 +1,6 @@
-"""Reference motions with exact truth: attitude, body rates and angle increments.
+"""Stage 1 of the simulator (docs/architecture.md): the truth.
 
+Reference motions with exact truth: attitude, body rates and angle increments.
 Every trajectory gives, for any time ``t`` (s):
 
 * ``quat(t)`` — the true attitude Q (scalar first, body → ENU);
@@ -13,6 +14,12 @@ Every trajectory gives, for any time ``t`` (s):
 Trajectories: ``paper`` (sinusoidal Euler angles, rates from the exact z-x-y
 Euler-rate kinematics), ``coning`` (classical coning, closed form),
 ``static``, ``constant-rate`` and ``csv`` (user data, slerp between rows).
+
+The sensor stage (:mod:`attitude_c.sim.sensors`) reads ``omega``; sensors of
+other quantities read further truth methods added here beside it (a
+trajectory then also gives, e.g., the specific force and the Earth's field
+in the body frame). The truth's rotation math is the NumPy reference
+(:mod:`attitude_c.reference`), never the C library the chain tests.
 """
 
 from __future__ import annotations
@@ -26,7 +33,16 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from ..errors import InvalidArgument, NonFiniteError
-from ._rot import euler_to_quat, quat_conj, quat_mul, quat_to_euler, quat_to_rotvec, rotvec_to_quat
+
+# truth-side rotation math: the NumPy reference, independent of the C library the chain tests
+from ..reference import (
+    euler_to_quat,
+    quat_conj,
+    quat_multiply,
+    quat_to_euler,
+    quat_to_rotvec,
+    rotvec_to_quat,
+)
 
 __all__ = [
     "TRAJECTORIES",
@@ -231,7 +247,7 @@ class ConstantRateTrajectory(Trajectory):
 
     def quat(self, t: Any) -> np.ndarray:
         t = np.asarray(t, dtype=float)[..., None]
-        return quat_mul(np.broadcast_to(self._q0, t.shape[:-1] + (4,)), rotvec_to_quat(self.rate * t))
+        return quat_multiply(np.broadcast_to(self._q0, t.shape[:-1] + (4,)), rotvec_to_quat(self.rate * t))
 
     def omega(self, t: Any) -> np.ndarray:
         t = np.asarray(t, dtype=float)
@@ -341,7 +357,7 @@ class CsvTrajectory(Trajectory):
         self.t_start = float(t[0])
         self.t_end = float(t[-1])
         dt = np.diff(t)
-        rv = quat_to_rotvec(quat_mul(quat_conj(q[:-1]), q[1:]))
+        rv = quat_to_rotvec(quat_multiply(quat_conj(q[:-1]), q[1:]))
         self.rates = rv / dt[:, None]  # body rate of each segment
         # cumulative integral of ω at the rows (piecewise linear in between)
         self._cum = np.vstack([np.zeros(3), np.cumsum(rv, axis=0)])
@@ -359,7 +375,7 @@ class CsvTrajectory(Trajectory):
     def quat(self, t: Any) -> np.ndarray:
         t = np.asarray(t, dtype=float)
         _, i, tau = self._seg(t)
-        return quat_mul(self.q[i], rotvec_to_quat(self.rates[i] * tau[..., None]))
+        return quat_multiply(self.q[i], rotvec_to_quat(self.rates[i] * tau[..., None]))
 
     def omega(self, t: Any) -> np.ndarray:
         t = np.asarray(t, dtype=float)

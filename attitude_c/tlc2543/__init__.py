@@ -69,12 +69,14 @@ class SelfTestError(DeviceError):
         self.codes = codes
 
 
+#: The driver's and its model's status codes (attitude/tlc2543.h, csrc/host/tlc2543_model.h),
+#: keyed by C name (attitude_c.names).
 _STATUS = {
-    -40: (DeviceTimeout, "EOC did not rise (conversion never ended): EOC stuck low?"),
-    -41: (SelfTestError, "self-test: (Vref+ + Vref-)/2 code is not 0x800 +- 2"),
-    -42: (SelfTestError, "self-test: Vref- code is not 0x000 + 2"),
-    -43: (SelfTestError, "self-test: Vref+ code is not 0xFFF - 2"),
-    -50: (ProtocolViolation, "protocol violation"),
+    "TLC2543_E_EOC_TIMEOUT": (DeviceTimeout, "EOC did not rise (conversion never ended): EOC stuck low?"),
+    "TLC2543_E_SELFTEST_MID": (SelfTestError, "self-test: (Vref+ + Vref-)/2 code is not 0x800 +- 2"),
+    "TLC2543_E_SELFTEST_REFM": (SelfTestError, "self-test: Vref- code is not 0x000 + 2"),
+    "TLC2543_E_SELFTEST_REFP": (SelfTestError, "self-test: Vref+ code is not 0xFFF - 2"),
+    "TLC2543M_E_VIOLATION": (ProtocolViolation, "protocol violation"),
 }
 
 

@@ -67,7 +67,7 @@ typedef struct {
     unsigned long pending;     /* sample periods integrated since the last update (rv2/rv3/rk4) */
     unsigned long undelivered; /* acknowledged samples never integrated: output failed or blocked */
     unsigned long lines_lost;  /* attitude lines that could not be written */
-    unsigned long reports[ATT_BLOCK_ADC_ERROR + 1];
+    unsigned long reports[ATT_BLOCK_OVERSAMPLE + 1];
     unsigned long block_errors, seq_errors;
     double period;   /* s, the sample period in use */
     double t;        /* s, time integrated so far (sample periods, held ones included) */
@@ -76,8 +76,8 @@ typedef struct {
     int out_blocked; /* stdout stayed blocked past the grace time after a stop */
 } rx_app;
 
-static const char *const report_names[ATT_BLOCK_ADC_ERROR + 1] = { "BOOT", "SELFTEST", "GAVE_UP", "OVERRUN",
-                                                                   "ADC_ERROR" };
+static const char *const report_names[ATT_BLOCK_OVERSAMPLE + 1] = { "BOOT",    "SELFTEST",  "GAVE_UP",
+                                                                    "OVERRUN", "ADC_ERROR", "OVERSAMPLE" };
 
 static rx_stop *g_stop = NULL; /* for the signal handler only */
 static volatile sig_atomic_t g_signal = 0;
@@ -217,9 +217,12 @@ static int deliver(rx_app *app, rx_acked *x, const uint8_t *block)
         rx_item *it = &items[n];
         memset(it, 0, sizeof *it);
         memcpy(it->raw, block + k, sizeof it->raw);
-        it->status = att_block_decode(it->raw, &it->blk);
-        if (it->status == ATT_OK || it->status == ATT_BLOCK_E_CODE) /* a bad sample still takes its number */
-            it->seq_status = att_block_seq_feed(&seq, &it->blk, &it->span);
+        it->status = att_block_seq_decode(&seq, it->raw, &it->blk,
+                                          &it->span); /* a bad sample still takes its number */
+        if (it->status == ATT_BLOCK_E_SEQ) {
+            it->seq_status = it->status;
+            it->status = ATT_OK;
+        }
         if (it->blk.kind == ATT_BLOCK_SAMPLE)
             samples++;
         periods += periods_of(it, &have_good);
@@ -400,9 +403,11 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
 /* The attitude thread's integration state. */
 typedef struct {
     att_integ integ;
-    att_real rate[3]; /* body rate of the last good sample, rad/s */
-    uint16_t code[3]; /* its codes */
-    int have_rate;    /* a good sample has been integrated */
+    att_sensor gyro;    /* codes -> body rate (--gyro-zero, --gyro-scale, --axes) */
+    uint8_t oversample; /* conversions per sample word: 1, or the stream's OVERSAMPLE */
+    att_real rate[3];   /* body rate of the last good sample, rad/s */
+    uint16_t code[3];   /* its codes */
+    int have_rate;      /* a good sample has been integrated */
 } rx_att;
 
 static int finished(const rx_app *app)
@@ -469,18 +474,14 @@ static void hold(rx_app *app, rx_att *a, uint32_t first, uint32_t n, const char 
     }
 }
 
-/* A good sample: codes -> body rate (calibration, axes) -> integrator. */
+/* A good sample: codes -> body rate (calibration, axes: att_sensor) -> integrator. */
 static void sample(rx_app *app, rx_att *a, const rx_item *it)
 {
-    const rx_config *c = &app->cfg;
-    att_real ch[3];
     int i;
+    if (att_sensor_convert(&a->gyro, it->blk.code, a->oversample, a->rate) != ATT_OK)
+        return; /* not reached: the tracker checked the codes against the stream's limit */
     for (i = 0; i < 3; i++)
-        ch[i] = (att_real)(((double)it->blk.code[i] - c->zero[i]) * c->scale[i]); /* rad/s */
-    for (i = 0; i < 3; i++) {
-        a->rate[i] = (att_real)c->axis_sign[i] * ch[c->axis_src[i]];
         a->code[i] = it->blk.code[i];
-    }
     a->have_rate = 1;
     app->integrated++;
     integrate(app, a, it->span.first, a->rate, a->code);
@@ -535,7 +536,15 @@ static void report(rx_app *app, rx_att *a, const rx_item *it)
     const char *name = report_names[b->kind];
     app->reports[b->kind]++;
     if (b->kind == ATT_BLOCK_BOOT) {
+        a->oversample = 1; /* a new stream: plain codes until an OVERSAMPLE report */
         boot(app, b);
+        return;
+    }
+    if (b->kind == ATT_BLOCK_OVERSAMPLE) {
+        a->oversample = b->oversample;
+        rx_log(&app->stop, "OVERSAMPLE: each sample word is the sum of %u conversions", b->oversample);
+        snprintf(body, sizeof body, "\"report\":\"OVERSAMPLE\",\"n\":%u", b->oversample);
+        json_record(app, body);
         return;
     }
     if (b->kind == ATT_BLOCK_SELFTEST) {
@@ -604,6 +613,12 @@ static void *attitude_thread(void *arg)
     rx_item it;
 
     memset(&a, 0, sizeof a);
+    a.oversample = 1;
+    if (rx_gyro_init(c, &a.gyro) != ATT_OK) {
+        rx_log(&app->stop, "gyro calibration rejected (--gyro-zero, --gyro-scale, --axes)");
+        rx_stop_request(&app->stop);
+        return NULL;
+    }
     if (att_integ_init(&a.integ, c->method, NULL) != ATT_OK) {
         rx_log(&app->stop, "integrator rejected method %s", rx_method_name(c->method));
         rx_stop_request(&app->stop);
@@ -659,11 +674,11 @@ static void print_statistics(rx_app *app)
            app->undelivered, app->lines_lost, app->queue.high_water, app->updates, app->integ_errors,
            app->port_errors, app->reopens);
     rx_log(&app->stop,
-           "reports: boot=%lu selftest=%lu gave_up=%lu overrun=%lu adc_error=%lu block_errors=%lu "
-           "seq_errors=%lu",
+           "reports: boot=%lu selftest=%lu gave_up=%lu overrun=%lu adc_error=%lu oversample=%lu "
+           "block_errors=%lu seq_errors=%lu",
            app->reports[ATT_BLOCK_BOOT], app->reports[ATT_BLOCK_SELFTEST], app->reports[ATT_BLOCK_GAVE_UP],
-           app->reports[ATT_BLOCK_OVERRUN], app->reports[ATT_BLOCK_ADC_ERROR], app->block_errors,
-           app->seq_errors);
+           app->reports[ATT_BLOCK_OVERRUN], app->reports[ATT_BLOCK_ADC_ERROR],
+           app->reports[ATT_BLOCK_OVERSAMPLE], app->block_errors, app->seq_errors);
     if (app->undelivered || app->lines_lost)
         rx_log(&app->stop, "%lu acknowledged sample%s not integrated and %lu attitude line%s not printed: %s",
                app->undelivered, app->undelivered == 1 ? "" : "s", app->lines_lost,

@@ -105,6 +105,10 @@ const char *rx_method_name(att_method m);
  * 0 if the rate fits, 1 with the numbers in msg if it does not. */
 int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t msglen);
 
+/* The gyro converter (attitude/sensor.h) of the configuration's zero,
+ * scale and axes: att_sensor_init's status. */
+int rx_gyro_init(const rx_config *c, att_sensor *gyro);
+
 void rx_usage(const char *prog, void *stream);
 
 /* ---- bounded record queue (one producer, one consumer) ---- */

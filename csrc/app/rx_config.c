@@ -24,6 +24,21 @@ static const struct {
     { "rk4", ATT_METHOD_RK4 },
 };
 
+int rx_gyro_init(const rx_config *c, att_sensor *gyro)
+{
+    att_real zero[3], scale[3];
+    uint8_t axis[3];
+    int8_t sign[3];
+    int i;
+    for (i = 0; i < 3; i++) {
+        zero[i] = (att_real)c->zero[i];
+        scale[i] = (att_real)c->scale[i];
+        axis[i] = (uint8_t)c->axis_src[i];
+        sign[i] = (int8_t)c->axis_sign[i];
+    }
+    return att_sensor_init(gyro, zero, scale, axis, sign);
+}
+
 const char *rx_method_name(att_method m)
 {
     size_t i;

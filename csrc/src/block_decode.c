@@ -72,6 +72,13 @@ int att_block_decode(const uint8_t *raw, att_block *out)
             st = ATT_BLOCK_E_FIELD;
         }
         break;
+    case ATT_BLOCK_OVERSAMPLE:
+        out->oversample = raw[2];
+        if (raw[2] < 1u || raw[2] > (uint8_t)ATT_BLOCK_OVERSAMPLE_MAX || raw[3] != 0u || raw[4] != 0u
+            || raw[5] != 0u) {
+            st = ATT_BLOCK_E_FIELD;
+        }
+        break;
     default:
         st = ATT_BLOCK_E_KIND;
         break;
@@ -86,6 +93,7 @@ void att_block_seq_init(att_block_seq *s)
     }
     s->next = 0;
     s->synced = 0;
+    s->oversample = 1;
 }
 
 int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span)
@@ -106,10 +114,19 @@ int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *spa
     case ATT_BLOCK_BOOT:
         s->next = 0;
         s->synced = 1;
+        s->oversample = 1; /* a new stream: plain until it says otherwise */
         span->first = 0;
         span->count = 0;
         return ATT_OK;
     case ATT_BLOCK_SELFTEST:
+        span->first = s->next;
+        span->count = 0;
+        return ATT_OK;
+    case ATT_BLOCK_OVERSAMPLE:
+        if (b->oversample < 1u || b->oversample > (uint8_t)ATT_BLOCK_OVERSAMPLE_MAX) {
+            return ATT_BLOCK_E_FIELD;
+        }
+        s->oversample = b->oversample;
         span->first = s->next;
         span->count = 0;
         return ATT_OK;
@@ -144,4 +161,32 @@ int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *spa
     }
     s->next = span->first + span->count;
     return d == 0 ? ATT_OK : ATT_BLOCK_E_SEQ;
+}
+
+int att_block_seq_decode(att_block_seq *s, const uint8_t *raw, att_block *out, att_block_span *span)
+{
+    uint32_t limit;
+    uint8_t i;
+    int st, placed;
+    if (s == NULL || raw == NULL || out == NULL || span == NULL) {
+        return ATT_E_NULL;
+    }
+    st = att_block_decode(raw, out);
+    if (out->kind == (uint16_t)ATT_BLOCK_SAMPLE) {
+        /* the stream's limit instead of the plain one (a zeroed tracker is plain) */
+        limit = (uint32_t)(s->oversample > 1u ? s->oversample : 1u) * (uint32_t)ATT_BLOCK_CODE_MAX;
+        if (limit > (uint32_t)ATT_BLOCK_SUM_MAX) {
+            limit = (uint32_t)ATT_BLOCK_SUM_MAX;
+        }
+        st = ATT_OK;
+        for (i = 0; i < 3u; i++) {
+            if ((uint32_t)out->code[i] > limit) {
+                st = ATT_BLOCK_E_CODE;
+            }
+        }
+    } else if (st != ATT_OK) {
+        return st; /* no place in the numbering */
+    }
+    placed = att_block_seq_feed(s, out, span);
+    return st != ATT_OK ? st : placed;
 }

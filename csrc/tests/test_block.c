@@ -136,9 +136,9 @@ static void test_decoder_rejects(void)
     }
     CHECK_EQ_INT(v, 0x10000L);
     r[0] = 0xFE;
-    r[1] = 5; /* no such kind */
+    r[1] = 6; /* no such kind */
     CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
-    CHECK_EQ_INT(d.kind, 5);
+    CHECK_EQ_INT(d.kind, 6);
     r[1] = 0xFF;
     CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
     CHECK(d.kind != ATT_BLOCK_SAMPLE);
@@ -154,6 +154,9 @@ static void test_decoder_rejects(void)
             { 0xFE, 0x03, 0x00, 0x05, 0x00, 0x00 }, /* overrun of 0 samples */
             { 0xFE, 0x04, 0x00, 0x05, 0x05, 0x00 }, /* ADC error status 5 */
             { 0xFE, 0x04, 0x00, 0x05, 0xD8, 0x01 }, /* ADC error, last byte not 0 */
+            { 0xFE, 0x05, 0x00, 0x00, 0x00, 0x00 }, /* oversample 0 */
+            { 0xFE, 0x05, 0x11, 0x00, 0x00, 0x00 }, /* oversample 17 */
+            { 0xFE, 0x05, 0x10, 0x00, 0x01, 0x00 }, /* oversample, a padding byte not 0 */
         };
         size_t i;
         for (i = 0; i < sizeof bad / sizeof bad[0]; i++) {
@@ -291,6 +294,112 @@ static void test_tracker_wraps_and_late_join(void)
     CHECK_EQ_INT(att_block_seq_feed(&t, &d, NULL), ATT_E_NULL);
 }
 
+/* Oversampled streams: the OVERSAMPLE report, sample records of sums, and
+ * the tracker's per-stream limit (block.h, "Oversampled streams"). */
+static void test_oversampled_streams(void)
+{
+    uint8_t b[ATT_BLOCK_SIZE], raw[ATT_BLOCK_SIZE];
+    static const uint8_t over16[6] = { 0xFE, 0x05, 0x10, 0x00, 0x00, 0x00 };
+    static const uint8_t sums[6] = { 0x80, 0x00, 0xFD, 0xFF, 0x00, 0x00 };
+    uint16_t w[3] = { 0x8000, 0xFDFF, 0 };
+    uint16_t plain[3] = { 0x123, 0xFFF, 0 };
+    att_block d;
+    att_block_seq s;
+    att_block_span span;
+    unsigned n;
+
+    CHECK_EQ_INT(att_block_encode_oversample(b, 16), ATT_OK);
+    CHECK(bytes_eq(b, over16));
+    CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
+    CHECK_EQ_INT(d.kind, ATT_BLOCK_OVERSAMPLE);
+    CHECK_EQ_INT(d.oversample, 16);
+    CHECK_EQ_INT(att_block_encode_oversample(b, 0), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_oversample(b, 17), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_oversample(NULL, 1), ATT_E_NULL);
+
+    CHECK_EQ_INT(att_block_encode_sums(b, w, 16), ATT_OK);
+    CHECK(bytes_eq(b, sums));
+    w[1] = 0xFE00; /* byte 0 would read as the report mark */
+    CHECK_EQ_INT(att_block_encode_sums(b, w, 16), ATT_BLOCK_E_CODE);
+    CHECK(bytes_eq(b, sums)); /* checked before writing */
+    w[1] = 2u * 4095u + 1u;
+    CHECK_EQ_INT(att_block_encode_sums(b, w, 2), ATT_BLOCK_E_CODE);
+    w[1] = 2u * 4095u;
+    CHECK_EQ_INT(att_block_encode_sums(b, w, 2), ATT_BLOCK_E_CODE); /* w[0] = 0x8000 > 8190 */
+    CHECK_EQ_INT(att_block_encode_sums(b, w, 0), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_sums(b, NULL, 1), ATT_E_NULL);
+    /* n = 1 is the plain sample record */
+    CHECK_EQ_INT(att_block_encode_sums(raw, plain, 1), ATT_OK);
+    CHECK_EQ_INT(att_block_encode_sample(b, plain), ATT_OK);
+    CHECK(bytes_eq(b, raw));
+
+    /* the limit of every n: n x 4095, capped at 0xFDFF (n = 16 only) */
+    for (n = 1; n <= ATT_BLOCK_OVERSAMPLE_MAX; n++) {
+        uint32_t lim = n * 4095u < 0xFDFFu ? n * 4095u : 0xFDFFu;
+        uint16_t top[3], over[3];
+        top[0] = top[1] = top[2] = (uint16_t)lim;
+        over[0] = over[1] = 0;
+        over[2] = (uint16_t)(lim + 1u);
+        att_block_seq_init(&s);
+        att_block_encode_boot(raw, 72, 8);
+        CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+        att_block_encode_oversample(raw, (uint8_t)n);
+        CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+        CHECK_EQ_INT(span.count, 0);
+        CHECK_EQ_INT(s.oversample, n);
+        CHECK_EQ_INT(att_block_encode_sums(raw, top, (uint8_t)n), ATT_OK);
+        CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+        CHECK_EQ_INT(d.code[2], lim);
+        CHECK_EQ_INT(span.first, 0);
+        CHECK_EQ_INT(att_block_encode_sums(raw, over, (uint8_t)n), ATT_BLOCK_E_CODE);
+        raw[4] = (uint8_t)(over[2] >> 8); /* written by hand: the encoder refuses it */
+        raw[5] = (uint8_t)over[2];
+        raw[0] = raw[1] = raw[2] = raw[3] = 0;
+        CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_CODE);
+        CHECK_EQ_INT(span.first, 1); /* a bad sample still takes its number */
+        CHECK_EQ_INT(d.code[2], lim + 1u);
+    }
+
+    /* a BOOT makes the stream plain again; a zeroed tracker is plain */
+    att_block_encode_boot(raw, 72, 8);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+    CHECK_EQ_INT(s.oversample, 1);
+    w[0] = 4096;
+    w[1] = w[2] = 0;
+    att_block_encode_sums(raw, w, 2);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_CODE);
+    memset(&s, 0, sizeof s);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_CODE);
+    w[0] = 4095;
+    att_block_encode_sums(raw, w, 1);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+
+    /* records with no place: the stream is unchanged */
+    att_block_seq_init(&s);
+    CHECK_EQ_INT(att_block_seq_decode(&s, over16, &d, &span), ATT_OK);
+    raw[0] = 0xFE;
+    raw[1] = 0x05;
+    raw[2] = 0x00; /* oversample 0 */
+    raw[3] = raw[4] = raw[5] = 0;
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_FIELD);
+    raw[1] = 0x09;
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_KIND);
+    CHECK_EQ_INT(s.oversample, 16);
+    CHECK_EQ_INT(s.next, 0);
+    /* a loss report after a slip: E_SEQ as att_block_seq_feed says */
+    att_block_encode_sums(raw, w, 16);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+    att_block_encode_boot(raw, 72, 8);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_OK);
+    att_block_encode_loss(raw, ATT_BLOCK_OVERRUN, 3, 1);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, &span), ATT_BLOCK_E_SEQ);
+    CHECK_EQ_INT(span.slip, 3);
+    CHECK_EQ_INT(att_block_seq_decode(NULL, raw, &d, &span), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_seq_decode(&s, NULL, &d, &span), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, NULL, &span), ATT_E_NULL);
+    CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, NULL), ATT_E_NULL);
+}
+
 int main(void)
 {
     test_encoders_write_the_specified_bytes();
@@ -301,5 +410,6 @@ int main(void)
     test_round_trips();
     test_tracker_numbers_across_losses();
     test_tracker_wraps_and_late_join();
+    test_oversampled_streams();
     return ATT_TEST_REPORT();
 }

@@ -21,6 +21,8 @@
  *   link_tx BLOCK SYN_TO ANS_TO ATTEMPTS BYTES... -- N events for sender A;
  *   wden_dwt WAVELET LEVELS, wden_idwt WAVELET LEVELS -- N samples (1) -> N coefficients
  *     (wavedec order) and back;
+ *   sensor OVERSAMPLE PERIOD Z0 Z1 Z2 K0 K1 K2 A0 A1 A2 S0 S1 S2 -- N words (3) -> N increments (3)
+ *     (att_sensor_increments; Z zero codes, K scales, A the channel of each body axis, S signs);
  *   wden_stream WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END DETREND -- N samples (1) pushed in one
  *     att_wden_push_n() call, then flushed -> N denoised samples;
  *     WAVELET = haar|db2|db4, MODE = soft|hard;
@@ -284,6 +286,38 @@ static int run_wden(const char *id, const char *fn, size_t n)
     return -1;
 }
 
+/* Sensor words to increments (attitude/sensor.h). */
+static int run_sensor(const char *id, size_t n)
+{
+    static uint16_t words[3 * MAX_REC];
+    double p[14];
+    att_real zero[3], scale[3];
+    uint8_t axis[3];
+    int8_t sign[3];
+    att_sensor s;
+    size_t i, err = 0;
+    att_status st;
+    for (i = 0; i < 14; i++)
+        if (number(&p[i]) != 0)
+            return -1;
+    for (i = 0; i < 3; i++) {
+        zero[i] = (att_real)p[2 + i];
+        scale[i] = (att_real)p[5 + i];
+        axis[i] = (uint8_t)p[8 + i];
+        sign[i] = (int8_t)p[11 + i];
+    }
+    if (read_values(in_buf, 3 * n) != 0)
+        return -1;
+    for (i = 0; i < 3 * n; i++)
+        words[i] = (uint16_t)in_buf[i];
+    st = att_sensor_init(&s, zero, scale, axis, sign);
+    if (st == ATT_OK)
+        st = att_sensor_increments(&s, words, n, (uint8_t)p[0], (att_real)p[1], out_buf, &err);
+    result(id, st, st == ATT_OK ? -1L : (long)err, st == ATT_OK ? n : 0);
+    print_records(out_buf, st == ATT_OK ? n : 0, 3);
+    return 0;
+}
+
 static int run_case(const char *id, const char *fn, size_t n)
 {
     size_t i, err = 0;
@@ -337,6 +371,8 @@ static int run_case(const char *id, const char *fn, size_t n)
         return run_link(id, strcmp(fn, "link_tx") == 0, n);
     if (strncmp(fn, "wden_", 5) == 0)
         return run_wden(id, fn, n);
+    if (strcmp(fn, "sensor") == 0)
+        return run_sensor(id, n);
     if (strcmp(fn, "integ") == 0 || strcmp(fn, "rk4") == 0) {
         char mname[32];
         att_real q0[4], h = 0;

@@ -193,7 +193,6 @@ def assemble_bench_doc() -> None:
 })
 def bench(c, only="", quick=False):
     """Run every benchmark and write the figures into docs/benchmarks.md."""
-    sys.path.insert(0, str(ROOT))
     if only == "assemble":  # just rebuild docs/benchmarks.md from docs/bench/*.md
         assemble_bench_doc()
         return

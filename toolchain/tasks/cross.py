@@ -184,4 +184,3 @@ def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
             print(f"  {kind:8s} {rel}")
 
 
-TOP_LEVEL = (cross_build,)

@@ -4,19 +4,15 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from types import ModuleType
 
 from invoke import task
 
-ROOT = Path(__file__).resolve().parents[2]
-NAMESPACE = True
 
+def _tool() -> ModuleType:
+    from toolchain import firmware  # imported at use: the other tasks need no simulator
 
-def _tool():  # type: ignore[no-untyped-def]
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from firmware import tool
-
-    return tool
+    return firmware
 
 
 @task(help={
@@ -50,8 +46,10 @@ def sim(c, samples=20, baud=9600, period_ticks=108, fault="", timeout=120, impl=
     """Run the firmware in s51 -t C51 against the C receiver on a socat pty pair; print the samples received."""
     tool = _tool()
     cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), selftest_retry=360)
-    blocks = int(samples) + 1 if not fault or fault.startswith("adc_error_at") else 3
-    img = tool.build(tool.BUILD, cfg, kind="sim", sim_blocks=blocks, faults=[fault] if fault else [])
+    # stop after the samples; a failing self-test never samples: stop after BOOT and two SELFTEST reports
+    stop = ({"sim_samples": int(samples)} if not fault or fault.startswith("adc_error_at")
+            else {"sim_blocks": 3})
+    img = tool.build(tool.BUILD, cfg, kind="sim", faults=[fault] if fault else [], **stop)
     print(img.size_report())
     res = tool.run(img, tool.LinkHost(impl), timeout=float(timeout))
     print(f"# {res.sim_seconds:.3f} s simulated in {res.wall_seconds:.1f} s; max SP 0x{res.max_sp:02X}")

@@ -102,4 +102,3 @@ def fuzz(c, seconds=60, target="all", corpus="", coverage=False):
                 print(f"fuzz {name}: {src}: {got}/{total} lines = {100.0 * got / total:.1f} %")
 
 
-TOP_LEVEL = (fuzz,)

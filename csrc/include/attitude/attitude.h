@@ -12,6 +12,7 @@
 #include "attitude/integrator.h"
 #include "attitude/link.h"
 #include "attitude/block.h"
+#include "attitude/sensor.h"
 #include "attitude/fixed.h"
 #include "attitude/ad7927.h"
 #include "attitude/denoise.h"

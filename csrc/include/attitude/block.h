@@ -29,6 +29,11 @@
  *     3 OVERRUN    first (16)    count (16)                     samples lost to a full queue
  *     4 ADC_ERROR  first (16)    status (8), then 0 (8)         a scan that failed: 1 sample
  *
+ *     kind         byte 2        bytes 3-5                      sent
+ *     5 OVERSAMPLE n (8)         0 (24)                         by a board that sums n
+ *                                                               conversions per word, right
+ *                                                               after BOOT
+ *
  * Fields (the decoder checks every range; a report outside them is
  * rejected with ATT_BLOCK_E_FIELD, an unknown kind with ATT_BLOCK_E_KIND):
  *   version   ATT_BLOCK_VERSION (1), the format this header describes; a
@@ -46,6 +51,28 @@
  *   first     number of the first lost sample (mod 2^16).
  *   count     GAVE_UP, OVERRUN: samples lost, 1..65535: first .. first +
  *             count - 1. ADC_ERROR always loses one sample (count 1).
+ *   n         OVERSAMPLE: conversions summed into each word of the sample
+ *             records that follow, 1..ATT_BLOCK_OVERSAMPLE_MAX (16).
+ *
+ * Oversampled streams. A board that converts each channel n times per
+ * sample period and sends the sums (the paper's increment formation, the
+ * simulator's modeled board) keeps the sums' resolution (1/n of a code)
+ * in the same 6-byte sample record: it announces n with an OVERSAMPLE
+ * report right after BOOT, and its sample records then carry per channel
+ * the sum of n codes, 0..min(n x 4095, ATT_BLOCK_SUM_MAX). The limit
+ * ATT_BLOCK_SUM_MAX = 0xFDFF keeps byte 0 of every sample below the
+ * report mark; it only matters for n = 16, whose sums above 65023 (a mean
+ * code above 4063.9, the top 0.8 % of the ADC range) cannot be sent: the
+ * encoder refuses them (ATT_BLOCK_E_CODE) and a board reports an
+ * ADC_ERROR in their place, as for any code it cannot encode. (No 6-byte
+ * record can do better: three words of 0..65520 and the reports need
+ * more than 2^48 values.) The AT89S51 firmware sends one conversion per
+ * channel and no OVERSAMPLE report (n = 1). A BOOT restarts a stream as a
+ * plain one (n = 1). Which limit applies to a sample is therefore a
+ * property of the stream: att_block_decode checks a record alone against
+ * the plain limit (4095); att_block_seq_decode checks it against its
+ * stream's. A receiver that joins after the OVERSAMPLE report reads the
+ * sums as plain codes: those above 4095 are rejected, never integrated.
  *
  * Loss accounting by sequence number. Samples are numbered from 0, the
  * first sample after BOOT (the self-test runs before sampling starts);
@@ -62,9 +89,10 @@
  *
  * Encoders (block.c) are what the firmware links: portable C99 that SDCC
  * compiles for the AT89S51 (leaf functions, 8/16-bit arithmetic, buffers
- * in __data memory there: ATT_LINK_MEM). The decoder and the sequence
- * tracker (block_decode.c) are host code, kept in their own translation
- * unit so that an 8051 image does not carry them.
+ * in __data memory there: ATT_LINK_MEM). The encoders of oversampled
+ * streams (block_sums.c), the decoder and the sequence tracker
+ * (block_decode.c) are kept in their own translation units so that an
+ * 8051 image does not carry them.
  */
 #ifndef ATTITUDE_BLOCK_H
 #define ATTITUDE_BLOCK_H
@@ -74,13 +102,15 @@
 
 /* Format constants. */
 enum {
-    ATT_BLOCK_SIZE = 6,           /* bytes of one record (= ATT_LINK_BLOCK_DEFAULT) */
-    ATT_BLOCK_CODE_MAX = 4095,    /* largest sample code (12-bit ADC) */
-    ATT_BLOCK_MARK = 0xFE,        /* byte 0 of every report record */
-    ATT_BLOCK_VERSION = 1,        /* format version carried by BOOT */
-    ATT_BLOCK_TICK_HZ = 3600,     /* BOOT period unit: ticks per second */
-    ATT_BLOCK_PERIOD_MAX = 32767, /* largest BOOT period (ticks) */
-    ATT_BLOCK_BAUD_UNIT = 1200    /* BOOT baud_div unit (baud per count) */
+    ATT_BLOCK_SIZE = 6,            /* bytes of one record (= ATT_LINK_BLOCK_DEFAULT) */
+    ATT_BLOCK_CODE_MAX = 4095,     /* largest sample code (12-bit ADC) */
+    ATT_BLOCK_MARK = 0xFE,         /* byte 0 of every report record */
+    ATT_BLOCK_VERSION = 1,         /* format version carried by BOOT */
+    ATT_BLOCK_TICK_HZ = 3600,      /* BOOT period unit: ticks per second */
+    ATT_BLOCK_PERIOD_MAX = 32767,  /* largest BOOT period (ticks) */
+    ATT_BLOCK_BAUD_UNIT = 1200,    /* BOOT baud_div unit (baud per count) */
+    ATT_BLOCK_OVERSAMPLE_MAX = 16, /* largest OVERSAMPLE n (conversions per word) */
+    ATT_BLOCK_SUM_MAX = 0xFDFF     /* largest word of an oversampled sample (byte 0 below the mark) */
 };
 
 /* Record kinds: byte 1 of a report record, or ATT_BLOCK_SAMPLE. */
@@ -90,12 +120,14 @@ typedef enum {
     ATT_BLOCK_GAVE_UP = 2,
     ATT_BLOCK_OVERRUN = 3,
     ATT_BLOCK_ADC_ERROR = 4,
+    ATT_BLOCK_OVERSAMPLE = 5,
     ATT_BLOCK_SAMPLE = 0x100 /* a sample record (not a byte value: never a report kind) */
 } att_block_kind;
 
 /* Status codes of this module (range -100..-119 of common.h). */
 enum {
-    ATT_BLOCK_E_CODE = -100,  /* a sample code above ATT_BLOCK_CODE_MAX */
+    ATT_BLOCK_E_CODE = -100,  /* a sample code above its stream's limit (ATT_BLOCK_CODE_MAX, or
+                                 n x ATT_BLOCK_CODE_MAX capped at ATT_BLOCK_SUM_MAX) */
     ATT_BLOCK_E_KIND = -101,  /* a report kind this format does not define */
     ATT_BLOCK_E_FIELD = -102, /* a report field outside its range (see above) */
     ATT_BLOCK_E_SEQ = -103    /* a loss report's first disagrees with the sample count */
@@ -127,6 +159,18 @@ int att_block_encode_loss(uint8_t ATT_LINK_MEM *blk, uint8_t kind, uint16_t firs
  * (else ATT_BLOCK_E_FIELD). */
 int att_block_encode_adc_error(uint8_t ATT_LINK_MEM *blk, uint16_t first, int8_t status);
 
+/* Oversampled streams (block_sums.c, not for the 8051 firmware). */
+
+/* OVERSAMPLE: the sample records that follow carry sums of n conversions,
+ * n = 1..ATT_BLOCK_OVERSAMPLE_MAX (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_oversample(uint8_t ATT_LINK_MEM *blk, uint8_t n);
+
+/* Sample record of an oversampled stream from sums[0..2] = X, Y, Z, each
+ * the sum of n codes: 0..min(n x ATT_BLOCK_CODE_MAX, ATT_BLOCK_SUM_MAX)
+ * (else ATT_BLOCK_E_CODE); n 1..ATT_BLOCK_OVERSAMPLE_MAX (else
+ * ATT_BLOCK_E_FIELD). n = 1 gives att_block_encode_sample's bytes. */
+int att_block_encode_sums(uint8_t ATT_LINK_MEM *blk, const uint16_t ATT_LINK_MEM *sums, uint8_t n);
+
 /* ------------------------------------------------------------------ */
 /* Decoder (block_decode.c)                                           */
 /* ------------------------------------------------------------------ */
@@ -142,10 +186,12 @@ typedef struct {
     uint8_t version;       /* BOOT: format version */
     uint8_t baud_div;      /* BOOT: line rate / ATT_BLOCK_BAUD_UNIT */
     uint8_t attempt;       /* SELFTEST: attempt number (from 1, mod 256) */
+    uint8_t oversample;    /* OVERSAMPLE: conversions per word of the samples that follow */
     int8_t status;         /* SELFTEST, ADC_ERROR: the failure's att_status */
 } att_block;
 
-/* Decode the ATT_BLOCK_SIZE bytes at raw into *out. Returns ATT_OK,
+/* Decode the ATT_BLOCK_SIZE bytes at raw into *out, a record read alone
+ * (a sample's words checked against the plain limit, 4095). Returns ATT_OK,
  * ATT_E_NULL, ATT_BLOCK_E_CODE (out->kind = ATT_BLOCK_SAMPLE and the codes
  * as received, for the caller's log: never integrate them),
  * ATT_BLOCK_E_KIND (out->kind = the unknown kind byte) or
@@ -155,8 +201,9 @@ int att_block_decode(const uint8_t *raw, att_block *out);
 
 /* Sequence tracker: numbers the samples of a record stream. */
 typedef struct {
-    uint32_t next;  /* number of the next sample expected (since the last BOOT; not wrapped) */
-    uint8_t synced; /* the numbering was fixed by a BOOT or a loss report */
+    uint32_t next;      /* number of the next sample expected (since the last BOOT; not wrapped) */
+    uint8_t synced;     /* the numbering was fixed by a BOOT or a loss report */
+    uint8_t oversample; /* conversions per sample word: 1, or the last OVERSAMPLE's n */
 } att_block_seq;
 
 /* Where one record falls in the numbering. */
@@ -171,9 +218,10 @@ typedef struct {
                        0 otherwise */
 } att_block_span;
 
-/* Start unsynced: samples are numbered from 0 until a BOOT (numbering
- * restarts at 0) or a loss report (its first and count are adopted as
- * they are, no slip) fixes the numbering. */
+/* Start unsynced, plain (oversample 1): samples are numbered from 0 until
+ * a BOOT (numbering restarts at 0, the stream is plain again) or a loss
+ * report (its first and count are adopted as they are, no slip) fixes the
+ * numbering; an OVERSAMPLE report sets the stream's n. */
 void att_block_seq_init(att_block_seq *s);
 
 /* Place the decoded record b (also a SAMPLE that failed with
@@ -183,5 +231,15 @@ void att_block_seq_init(att_block_seq *s);
  * ATT_BLOCK_E_SEQ (synced, and a loss report disagrees with the count:
  * *span says how; the numbering follows the report from now on). */
 int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span);
+
+/* What a receiver calls for each record: decode the ATT_BLOCK_SIZE bytes
+ * at raw into *out with the stream's limit for sample words (4095, or
+ * n x 4095 capped at ATT_BLOCK_SUM_MAX after an OVERSAMPLE report) and
+ * place the record (att_block_seq_feed). Returns ATT_OK, ATT_E_NULL,
+ * ATT_BLOCK_E_CODE (a sample above the stream's limit: it took its
+ * number, *span is valid; never integrate it), ATT_BLOCK_E_KIND or
+ * ATT_BLOCK_E_FIELD (as att_block_decode; not placed, the stream is
+ * unchanged) or ATT_BLOCK_E_SEQ (as att_block_seq_feed). */
+int att_block_seq_decode(att_block_seq *s, const uint8_t *raw, att_block *out, att_block_span *span);
 
 #endif /* ATTITUDE_BLOCK_H */

@@ -162,13 +162,12 @@ typedef struct {
 typedef struct {
     att_link_receiver_config cfg;
     att_link_receiver_stats stats;
-    uint8_t *block;   /* caller's buffer, cfg.block_size bytes */
-    uint16_t t_last;  /* tick of the last byte received (or 0xBB handed out) in a block */
-    uint8_t state;    /* private state (enum in link_receiver.c) */
-    uint8_t index;    /* data bytes stored so far */
-    uint8_t sum;      /* running sum of the data bytes mod 256 */
-    uint8_t out_byte; /* byte waiting to be handed out by poll */
-    uint8_t flags;    /* private flags (pending output, pending timeout, discarded) */
+    uint8_t *block;  /* caller's buffer, cfg.block_size bytes */
+    uint16_t t_last; /* tick of the last byte received (or 0xBB handed out) in a block */
+    uint8_t state;   /* private receive state (enum in link_receiver.c) */
+    uint8_t pending; /* private: what the next poll reports (enum in link_receiver.c) */
+    uint8_t index;   /* data bytes stored so far */
+    uint8_t sum;     /* running sum of the data bytes mod 256 */
 } att_link_receiver;
 
 /* Defaults for 1 ms ticks at 9600 baud: N = block_size, gap 20 ms. */

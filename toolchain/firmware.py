@@ -1,23 +1,34 @@
-"""Build the AT89S51 firmware with SDCC and run it in s51 against the host end of the link.
+"""The AT89S51 firmware in the tooling layer: build it with SDCC, run it in s51
+against the host end of the link, and plug it into the simulator as an
+acquisition source (docs/firmware.md, docs/architecture.md).
 
 Three kinds of image come from the same sources (firmware/main.c + the
-library's csrc/src/tlc2543.c and csrc/src/link_sender.c, unchanged):
+library's csrc/src/tlc2543.c, csrc/src/link_sender.c and csrc/src/block.c,
+unchanged):
 
 * ``production`` — what goes into the chip: TLC2543 on P1.0-P1.4.
 * ``sim`` — the same firmware, but the driver's pin HAL calls a TLC2543 +
   gyro device model compiled into the image (firmware/sim/tlc_model.c), and
   the program stops itself through the uCsim simulator interface after a
-  given number of accepted blocks, printing its link statistics.
+  given number of accepted blocks (or sample records), printing its link
+  statistics (main.c's hooks, firmware/hooks.h and firmware/sim/hooks.h).
 * ``bench`` — production pins plus machine-cycle counters (Timer 0 based).
 
 Running: s51 (``-t C51``, 128 B RAM) gets its UART on one end of a
-``socat pty,raw,echo=0`` pair; this module's :class:`LinkHost` (the C
-receiver B of libattitude through CFFI, or the Python one) answers on the
-other end, optionally injecting faults (NAKs, silence after 0xAA).
+``socat pty,raw,echo=0`` pair; :class:`LinkHost` (the C receiver B of
+libattitude through CFFI, or the Python one) answers on the other end,
+optionally injecting faults (NAKs, silence after 0xAA). The blocks are
+decoded and numbered by the library (:mod:`attitude_c.link.block`).
 
     img = build(BUILD / "fw", Config(), kind="sim", sim_blocks=50)
     res = run(img, LinkHost())
     stream = decode_stream(res.host.blocks)
+
+The simulator's source: importing this module registers ``"s51"``
+(:func:`attitude_c.sim.register_source`), so ``SimConfig(firmware="s51",
+trajectory=FirmwareTrajectory(...))`` runs the firmware; ``python -m
+toolchain.simulate --firmware s51 ...`` is ``attitude simulate`` with it.
+The runtime package never imports this module.
 """
 
 from __future__ import annotations
@@ -33,10 +44,27 @@ import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
-from attitude_c.errors import BlockFormatError
+import numpy as np
+
+from attitude_c.errors import BlockFormatError, DeviceError, InvalidArgument
 from attitude_c.link import block
+from attitude_c.reference import quat_multiply, rotvec_to_quat
+from attitude_c.sim import (
+    Conditioning,
+    GyroModel,
+    SimConfig,
+    Source,
+    SourceOutput,
+    Trajectory,
+    register_source,
+)
+from attitude_c.sim.host import Calibration
+from attitude_c.sim.link import Delivered
+from attitude_c.sim.sensors import DEG
+
+from . import targets
 
 ROOT = Path(__file__).resolve().parents[1]
 FW_DIR = ROOT / "firmware"
@@ -55,6 +83,9 @@ BLOCK_SIZE = block.fmt().size
 BAUD_RATES = (1200, 2400, 4800, 9600, 14400, 19200, 28800, 57600)
 #: Bytes on the wire per delivered block: 0xAA, 0xBB, N data, checksum, answer.
 WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
+
+#: Scheduling priority of s51 under the host end (see Session.run).
+S51_NICE = 10
 
 SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
            CSRC / "src" / "block.c"]
@@ -172,8 +203,6 @@ class Image:
 
 
 def _sdcc_flags() -> list[str]:
-    from toolchain import targets
-
     t = targets.load("mcs51")
     t.require()
     return list(t.cflags)
@@ -196,13 +225,14 @@ def parse_mem(mem: Path) -> tuple[int, int, int]:
 
 
 def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
-          sim_blocks: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
+          sim_blocks: int = 0, sim_samples: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
           extra_defines: Iterable[str] = (), name: str | None = None,
           code_size: int = FLASH_SIZE) -> Image:
     """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
 
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
-    ``sim_blocks`` accepted blocks, 0 = never) or ``bench`` (production pins,
+    ``sim_blocks`` accepted blocks or ``sim_samples`` accepted sample records, whichever
+    comes first; 0 = that count never stops it) or ``bench`` (production pins,
     self-test skipped because s51's port pins read 1, cycle counters).
     ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck`` (every
     conversion), ``adc_error_at=K`` (EOC stuck in the scan of sample K only, 0 <= K < 256: one
@@ -226,7 +256,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if faults and kind != "sim":
         raise ValueError("faults need kind='sim'")
     if kind in ("sim", "bench"):
-        defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}"]
+        defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}", f"FW_SIM_SAMPLES={int(sim_samples)}"]
         sources.append(FW_DIR / "sim" / "sim_io.c")
     if kind == "sim":
         defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
@@ -491,7 +521,7 @@ class Session:
         self._s51: subprocess.Popen[bytes] | None = None
         self._t0 = time.monotonic()
 
-    def __enter__(self) -> Session:
+    def __enter__(self) -> Session:  # noqa: PYI034 - typing.Self needs Python 3.11
         try:
             self._socat = subprocess.Popen(
                 ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],
@@ -525,34 +555,54 @@ class Session:
         code 0 (e.g. the device model detected a protocol violation)."""
         sif_out = self._tmp / "sif.out"
         cmds = self._tmp / "cmds"
-        cmds.write_text(f'file "{self.image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\nkill\n')
+        # no `kill` command: s51 leaving through it writes a terminal reset to the UART's pty
+        # (ESC [ ? 9 l, ESC [ 0 ; 0 ' z, ESC [ ! p: 16 bytes the host end would take for line
+        # noise); once `state` has printed, the process group is killed instead (SIGKILL)
+        cmds.write_text(f'file "{self.image.ihx}"\nexpr uart0_check_often=1\nrun\nstate\n')
         t_start = time.monotonic()
+        # s51 at a lower priority (nice 10) than the host end: s51 runs in simulated time, the host
+        # answers in wall time, and on a loaded machine a host that waits for the CPU while s51
+        # runs on would show up, stretched, as latency in simulated time (overruns). Niced, s51
+        # yields the CPU to the host whenever both are ready: the simulation slows down with the
+        # machine instead of running away from its host.
         self._s51 = s51 = subprocess.Popen(
-            ["s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}", "-s", str(self._dev_fw),
-             "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-            start_new_session=True, cwd=self._tmp)
+            ["nice", "-n", str(S51_NICE), "s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
+             "-s", str(self._dev_fw), "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
+        assert s51.stdout is not None
+        os.set_blocking(s51.stdout.fileno(), False)
+        out = bytearray()
         deadline = time.monotonic() + self.timeout
         while s51.poll() is None:
+            chunk = s51.stdout.read()
+            if chunk:
+                out += chunk
+            if _STATE_SP.search(out) and _STATE_CLOCK.search(out):
+                break  # stopped, and `state` has printed: done
             if time.monotonic() > deadline:
                 _kill_group(s51)
-                con = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
                 raise SimTimeout(f"s51 did not stop within {self.timeout} s; firmware output so far:\n"
                                  + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
-                                 + "\ns51 console (end):\n" + con[-3000:]
+                                 + "\ns51 console (end):\n" + out.decode(errors="replace")[-3000:]
                                  + (f"\nhost: {describe()}" if describe is not None else ""))
             if pump is not None:
                 pump()
             else:
                 time.sleep(0.02)
-        console = s51.stdout.read().decode(errors="replace") if s51.stdout else ""
+        _kill_group(s51)
+        try:
+            out += s51.stdout.read() or b""
+        except (OSError, ValueError):
+            pass
+        console = out.decode(errors="replace")
         output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
         wall = time.monotonic() - t_start
         m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
         if m is None or int(m.group(1)) != 0:
             raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\n"
                                 f"console:\n{console[-2000:]}")
-        sp = re.search(r"Max value of stack pointer= 0x([0-9a-fA-F]+)", console)
-        clk = re.search(r"Total time since last reset= ([0-9.]+) sec", console)
+        sp = _STATE_SP.search(out)
+        clk = _STATE_CLOCK.search(out)
         if sp is None or clk is None:
             raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
         return SimOutput(output=output, console=console, stats=_parse_kv("STATS", output),
@@ -560,12 +610,16 @@ class Session:
                          sim_seconds=float(clk.group(1)), wall_seconds=wall)
 
 
+_STATE_SP = re.compile(rb"Max value of stack pointer= 0x([0-9a-fA-F]+)")
+_STATE_CLOCK = re.compile(rb"Total time since last reset= ([0-9.]+) sec")
+
+
 def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) -> SimResult:
     """Run a sim/bench image in ``s51 -t C51`` with its UART on a pty pair and ``host`` on the other end.
 
     The firmware stops itself (simulator interface) after the configured
     number of accepted blocks; s51 then prints its ``state`` (maximum stack
-    pointer) and is told to ``kill`` itself. Raises :class:`SimTimeout` if
+    pointer) and is killed. Raises :class:`SimTimeout` if
     that has not happened after ``timeout`` wall-clock seconds, and
     :class:`FirmwareError` if the program did not stop through ``s51_exit``
     with code 0 (e.g. the device model detected a protocol violation).
@@ -591,3 +645,167 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
         finally:
             port.close()
     return SimResult(**vars(out), host=host)
+
+
+# -- the simulator's acquisition source "s51" ---------------------------------------
+
+#: (offset, shift, phase, step) per axis of the simulator's firmware runs. X, Y: a
+#: quadrature pair (phase of X = phase of Y + 64, a quarter turn) about mid-scale,
+#: ±512 LSB (shift 2), 4 cycles per 256 samples (0.20 Hz at h = 0.08 s); Z: a constant
+#: −95.5 LSB (offset 31240 = 32768 − 1528: the middle of a code, so truncation loses nothing).
+FW_GYROS = ((32768, 2, 64, 4), (32768, 2, 0, 4), (31240, 0, 0, 0))
+
+
+def _qz(angle: np.ndarray) -> np.ndarray:
+    a = np.asarray(angle, dtype=float)
+    q = np.zeros(a.shape + (4,))
+    q[..., 0] = np.cos(a / 2)
+    q[..., 3] = np.sin(a / 2)
+    return q
+
+
+@dataclass
+class FirmwareTrajectory(Trajectory):
+    """Body rates of the firmware image's gyro model, with a closed-form truth.
+
+    The image's model inputs are sinusoids of integer parameters (:class:`Gyro`:
+    input = (offset + 32767 sin(2π(phase + k·step)/256) / 2^shift) / 65536 · Vref
+    for sample k), mapped to rad/s by the host's rad/s per code. The parameters
+    make a motion with a closed form: X and Y a quadrature pair of equal
+    amplitude A (X = A cos β, Y = A sin β, β advancing at Ω), Z a constant rate
+    c. The body rate ω(t) = R_z(β(t))·[A, 0, c] turns about the body z axis at
+    Ω, and in a frame turning with it the rate is constant, so
+
+        Q(t) = q_z(β₀) ⊗ q(u t) ⊗ q_z(−β(t)),   u = [A, 0, c + Ω],
+
+    exactly (q_z(a): rotation by a about z; q(v): rotation vector v; Q(0) = 1).
+    Check: with S(t) = exp(t[u×]) R_z(−Ωt), Sᵀ Ṡ = [(R_z(Ωt) u − Ω e_z)×] =
+    [(R_z(Ωt)[A, 0, c])×]; the constant factors R_z(±β₀) turn that into
+    R_z(β(t))[A, 0, c]. Classical coning is the case c = −Ω(1 − cos α),
+    A = Ω sin α; here A, c and Ω are whatever the integers give. The truth never
+    goes through an integrator (tests/test_sim_truth.py checks it against RK4).
+
+    Sample k is taken at the midpoint of period k (the rate function's time
+    origin is placed so), one conversion per axis per period (the firmware does
+    no oversampling), and the in-image model truncates (code = v >> 4): the host
+    uses the zero code 2047.5 of a truncating converter.
+    """
+
+    period: float = 0.08
+    rad_per_s_per_code: float = 1e-3
+    gyros: tuple[tuple[int, int, int, int], ...] = FW_GYROS
+    duration: float = 60.0
+
+    def __post_init__(self) -> None:
+        self.name = "firmware"
+        if len(self.gyros) != 3 or any(len(g) != 4 for g in self.gyros):
+            raise InvalidArgument("gyros needs 3 (offset, shift, phase, step) tuples")
+        if not (self.period > 0 and math.isfinite(self.period)):
+            raise InvalidArgument(f"period must be > 0 s, got {self.period!r}")
+        (ox, shx, phx, stx), (oy, shy, phy, sty), (oz, shz, phz, stz) = self.gyros
+        if not (ox == oy == 32768 and shx == shy and stx == sty and (phx - phy) % 256 == 64 and stz == 0):
+            raise InvalidArgument(
+                "gyros must be X, Y a quadrature pair about mid-scale (offset 32768, same shift and "
+                "step, phase of X = phase of Y + 64) and Z constant (step 0): the motion with a "
+                f"closed-form truth; got {self.gyros}")
+        k = self.rad_per_s_per_code
+        # rate (rad/s) = k · 4096 · (fraction − 1/2), fraction of the model above
+        self._amp = k * 4096 * 32767 / 2**shy / 65536
+        self._c = k * 4096 * ((oz + 32767 * math.sin(2 * math.pi * phz / 256) / 2**shz) / 65536 - 0.5)
+        self._w = 2 * math.pi * sty / (256 * self.period)  # Ω, rad/s
+        self._b0 = 2 * math.pi * phy / 256 - self._w * self.period / 2  # β(0): sample k at (k + ½) h
+        self._u = np.array([self._amp, 0.0, self._c + self._w])
+
+    def _beta(self, t: Any) -> np.ndarray:
+        return self._b0 + self._w * np.asarray(t, dtype=float)
+
+    def omega(self, t: Any) -> np.ndarray:
+        b = self._beta(t)
+        return np.stack([self._amp * np.cos(b), self._amp * np.sin(b), np.full_like(b, self._c)], axis=-1)
+
+    def increments(self, t0: float, h: float, n: int) -> np.ndarray:
+        t = t0 + np.arange(n + 1) * h
+        b = self._beta(t)
+        if self._w == 0:
+            xy = [self._amp * np.cos(b[:-1]) * h, self._amp * np.sin(b[:-1]) * h]
+        else:
+            xy = [self._amp / self._w * np.diff(np.sin(b)), -self._amp / self._w * np.diff(np.cos(b))]
+        return np.stack([*xy, np.full(n, self._c * h)], axis=-1)
+
+    def quat(self, t: Any) -> np.ndarray:
+        t = np.asarray(t, dtype=float)
+        turn = rotvec_to_quat(t[..., None] * self._u)
+        return quat_multiply(quat_multiply(_qz(np.full_like(t, self._b0)), turn), _qz(-self._beta(t)))
+
+    def params(self) -> dict[str, Any]:
+        return {"trajectory": self.name, "gyros_offset_shift_phase_step": [list(g) for g in self.gyros],
+                "rate_amplitude_xy_dps": math.degrees(self._amp), "rate_z_dps": math.degrees(self._c),
+                "frequency_hz": self._w / (2 * math.pi),
+                "truth": "closed form: q_z(β0) ⊗ q(u t) ⊗ q_z(−β(t))"}
+
+
+def firmware_available() -> bool:
+    """Whether sdcc, s51 and socat are installed (the source's tools)."""
+    return all(shutil.which(t) for t in ("sdcc", "s51", "socat"))
+
+
+def _trajectory(period: float, gyro: GyroModel, cond: Conditioning, duration: float) -> FirmwareTrajectory:
+    """The firmware's motion as the host reads it: the gyro preset through the conditioning."""
+    k = cond.vref / 4096 / (gyro.scale_v_per_dps / DEG * cond.gain(gyro))
+    return FirmwareTrajectory(period=period, rad_per_s_per_code=k, duration=duration)
+
+
+def _check(cfg: SimConfig) -> None:
+    if not isinstance(cfg.trajectory, FirmwareTrajectory):
+        raise InvalidArgument("firmware='s51' runs the firmware's own gyro model: use a "
+                              "FirmwareTrajectory (python -m toolchain.simulate --firmware s51 does)")
+    if cfg.sensors == "ideal" or cfg.ber > 0:
+        raise InvalidArgument("firmware='s51' takes the firmware's codes: sensors must "
+                              "not be 'ideal' and ber must be 0 (the pty link is clean)")
+
+
+def _acquire(cfg: SimConfig, n: int, progress: Callable[[str, int, int], None] | None) -> SourceOutput:
+    """Build and run the firmware's simulation image for n samples: the blocks its
+    host end accepted, and the host's calibration of the in-image model."""
+    traj = cfg.trajectory
+    assert isinstance(traj, FirmwareTrajectory)
+    ticks = cfg.period * TICK_HZ
+    if abs(ticks - round(ticks)) > 1e-6 or not 1 <= round(ticks) <= 32767:
+        raise InvalidArgument(f"--firmware s51 needs a period that is a whole number of the "
+                              f"firmware's 1/{TICK_HZ} s ticks, got {cfg.period} s")
+    try:
+        # Link timeouts of 1 s of simulated time (the chip's default is 50 ms): s51 runs in
+        # simulated time, the host end in wall time, and a host answering late on a loaded
+        # machine must not make the firmware resend a block the host already accepted (the
+        # protocol's duplicate, docs/link.md), which would shift the numbering of the samples
+        # after it; late answers cost overruns instead, reported in place and counted as lost.
+        fw_cfg = Config(period_ticks=round(ticks), max_attempts=cfg.link_attempts, syn_timeout=3600,
+                        answer_timeout=3600)
+        # every run builds its own image in its own directory: two runs at once (pytest -n 2)
+        # must never run, or link, each other's half-written image
+        with tempfile.TemporaryDirectory(prefix="fw_source_") as tmp:
+            img = build(Path(tmp), fw_cfg, kind="sim", sim_blocks=n + 1, gyros=[Gyro(*g) for g in traj.gyros],
+                        name="fw_sim_attitude")
+            if progress is not None:
+                progress("s51", 0, n)
+            res = run(img, timeout=max(60.0, 3.0 * n * cfg.period + 30.0))
+    except (FirmwareError, OSError, ValueError) as exc:
+        raise DeviceError(f"firmware run in s51 failed: {exc}") from exc
+    if progress is not None:
+        progress("s51", n, n)
+    stats = {"link": "firmware (s51) → pty → C receiver", "backend": "s51 firmware", "ber": 0.0,
+             "sent": int(res.stats.get("sent", 0)), "duplicated": 0, "corrupted_undetected": 0,
+             "firmware_stats": dict(res.stats), "receiver": dict(res.host.stats()),
+             "max_stack_pointer": res.max_sp, "simulated_s": res.sim_seconds, "wall_s": res.wall_seconds,
+             "flash_bytes": img.flash}
+    # one truncating conversion per period (the in-image model: code = v >> 4)
+    calib = Calibration(np.full(3, 2047.5), traj.rad_per_s_per_code, 1)
+    backends = {"sensors": "AT89S51 firmware in s51 (TLC2543 + gyro model in the image)",
+                "link": "firmware link sender → pty → C receiver"}
+    return SourceOutput(Delivered(list(res.host.blocks), None, stats), calib, backends)
+
+
+#: The source (registered on import).
+SOURCE = Source(name="s51", description="the AT89S51 firmware image in s51, its UART on a pty to the C receiver",
+                acquire=_acquire, check=_check, trajectory=_trajectory)
+register_source(SOURCE)

@@ -1,0 +1,118 @@
+"""Sensor words to body rates and increments, through the C library.
+
+A thin typed layer over ``att_sensor_*`` (``csrc/include/attitude/sensor.h``,
+docs/sensor.md): the one implementation of the host's codes → rates step,
+shared with ``attitude-rx``. For body axis i reading channel ``axes[i]``::
+
+    value_i = signs[i] · (word / n − zero) · scale      (a gyro: rad/s)
+    Δθ_i    = value_i · period
+
+``n`` is the number of conversions summed into each word (1, or the
+stream's OVERSAMPLE report, docs/block.md). The NumPy reference is
+:func:`attitude_c.reference.sensor_values`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._lib import ffi_lib
+from .core import FloatPrecision
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+
+__all__ = ["Sensor", "adc_words"]
+
+_DTYPES = {"f64": np.float64, "f32": np.float32}
+
+
+def _triple(x: ArrayLike, name: str) -> NDArray[np.float64]:
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidType(f"{name} must be a number or 3 numbers: {exc}") from None
+    if a.shape == ():
+        a = np.full(3, float(a))
+    if a.shape != (3,):
+        raise InvalidArgument(f"{name} must be a number or 3 numbers (X, Y, Z), got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise NonFiniteError(f"{name} holds NaN or Inf: {a.tolist()}")
+    return a
+
+
+def adc_words(words: ArrayLike, name: str = "words") -> NDArray[np.uint16]:
+    """Check ADC words (M, 3) (integer dtype, 0..65535) and return them as a C-contiguous
+    uint16 array; InvalidType, InvalidArgument (shape) or RangeError naming the sample."""
+    w = np.asarray(words)
+    if w.dtype.kind not in "iu":
+        raise InvalidType(f"{name} must be integer ADC words, got dtype {w.dtype}")
+    if w.ndim != 2 or w.shape[1] != 3:
+        raise InvalidArgument(f"{name} must have shape (M, 3), got {w.shape}")
+    if w.size and (w.min() < 0 or w.max() > 0xFFFF):
+        i = int(np.argmax(((w < 0) | (w > 0xFFFF)).any(axis=1)))
+        raise RangeError(f"{name}: sample {i} = {w[i].tolist()} is not a 16-bit word")
+    return np.ascontiguousarray(w, dtype=np.uint16)
+
+
+class Sensor:
+    """One three-axis sensor's calibration (an ``att_sensor``).
+
+    ``zero``: the reading at zero input per channel, in codes of one conversion
+    (0..65535; fractional after a calibration); ``scale``: units per code per
+    channel (a gyro: rad/s per code; non-zero); ``axes``: the channel each body
+    axis reads (a permutation of 0, 1, 2); ``signs``: +1 or −1 per body axis;
+    ``precision``: the float build that converts.
+    """
+
+    def __init__(self, zero: ArrayLike, scale: ArrayLike, axes: ArrayLike = (0, 1, 2),
+                 signs: ArrayLike = (1, 1, 1), precision: FloatPrecision = "f64") -> None:
+        if precision not in _DTYPES:
+            raise InvalidArgument(f"precision must be one of {tuple(_DTYPES)}, got {precision!r}")
+        self.zero = _triple(zero, "zero")
+        self.scale = _triple(scale, "scale")
+        self.axes = tuple(int(a) for a in np.asarray(axes).reshape(-1))
+        self.signs = tuple(int(s) for s in np.asarray(signs).reshape(-1))
+        self.precision: FloatPrecision = precision
+        self._ffi, self._lib = ffi_lib(precision)
+        self._s: Any = self._ffi.new("att_sensor *")
+        if len(self.axes) != 3 or sorted(self.axes) != [0, 1, 2]:
+            raise InvalidArgument(f"axes must name each channel 0, 1, 2 once, got {self.axes}")
+        if any(s not in (1, -1) for s in self.signs) or len(self.signs) != 3:
+            raise InvalidArgument(f"signs must be three of +1 / -1, got {self.signs}")
+        st = self._lib.att_sensor_init(self._s, self.zero.tolist(), self.scale.tolist(), list(self.axes),
+                                       list(self.signs))
+        if st == self._lib.ATT_E_ARG:
+            raise InvalidArgument(f"zero must be 0..65535 and scale non-zero, got zero {self.zero.tolist()}, "
+                                  f"scale {self.scale.tolist()}")
+        raise_for_status(st, "Sensor(zero, scale)")
+
+    def increments(self, words: ArrayLike, n: int = 1, period: float = 1.0) -> NDArray[Any]:
+        """Words (M, 3) of ``n`` conversions each, sampled every ``period`` s → values
+        × period (M, 3) (a gyro: angle increments, rad), in the precision's dtype.
+        A word above n × 4095 raises :class:`RangeError` naming the sample."""
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
+            raise InvalidType(f"n must be an integer, got {type(n).__name__}")
+        w = adc_words(words)
+        out = np.empty(w.shape, dtype=_DTYPES[self.precision])
+        ffi, lib = self._ffi, self._lib
+        err = ffi.new("size_t *")
+        st = lib.att_sensor_increments(self._s, ffi.cast("uint16_t *", ffi.from_buffer(w)), w.shape[0], int(n),
+                                       float(period), ffi.cast("att_real *", ffi.from_buffer(out)), err)
+        if st == lib.ATT_E_RANGE:
+            i = int(err[0])
+            raise RangeError(f"words: sample {i} = {w[i].tolist()} is above {int(n)} × 4095 (sums of {int(n)} "
+                             "12-bit codes), or its value is not finite")
+        if st == lib.ATT_E_ARG:
+            raise InvalidArgument(f"n must be 1..16 and period > 0, got n={n}, period={period!r}")
+        raise_for_status(st, "Sensor.increments")
+        return out
+
+    def convert(self, words: ArrayLike, n: int = 1) -> NDArray[Any]:
+        """Words (M, 3) of ``n`` conversions each → body values (M, 3) (a gyro: rad/s)."""
+        return self.increments(words, n, 1.0)
+
+    def __repr__(self) -> str:
+        return (f"Sensor(zero={self.zero.tolist()}, scale={self.scale.tolist()}, axes={self.axes}, "
+                f"signs={self.signs}, precision={self.precision!r})")

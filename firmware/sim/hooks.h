@@ -1,0 +1,340 @@
+/*
+ * firmware/sim/hooks.h — the instrumentation of the simulation and bench
+ * images: the bodies of main.c's hooks (firmware/hooks.h), included by
+ * main.c after its state when FW_SIM is defined (toolchain/firmware.py
+ * builds kind "sim" and "bench" with it). Never in the production image.
+ *
+ *   FW_SIM        text output and stop through the uCsim simulator interface
+ *                 (sim_io.c): after FW_SIM_BLOCKS accepted blocks, or after
+ *                 FW_SIM_SAMPLES accepted sample records (0: that count does
+ *                 not stop), the link statistics are printed and s51 stops.
+ *   FW_SIM_MODEL  the ADC inputs come from the TLC2543 + gyro model behind
+ *                 the driver's pins (fw_sim.h, tlc_hal_sim.h, tlc_model.c):
+ *                 its clock steps before every scan, its checks after.
+ *   FW_SIM_TRACE  every byte received and every poll result on the output.
+ *   FW_BENCH      machine-cycle counters of the scan and the link work
+ *                 (production pins, s51's pins read 1: a failed self-test
+ *                 is skipped so that the bench samples).
+ *
+ * Everything here lives in SFR cells the C51 core does not implement
+ * (uCsim keeps them as memory), so the images keep the production image's
+ * RAM use; the helpers run where main has no live locals.
+ */
+#ifndef FW_SIM_HOOKS_H
+#define FW_SIM_HOOKS_H
+
+#include "sim/sim_io.h"
+#if defined(FW_SIM_MODEL)
+#include "sim/fw_sim.h" /* ADC inputs from the TLC2543 + gyro model */
+#endif
+
+#ifndef FW_SIM_BLOCKS
+#define FW_SIM_BLOCKS 0 /* 0: the block count does not stop the run */
+#endif
+#ifndef FW_SIM_SAMPLES
+#define FW_SIM_SAMPLES 0 /* 0: the sample count does not stop the run */
+#endif
+
+#if defined(FW_BENCH)
+/* Machine-cycle timestamp (16 bits, wraps every 65536 cycles = 71 ms):
+ * TH0:TL0, read high-low-high so a carry between the reads is seen. */
+static uint16_t cycles_now(void)
+{
+    uint8_t h, l;
+    do {
+        h = TH0;
+        l = TL0;
+    } while (h != TH0);
+    return (uint16_t)(((uint16_t)h << 8) | l);
+}
+
+/* Bench counters (machine cycles from cycles_now()). They live in SFR cells
+ * the C51 core does not implement (uCsim keeps them as memory), so the
+ * bench image has the production image's RAM use; the helpers are called
+ * where main has no live locals. */
+__sfr16 __at(0xD2D1) bench_scan_min;
+__sfr16 __at(0xD4D3) bench_scan_max;
+__sfr16 __at(0xD6D5) bench_scans;
+__sfr32 __at(0xDCDBDAD9) bench_scan_sum;
+__sfr16 __at(0xDEDD) bench_blocks;
+__sfr16 __at(0xE2E1) bench_busy_block; /* CPU cycles of link handling, block in progress */
+__sfr16 __at(0xE4E3) bench_busy_max;
+__sfr16 __at(0xE6E5) bench_t_start; /* block started */
+__sfr16 __at(0xE9E8) bench_t_syn;   /* 0xAA handed out */
+__sfr16 __at(0xEBEA) bench_t_sum;   /* checksum handed out */
+__sfr16 __at(0xEDEC) bench_sent;    /* tx.stats.blocks_sent seen last */
+__sfr16 __at(0xEFEE) bench_t_loop;  /* start of this loop iteration */
+__sfr16 __at(0xD8D7) bench_t_scan;
+__sfr __at(0xBE) bench_busy; /* this iteration did link work */
+__sfr32 __at(0xF4F3F2F1) bench_busy_sum;
+__sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
+__sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
+__sfr32 __at(0xFDFCFBFA) bench_ans_wait_sum; /* checksum handed out -> answer received */
+
+static void bench_init(void)
+{
+    bench_scan_min = 0xFFFFu;
+    bench_scan_max = 0;
+    bench_scans = 0;
+    bench_scan_sum = 0;
+    bench_blocks = 0;
+    bench_busy_block = 0;
+    bench_busy_max = 0;
+    bench_sent = 0;
+    bench_busy_sum = 0;
+    bench_exch_sum = 0;
+    bench_syn_wait_sum = 0;
+    bench_ans_wait_sum = 0;
+}
+
+static void bench_loop_start(void)
+{
+    bench_t_loop = cycles_now();
+    bench_busy = 0;
+}
+
+static void bench_loop_end(void)
+{
+    if (bench_busy) {
+        bench_busy_block += (uint16_t)(cycles_now() - bench_t_loop);
+    }
+}
+
+static void bench_rx(uint8_t b)
+{
+    bench_busy = 1;
+    if (b == (uint8_t)ATT_LINK_SYN_ACK) {
+        bench_syn_wait_sum += (uint16_t)(bench_t_loop - bench_t_syn);
+    } else if (b == (uint8_t)ATT_LINK_ACK || b == (uint8_t)ATT_LINK_NAK) {
+        bench_ans_wait_sum += (uint16_t)(bench_t_loop - bench_t_sum);
+    }
+}
+
+static void bench_tx(void)
+{
+    bench_busy = 1;
+    if (tx.stats.blocks_sent != bench_sent) { /* the checksum was handed out */
+        bench_sent = tx.stats.blocks_sent;
+        bench_t_sum = bench_t_loop;
+    } else if (txb == (uint8_t)ATT_LINK_SYN && tx.index == 0u) {
+        bench_t_syn = bench_t_loop;
+    }
+}
+
+static void bench_block_start(void)
+{
+    bench_busy = 1;
+    bench_t_start = bench_t_loop;
+    bench_busy_block = 0;
+}
+
+static void bench_scan_begin(void)
+{
+    bench_t_scan = cycles_now();
+}
+
+static void bench_scan_end(void)
+{
+    uint16_t c = (uint16_t)(cycles_now() - bench_t_scan);
+    if (c < bench_scan_min) {
+        bench_scan_min = c;
+    }
+    if (c > bench_scan_max) {
+        bench_scan_max = c;
+    }
+    bench_scan_sum += c;
+    bench_scans++;
+}
+
+/* The accepted block's exchange and link work (inline: main's cost as it was). */
+#define BENCH_ACCEPTED()                                            \
+    do {                                                            \
+        bench_exch_sum += (uint16_t)(cycles_now() - bench_t_start); \
+        bench_busy_sum += bench_busy_block;                         \
+        if (bench_busy_block > bench_busy_max) {                    \
+            bench_busy_max = bench_busy_block;                      \
+        }                                                           \
+        bench_blocks++;                                             \
+    } while (0)
+#else
+#define BENCH_ACCEPTED()
+#endif /* FW_BENCH */
+
+/* Instrumentation lives in SFR cells the C51 core does not implement
+ * (uCsim keeps them as memory), so it takes none of the 128 bytes of RAM. */
+__sfr16 __at(0xCECD) sim_accepted; /* blocks the receiver accepted (FW_SIM_BLOCKS) */
+__sfr16 __at(0xB5B4) sim_samples;  /* ... of them sample records (FW_SIM_SAMPLES) */
+
+static void put_stat(const char *name)
+{
+    fw_sim_putc(' ');
+    fw_sim_puts(name);
+    fw_sim_putc('=');
+}
+#define STAT(name, v)                 \
+    do {                              \
+        put_stat(name);               \
+        fw_sim_puthex((uint16_t)(v)); \
+    } while (0)
+#define STAT32(name, v)                       \
+    do {                                      \
+        put_stat(name);                       \
+        fw_sim_puthex((uint16_t)((v) >> 16)); \
+        fw_sim_puthex((uint16_t)(v));         \
+    } while (0)
+
+/* Final report of a simulation run (hex values), then stop. */
+static void sim_finish(void)
+{
+    fw_sim_puts("STATS");
+    STAT("accepted", tx.stats.blocks_accepted);
+    STAT("sent", tx.stats.blocks_sent);
+    STAT("naks", tx.stats.naks);
+    STAT("timeouts", tx.stats.timeouts);
+    STAT("gave_up", tx.stats.gave_up);
+    STAT("discarded", tx.stats.bytes_discarded);
+    STAT("samples", seq);
+    STAT("queued", (uint8_t)q_any + (uint8_t)q_full);
+    STAT("overrun_pending", ovr_count);
+    STAT("ticks", fw_ticks);
+#if defined(FW_SIM_MODEL)
+    STAT("conversions", fw_sim_conversions());
+#endif
+    fw_sim_putc('\n');
+#if defined(FW_BENCH)
+    fw_sim_puts("BENCH");
+    STAT("scans", bench_scans);
+    STAT("scan_min", bench_scan_min);
+    STAT("scan_max", bench_scan_max);
+    STAT32("scan_sum", bench_scan_sum);
+    STAT("blocks", bench_blocks);
+    STAT32("busy_sum", bench_busy_sum);
+    STAT("busy_max", bench_busy_max);
+    STAT32("exch_sum", bench_exch_sum);
+    STAT32("syn_wait_sum", bench_syn_wait_sum);
+    STAT32("ans_wait_sum", bench_ans_wait_sum);
+    fw_sim_putc('\n');
+#endif
+    fw_sim_stop(0);
+}
+
+static void sim_init(void)
+{
+    sim_accepted = 0;
+    sim_samples = 0;
+#if defined(FW_BENCH)
+    bench_init();
+#endif
+#if defined(FW_SIM_MODEL)
+    fw_sim_model_init();
+#endif
+}
+
+/* The block accepted last (queue[!q_head]): count it; stop after the configured
+ * number (a count that is 0 costs nothing: the bench image measures main's own work). */
+#if FW_SIM_BLOCKS != 0
+#define SIM_COUNT_BLOCK()                                \
+    do {                                                 \
+        if (++sim_accepted >= (uint16_t)FW_SIM_BLOCKS) { \
+            sim_finish();                                \
+        }                                                \
+    } while (0)
+#else
+#define SIM_COUNT_BLOCK()
+#endif
+#if FW_SIM_SAMPLES != 0
+#define SIM_COUNT_SAMPLE()                                                                               \
+    do {                                                                                                 \
+        if (queue[!q_head][0] != (uint8_t)ATT_BLOCK_MARK && ++sim_samples >= (uint16_t)FW_SIM_SAMPLES) { \
+            sim_finish();                                                                                \
+        }                                                                                                \
+    } while (0)
+#else
+#define SIM_COUNT_SAMPLE()
+#endif
+
+#if defined(FW_SIM_TRACE)
+/* "r<byte>@<tick>" per byte received, "p<result> <byte>@<tick>" per poll that did something */
+#define SIM_TRACE_RX(b)          \
+    do {                         \
+        fw_sim_putc('r');        \
+        fw_sim_puthex(b);        \
+        fw_sim_putc('@');        \
+        fw_sim_puthex(fw_ticks); \
+        fw_sim_putc('\n');       \
+    } while (0)
+#define SIM_TRACE_POLL(st)                                    \
+    do {                                                      \
+        if ((st) != ATT_LINK_NONE && (st) != ATT_LINK_IDLE) { \
+            fw_sim_putc('p');                                 \
+            fw_sim_puthex((uint16_t)(st));                    \
+            fw_sim_putc(' ');                                 \
+            fw_sim_puthex(txb);                               \
+            fw_sim_putc('@');                                 \
+            fw_sim_puthex(fw_ticks);                          \
+            fw_sim_putc('\n');                                \
+        }                                                     \
+    } while (0)
+#else
+#define SIM_TRACE_RX(b)
+#define SIM_TRACE_POLL(st)
+#endif
+
+/* ---- the hooks (firmware/hooks.h lists them) ---- */
+#define FW_HOOK_INIT() sim_init()
+#define FW_HOOK_ACCEPTED()  \
+    do {                    \
+        BENCH_ACCEPTED();   \
+        SIM_COUNT_BLOCK();  \
+        SIM_COUNT_SAMPLE(); \
+    } while (0)
+#define FW_HOOK_POLL(st) SIM_TRACE_POLL(st)
+#if defined(FW_BENCH)
+#define FW_HOOK_LOOP_START() bench_loop_start()
+#define FW_HOOK_LOOP_END()   bench_loop_end()
+#define FW_HOOK_RX(b)    \
+    do {                 \
+        bench_rx(b);     \
+        SIM_TRACE_RX(b); \
+    } while (0)
+#define FW_HOOK_TX()              bench_tx()
+#define FW_HOOK_BLOCK_START()     bench_block_start()
+/* s51's port pins read 1: the self-test fails, but it ran (its stack depth
+ * is measured); the bench goes on to sample: the slot is given back, 1 */
+#define FW_HOOK_SELFTEST_FAILED() (q_unpush(), 1)
+#else
+#define FW_HOOK_LOOP_START()
+#define FW_HOOK_LOOP_END()
+#define FW_HOOK_RX(b) SIM_TRACE_RX(b)
+#define FW_HOOK_TX()
+#define FW_HOOK_BLOCK_START()
+#define FW_HOOK_SELFTEST_FAILED() 0
+#endif
+#if defined(FW_SIM_MODEL) && defined(FW_BENCH)
+#define FW_HOOK_SCAN_BEGIN() \
+    do {                     \
+        fw_sim_model_step(); \
+        bench_scan_begin();  \
+    } while (0)
+#define FW_HOOK_SCAN_END()    \
+    do {                      \
+        bench_scan_end();     \
+        fw_sim_model_check(); \
+    } while (0)
+#elif defined(FW_SIM_MODEL)
+#define FW_HOOK_SCAN_BEGIN() fw_sim_model_step()
+#define FW_HOOK_SCAN_END()   fw_sim_model_check()
+#elif defined(FW_BENCH)
+#define FW_HOOK_SCAN_BEGIN() bench_scan_begin()
+#define FW_HOOK_SCAN_END()   bench_scan_end()
+#else
+#define FW_HOOK_SCAN_BEGIN()
+#define FW_HOOK_SCAN_END()
+#endif
+#if defined(FW_SIM_MODEL)
+#define FW_HOOK_SELFTEST_END() fw_sim_model_check()
+#else
+#define FW_HOOK_SELFTEST_END()
+#endif
+
+#endif /* FW_SIM_HOOKS_H */
