@@ -12,7 +12,7 @@
  *  - decode: a record whose byte 0 is not the mark is a sample with the
  *    big-endian codes, ATT_OK exactly when every code is <= 4095 (else
  *    ATT_BLOCK_E_CODE); a report has kind = byte 1, ATT_BLOCK_E_KIND
- *    above ADC_ERROR, ATT_BLOCK_E_FIELD exactly when a field is out of
+ *    above OVERSAMPLE, ATT_BLOCK_E_FIELD exactly when a field is out of
  *    its range; the fields a kind does not use are 0; every record it
  *    accepts encodes back to the same 6 bytes, and every field it rejects
  *    is rejected by the encoder too.
@@ -20,8 +20,12 @@
  *    at 0, SELFTEST takes none, a loss report is adopted as it is before
  *    the numbering is fixed, then its slip is its first minus the count
  *    (in -32768..32767), ATT_BLOCK_E_SEQ exactly when it is not 0, and the
- *    count goes on after the report's samples; rejected records change
- *    nothing.
+ *    count goes on after the report's samples; OVERSAMPLE n sets the
+ *    stream's n (BOOT sets it back to 1) and takes no number; rejected
+ *    records change nothing.
+ *  - att_block_seq_decode: the same record and placement as decode + feed,
+ *    except that a sample's words are checked against the stream's limit
+ *    (4095, or min(n x 4095, ATT_BLOCK_SUM_MAX) after OVERSAMPLE n).
  *  - an encoder returns ATT_OK exactly for arguments in range, and its
  *    record decodes to those arguments.
  *  - NULL pointers give ATT_E_NULL.
@@ -121,6 +125,19 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
             check(e == st);
         }
         break;
+    case ATT_BLOCK_OVERSAMPLE:
+        check(b->oversample == raw[2]);
+        check(
+            st
+            == (raw[2] >= 1 && raw[2] <= ATT_BLOCK_OVERSAMPLE_MAX && raw[3] == 0 && raw[4] == 0 && raw[5] == 0
+                    ? ATT_OK
+                    : ATT_BLOCK_E_FIELD));
+        zero.oversample = b->oversample;
+        e = att_block_encode_oversample(enc, b->oversample);
+        if (raw[3] == 0 && raw[4] == 0 && raw[5] == 0) { /* the encoder always writes 0 there */
+            check(e == st);
+        }
+        break;
     default:
         check(st == ATT_BLOCK_E_KIND);
         return;
@@ -143,9 +160,21 @@ static void check_seq(att_block_seq *s, const att_block *b)
         return;
     }
     if (b->kind == ATT_BLOCK_BOOT) {
-        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && s->next == 0 && s->synced);
+        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && s->next == 0 && s->synced
+              && s->oversample == 1);
         return;
     }
+    if (b->kind == ATT_BLOCK_OVERSAMPLE && (b->oversample < 1 || b->oversample > ATT_BLOCK_OVERSAMPLE_MAX)) {
+        check(st == ATT_BLOCK_E_FIELD && s->next == before.next && s->synced == before.synced
+              && s->oversample == before.oversample); /* rejected: nothing changes */
+        return;
+    }
+    if (b->kind == ATT_BLOCK_OVERSAMPLE) {
+        check(st == ATT_OK && sp.first == before.next && sp.count == 0 && s->next == before.next
+              && s->synced == before.synced && s->oversample == b->oversample);
+        return;
+    }
+    check(s->oversample == before.oversample); /* only BOOT and OVERSAMPLE change n */
     if (b->kind == ATT_BLOCK_SELFTEST) {
         check(st == ATT_OK && sp.first == before.next && sp.count == 0 && s->next == before.next
               && s->synced == before.synced);
@@ -179,7 +208,7 @@ static void check_encode(uint8_t which, const uint8_t *p)
     uint8_t enc[ATT_BLOCK_SIZE];
     att_block b;
     int e, want, d;
-    switch (which % 5) {
+    switch (which % 7) {
     case 0: {
         uint16_t codes[3];
         codes[0] = (uint16_t)(be16(p) & 0x1FFF); /* mostly in range, sometimes not */
@@ -234,6 +263,46 @@ static void check_encode(uint8_t which, const uint8_t *p)
                   && b.count == be16(p + 3));
         }
         return;
+    case 5:
+        e = att_block_encode_oversample(enc, p[0]);
+        check(e == (p[0] >= 1 && p[0] <= ATT_BLOCK_OVERSAMPLE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_OVERSAMPLE
+                  && b.oversample == p[0]);
+        }
+        return;
+    case 6: {
+        uint16_t sums[3];
+        uint8_t n = (uint8_t)(p[0] % 18); /* 0..17: both ends of 1..16 and beyond */
+        uint32_t lim = (uint32_t)n * ATT_BLOCK_CODE_MAX;
+        att_block_seq s;
+        att_block_span sp;
+        uint8_t ov[ATT_BLOCK_SIZE];
+        if (lim > ATT_BLOCK_SUM_MAX) {
+            lim = ATT_BLOCK_SUM_MAX;
+        }
+        sums[0] = be16(p + 1);
+        sums[1] = (uint16_t)(be16(p + 3) >> (p[0] & 3)); /* smaller words too */
+        sums[2] = (uint16_t)((uint16_t)p[5] << (p[0] & 7));
+        want = n < 1 || n > ATT_BLOCK_OVERSAMPLE_MAX             ? ATT_BLOCK_E_FIELD
+               : sums[0] > lim || sums[1] > lim || sums[2] > lim ? ATT_BLOCK_E_CODE
+                                                                 : ATT_OK;
+        e = att_block_encode_sums(enc, sums, n);
+        check(e == want);
+        if (e == ATT_OK) { /* decoded in its stream: after BOOT and OVERSAMPLE n */
+            att_block_seq_init(&s);
+            check(att_block_encode_boot(ov, 72, 8) == ATT_OK
+                  && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
+            check(att_block_encode_oversample(ov, n) == ATT_OK
+                  && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
+            check(att_block_seq_decode(&s, enc, &b, &sp) == ATT_OK && b.kind == (uint16_t)ATT_BLOCK_SAMPLE
+                  && memcmp(b.code, sums, sizeof sums) == 0 && sp.first == 0 && sp.count == 1);
+            if (n == 1) { /* n = 1 gives att_block_encode_sample's bytes */
+                check(att_block_encode_sample(ov, sums) == ATT_OK && memcmp(ov, enc, sizeof ov) == 0);
+            }
+        }
+        return;
+    }
     default:
         e = att_block_encode_adc_error(enc, be16(p), s8(p[2]));
         check(e == (s8(p[2]) < 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
@@ -278,10 +347,31 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (i = 0; i + 7 <= size; i += 7) {
         const uint8_t *raw = data + i + 1;
         if ((data[i] & 1) == 0) {
-            att_block b;
-            int st = att_block_decode(raw, &b);
+            att_block b, b2;
+            att_block_seq seq2 = seq;
+            att_block_span sp2;
+            uint32_t lim = (uint32_t)seq.oversample * ATT_BLOCK_CODE_MAX;
+            int st = att_block_decode(raw, &b), st2;
             check_decoded(raw, &b, st);
+            /* the receiver's one call: decode against the stream's limit, then place */
+            st2 = att_block_seq_decode(&seq2, raw, &b2, &sp2);
+            if (lim > ATT_BLOCK_SUM_MAX) {
+                lim = ATT_BLOCK_SUM_MAX;
+            }
+            if (b.kind == (uint16_t)ATT_BLOCK_SAMPLE) {
+                int big = b.code[0] > lim || b.code[1] > lim || b.code[2] > lim;
+                check(memcmp(b2.code, b.code, sizeof b.code) == 0 && b2.kind == b.kind);
+                check(st2 == (big ? ATT_BLOCK_E_CODE : ATT_OK) && sp2.first == seq.next && sp2.count == 1);
+                b.kind = (uint16_t)ATT_BLOCK_SAMPLE; /* feed it as a sample, as seq_decode did */
+            } else if (st == ATT_BLOCK_E_KIND || st == ATT_BLOCK_E_FIELD) {
+                check(st2 == st && seq2.next == seq.next && seq2.synced == seq.synced
+                      && seq2.oversample == seq.oversample); /* not placed */
+            }
             check_seq(&seq, &b);
+            if (b.kind != (uint16_t)ATT_BLOCK_SAMPLE && st == ATT_OK) {
+                check(seq2.next == seq.next && seq2.synced == seq.synced
+                      && seq2.oversample == seq.oversample);
+            }
         } else {
             check_encode((uint8_t)(data[i] >> 1), raw);
         }
