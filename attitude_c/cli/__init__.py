@@ -28,7 +28,7 @@ class _VersionAction(argparse.Action):
         parser.exit(message=f"{parser.prog} {attitude_c.__version__}\n")
 
 # Module names under attitude_c.cli, in the order their commands are listed.
-_MODULES = ("simulate", "link", "demo")
+_MODULES = ("simulate", "link", "demo", "view")
 
 
 def build_parser() -> argparse.ArgumentParser:
