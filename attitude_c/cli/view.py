@@ -170,8 +170,8 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_SERVE
     port = sock.getsockname()[1]
     loopback = server.is_loopback(args.bind)
-    host = args.bind if ":" not in args.bind else f"[{args.bind}]"
-    url = f"http://{host}:{port}/"
+    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(args.bind, args.bind)  # any address: this machine's
+    url = f"http://{host if ':' not in host else f'[{host}]'}:{port}/"
     if not loopback:
         _err(f"warning: listening on {args.bind}, not the loopback address: anyone who can reach this "
              f"machine on port {port} can watch the attitude and download the recording (the page "
