@@ -15,7 +15,7 @@ for t in (core.build, core.test, core.lint, core.format, core.clean, core.bench)
 # Areas that add their own tasks (top-level tasks and/or a namespace).
 import importlib
 
-for _name in ("cross", "link", "sim", "firmware"):
+for _name in ("cross", "link", "sim", "firmware", "view"):
     try:
         _mod = importlib.import_module(f"toolchain.tasks.{_name}")
     except ModuleNotFoundError as _exc:

@@ -77,7 +77,7 @@ class View:
 
 def _run(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     return subprocess.run(_cmd(*args), capture_output=True, text=True, timeout=timeout, cwd=ROOT,
-                          stdin=subprocess.DEVNULL)
+                          stdin=subprocess.DEVNULL, check=False)
 
 
 def _one_line_error(proc: subprocess.CompletedProcess, rc: int, text: str) -> None:
@@ -144,7 +144,7 @@ def test_signal_ends_cleanly_with_the_recording_complete(tmp_path: Path, sig: in
     assert rc == 0, err
     assert "Traceback" not in err
     assert f"stopped: 50 samples and 1 events recorded in {rec}" in err
-    rows = list(csv.DictReader(open(rec, encoding="utf-8")))
+    rows = list(csv.DictReader(rec.read_text(encoding="utf-8").splitlines()))
     assert [r["n"] for r in rows[:50]] == [str(k) for k in range(50)] and rows[50]["event"] == "BOOT"
     assert not (tmp_path / "kept.csv.part").exists()
 
@@ -171,7 +171,7 @@ def test_default_bind_is_loopback_only() -> None:
         # the listening socket's local address, from the kernel's table: 127.0.0.1 only
         listening = [ln.split()[1] for ln in Path("/proc/net/tcp").read_text().splitlines()[1:]
                      if ln.split()[3] == "0A" and int(ln.split()[1].split(":")[1], 16) == port]
-        assert listening == ["0100007F:%04X" % port], listening
+        assert listening == [f"0100007F:{port:04X}"], listening
         rc, err = v.stop()
     finally:
         v.kill()

@@ -387,7 +387,7 @@ def test_recording_keeps_events_in_order_and_is_complete_or_absent(tmp_path: Pat
     assert (tmp_path / "rec.csv.part").exists() and not (tmp_path / "rec.csv").exists()
     kept = hub.recorder.close()
     assert kept == tmp_path / "rec.csv" and not (tmp_path / "rec.csv.part").exists()
-    rows = list(csv.DictReader(open(kept, encoding="utf-8")))
+    rows = list(csv.DictReader(kept.read_text(encoding="utf-8").splitlines()))
     assert list(rows[0].keys()) == list(CSV_HEADER)
     assert [(r["event"] or r["n"]) for r in rows] == ["BOOT", "0", "1", "OVERRUN", "3", "note"]
     assert json.loads(rows[3]["detail"]) == {"first": 2, "count": 1}
@@ -501,6 +501,9 @@ def test_server_serves_fixed_routes_read_only() -> None:
 def test_server_refuses_foreign_hosts_and_origins() -> None:
     """DNS rebinding (a page of evil.example resolved to 127.0.0.1) and
     cross-origin WebSockets are refused; the loopback names are served."""
+    _aiohttp()
+    import aiohttp
+
     async def fn(client, hub, port):
         hosts, origins = {}, {}
         for host in ("evil.example", f"evil.example:{port}", f"localhost:{port}", f"127.0.0.1:{port}",
@@ -512,7 +515,7 @@ def test_server_refuses_foreign_hosts_and_origins() -> None:
                 ws = await client.ws_connect("/ws", headers={"Origin": origin})
                 origins[origin.replace(str(port), "PORT")] = "open"
                 await ws.close()
-            except Exception as exc:  # aiohttp.WSServerHandshakeError
+            except aiohttp.WSServerHandshakeError as exc:
                 origins[origin.replace(str(port), "PORT")] = getattr(exc, "status", str(exc))
         return hosts, origins
 
@@ -581,7 +584,7 @@ def test_assets_are_in_the_package_and_the_page_loads_only_them() -> None:
 def test_hub_source_threads_never_wait_for_the_loop() -> None:
     """Samples handed over from another thread while the loop is busy are all
     recorded at the next tick, in order."""
-    hub, clock = _hub()
+    hub, _ = _hub()
     done = threading.Event()
 
     def produce() -> None:

@@ -158,7 +158,8 @@ def make_app(hub: Hub, *, port: int, loopback_only: bool = True) -> Any:
             resp.headers.setdefault(k, v)
         await resp.prepare(request)
         loop = asyncio.get_running_loop()
-        with open(path, "rb") as fh:  # the first `size` bytes are complete rows
+        fh = await loop.run_in_executor(None, open, path, "rb")
+        try:  # the first `size` bytes are complete rows
             left = size
             while left > 0:
                 chunk = await loop.run_in_executor(None, fh.read, min(1 << 16, left))
@@ -166,6 +167,8 @@ def make_app(hub: Hub, *, port: int, loopback_only: bool = True) -> Any:
                     break
                 await resp.write(chunk)
                 left -= len(chunk)
+        finally:
+            fh.close()
         await resp.write_eof()
         return resp
 

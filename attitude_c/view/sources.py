@@ -12,6 +12,7 @@ naming the file and line), before the server starts.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -67,7 +68,7 @@ class Source:
     def _main(self, hub: Hub) -> None:
         try:
             self.run(hub)
-        except Exception as exc:  # the display says what happened; the server stays up
+        except Exception as exc:  # noqa: BLE001 - the page says what happened; the server stays up
             hub.status("lost", f"source failed: {type(exc).__name__}: {exc}")
 
     def run(self, hub: Hub) -> None:  # pragma: no cover - abstract
@@ -166,7 +167,7 @@ class LineReader:
         except json.JSONDecodeError as exc:
             raise ValueError(f"not JSON: {exc.msg}") from None
         if not isinstance(d, dict):
-            raise ValueError("not a JSON object")
+            raise TypeError("not a JSON object")
         if "q" in d:
             t = float(d["t"])
             q = _vec(d, "q", 4)
@@ -249,7 +250,7 @@ class LineReader:
 
 
 def _apply(p: Parsed, hub: Hub, src: Source) -> None:
-    if p.kind == "sample":
+    if p.kind == "sample" and p.sample is not None:
         hub.samples([p.sample])
         if p.counters:
             src.set_counts(p.counters)
@@ -281,7 +282,7 @@ class StdinSource(Source):
         for lineno, raw in enumerate(self.stream, 1):
             if self._stop.is_set():
                 return
-            line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else raw
+            line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else str(raw)
             self.count("lines")
             try:
                 p = reader.feed(line)
@@ -620,8 +621,6 @@ class SerialSource(Source):
             self._close_port()
 
     def _close_port(self) -> None:
-        try:
+        with contextlib.suppress(OSError):  # closing a failed port may fail again (SerialException is one)
             if self.port is not None:
                 self.port.close()
-        except Exception:  # noqa: BLE001 - closing a failed port may fail again
-            pass

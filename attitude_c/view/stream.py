@@ -307,12 +307,14 @@ class _Rate:
             self.marks.popleft()
 
     def rates(self, now: float) -> tuple[float, float]:
-        """(records/s, samples/s by sample number; NaN when unknown)."""
-        m = [x for x in self.marks if now - x[0] <= self.span]
-        if len(m) < 2:
-            return (0.0, 0.0) if not m or now - m[-1][0] > self.span else (float("nan"), float("nan"))
+        """(records/s, samples/s by sample number; NaN when unknown), from the
+        first tick with data in the window (what it brought arrived before it)
+        to now: right when the stream has just started, falling when it stops."""
+        m = [x for x in self.marks if now - x[0] <= self.span and x[1] > 0]
+        if not m:
+            return 0.0, 0.0
         dt = now - m[0][0]
-        if dt <= 0:
+        if len(m) < 2 or dt <= 0:
             return float("nan"), float("nan")
         recs = sum(c for _, c, _ in m[1:]) / dt
         ns = [n for _, _, n in m if math.isfinite(n)]
@@ -355,8 +357,9 @@ class Hub:
         self._counters: Callable[[], dict[str, Any]] = dict
         # loop side
         self.clients: set[Client] = set()
-        self.history: collections.deque[list[float | None]] = collections.deque(
-            maxlen=max(1, int(math.ceil(self.history_s * self.display_rate))))
+        # chart points, each kept serialized (a third of the memory of a list of floats)
+        self.history: collections.deque[str] = collections.deque(
+            maxlen=max(1, math.ceil(self.history_s * self.display_rate)))
         self.events: collections.deque[dict[str, Any]] = collections.deque(maxlen=100)
         self.event_counts: dict[str, int] = {}
         self.seq = 0
@@ -368,6 +371,7 @@ class Hub:
         self._last_td = -math.inf
         self._last: dict[str, Any] | None = None
         self._last_wall = -math.inf
+        self._arrival = float("nan")  # typical wall time between ticks that brought samples (moving average)
         self._rate = _Rate()
         self._last_status: str = ""
         self._last_status_wall = -math.inf
@@ -482,9 +486,12 @@ class Hub:
             te = np.concatenate([b.true_eul for b in batches]) if len(batches) > 1 else batches[0].true_eul
             th = np.concatenate([b.true_head for b in batches]) if len(batches) > 1 else batches[0].true_head
             self.samples_in += k
+            if math.isfinite(self._last_wall):
+                gap = now - self._last_wall
+                self._arrival = gap if not math.isfinite(self._arrival) else 0.8 * self._arrival + 0.2 * gap
             self._last_wall = now
             point = self._chart_point(a, td, te, th)
-            self.history.append(point)
+            self.history.append(json.dumps(point, separators=(",", ":"), allow_nan=False))
             self._last = self._last_sample(a[-1], td[-1], te[-1], th[-1])
             n_fin = a[np.isfinite(a[:, _N]), _N]
             self._rate.add(now, k, float(n_fin[-1]) if n_fin.size else float("nan"))
@@ -555,7 +562,7 @@ class Hub:
         """The source's counters and the count of each report/error kind."""
         try:
             c = dict(self._counters())
-        except Exception as exc:  # a source's bug must not stop the display
+        except Exception as exc:  # noqa: BLE001 - a source's bug must not stop the display
             c = {"counters_error": str(exc)}
         out: dict[str, Any] = {k: v for k, v in c.items() if isinstance(v, (int, float, str))
                                and not (isinstance(v, float) and not math.isfinite(v))}
@@ -577,10 +584,9 @@ class Hub:
             return self._source_state, self._source_text or self._source_state
         if self._last is None:
             return "waiting", self._source_text or "no data yet"
-        recs, _ = self._rate.rates(now)
         limit = self.stall_s
-        if self.samples_in > 1 and math.isfinite(recs) and recs > 0:
-            limit = max(limit, 4.0 / recs)
+        if math.isfinite(self._arrival):
+            limit = max(limit, 4.0 * self._arrival)
         quiet = now - self._last_wall
         if quiet > limit:
             return "stalled", f"no data for {quiet:.1f} s"
@@ -591,9 +597,10 @@ class Hub:
         state, text = self.state()
         msg = {"type": "hello", "session": self.session, "seq": self.seq, "source": self.description,
                "display_rate": self.display_rate, "history_s": self.history_s, "columns": list(CHART_COLUMNS),
-               "history": list(self.history), "events": list(self.events), "last": self._last,
+               "events": list(self.events), "last": self._last,
                "state": state, "text": text, "counters": self.counters(), "hub": self._hub_counters()}
-        return json.dumps(msg, separators=(",", ":"), allow_nan=False)
+        head = json.dumps(msg, separators=(",", ":"), allow_nan=False)
+        return head[:-1] + ',"history":[' + ",".join(self.history) + "]}"
 
     def add_client(self) -> tuple[Client, str]:
         """A new client and its hello message (to send before anything queued)."""

@@ -24,7 +24,15 @@
     paused: false, frozen: null, windowS: 30, rate: {},
     dirty: true, retryMs: 500, ws: null,
   };
-  const stats = { frames: 0, hellos: 0, draws: 0, lastDrawMs: 0, maxDrawMs: 0, connects: 0 };
+  const drawTimes = []; // the last 200 draw times (ms)
+  const stats = {
+    frames: 0, hellos: 0, draws: 0, lastDrawMs: 0, maxDrawMs: 0, connects: 0,
+    medianDrawMs: () => {
+      if (!drawTimes.length) return null;
+      const s = drawTimes.slice().sort((a, b) => a - b);
+      return s[s.length >> 1];
+    },
+  };
   window.attitudeView = { S: S, stats: stats };
 
   // ---- connection -------------------------------------------------------------
@@ -669,6 +677,8 @@
     stats.draws += 1;
     stats.lastDrawMs = ms;
     stats.maxDrawMs = Math.max(stats.maxDrawMs, ms);
+    drawTimes.push(ms);
+    if (drawTimes.length > 200) drawTimes.shift();
   }
 
   function loop() {
