@@ -299,7 +299,9 @@ def test_two_tabs_pause_zoom_download_at_200_samples_per_s(browser, tmp_path: Pa
         path = tmp_path / "dl.csv"
         dl.value.save_as(path)
         assert dl.value.suggested_filename.startswith("attitude-view-")
-        rows = list(csv.DictReader(io_text(path)))
+        every = list(csv.DictReader(io_text(path)))
+        assert every[0]["event"] == "note"  # "simulated 30 s in ... s: 6000 attitude updates"
+        rows = [r for r in every if not r["event"]]
         n = [int(r["n"]) for r in rows]
         assert len(n) > 200 and n == list(range(len(n)))
         assert rows[0]["true_q0"] != ""

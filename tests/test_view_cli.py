@@ -10,7 +10,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 import os
 import re
 import select
@@ -25,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import ROOT, _missing, require_target
+from test_view_sources import CODES, K, send_boot_and_samples
 
 import attitude_c
 
@@ -178,10 +178,6 @@ def test_default_bind_is_loopback_only() -> None:
     assert rc == 0 and "warning" not in err
 
 
-K = math.radians(90.0) / 2048.0  # attitude-rx's default rad/s per code
-CODES = (2048 + 300, 2048 - 120, 2048 + 45)
-
-
 def test_attitude_rx_jsonl_piped_into_view(tmp_path: Path) -> None:
     """The real receiver app on a pty fed by the link sender (BOOT + 90 samples of
     a constant rate), its JSON Lines piped into ``attitude view --stdin``: the
@@ -189,8 +185,7 @@ def test_attitude_rx_jsonl_piped_into_view(tmp_path: Path) -> None:
     closed-form attitude of the constant rate."""
     _aiohttp()
     require_target("host")
-    from attitude_c.link import block
-    from attitude_c.link.transport import PtyPair, open_port, run_sender
+    from attitude_c.link.transport import PtyPair
     from toolchain.tasks.cross import cross_build_target
 
     exe = str(cross_build_target("host", out=tmp_path / "rx")["app"])
@@ -203,13 +198,7 @@ def test_attitude_rx_jsonl_piped_into_view(tmp_path: Path) -> None:
             assert rx.stderr is not None
             banner = rx.stderr.readline().decode()  # the port is configured
             assert "until a BOOT report announces it" in banner, banner
-            blocks = [block.encode_boot(72, 9600)] + [block.encode_sample(CODES)] * 90
-            pa = open_port(p0)
-            try:
-                reports, _ = run_sender(pa, blocks, impl="python", syn_timeout_ms=2000, answer_timeout_ms=2000)
-            finally:
-                pa.close()
-            assert all(r.outcome == "accepted" for r in reports)
+            send_boot_and_samples(p0, 90)
             deadline = time.monotonic() + 30
             body = b""
             while time.monotonic() < deadline:

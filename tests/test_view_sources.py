@@ -261,6 +261,20 @@ CODES = (2048 + 300, 2048 - 120, 2048 + 45)
 W = (np.array(CODES) - 2048.0) * K  # the constant body rate these codes stand for
 
 
+def send_boot_and_samples(path: str, n: int) -> None:
+    """The Python sender A on ``path``: BOOT (20 ms) then ``n`` samples of CODES, every one accepted."""
+    from attitude_c.link.transport import open_port, run_sender
+
+    blocks = [block.encode_boot(72, 9600)] + [block.encode_sample(CODES)] * n
+    pa = open_port(path)
+    try:
+        # long timeouts: a loaded machine must not turn scheduling delays into resends
+        reports, _ = run_sender(pa, blocks, impl="python", syn_timeout_ms=2000, answer_timeout_ms=2000)
+    finally:
+        pa.close()
+    assert all(r.outcome == "accepted" for r in reports)
+
+
 def _closed(t: np.ndarray) -> np.ndarray:
     return attitude_c.rotvec_to_quat(np.asarray(t)[:, None] * W)
 
@@ -333,20 +347,13 @@ def test_serial_source_over_a_pty(impl: str) -> None:
     """The link protocol on a real pseudo-terminal pair: the Python sender A sends
     BOOT and 60 samples; SerialSource (receiver B, decoder, rv3) delivers the
     closed-form attitude and the link's counters."""
-    from attitude_c.link.transport import PtyPair, open_port, run_sender
+    from attitude_c.link.transport import PtyPair
 
     with PtyPair() as (p0, p1):
         src = sources.SerialSource(p1, impl=impl, method="rv3", gap_timeout_ms=400)
         hub = Hub(recorder=Recorder())
         src.start(hub)
-        blocks = [block.encode_boot(72, 9600)] + [block.encode_sample(CODES)] * 60
-        pa = open_port(p0)
-        try:
-            # long timeouts: a loaded machine must not turn scheduling delays into resends
-            reports, _ = run_sender(pa, blocks, impl="python", syn_timeout_ms=2000, answer_timeout_ms=2000)
-        finally:
-            pa.close()
-        assert all(r.outcome == "accepted" for r in reports)
+        send_boot_and_samples(p0, 60)
         _drain(hub, lambda: hub.samples_in >= 20)
         src.stop()
         src.join(5)
@@ -384,7 +391,9 @@ def test_simulator_source_plays_every_update_with_its_truth() -> None:
     hub = Hub(recorder=Recorder())
     src.start(hub)
     _drain(hub, lambda: hub.state()[0] == "ended", timeout=60)
-    rows = _recording(hub)
+    every = _recording(hub)
+    assert every[0]["event"] == "note" and "33 attitude updates" in json.loads(every[0]["detail"])["note"]
+    rows = every[1:]
     res = simulate(parse_simulate_options(opts))  # the same seed: the same run
     assert len(rows) == len(res.t) == 33
     assert [int(r["n"]) for r in rows] == list(range(2, 100, 3))  # rv3: after samples 2, 5, 8, ...

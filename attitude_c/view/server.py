@@ -214,8 +214,10 @@ async def serve(hub: Hub, source: Source, sock: socket.socket, stop: asyncio.Eve
         if on_ready is not None:
             on_ready()
         await stop.wait()
-        source.stop()
+        source.stop()  # then let it hand over what it holds (a source blocked in a read just stays)
+        await asyncio.get_running_loop().run_in_executor(None, source.join, 1.0)
         await ticker
+        hub.tick()  # everything handed over is recorded
         hub.close_clients()
         await asyncio.sleep(0.05)  # let the writers send their close frames
     finally:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import time
 from collections.abc import Iterator, Sequence
 from typing import Any
 
@@ -79,9 +80,13 @@ class SimulatorSource(Source):
         def progress(stage: str, done: int, total: int) -> None:
             hub.status("starting", f"simulating: {stage} {100.0 * done / max(total, 1):.0f} %")
 
+        t0 = time.monotonic()
         res = simulate(self.cfg, progress=progress)
         self.result = res
         self.set_counts(_link_counters(res.link_stats))
+        t_first = float(res.t[0]) if len(res.t) else 0.0
+        hub.event(t_first, "note", {"note": f"simulated {self.cfg.duration:g} s in {time.monotonic() - t0:.1f} s: "
+                                            f"{len(res.t)} attitude updates"})
         hub.status("running", f"playing the simulation at {self.speed:g}x")
         n = pace(hub, self.items(res), self.speed, self._stop)
         if not self._stop.is_set():

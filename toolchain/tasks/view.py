@@ -240,4 +240,36 @@ def view_firmware(c, samples=3000, port=8765, period_ticks=72):
                         p.kill()
 
 
-TOP_LEVEL = (view_soak, view_firmware)
+@task(help={
+    "out": "PNG to write (default docs/img/view.png)",
+    "seconds": "seconds of playback before the picture (default 12)",
+})
+def view_screenshot(c, out="", seconds=12.0):
+    """The screenshot of docs/view.md: the simulator at 200 samples/s with bit errors on the link."""
+    if (why := browser_missing()) is not None:
+        print(f"view-screenshot: {why}", file=sys.stderr)
+        raise SystemExit(1)
+    from playwright.sync_api import sync_playwright
+
+    path = Path(out) if out else ROOT / "docs" / "img" / "view.png"
+    v = ViewProcess("--port", "0", "--simulate", "--duration", "60", "--period", "0.005", "--method", "rv3-reuse",
+                    "--ber", "1e-3", "--calibration", "5")
+    try:
+        with sync_playwright() as pw:
+            browser = launch_chromium(pw)
+            try:
+                page = browser.new_page(viewport={"width": 1280, "height": 860})
+                page.goto(v.url)
+                page.wait_for_selector("body[data-state=live]", timeout=300_000)
+                page.select_option("#window", "10")
+                page.wait_for_timeout(float(seconds) * 1000)
+                page.screenshot(path=str(path), full_page=True)
+            finally:
+                browser.close()
+        v.stop()
+    finally:
+        v.kill()
+    print(f"view-screenshot: wrote {path}")
+
+
+TOP_LEVEL = (view_soak, view_firmware, view_screenshot)
