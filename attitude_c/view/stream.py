@@ -32,6 +32,7 @@ import json
 import math
 import os
 import shutil
+import sys
 import tempfile
 import threading
 import time
@@ -573,7 +574,10 @@ class Hub:
         rec_s, rec_e = self.recorder.counts()
         return {"samples": self.samples_in, "recorded": rec_s, "recorded_events": rec_e,
                 "clients": len(self.clients), "frames_dropped": self.frames_dropped,
-                "recording_error": self.recorder.error}
+                "recording_error": self.recorder.error,
+                # what the server holds (diagnostics: bounded, whatever the run's length)
+                "history_points": len(self.history), "queued_frames": sum(c.queue.qsize() for c in self.clients),
+                "py_blocks": sys.getallocatedblocks()}
 
     def state(self, now: float | None = None) -> tuple[str, str]:
         """The stream's state for the display: ``waiting`` (no data yet),

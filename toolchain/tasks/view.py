@@ -93,7 +93,8 @@ class ViewProcess:
 
 
 def run_soak(seconds: float, *, period: float = 0.005, tabs: int = 2, history: float = 120.0,
-             every: float = 10.0, log: Callable[[str], None] = print, browser: Any = None) -> dict[str, Any]:
+             every: float = 10.0, log: Callable[[str], None] | None = None,
+             browser: Any = None) -> dict[str, Any]:
     """``attitude view --simulate`` for ``seconds`` of simulated time at 1/period
     samples/s (rv3-reuse: one attitude update per sample) with ``tabs`` browser
     tabs open. Samples the server's memory every ``every`` seconds, then checks
@@ -102,12 +103,16 @@ def run_soak(seconds: float, *, period: float = 0.005, tabs: int = 2, history: f
     to open the tabs in (default: launch chromium for the run)."""
     import contextlib
 
+    if log is None:
+        def log(line: str) -> None:
+            print(line, flush=True)
     n_expected = math.floor(seconds / period + 1e-9)
     v = ViewProcess("--port", "0", "--history", f"{history:g}", "--simulate", "--duration", f"{seconds:g}",
                     "--period", f"{period:g}", "--method", "rv3-reuse", "--calibration", "5", "--no-progress")
     figures: dict[str, Any] = {"seconds": seconds, "rate_hz": 1 / period, "tabs": tabs, "history_s": history,
                                "expected_samples": n_expected}
     rss: list[tuple[float, float]] = []
+    held: list[tuple[float, Any, Any, Any]] = []  # (s, Python blocks allocated, history points, queued frames)
     try:
         with contextlib.ExitStack() as stack:
             if browser is None:
@@ -133,8 +138,11 @@ def run_soak(seconds: float, *, period: float = 0.005, tabs: int = 2, history: f
                 if el >= next_mark:
                     rss.append((round(el, 1), round(v.rss_mb(), 2)))
                     hub = pages[0].evaluate("window.attitudeView.S.hub")
-                    log(f"view-soak: t={el:6.1f} s  rss={rss[-1][1]:7.1f} MiB  samples={hub.get('samples')} "
-                        f"recorded={hub.get('recorded')}  dropped frames={hub.get('frames_dropped')}")
+                    held.append((round(el, 1), hub.get("py_blocks"), hub.get("history_points"),
+                                 hub.get("queued_frames")))
+                    log(f"view-soak: t={el:6.1f} s  rss={rss[-1][1]:7.1f} MiB  py_blocks={hub.get('py_blocks')}  "
+                        f"samples={hub.get('samples')} recorded={hub.get('recorded')}  "
+                        f"dropped frames={hub.get('frames_dropped')}")
                     next_mark += every
                 if pages[0].evaluate("document.body.dataset.state") == "ended":
                     break
@@ -166,6 +174,12 @@ def run_soak(seconds: float, *, period: float = 0.005, tabs: int = 2, history: f
     figures["rss_max_mb"] = max(mb)
     half = [m for t, m in rss if t >= rss[-1][0] / 2]
     figures["rss_growth_second_half_mb"] = round(half[-1] - half[0], 2) if len(half) >= 2 else 0.0
+    # the Python heap in objects, which RSS can hide (a leak reusing memory freed by the simulation)
+    figures["server_held"] = held
+    blocks = [b for t, b, _, _ in held if b is not None and t >= held[-1][0] / 2] if held else []
+    figures["py_blocks_second_half"] = [min(blocks), max(blocks)] if blocks else None
+    figures["history_points_max"] = max((h for _, _, h, _ in held if h is not None), default=None)
+    figures["queued_frames_max"] = max((q for _, _, _, q in held if q is not None), default=None)
     return figures
 
 
@@ -192,7 +206,8 @@ def view_soak(c, minutes=10.0, rate=200.0, tabs=2, history=120.0, out=""):
           and fig["times_increasing"] and fig["exit_status"] == 0)
     print(f"view-soak: {'OK' if ok else 'FAILED'}: {fig['recorded_samples']} of {fig['expected_samples']} "
           f"samples recorded, memory max {fig['rss_max_mb']:.1f} MiB, growth over the second half "
-          f"{fig['rss_growth_second_half_mb']:+.1f} MiB")
+          f"{fig['rss_growth_second_half_mb']:+.1f} MiB, Python blocks over the second half "
+          f"{fig['py_blocks_second_half']}")
     if not ok:
         raise SystemExit(1)
 
