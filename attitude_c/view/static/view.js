@@ -214,6 +214,9 @@
 
   function describeEvent(e) {
     const d = e.detail || {};
+    if (e.kind === "note" && typeof d.note === "string") {
+      return (e.t == null ? "" : "t=" + Number(e.t).toFixed(3) + " s ") + d.note;
+    }
     const parts = Object.keys(d).map((k) => k + "=" + (typeof d[k] === "object" ? JSON.stringify(d[k]) : d[k]));
     const t = e.t == null ? "" : "t=" + Number(e.t).toFixed(3) + " s ";
     return t + e.kind + (parts.length ? " " + parts.join(" ") : "");
