@@ -96,6 +96,7 @@ def test_usage_and_source_errors_are_one_line_with_their_exit_status(tmp_path: P
     _one_line_error(_run("--replay", str(bad)), 1, "line 2")
     _one_line_error(_run("--serial", "/dev/nonexistent-attitude-port"), 1, "/dev/nonexistent-attitude-port")
     _one_line_error(_run("--stdin", "--baud", "1200"), 2, "--baud is an option of --serial")
+    _one_line_error(_run("--serial", "loop://", "--block-size", "8"), 2, "--block-size: must be a multiple of 6")
     _one_line_error(_run("--stdin", "--speed", "3"), 2, "--speed is for --replay and --simulate")
     _one_line_error(_run("--simulate", "--budget"), 2, "--budget: not for the display")
     _one_line_error(_run("--simulate", "--period", "-1"), 2, "--period: must be a finite number > 0")

@@ -135,6 +135,12 @@ def _usage_problems(args: argparse.Namespace) -> str | None:
         return "--speed is for --replay and --simulate"
     from ..view.estimators import ESTIMATORS
 
+    if args.serial is not None:
+        from ..link import block
+
+        size = block.fmt().size
+        if args.block_size % size:
+            return f"--block-size: must be a multiple of {size} (records of the block format), got {args.block_size}"
     if args.serial is not None and ESTIMATORS[args.estimator].needs_acc:
         return f"--estimator {args.estimator} needs accelerometer samples, which the serial link does not carry"
     return None

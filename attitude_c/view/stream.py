@@ -36,7 +36,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Union
@@ -637,8 +637,3 @@ class Hub:
             except asyncio.TimeoutError:
                 pass
         self.tick()
-
-
-def rows_array(rows: Iterable[Sequence[float]]) -> NDArray[np.float64]:
-    """Rows (from :func:`row`) as a (k, WIDTH) array."""
-    return _as_rows(list(rows))
