@@ -6,7 +6,7 @@ settings live in toolchain/*.toml, not in code. This file only lists them.
 
 from invoke import Collection
 
-from toolchain.tasks import core, cross, firmware, link, sim
+from toolchain.tasks import core, cross, firmware, link, sim, view
 
 ns = Collection(
     core.build,
@@ -18,5 +18,8 @@ ns = Collection(
     cross.cross_build,
     link.fuzz,
     sim.sim,
+    view.view_soak,
+    view.view_firmware,
+    view.view_screenshot,
     Collection("firmware", firmware.build, firmware.sim),
 )

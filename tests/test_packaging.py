@@ -78,7 +78,11 @@ def test_sdist_wheel_fresh_venv_smoke(tmp_path: Path) -> None:
     assert "-cp39-abi3-" in wheel.name, wheel.name
     with zipfile.ZipFile(wheel) as zf:
         sos = sorted(n for n in zf.namelist() if n.endswith(".so"))
+        static = {n for n in zf.namelist() if n.startswith("attitude_c/view/static/")}
     assert sos == ["attitude_c/_att_f32.abi3.so", "attitude_c/_att_f64.abi3.so"]
+    from attitude_c.view.server import ASSETS  # the display's page works offline: all of it is package data
+
+    assert static == {f"attitude_c/view/static/{name}" for name in ASSETS}, static
 
     # a fresh venv outside the checkout; pip of this interpreter installs into it
     # (--python), so the venv needs no ensurepip (Debian's python3 lacks it)

@@ -349,12 +349,16 @@ def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT
                  gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: int | None = None,
                  duration: float | None = None, on_block: Callable[[bytes], None] | None = None,
                  stop: threading.Event | None = None, eof_after: float | None = None,
-                 keep_blocks: bool = True) -> ReceiverReport:
+                 keep_blocks: bool = True, receiver: Any = None) -> ReceiverReport:
     """Run receiver B on an open ``port`` until ``count`` blocks, ``duration``
     seconds, ``stop`` is set, or ``eof_after`` seconds of silence.
     A port failure ends the loop with ``ended_by="error"`` (the blocks
-    accepted so far are in the report and were passed to ``on_block``)."""
-    rx = make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout_ms)
+    accepted so far are in the report and were passed to ``on_block``).
+    ``receiver``: an end from :func:`make_receiver` to run (its ``stats`` can
+    then be read while the loop runs); default: a new one from ``impl``,
+    ``block_size`` and ``gap_timeout_ms``."""
+    rx = receiver if receiver is not None else make_receiver(impl, block_size=block_size,
+                                                             gap_timeout=gap_timeout_ms)
     clock = _Clock()
     rep = ReceiverReport()
     t_end = None if duration is None else time.monotonic() + duration

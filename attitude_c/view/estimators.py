@@ -1,0 +1,94 @@
+"""Attitude estimators a source of raw inertial samples can run (the serial
+port's gyro codes, a BROAD recording): one registry, chosen by name with
+``attitude view --estimator NAME``.
+
+An estimator takes one sample at a time -- body rate ``gyr`` (rad/s) over
+``dt`` seconds, and the accelerometer and magnetometer when the source has
+them -- and returns the attitude quaternion (scalar first, body -> ENU)
+when the sample completes an attitude update, else None (an rv3 frame
+being filled).
+
+Today the registry holds the strapdown integrator (``integrator``: every
+:data:`attitude_c.core.METHODS`). The attitude filter plugs in by one
+:func:`register` call with a factory building an object with this
+``update`` (its ``needs_acc`` tells the sources without an accelerometer,
+such as the legacy serial link, to refuse it with a clear message).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .. import core
+from ..errors import InvalidArgument
+
+__all__ = ["ESTIMATORS", "Estimator", "EstimatorSpec", "IntegratorEstimator", "make_estimator", "register"]
+
+
+class Estimator(Protocol):
+    """What a source calls per sample."""
+
+    label: str  #: shown on the page, e.g. ``"integrator rv3"``
+
+    def update(self, gyr: NDArray[np.float64], dt: float, acc: NDArray[np.float64] | None = None,
+               mag: NDArray[np.float64] | None = None) -> NDArray[np.float64] | None:
+        """Feed one sample; the attitude (4,) if it completed an update, else None."""
+        ...
+
+
+@dataclass(frozen=True)
+class EstimatorSpec:
+    name: str
+    summary: str
+    needs_acc: bool
+    #: factory(method=..., q0=...) -> Estimator; keywords it does not use are ignored
+    make: Callable[..., Estimator]
+
+
+class IntegratorEstimator:
+    """The strapdown integrator (:class:`attitude_c.Integrator`): increments
+    ``gyr * dt`` for the increment methods, rates with ``dt`` for ``rk4``."""
+
+    def __init__(self, method: core.Method = "rv3", q0: ArrayLike | None = None, **_: Any) -> None:
+        self.integ = core.Integrator(method, q0)
+        self.method = method
+        self.label = f"integrator {method}"
+
+    def update(self, gyr: NDArray[np.float64], dt: float, acc: NDArray[np.float64] | None = None,
+               mag: NDArray[np.float64] | None = None) -> NDArray[np.float64] | None:
+        g = np.asarray(gyr, dtype=np.float64)
+        if self.method == "rk4":
+            out = self.integ.update(g.reshape(1, 3), dt=dt)
+        else:
+            out = self.integ.update(g * dt)
+        return out[-1].astype(np.float64) if len(out) else None
+
+
+ESTIMATORS: dict[str, EstimatorSpec] = {}
+
+
+def register(spec: EstimatorSpec) -> None:
+    """Add (or replace) an estimator under ``spec.name``."""
+    ESTIMATORS[spec.name] = spec
+
+
+register(EstimatorSpec("integrator", "strapdown integrator of the gyro rates (--method)", False,
+                       IntegratorEstimator))
+
+
+def make_estimator(name: str, *, has_acc: bool, **kw: Any) -> Estimator:
+    """Build estimator ``name`` for a source (``has_acc``: the source delivers
+    accelerometer samples). Raises :class:`InvalidArgument` for an unknown
+    name or one the source cannot feed."""
+    spec = ESTIMATORS.get(name)
+    if spec is None:
+        raise InvalidArgument(f"estimator must be one of {', '.join(sorted(ESTIMATORS))}, got {name!r}")
+    if spec.needs_acc and not has_acc:
+        raise InvalidArgument(f"estimator {name!r} needs accelerometer samples, which this source does "
+                              "not deliver")
+    return spec.make(**kw)

@@ -1,0 +1,123 @@
+"""The simulator as a source of the display: a thin adapter over
+:mod:`attitude_c.sim`'s public API (``SimConfig``, ``simulate``) and
+``attitude simulate``'s own option parser, so that ``attitude view
+--simulate [SIMULATE OPTIONS]`` takes exactly simulate's options.
+
+Everything the view knows of the simulator is in this module: when the
+simulator becomes a pipeline of stages, only this file follows. Today the
+whole run is simulated first (in the source's thread; the page shows the
+progress), then played at ``speed`` times real time: one display sample per
+attitude update, with the simulator's truth beside the estimate and the
+body rate of the update's last gyro sample (its increment over the period).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidArgument
+from .sources import Item, Source, pace
+from .stream import Hub, row
+
+__all__ = ["SimulatorSource", "parse_simulate_options"]
+
+#: simulate's options that write files or run a budget: not what a display does.
+_NOT_HERE = ("budget", "methods", "budget_ber", "out", "no_plots", "json")
+
+
+def _simulate_parser() -> argparse.ArgumentParser:
+    from ..cli import simulate as sim_cli
+
+    holder = argparse.ArgumentParser(prog="attitude view")
+    sub = holder.add_subparsers()
+    sim_cli.register(sub)
+    p: argparse.ArgumentParser = sub.choices["simulate"]
+    p.prog = "attitude view --simulate"
+    return p
+
+
+def parse_simulate_options(argv: Sequence[str]) -> Any:
+    """``attitude simulate`` options -> the simulator's configuration
+    (``SimConfig``). A bad option exits with simulate's usage message
+    (status 2); one that makes no sense for a display raises InvalidArgument."""
+    from ..cli.simulate import build_config
+
+    p = _simulate_parser()
+    args = p.parse_args(list(argv))
+    given = [d for d in _NOT_HERE if getattr(args, d, None) != p.get_default(d)]
+    if given:
+        opts = ", ".join("--" + d.replace("_", "-") for d in given)
+        raise InvalidArgument(f"{opts}: not for the display (attitude simulate writes files and budgets)")
+    return build_config(args)
+
+
+class SimulatorSource(Source):
+    """``simulate(cfg)`` once, then its attitude updates played at ``speed``."""
+
+    def __init__(self, cfg: Any, speed: float = 1.0) -> None:
+        super().__init__()
+        if not (math.isfinite(speed) and speed > 0):
+            raise InvalidArgument(f"speed must be a finite number > 0, got {speed!r}")
+        cfg.validate()
+        self.cfg = cfg
+        self.speed = speed
+        self.result: Any = None
+        self.description = (f"simulator: {cfg.trajectory.name} trajectory, {cfg.duration:g} s, period "
+                            f"{cfg.period:g} s, {cfg.method} ({cfg.precision}), sensors {cfg.sensors}, "
+                            f"link {cfg.link}, at {speed:g}x")
+
+    def run(self, hub: Hub) -> None:
+        from ..sim import simulate
+
+        hub.status("starting", "simulating...")
+
+        def progress(stage: str, done: int, total: int) -> None:
+            hub.status("starting", f"simulating: {stage} {100.0 * done / max(total, 1):.0f} %")
+
+        t0 = time.monotonic()
+        res = simulate(self.cfg, progress=progress)
+        self.result = res
+        self.set_counts(_link_counters(res.link_stats))
+        t_first = float(res.t[0]) if len(res.t) else 0.0
+        hub.event(t_first, "note", {"note": f"simulated {self.cfg.duration:g} s in {time.monotonic() - t0:.1f} s: "
+                                            f"{len(res.t)} attitude updates"})
+        hub.status("running", f"playing the simulation at {self.speed:g}x")
+        n = pace(hub, self.items(res), self.speed, self._stop)
+        if not self._stop.is_set():
+            hub.status("ended", f"simulation finished ({n} attitude updates, {self.cfg.duration:g} s)")
+
+    def items(self, res: Any) -> Iterator[Item]:
+        """One sample per attitude update: estimate, truth, the newest gyro sample's rate."""
+        h = self.cfg.period
+        t0 = self.cfg.trajectory.t_start
+        # an update at t = t0 + (n + offset) h, offset 1 (end of the sample) or 0.5 (rk4)
+        ns = np.round((res.t - t0) / h - 0.75).astype(np.int64)
+        j = np.clip(np.searchsorted(res.sample_index, ns), 0, max(len(res.sample_index) - 1, 0))
+        rates = res.increments[j] / h if len(res.increments) else np.full((len(ns), 3), np.nan)
+        for k in range(len(res.t)):
+            t = float(res.t[k])
+            yield (t, "sample", row(t, res.q_est[k], n=int(ns[k]), rate=rates[k], q_true=res.q_true[k],
+                                    euler=res.euler_est[k]))
+
+
+def _link_counters(stats: dict[str, Any]) -> dict[str, Any]:
+    """The simulated link's totals for the whole run (flattened)."""
+    out: dict[str, Any] = {}
+    snd = stats.get("sender", {}) if isinstance(stats.get("sender"), dict) else {}
+    rcv = stats.get("receiver", {}) if isinstance(stats.get("receiver"), dict) else {}
+    if rcv:
+        out["blocks"] = rcv.get("blocks_accepted", 0)
+        out["naks"] = rcv.get("naks", 0)
+        out["timeouts"] = snd.get("timeouts", rcv.get("timeouts", 0))
+    for k in ("duplicated", "lost", "gave_up", "corrupted_undetected", "sent", "delivered"):
+        if isinstance(stats.get(k), (int, float)):
+            out["duplicates" if k == "duplicated" else k] = stats[k]
+    out["link"] = str(stats.get("link", ""))
+    out["note"] = "link counters: totals of the whole simulated run"
+    return out

@@ -1,0 +1,626 @@
+"""Sources of the display: attitude-rx's output on stdin, a recording
+replayed at a chosen speed (CSV, JSON Lines, BROAD ``.mat``), a serial port
+or any pyserial URL through the Python host end of the link.
+
+Each source runs in its own daemon thread and talks to the
+:class:`~attitude_c.view.stream.Hub` only through its non-blocking calls
+(``samples``, ``event``, ``status``); the hub reads the source's counters
+with :meth:`Source.counters`. Everything that can be wrong with a file or a
+port is found when the source is made (an :class:`~attitude_c.errors.AttitudeError`
+naming the file and line), before the server starts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import math
+import threading
+import time
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Any, Callable, Literal, Union
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import AttitudeError, InvalidArgument
+from .estimators import Estimator, make_estimator
+from .stream import Hub, row
+
+__all__ = ["BlockPipeline", "LineReader", "ReplaySource", "SerialSource", "Source", "StdinSource",
+           "load_recording", "pace"]
+
+_RAD = math.pi / 180.0
+
+#: The firmware's default sampling period (firmware/config.h ``FW_PERIOD_TICKS``, ticks of
+#: 1/ATT_BLOCK_TICK_HZ s) -- attitude-rx's period too until a BOOT report announces one.
+DEFAULT_PERIOD_TICKS = 72
+#: attitude-rx's default gyro calibration (csrc/app/rx_config.c): zero-rate code and rad/s per code
+#: (90 deg/s per 2048 codes).
+DEFAULT_ZERO_CODE = 2048.0
+DEFAULT_SCALE = math.radians(90.0) / 2048.0
+#: Seconds between attempts to reopen a serial port that failed.
+REOPEN_S = 1.0
+
+
+class Source:
+    """Base of the sources: a daemon thread running :meth:`run`, counters
+    behind a lock, a stop flag. Subclasses set :attr:`description`."""
+
+    description = ""
+
+    def __init__(self) -> None:
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._counts: dict[str, Any] = {}
+        self._thread: threading.Thread | None = None
+
+    def start(self, hub: Hub) -> None:
+        hub.counters_from(self.counters)
+        self._thread = threading.Thread(target=self._main, args=(hub,), daemon=True,
+                                        name=f"view-source-{type(self).__name__}")
+        self._thread.start()
+
+    def _main(self, hub: Hub) -> None:
+        try:
+            self.run(hub)
+        except Exception as exc:  # noqa: BLE001 - the page says what happened; the server stays up
+            hub.status("lost", f"source failed: {type(exc).__name__}: {exc}")
+
+    def run(self, hub: Hub) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def stop(self) -> None:
+        """Ask the thread to end (sources blocked in a read end with the process)."""
+        self._stop.set()
+
+    def join(self, timeout: float | None = None) -> None:
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+    def counters(self) -> dict[str, Any]:
+        with self._lock:
+            return dict(self._counts)
+
+    def count(self, name: str, k: float = 1) -> None:
+        with self._lock:
+            self._counts[name] = self._counts.get(name, 0) + k
+
+    def set_counts(self, values: dict[str, Any]) -> None:
+        with self._lock:
+            self._counts.update(values)
+
+
+# ---------------------------------------------------------------------------------------
+# lines: attitude-rx JSON Lines and CSV, and the view's own recordings
+# ---------------------------------------------------------------------------------------
+
+Sample = tuple  # a row of attitude_c.view.COLUMNS
+
+
+@dataclass
+class Parsed:
+    """One line, understood: a sample row, an event, counters, or nothing."""
+
+    kind: Literal["sample", "event", "counters", "skip"]
+    t: float = float("nan")
+    sample: Sample | None = None
+    event: str = ""
+    detail: dict[str, Any] | None = None
+    counters: dict[str, Any] | None = None
+
+
+_SKIP = Parsed("skip")
+
+# CSV columns understood, by role (first name found wins).
+_CSV_TIME = ("t", "t_s", "time")
+_CSV_Q = (("q0", "q1", "q2", "q3"), ("q0_est", "q1_est", "q2_est", "q3_est"))
+_CSV_TRUE_Q = (("true_q0", "true_q1", "true_q2", "true_q3"), ("q0_true", "q1_true", "q2_true", "q3_true"))
+_CSV_EULER_DEG = ("yaw_deg", "pitch_deg", "roll_deg")
+_CSV_EULER_RAD = ("yaw_est", "pitch_est", "roll_est")  # attitude simulate's timeseries.csv
+_CSV_RATE_DPS = ("rate_x_dps", "rate_y_dps", "rate_z_dps")
+
+
+def _vec(d: dict[str, Any], key: str, k: int, scale: float = 1.0) -> list[float] | None:
+    v = d.get(key)
+    if v is None:
+        return None
+    if not isinstance(v, list) or len(v) != k:
+        raise ValueError(f"{key!r} must be a list of {k} numbers")
+    return [float(x) * scale for x in v]
+
+
+class LineReader:
+    """Turns the lines of attitude-rx's output (``--format jsonl`` or CSV with
+    its header) or of a view recording (CSV, :data:`~attitude_c.view.CSV_HEADER`)
+    into samples and events.
+
+    JSON Lines: a record with ``q`` is a sample (``t``, ``n``, ``q``, and
+    ``yaw_deg``, ``pitch_deg``, ``roll_deg``, ``heading_deg`` when present;
+    ``rate_dps`` [x, y, z] and ``true_q`` are used if a producer adds them);
+    ``{"report": NAME, ...}`` is a report and ``{"error": ...}`` an error
+    (events); ``{"link": {...}}`` or ``{"stats": {...}}`` records give
+    counters (their numeric fields). attitude-rx's cumulative ``held``
+    becomes a counter. Anything else is counted and ignored.
+    """
+
+    def __init__(self) -> None:
+        self._cols: dict[str, int] | None = None
+        self._roles: dict[str, Any] = {}
+
+    def feed(self, line: str) -> Parsed:
+        """Parse one line. Raises ValueError (with a reason) for a broken line."""
+        s = line.strip()
+        if not s or s.startswith("#"):
+            return _SKIP
+        if s.startswith(("{", "[")):
+            return self._json(s)
+        return self._csv(s)
+
+    def _json(self, s: str) -> Parsed:
+        try:
+            d = json.loads(s)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"not JSON: {exc.msg}") from None
+        if not isinstance(d, dict):
+            raise TypeError("not a JSON object")
+        if "q" in d:
+            t = float(d["t"])
+            q = _vec(d, "q", 4)
+            eul = None
+            if all(k in d for k in _CSV_EULER_DEG):
+                eul = [float(d[k]) * _RAD for k in _CSV_EULER_DEG]
+            h = d.get("heading_deg")
+            n = d.get("n")
+            smp = row(t, q, n=None if n is None else float(n), rate=_vec(d, "rate_dps", 3, _RAD),
+                      q_true=_vec(d, "true_q", 4), euler=eul, heading=None if h is None else float(h) * _RAD)
+            p = Parsed("sample", t, sample=smp)
+            if "held" in d:
+                p.counters = {"held": d["held"]}
+            return p
+        t = float(d.get("t", float("nan")))
+        if "report" in d:
+            detail = {k: v for k, v in d.items() if k not in ("t", "report")}
+            return Parsed("event", t, event=str(d["report"]), detail=detail)
+        if "error" in d:
+            detail = {k: v for k, v in d.items() if k != "t"}
+            return Parsed("event", t, event="error", detail=detail)
+        for key in ("link", "stats"):
+            if isinstance(d.get(key), dict):
+                c = {k: v for k, v in d[key].items() if isinstance(v, (int, float)) and not isinstance(v, bool)}
+                return Parsed("counters", t, counters=c)
+        return Parsed("counters", t, counters={"other_records": 1})
+
+    def _csv(self, s: str) -> Parsed:
+        fields = next(csv.reader([s]))
+        if self._cols is None:
+            self._header(fields)
+            return _SKIP
+        r = self._roles
+        cols = self._cols
+
+        def num(name: str) -> float:
+            i = cols[name]
+            v = fields[i].strip() if i < len(fields) else ""
+            return float(v) if v else float("nan")
+
+        t = num(r["t"])
+        if not math.isfinite(t):
+            raise ValueError("no time")
+        ev = r.get("event")
+        if ev is not None and cols[ev] < len(fields) and fields[cols[ev]].strip():
+            det = fields[cols[r["detail"]]].strip() if r.get("detail") and cols[r["detail"]] < len(fields) else ""
+            detail = json.loads(det) if det else {}
+            return Parsed("event", t, event=fields[cols[ev]].strip(), detail=detail)
+        q = [num(c) for c in r["q"]] if r.get("q") else None
+        eul = None
+        if r.get("euler_deg"):
+            eul = [num(c) * _RAD for c in r["euler_deg"]]
+        elif r.get("euler_rad"):
+            eul = [num(c) for c in r["euler_rad"]]
+        rate = [num(c) * _RAD for c in r["rate"]] if r.get("rate") else None
+        tq = [num(c) for c in r["true_q"]] if r.get("true_q") else None
+        h = num(r["heading"]) * _RAD if r.get("heading") else None
+        n = num(r["n"]) if r.get("n") else None
+        return Parsed("sample", t, sample=row(t, q, n=n, rate=rate, q_true=tq, euler=eul, heading=h))
+
+    def _header(self, fields: list[str]) -> None:
+        names = [f.strip() for f in fields]
+        cols = {n: i for i, n in enumerate(names)}
+        r: dict[str, Any] = {}
+        r["t"] = next((c for c in _CSV_TIME if c in cols), None)
+        r["q"] = next((g for g in _CSV_Q if all(c in cols for c in g)), None)
+        r["true_q"] = next((g for g in _CSV_TRUE_Q if all(c in cols for c in g)), None)
+        r["euler_deg"] = _CSV_EULER_DEG if all(c in cols for c in _CSV_EULER_DEG) else None
+        r["euler_rad"] = _CSV_EULER_RAD if all(c in cols for c in _CSV_EULER_RAD) else None
+        r["rate"] = _CSV_RATE_DPS if all(c in cols for c in _CSV_RATE_DPS) else None
+        r["heading"] = "heading_deg" if "heading_deg" in cols else None
+        r["n"] = "n" if "n" in cols else None
+        r["event"] = "event" if "event" in cols else None
+        r["detail"] = "detail" if "detail" in cols else None
+        if r["t"] is None or not (r["q"] or r["euler_deg"] or r["euler_rad"]):
+            raise ValueError("not a header this reader knows: it needs a time column (t) and the attitude "
+                             "(q0..q3, or yaw_deg, pitch_deg, roll_deg): attitude-rx's CSV, a view "
+                             "recording or attitude simulate's timeseries.csv")
+        self._cols, self._roles = cols, r
+
+
+def _apply(p: Parsed, hub: Hub, src: Source) -> None:
+    if p.kind == "sample" and p.sample is not None:
+        hub.samples([p.sample])
+        if p.counters:
+            src.set_counts(p.counters)
+    elif p.kind == "event":
+        hub.event(p.t, p.event, p.detail)
+    elif p.kind == "counters" and p.counters:
+        if "other_records" in p.counters:
+            src.count("other_records")
+        else:
+            src.set_counts(p.counters)
+
+
+class StdinSource(Source):
+    """attitude-rx's output on a stream (``attitude-rx --format jsonl | attitude view --stdin``).
+
+    A broken line is counted (``bad_lines``) and shown as an error event, never
+    fatal. End of input makes the source *lost* ("input ended")."""
+
+    def __init__(self, stream: IO[bytes] | IO[str], name: str = "stdin") -> None:
+        super().__init__()
+        self.stream = stream
+        self.description = f"{name} (attitude-rx JSON Lines or CSV)"
+        self.name = name
+
+    def run(self, hub: Hub) -> None:
+        reader = LineReader()
+        hub.status("running", f"reading {self.name}")
+        last_t = 0.0
+        for lineno, raw in enumerate(self.stream, 1):
+            if self._stop.is_set():
+                return
+            line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else str(raw)
+            self.count("lines")
+            try:
+                p = reader.feed(line)
+            except (ValueError, TypeError, KeyError) as exc:
+                self.count("bad_lines")
+                hub.event(last_t, "error", {"error": f"{self.name} line {lineno}: {exc}",
+                                            "line": line.strip()[:200]})
+                continue
+            if math.isfinite(p.t):
+                last_t = p.t
+            _apply(p, hub, self)
+        hub.status("lost", f"input ended ({self.name} closed)")
+
+
+# ---------------------------------------------------------------------------------------
+# replay
+# ---------------------------------------------------------------------------------------
+
+#: An item of a replay: (source time, what, payload) -- a sample row, an
+#: event (kind, detail) or counters.
+Item = tuple[float, str, Any]
+
+
+def pace(hub: Hub, items: Iterable[Item], speed: float, stop: threading.Event,
+         on_counters: Callable[[dict[str, Any]], None] | None = None,
+         clock: Callable[[], float] = time.monotonic) -> int:
+    """Hand ``items`` to the hub at ``speed`` times their source time (a time
+    going backwards continues from where it was). Returns the number of
+    samples handed over; stops early (returning) when ``stop`` is set."""
+    w0 = clock()
+    t0: float | None = None
+    last_t = -math.inf
+    batch: list[Sample] = []
+    n = 0
+    for t, what, payload in items:
+        if t0 is None:
+            t0 = t
+        if t < last_t:  # the recording's clock started again: keep going from here
+            t0 -= last_t - t
+        last_t = t
+        due = w0 + (t - t0) / speed
+        now = clock()
+        if due > now:
+            if batch:
+                hub.samples(batch)
+                batch = []
+            while due > now:
+                if stop.wait(min(due - now, 0.05)):
+                    return n
+                now = clock()
+        if stop.is_set():
+            return n
+        if what == "sample":
+            batch.append(payload)
+            n += 1
+            if len(batch) >= 256:
+                hub.samples(batch)
+                batch = []
+            continue
+        if batch:
+            hub.samples(batch)
+            batch = []
+        if what == "event":
+            hub.event(t, payload[0], payload[1])
+        elif what == "counters" and on_counters is not None:
+            on_counters(payload)
+    if batch:
+        hub.samples(batch)
+    return n
+
+
+@dataclass
+class Recording:
+    """A recording loaded for replay: its items in order, or BROAD's arrays."""
+
+    name: str
+    kind: Literal["lines", "broad"]
+    items: list[Item]
+    samples: int
+    trial: Any = None  # attitude_c.broad.Trial for kind "broad"
+
+
+def load_recording(path: str | Path) -> Recording:
+    """Read a recording: attitude-rx's JSON Lines or CSV, a view recording
+    (CSV), ``attitude simulate``'s ``timeseries.csv``, or a BROAD trial
+    (``.mat``). Raises :class:`InvalidArgument` naming the file (and line)."""
+    p = Path(path)
+    if not p.is_file():
+        raise InvalidArgument(f"recording {str(p)!r}: no such file")
+    if p.suffix.lower() == ".mat":
+        from .. import broad
+
+        trial = broad.load_trial(p)
+        return Recording(p.name, "broad", [], trial.n, trial)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InvalidArgument(f"recording {str(p)!r}: cannot read it ({exc})") from None
+    reader = LineReader()
+    items: list[Item] = []
+    samples = 0
+    for lineno, line in enumerate(io.StringIO(text), 1):
+        try:
+            x = reader.feed(line)
+        except (ValueError, TypeError, KeyError, IndexError) as exc:
+            raise InvalidArgument(f"recording {str(p)!r} line {lineno}: {exc}") from None
+        if x.kind == "sample":
+            items.append((x.t, "sample", x.sample))
+            samples += 1
+        elif x.kind == "event":
+            items.append((x.t if math.isfinite(x.t) else (items[-1][0] if items else 0.0), "event",
+                          (x.event, x.detail)))
+        elif x.kind == "counters" and x.counters:
+            items.append((x.t if math.isfinite(x.t) else (items[-1][0] if items else 0.0), "counters",
+                          x.counters))
+    if samples == 0:
+        raise InvalidArgument(f"recording {str(p)!r}: no attitude sample in it")
+    return Recording(p.name, "lines", items, samples)
+
+
+def _broad_items(trial: Any, estimator: Estimator) -> Iterator[Item]:
+    """BROAD samples through the estimator, with the optical reference as the truth."""
+    dt = trial.dt
+    gyr, acc, mag, quat = trial.gyr, trial.acc, trial.mag, trial.quat
+    for k in range(trial.n):
+        q = estimator.update(gyr[k], dt, acc[k], mag[k])
+        if q is None:
+            continue
+        tq = quat[k] if np.isfinite(quat[k]).all() else None
+        yield ((k + 1) * dt, "sample", row((k + 1) * dt, q, n=k, rate=gyr[k], q_true=tq))
+
+
+class ReplaySource(Source):
+    """A recording replayed at ``speed`` times real time. BROAD trials run
+    through an estimator (``estimator``, ``method``) started at the first
+    valid optical reference attitude, with the reference drawn as the truth."""
+
+    def __init__(self, path: str | Path, speed: float = 1.0, estimator: str = "integrator",
+                 method: str = "rv3") -> None:
+        super().__init__()
+        if not (math.isfinite(speed) and speed > 0):
+            raise InvalidArgument(f"speed must be a finite number > 0, got {speed!r}")
+        self.speed = speed
+        self.rec = load_recording(path)
+        self.estimator: Estimator | None = None
+        if self.rec.kind == "broad":
+            trial = self.rec.trial
+            ok = np.isfinite(trial.quat).all(axis=1)
+            q0 = trial.quat[int(np.flatnonzero(ok)[0])] if ok.any() else None
+            self.estimator = make_estimator(estimator, has_acc=True, method=method, q0=q0, rate=trial.rate)
+        what = f"BROAD trial, {self.estimator.label}" if self.estimator else "recording"
+        self.description = f"replay of {self.rec.name} ({what}) at {speed:g}x"
+
+    def run(self, hub: Hub) -> None:
+        hub.status("running", f"replaying {self.rec.name} at {self.speed:g}x")
+        if self.rec.kind == "broad":
+            assert self.estimator is not None
+            items: Iterable[Item] = _broad_items(self.rec.trial, self.estimator)
+        else:
+            items = self.rec.items
+        n = pace(hub, items, self.speed, self._stop, on_counters=self.set_counts)
+        self.set_counts({"replayed": n})
+        if not self._stop.is_set():
+            hub.status("ended", f"replay of {self.rec.name} finished ({n} samples)")
+
+
+# ---------------------------------------------------------------------------------------
+# serial port: the Python host end, the block decoder, an estimator
+# ---------------------------------------------------------------------------------------
+
+Triple = Union[float, tuple[float, float, float]]
+
+
+def _triple(v: Triple, name: str) -> NDArray[np.float64]:
+    a = np.broadcast_to(np.asarray(v, dtype=np.float64), (3,)).copy()
+    if not np.isfinite(a).all():
+        raise InvalidArgument(f"{name} must be finite, got {v!r}")
+    return a
+
+
+class BlockPipeline:
+    """Records of accepted link blocks -> numbered samples -> body rates -> estimator.
+
+    The Python counterpart of attitude-rx's attitude thread, on libattitude's
+    block decoder and sequence tracker (:mod:`attitude_c.link.block`): the
+    period comes from BOOT unless ``period_fixed``; codes become rates with
+    ``(code - zero) * scale``; a lost sample (a loss report, a code out of
+    range) is held at the last good rate so the time base stays the
+    firmware's. ``count(name, k)`` receives the counters.
+    """
+
+    def __init__(self, hub: Hub, estimator: Estimator, count: Callable[[str, float], None], *,
+                 period: float, period_fixed: bool, zero: Triple = DEFAULT_ZERO_CODE,
+                 scale: Triple = DEFAULT_SCALE) -> None:
+        from ..link import block
+
+        self.block = block
+        self.fmt = block.fmt()
+        self.tracker = block.SeqTracker()
+        self.hub = hub
+        self.estimator = estimator
+        self.count = count
+        self.period = float(period)
+        self.period_fixed = period_fixed
+        self.zero = _triple(zero, "zero")
+        self.scale = _triple(scale, "scale")
+        if not (math.isfinite(self.period) and self.period > 0):
+            raise InvalidArgument(f"period must be a finite number > 0 s, got {period!r}")
+        self.t = 0.0
+        self.rate: NDArray[np.float64] | None = None
+
+    def feed_block(self, blk: bytes) -> None:
+        size = self.fmt.size
+        for k in range(0, len(blk) - size + 1, size):
+            self.feed_record(blk[k:k + size])
+
+    def feed_record(self, raw: bytes) -> None:
+        rec, st = self.block.try_decode(raw)
+        if rec is None or (st != 0 and rec.kind != "sample"):
+            self.count("block_errors", 1)
+            self.hub.event(self.t, "error", {"error": self.fmt.errors.get(st, str(st)), "raw": raw.hex()})
+            return
+        span, sst = self.tracker.feed(rec)
+        if sst != 0:
+            self.count("slips", 1)
+            if span.slip < 0:
+                self.count("duplicates", -span.slip)  # samples the numbering had counted twice
+        if rec.kind == "sample":
+            self.count("samples", 1)
+            if st != 0:
+                self.count("code_errors", 1)
+                self.hub.event(self.t, "error", {"error": self.fmt.errors[st], "n": span.first,
+                                                 "codes": list(rec.codes)})
+                self._hold(span.first, 1)
+                return
+            rate = (np.asarray(rec.codes, dtype=np.float64) - self.zero) * self.scale
+            self.rate = rate
+            self._integrate(span.first, rate)
+            return
+        detail = rec.as_dict()
+        name = detail.pop("report")
+        if rec.kind == "boot" and not self.period_fixed:
+            self.period = rec.period_s
+        if rec.is_loss:
+            detail.update(first=span.first, count=span.count, slip=span.slip)
+        self.hub.event(self.t, name, detail)
+        if rec.is_loss:
+            self._hold(span.first, span.count)
+
+    def _hold(self, first: int, count: int) -> None:
+        self.count("missing", count)
+        if self.rate is None:  # nothing to hold before the first good sample: time passes
+            self.t += count * self.period
+            return
+        self.count("held", count)
+        for k in range(count):
+            self._integrate(first + k, self.rate)
+
+    def _integrate(self, n: int, rate: NDArray[np.float64]) -> None:
+        q = self.estimator.update(rate, self.period)
+        self.t += self.period
+        if q is not None:
+            self.hub.samples([row(self.t, q, n=n, rate=rate)])
+
+
+class SerialSource(Source):
+    """A serial port or pyserial URL running libattitude's receiver B
+    (``impl`` "c" or "python"), the block decoder and an estimator.
+
+    The port is opened here (an error raises before the server starts). A
+    port that fails later makes the source *lost* and is reopened every
+    :data:`REOPEN_S` seconds."""
+
+    def __init__(self, url: str, *, baud: int = 9600, block_size: int = 6, impl: str = "c",
+                 gap_timeout_ms: int = 20, estimator: str = "integrator", method: str = "rv3",
+                 period: float | None = None, zero: Triple = DEFAULT_ZERO_CODE,
+                 scale: Triple = DEFAULT_SCALE) -> None:
+        super().__init__()
+        from ..link import block
+        from ..link.cends import make_receiver
+        from ..link.transport import open_port
+
+        size = block.fmt().size
+        if block_size <= 0 or block_size % size:
+            raise InvalidArgument(f"block_size must be a multiple of {size} (records of the block format), "
+                                  f"got {block_size}")
+        self.url, self.baud, self.block_size, self.impl = url, baud, block_size, impl
+        self.gap_timeout_ms = gap_timeout_ms
+        self._make_rx = lambda: make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout_ms)  # type: ignore[arg-type]
+        self._rx = self._make_rx()  # checks block size and timeout
+        self.estimator = make_estimator(estimator, has_acc=False, method=method)
+        self.period_fixed = period is not None
+        self.period = period if period is not None else DEFAULT_PERIOD_TICKS / block.fmt().tick_hz
+        self.zero, self.scale = zero, scale
+        self.port: Any = open_port(url, baud)
+        self._rx_totals: dict[str, int] = {}
+        self.description = (f"serial {url} ({baud} 8N1, block {block_size}, receiver {impl}, "
+                            f"{self.estimator.label})")
+
+    def counters(self) -> dict[str, Any]:
+        out = super().counters()
+        stats = self._rx.stats.as_dict()
+        for k, v in stats.items():
+            out[k] = v + self._rx_totals.get(k, 0)
+        out["blocks"] = out.pop("blocks_accepted", 0)
+        return out
+
+    def run(self, hub: Hub) -> None:
+        from ..link.transport import open_port, run_receiver
+
+        pipe = BlockPipeline(hub, self.estimator, self.count, period=self.period,
+                             period_fixed=self.period_fixed, zero=self.zero, scale=self.scale)
+        hub.status("running", f"listening on {self.url}")
+        try:
+            while not self._stop.is_set():
+                rep = run_receiver(self.port, receiver=self._rx, impl=self.impl,  # type: ignore[arg-type]
+                                   block_size=self.block_size, on_block=pipe.feed_block, stop=self._stop,
+                                   keep_blocks=False)
+                if rep.ended_by == "stop":
+                    break
+                hub.status("lost", f"port {self.url} failed: {rep.error}; reopening every {REOPEN_S:g} s")
+                self._close_port()
+                while not self._stop.wait(REOPEN_S):
+                    try:
+                        self.port = open_port(self.url, self.baud)
+                    except AttitudeError:
+                        continue
+                    for k, v in self._rx.stats.as_dict().items():
+                        self._rx_totals[k] = self._rx_totals.get(k, 0) + v
+                    self._rx = self._make_rx()
+                    self.count("reopens", 1)
+                    hub.event(pipe.t, "note", {"note": f"port {self.url} reopened"})
+                    hub.status("running", f"listening on {self.url}")
+                    break
+        finally:
+            self._close_port()
+
+    def _close_port(self) -> None:
+        with contextlib.suppress(OSError):  # closing a failed port may fail again (SerialException is one)
+            if self.port is not None:
+                self.port.close()
