@@ -80,7 +80,8 @@ def test_sdist_wheel_fresh_venv_smoke(tmp_path: Path) -> None:
         sos = sorted(n for n in zf.namelist() if n.endswith(".so"))
         static = {n for n in zf.namelist() if n.startswith("attitude_c/view/static/")}
     assert sos == ["attitude_c/_att_f32.abi3.so", "attitude_c/_att_f64.abi3.so"]
-    from attitude_c.view.server import ASSETS  # the display's page works offline: all of it is package data
+    # the display's page works offline: all of it is package data
+    from attitude_c.view.server import ASSETS
 
     assert static == {f"attitude_c/view/static/{name}" for name in ASSETS}, static
 
@@ -131,7 +132,7 @@ def test_invoke_build_isolates_only_when_needed() -> None:
 #: (pyproject.toml [project] dependencies), and what only one function imports
 #: on demand with a message naming what to install (scipy: attitude_c.broad's .mat reader).
 _DEPENDENCIES = {"cffi", "numpy", "serial", "matplotlib", "tqdm"}
-_ON_DEMAND = {"scipy"}
+_ON_DEMAND = {"scipy", "aiohttp"}  # optional: imported where needed, with a message saying what to install
 
 
 def test_the_package_imports_nothing_outside_itself() -> None:

@@ -468,8 +468,9 @@ class BlockPipeline:
 
     The Python counterpart of attitude-rx's attitude thread, on libattitude's
     block decoder and sequence tracker (:mod:`attitude_c.link.block`): the
-    period comes from BOOT unless ``period_fixed``; codes become rates with
-    ``(code - zero) * scale``; a lost sample (a loss report, a code out of
+    period comes from BOOT unless ``period_fixed``; codes become rates through
+    the library's one converter (:class:`attitude_c.sensor.Sensor`: ``(code -
+    zero) * scale``, sums of an OVERSAMPLE stream included); a lost sample (a loss report, a code out of
     range) is held at the last good rate so the time base stays the
     firmware's. ``count(name, k)`` receives the counters.
     """
@@ -489,6 +490,9 @@ class BlockPipeline:
         self.period_fixed = period_fixed
         self.zero = _triple(zero, "zero")
         self.scale = _triple(scale, "scale")
+        from ..sensor import Sensor
+
+        self.sensor = Sensor(self.zero, self.scale)
         if not (math.isfinite(self.period) and self.period > 0):
             raise InvalidArgument(f"period must be a finite number > 0 s, got {period!r}")
         self.t = 0.0
@@ -500,25 +504,26 @@ class BlockPipeline:
             self.feed_record(blk[k:k + size])
 
     def feed_record(self, raw: bytes) -> None:
-        rec, st = self.block.try_decode(raw)
-        if rec is None or (st != 0 and rec.kind != "sample"):
+        # the receiver's one call: decode with the stream's limit and place (att_block_seq_decode)
+        rec, span, st = self.tracker.decode(raw)
+        from ..names import C
+        if span is None or rec is None:  # unknown kind or a field out of range: no place in the numbering
             self.count("block_errors", 1)
             self.hub.event(self.t, "error", {"error": self.fmt.errors.get(st, str(st)), "raw": raw.hex()})
             return
-        span, sst = self.tracker.feed(rec)
-        if sst != 0:
+        if st == C["ATT_BLOCK_E_SEQ"]:
             self.count("slips", 1)
             if span.slip < 0:
                 self.count("duplicates", -span.slip)  # samples the numbering had counted twice
         if rec.kind == "sample":
             self.count("samples", 1)
-            if st != 0:
+            if st == C["ATT_BLOCK_E_CODE"]:
                 self.count("code_errors", 1)
-                self.hub.event(self.t, "error", {"error": self.fmt.errors[st], "n": span.first,
+                self.hub.event(self.t, "error", {"error": self.tracker.error(st), "n": span.first,
                                                  "codes": list(rec.codes)})
                 self._hold(span.first, 1)
                 return
-            rate = (np.asarray(rec.codes, dtype=np.float64) - self.zero) * self.scale
+            rate = self.sensor.convert([rec.codes], self.tracker.oversample)[0].astype(np.float64)
             self.rate = rate
             self._integrate(span.first, rate)
             return

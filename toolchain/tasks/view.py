@@ -219,16 +219,14 @@ def view_soak(c, minutes=10.0, rate=200.0, tabs=2, history=120.0, out=""):
 })
 def view_firmware(c, samples=3000, port=8765, period_ticks=72):
     """The firmware in s51 -> socat pty -> attitude-rx --format jsonl -> attitude view --stdin."""
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    from firmware import tool
+    from toolchain import firmware as tool
     from toolchain.tasks.cross import cross_build_target
 
     build = ROOT / "build" / "view-firmware"
     exe = str(cross_build_target("host", out=build / "rx")["app"])
     # long link timeouts: a host answering late (a loaded machine) costs overruns, never duplicates
     cfg = tool.Config(period_ticks=int(period_ticks), syn_timeout=3600, answer_timeout=3600)
-    img = tool.build(build / "fw", cfg, kind="sim", sim_blocks=int(samples) + 1, name="fw_view")
+    img = tool.build(build / "fw", cfg, kind="sim", sim_samples=int(samples), name="fw_view")
     print(img.size_report())
     period = int(period_ticks) / tool.TICK_HZ
     with tool.Session(img, timeout=int(samples) * period * 5 + 120) as sess:
