@@ -7,7 +7,8 @@ one module each (:mod:`.trajectory`, :mod:`.sensors`, :mod:`.conditioning`,
 :mod:`.adc`, :mod:`.board`, :mod:`.link`, :mod:`.host`, :mod:`.estimator`,
 :mod:`.outputs`); :mod:`.chain` composes them (``simulate``, ``acquire``),
 :mod:`.budget` switches the error sources on one at a time, :mod:`.report`
-writes a run's plots and files.
+writes a run's plots and files, :mod:`.sweeps` runs many scenarios on Dask
+(``sweep``, docs/sweep.md).
 """
 
 from __future__ import annotations
@@ -35,6 +36,7 @@ from .link import Delivered, Link
 from .outputs import Errors, attitude_angle, compare, wrap_angle
 from .report import format_table, plot_attitude, plot_errors, write_run
 from .sensors import GYRO_PRESETS, Gyro, GyroModel, gyro_preset
+from .sweeps import load_spec, register_estimator, sweep
 from .trajectory import (
     TRAJECTORIES,
     ConingTrajectory,
@@ -86,15 +88,18 @@ __all__ = [
     "format_budget",
     "format_table",
     "gyro_preset",
+    "load_spec",
     "make_trajectory",
     "plot_attitude",
     "plot_budget",
     "plot_errors",
     "quantize_ideal",
+    "register_estimator",
     "register_source",
     "run_budget",
     "simulate",
     "source",
+    "sweep",
     "wrap_angle",
     "write_run",
 ]
