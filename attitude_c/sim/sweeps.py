@@ -349,8 +349,11 @@ def _key(kind: str, params: Mapping[str, Any]) -> str:
     return hashlib.sha256(blob.encode()).hexdigest()[:16]
 
 
+_DISTRIBUTIONS = ("uniform", "log_uniform", "int", "normal", "choice")
+
+
 def _draw(name: str, dist: Any, rng: np.random.Generator, n: int) -> list[Any]:
-    if not isinstance(dist, dict) or len(dist) != 1:
+    if not isinstance(dist, dict) or len(dist) != 1 or next(iter(dist)) not in _DISTRIBUTIONS:
         raise SpecError(f"[random] {name}: give one distribution, e.g. {{uniform = [lo, hi]}}, "
                         "{log_uniform = [lo, hi]}, {int = [lo, hi]}, {normal = [mean, sd]}, {choice = [...]}")
     (how, arg), = dist.items()
@@ -444,11 +447,13 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
         out = {}
         for k, v in d.items():
             n = _option_name(k)
-            if n == "seed":
+            if section == "cases" and n == "label":
+                n, v = "case", str(v)
+            if n == "seed" and section != "exclude":
                 raise SpecError(f"[{section}] seed: the sweep sets the seed; use [sweep] seeds = N or [list]")
-            if n == "case" and section != "cases":
+            if n == "case" and section not in ("cases", "exclude"):
                 raise SpecError(f"[{section}] case: reserved for the label of a [[cases]] entry")
-            if kind == "simulate" and n not in _options() and n != "case":
+            if kind == "simulate" and n not in _options() and n not in RESERVED:
                 raise SpecError(f"[{section}] {k}: not an option of attitude simulate (sweepable: "
                                 f"{', '.join(sorted(_options()))})")
             out[n] = v
@@ -457,9 +462,6 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     fixed, grid, rnd = norm("fixed", fixed), norm("grid", grid), norm("random", rnd)
     cases = [norm("cases", c) for c in cases]
     excl = [norm("exclude", e) for e in excl]
-    for c in cases:
-        if "label" in c:
-            c["case"] = str(c.pop("label"))
     clash = set(grid) & set(rnd)
     if clash:
         raise SpecError(f"parameter(s) {sorted(clash)} both in [grid] and [random]")
@@ -506,13 +508,16 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     for case in cases:
         for combo in itertools.product(*(grid[k] for k in gkeys)):
             for draw in drawn:
-                point = {**fixed, **case, **dict(zip(gkeys, combo)), **draw}
-                if any(all(point.get(k, _MISSING) == v for k, v in e.items()) for e in excl):
-                    continue
+                # a case pins what it names: over the grid and the draws
+                point = {**fixed, **dict(zip(gkeys, combo)), **draw, **case}
                 if kind == "recordings":
                     point.setdefault("estimator", "integrator")
+                live = [s for s in seeds if not any(all({**point, "seed": s}.get(k, _MISSING) == v
+                                                        for k, v in e.items()) for e in excl)]
+                if not live:
+                    continue
                 canon = _canonical(kind, point, estimators)
-                for s in seeds:
+                for s in live:
                     params = {**canon, "seed": s}
                     key = _key(kind, params)
                     if key not in seen:
