@@ -77,7 +77,7 @@ def run(quick: bool = False) -> str:
         for w in (1, 2):
             t = time.perf_counter()
             cluster = distributed.LocalCluster(n_workers=w, threads_per_worker=1, processes=True,
-                                               dashboard_address=None, silence_logs=logging.ERROR)
+                                               dashboard_address=":0", silence_logs=logging.ERROR)
             client = distributed.Client(cluster)
             client.run(lambda: __import__("attitude_c.sim.sweeps"))  # workers import the package
             startup[w] = time.perf_counter() - t

@@ -36,7 +36,7 @@ def _need_dask() -> None:
             _missing(f"needs {m}: pip install -e '.[sweep]'")
 
 
-# 5 runs of ~0.3 s each (1 s on a loaded 2-core box): methods x 2 seeds, and one run that raises at run time
+# 5 runs of ~0.1 s each (0.5 s on a loaded 2-core box): methods x 2 seeds, and one run that raises at run time
 # (the fixed-point integrator has no rk4: SimConfig.validate lets it through, the
 # integrator refuses it)
 SPEC = """
@@ -44,8 +44,8 @@ SPEC = """
 name = "small"
 seeds = 2
 [fixed]
-duration = 16
-period = 0.02
+duration = 12
+period = 0.04
 calibration = 1
 [grid]
 method = ["rv1", "rv3"]
@@ -319,6 +319,12 @@ def test_interrupted_sweep_resumes_running_only_the_missing_runs(reference, sche
     assert sorted(keys) == sorted(ref["key"])  # every run recorded once: none ran twice
     again = sweeps.sweep(spec, "serial", out=out, plots=False)
     assert again.attrs["executed"] == 0
+    with open(out / ".sweep.lock", "a") as held:  # another sweep writing the folder
+        import fcntl
+
+        fcntl.flock(held.fileno(), fcntl.LOCK_EX)
+        with pytest.raises(sweeps.InvalidArgument, match="another sweep is running"):
+            sweeps.sweep(spec, "serial", out=out, plots=False)
     retried = sweeps.sweep(spec, "serial", out=out, plots=False, retry_failed=True)
     assert retried.attrs["executed"] == 1  # the failed run, on request
     _same(retried, ref)
@@ -374,7 +380,7 @@ precision = ["f64", "f32"]
 method = "rk4"
 precision = "f32"
 """)
-        df = sweeps.sweep(spec, "serial", out=tmp_path / "out")
+        df = sweeps.sweep(spec, "serial", out=tmp_path / "out", plots=False)
         assert len(df) == 2 * 5 and (df["error"] == "").all()
         # constant rate: every method is exact up to rounding; the trapezoid of a constant rate is exact
         f64 = df[df["precision"] == "f64"]

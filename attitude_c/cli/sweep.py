@@ -124,6 +124,9 @@ def run(args: argparse.Namespace) -> int:
     except ImportError as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return EXIT_ENGINE
+    except (AttitudeError, ValueError) as exc:  # e.g. another sweep holds the folder
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return EXIT_SPEC
     except ConnectionError as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return EXIT_ENGINE

@@ -654,14 +654,16 @@ def run_chunk(kind: str, runs: Sequence[tuple[str, dict[str, Any]]], data: str |
 # the journal (resume) and atomic files
 # ---------------------------------------------------------------------------
 
-def read_journal(path: Path) -> dict[str, dict[str, Any]]:
-    """The finished runs recorded in ``path``, by key (a torn last line is dropped)."""
+def read_journal(path: Path, *, repair: bool = False) -> dict[str, dict[str, Any]]:
+    """The finished runs recorded in ``path``, by key (later lines win; a torn last
+    line is ignored, and with ``repair`` cut off so that appends start clean: only
+    the sweep that holds the folder's lock repairs)."""
     done: dict[str, dict[str, Any]] = {}
     if not path.exists():
         return done
     raw = path.read_bytes()
     end = raw.rfind(b"\n") + 1
-    if end < len(raw):  # killed while writing a line: cut it, so appends start clean
+    if repair and end < len(raw):  # killed while writing a line
         with open(path, "r+b") as f:
             f.truncate(end)
     for line in raw[:end].splitlines():
@@ -690,6 +692,26 @@ class _Journal:
     def close(self) -> None:
         self.f.flush()
         os.fsync(self.f.fileno())
+        self.f.close()
+
+
+class _Lock:
+    """An exclusive advisory lock on the output folder (one sweep writes a journal at a time)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.f = open(folder / ".sweep.lock", "a")  # noqa: SIM115 - held for the whole sweep
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX: no lock
+            return
+        try:
+            fcntl.flock(self.f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.f.close()
+            raise InvalidArgument(f"out: another sweep is running in {str(folder)!r} (it holds "
+                                  f"{str(folder / '.sweep.lock')!r})") from None
+
+    def release(self) -> None:
         self.f.close()
 
 
@@ -730,7 +752,7 @@ def _engine(client: Any, workers: int | None) -> tuple[Any, Callable[[], None], 
         import logging
 
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=None, silence_logs=logging.ERROR)
+                                           dashboard_address=":0", silence_logs=logging.ERROR)
         c = distributed.Client(cluster)
 
         def close() -> None:
@@ -860,9 +882,22 @@ def _is_num(s: Any) -> bool:
     return bool(pd.api.types.is_numeric_dtype(s))
 
 
+_MAX_PANELS = 9
+_MAX_LINES = 10
+
+
+def _band(ax: Any, sub: Any, axis: str, fig_col: str, numeric: bool, pos: dict[Any, int], label: str) -> None:
+    st = sub.groupby(axis, sort=True)[fig_col].quantile([0.05, 0.5, 0.95]).unstack()
+    x = np.asarray(st.index, dtype=float) if numeric else np.array([pos[v] for v in st.index], float)
+    line, = ax.plot(x, st[0.5], "o-", label=label, lw=1.3, ms=3)
+    ax.fill_between(x, st[0.05], st[0.95], color=line.get_color(), alpha=0.15, lw=0)
+
+
 def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
     """One PNG per swept parameter: ``spec.figure`` against it, median and 5–95 % band
-    over the replicates, one line per combination of the other swept parameters."""
+    over the replicates (``spec.over``). With two or more other swept parameters, one
+    panel per value of the first (up to 9) and one line per combination of the rest
+    (up to 10); a randomly drawn parameter is shown as a scatter of every run."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -873,42 +908,58 @@ def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
     if fig_col not in df.columns or df[fig_col].notna().sum() == 0:
         return files
     ok = df[df[fig_col].notna()]
+    reps = ", ".join(spec.over)
     for axis in spec.axes:
-        others = [a for a in spec.axes if a != axis and a not in spec.random_axes]
-        fig, ax = plt.subplots(figsize=(7.5, 4.8))
         numeric = _is_num(ok[axis])
-        if axis in spec.random_axes:
-            ax.scatter(ok[axis], ok[fig_col], s=8, alpha=0.6)
+        others = [a for a in spec.axes if a != axis and a not in spec.random_axes]
+        facet, lines = (others[0], others[1:]) if len(others) >= 2 else (None, others)
+        panels = list(dict.fromkeys(ok[facet].tolist()))[:_MAX_PANELS] if facet else [None]
+        ncol = min(3, len(panels))
+        nrow = math.ceil(len(panels) / ncol)
+        fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol + 1.2, 3.3 * nrow + 0.6), sharey=True,
+                                squeeze=False)
+        xs_all = list(dict.fromkeys(ok[axis].tolist()))
+        pos = {x: i for i, x in enumerate(xs_all)}
+        for k, panel in enumerate(panels):
+            ax = axs[k // ncol][k % ncol]
+            sub = ok if facet is None else ok[ok[facet] == panel]
+            if axis in spec.random_axes:
+                ax.scatter(sub[axis], sub[fig_col], s=8, alpha=0.6)
+            else:
+                groups = sub.groupby(lines, sort=False, dropna=False) if lines else [((), sub)]
+                for i, (label, part) in enumerate(groups):
+                    if i >= _MAX_LINES:
+                        break
+                    vals = label if isinstance(label, tuple) else (label,)
+                    _band(ax, part, axis, fig_col, numeric, pos,
+                          ", ".join(f"{o}={v}" for o, v in zip(lines, vals)) or fig_col)
+                if not numeric:
+                    ax.set_xticks(range(len(xs_all)), [str(v) for v in xs_all], rotation=30, ha="right",
+                                  fontsize=7)
+            if (ok[fig_col] > 0).all():
+                ax.set_yscale("log")
+            if numeric and (ok[axis] > 0).all() and ok[axis].max() / ok[axis].min() >= 10:
+                ax.set_xscale("log")
+            if facet is not None:
+                ax.set_title(f"{facet}={panel}", fontsize=8)
+            ax.set_xlabel(axis, fontsize=8)
+            if k % ncol == 0:
+                ax.set_ylabel(fig_col, fontsize=8)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.tick_params(labelsize=7)
+        for k in range(len(panels), nrow * ncol):
+            axs[k // ncol][k % ncol].set_visible(False)
+        handles, labels = axs[0][0].get_legend_handles_labels()
+        if len(handles) > 1:
+            fig.legend(handles, labels, fontsize=7, loc="center right")
+            fig.tight_layout(rect=(0, 0, 0.80, 0.95))
         else:
-            xs_all = list(dict.fromkeys(ok[axis].tolist()))
-            pos = {x: i for i, x in enumerate(xs_all)}
-            groups = ok.groupby(others, sort=False, dropna=False) if others else [((), ok)]
-            for i, (label, sub) in enumerate(groups):
-                if i >= 12:
-                    break
-                st = sub.groupby(axis, sort=True)[fig_col].quantile([0.05, 0.5, 0.95]).unstack()
-                x = np.asarray(st.index, dtype=float) if numeric else np.array([pos[v] for v in st.index], float)
-                lab = ", ".join(f"{o}={v}" for o, v in zip(others, label if isinstance(label, tuple)
-                                                                         else (label,))) or fig_col
-                line, = ax.plot(x, st[0.5], "o-", label=lab, lw=1.3, ms=3)
-                ax.fill_between(x, st[0.05], st[0.95], color=line.get_color(), alpha=0.15, lw=0)
-            if not numeric:
-                ax.set_xticks(range(len(xs_all)), [str(v) for v in xs_all], rotation=30, ha="right")
-            if len(ax.get_lines()) > 1:
-                ax.legend(fontsize=7)
-        if (ok[fig_col] > 0).all():
-            ax.set_yscale("log")
-        if numeric and (ok[axis] > 0).all() and ok[axis].max() / ok[axis].min() >= 10:
-            ax.set_xscale("log")
-        ax.set_xlabel(axis)
-        ax.set_ylabel(fig_col)
-        reps = ", ".join(spec.over)
-        ax.set_title(f"{spec.name}: {fig_col} vs {axis} (median, 5–95 % over {reps})", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        fig.tight_layout()
+            fig.tight_layout(rect=(0, 0, 1, 0.95))
+        fig.suptitle(f"{spec.name}: {fig_col} vs {axis} (median, 5–95 % over {reps})", fontsize=9)
         path = out / f"{fig_col}-vs-{axis}.png"
+
         def save(p: Path, fig: Any = fig) -> None:
-            fig.savefig(p, dpi=110)
+            fig.savefig(p, dpi=100)
         _atomic(path, save)
         plt.close(fig)
         files.append(path)
@@ -943,14 +994,23 @@ def sweep(spec: Spec | str | os.PathLike[str] | Mapping[str, Any], client: Any =
     sp = spec if isinstance(spec, Spec) else load_spec(spec)
     folder = Path(out) if out is not None else Path("results") / f"sweep-{sp.name}"
     folder.mkdir(parents=True, exist_ok=True)
-    if sp.text:
-        text = sp.text
+    lock = _Lock(folder)
+    try:
+        if sp.text:
+            text = sp.text
 
-        def put(p: Path) -> None:
-            p.write_text(text)
-        _atomic(folder / "spec.toml", put)
+            def put(p: Path) -> None:
+                p.write_text(text)
+            _atomic(folder / "spec.toml", put)
+        return _sweep_locked(sp, folder, client, workers, progress, retry_failed, plots)
+    finally:
+        lock.release()
+
+
+def _sweep_locked(sp: Spec, folder: Path, client: Any, workers: int | None,
+                  progress: bool | Callable[[int, int], None], retry_failed: bool, plots: bool) -> Any:
     jpath = folder / JOURNAL
-    records = read_journal(jpath)
+    records = read_journal(jpath, repair=True)
     want = {r.key for r in sp.runs}
     if retry_failed:
         records = {k: v for k, v in records.items() if not v.get("error")}
