@@ -29,6 +29,23 @@ def _workers(text: str) -> int:
     return v
 
 
+class _LogProgress:
+    """Progress as plain lines on stderr when it is not a terminal (logs, batch jobs):
+    every 10 % of the runs and at most every 30 s."""
+
+    def __init__(self, t0: float) -> None:
+        self.t0 = t0
+        self.last = t0
+        self.step = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        now = time.perf_counter()
+        step = done * 10 // max(total, 1)
+        if step != self.step or now - self.last >= 30:
+            self.step, self.last = step, now
+            print(f"  {done}/{total} runs ({now - self.t0:.0f} s)", file=sys.stderr, flush=True)
+
+
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "sweep",
@@ -112,9 +129,12 @@ def run(args: argparse.Namespace) -> int:
         return 0
     client: Any = "serial" if args.serial else args.scheduler
     t0 = time.perf_counter()
+    progress: Any = False
+    if not args.no_progress:
+        progress = True if sys.stderr.isatty() else _LogProgress(t0)
     try:
-        df = sweeps.sweep(spec, client, out=out, workers=args.workers, progress=not args.no_progress
-                          and sys.stderr.isatty(), retry_failed=args.retry_failed, plots=not args.no_plots)
+        df = sweeps.sweep(spec, client, out=out, workers=args.workers, progress=progress,
+                          retry_failed=args.retry_failed, plots=not args.no_plots)
     except KeyboardInterrupt:
         got = sweeps.read_journal(out / sweeps.JOURNAL)
         n = sum(1 for r in spec.runs if r.key in got)
@@ -137,6 +157,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"ran {a['executed']} run(s), reused {a['reused']}, on {a['engine']} in "
           f"{time.perf_counter() - t0:.1f} s; {a['failed']} failed; wrote {out}/ (runs.csv, summary.csv"
           f"{', plots' if not args.no_plots else ''})")
+    if not args.no_plots and not a["plots"] and spec.axes:
+        print(f"{prog}: no plot: figure {spec.figure!r} is not a column of runs.csv with values "
+              "([sweep] figure)", file=sys.stderr)
     if a["failed"]:
         first = df.loc[df["error"] != "", "error"].iloc[0]
         print(f"{prog}: {a['failed']} run(s) raised (error column of runs.csv), e.g. {first}", file=sys.stderr)

@@ -456,6 +456,8 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
             if kind == "simulate" and n not in _options() and n not in RESERVED:
                 raise SpecError(f"[{section}] {k}: not an option of attitude simulate (sweepable: "
                                 f"{', '.join(sorted(_options()))})")
+            if n.endswith(("_file", "_path")) and section != "exclude":  # a path: from the spec's folder
+                v = [_path(base, x) for x in v] if section == "grid" and isinstance(v, list) else _path(base, v)
             out[n] = v
         return out
 
@@ -566,6 +568,10 @@ def _canonical(kind: str, point: dict[str, Any], estimators: dict[str, Callable[
         if k not in ("trial", "estimator", "case") and _accepts(fn, k) is False:
             raise SpecError(f"estimator {name!r} has no setting {k!r}")
     return {k: _jsonable(v) for k, v in point.items()}
+
+
+def _path(base: Path, v: Any) -> Any:
+    return str((base / v).resolve()) if isinstance(v, str) and v else v
 
 
 def _show(point: Mapping[str, Any]) -> str:
@@ -988,7 +994,7 @@ def sweep(spec: Spec | str | os.PathLike[str] | Mapping[str, Any], client: Any =
     ``progress``: True for a bar on stderr, or ``fn(done, total)``.
 
     ``df.attrs`` holds ``executed`` (runs run now), ``reused`` (taken from
-    the journal), ``failed``, ``out`` and ``engine``.
+    the journal), ``failed``, ``out``, ``engine`` and ``plots`` (the PNG files).
     """
     _need("pandas")
     sp = spec if isinstance(spec, Spec) else load_spec(spec)
@@ -1054,8 +1060,8 @@ def _sweep_locked(sp: Spec, folder: Path, client: Any, workers: int | None,
     _atomic(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
     summ = summarize(df, sp)
     _atomic(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
-    if plots:
-        plot_results(df, sp, folder)
+    files = plot_results(df, sp, folder) if plots else []
+    df.attrs.update(plots=[str(f) for f in files])
     df.attrs.update(executed=executed, reused=reused, failed=int((df["error"] != "").sum()), out=str(folder),
                     engine=engine)
     return df
