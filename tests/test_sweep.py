@@ -230,8 +230,17 @@ def test_serial_reference_records_the_failing_run(reference):
     assert rv1[0] != rv1[1]
     out = Path(df.attrs["out"])
     assert df.attrs["failed"] == 1 and df.attrs["executed"] == 5
-    summ = (out / "summary.csv").read_text().splitlines()
-    assert summ[0].split(",")[-9:] == ["runs", "n", "mean", "std", "min", "p5", "p50", "p95", "max"]
+    import pandas as pd
+
+    summ = pd.read_csv(out / "summary.csv")
+    assert summ.columns[-9:].tolist() == ["runs", "n", "mean", "std", "min", "p5", "p50", "p95", "max"]
+    fig = summ[summ["figure"] == "err_attitude_angle_rms"]
+    assert len(fig) == 3 and fig["runs"].tolist() == [2, 2, 1]  # rv1, rv3 over 2 seeds; the failing run
+    got = fig[fig["n"] > 0]
+    assert got[["mean", "p5", "p50", "p95"]].notna().all().all()
+    rv3 = ok[ok["method"] == "rv3"]["err_attitude_angle_rms"]
+    row = got[got["method"] == "rv3"].iloc[0]
+    assert row["mean"] == pytest.approx(rv3.mean(), rel=1e-12) and row["min"] <= row["p50"] <= row["max"]
 
 
 def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):

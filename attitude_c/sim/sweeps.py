@@ -49,6 +49,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from ..core import Method, Precision
 from ..errors import InvalidArgument
 
 __all__ = [
@@ -243,7 +244,7 @@ def register_estimator(name: str, fn: Callable[..., Any]) -> None:
     ESTIMATORS[name] = fn
 
 
-def integrate_trial(trial: Any, method: str = "rv3", precision: str = "f64") -> tuple[np.ndarray, np.ndarray]:
+def integrate_trial(trial: Any, method: Method = "rv3", precision: Precision = "f64") -> tuple[np.ndarray, np.ndarray]:
     """The strapdown integrator (gyro only) on a BROAD trial.
 
     Starts at the first sample with a valid reference, from the reference
@@ -262,13 +263,13 @@ def integrate_trial(trial: Any, method: str = "rv3", precision: str = "f64") -> 
     gyr = trial.gyr[s0:]
     dt = 1.0 / trial.rate
     if method == "rk4":
-        q = core.integrate_rates(gyr, dt, method="rk4", q0=q0, precision=precision)  # type: ignore[arg-type]
+        q = core.integrate_rates(gyr, dt, method="rk4", q0=q0, precision=precision)
         step = 2
     else:
         inc = 0.5 * (gyr[1:] + gyr[:-1]) * dt
         if precision == "f32":
             inc = inc.astype(np.float32)
-        q = core.integrate(inc, method=method, q0=q0, precision=precision)  # type: ignore[arg-type]
+        q = core.integrate(inc, method=method, q0=q0, precision=precision)
         step = names.samples_per_update(method)
     q = np.asarray(q, dtype=np.float64)
     return q, s0 + step * (np.arange(len(q)) + 1)
@@ -758,7 +759,7 @@ def _engine(client: Any, workers: int | None) -> tuple[Any, Callable[[], None], 
         import logging
 
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                           dashboard_address=":0", silence_logs=logging.ERROR)
+                                           dashboard_address=":0", silence_logs=logging.CRITICAL)
         c = distributed.Client(cluster)
 
         def close() -> None:
@@ -870,12 +871,13 @@ def summarize(df: Any, spec: Spec) -> Any:
     pd = _need("pandas")
     figs = figure_columns(df, spec)
     group = [p for p in spec.params if p not in spec.over]
-    base = df.assign(**{p: df[p].astype(str) for p in group})  # NaN/None groups too
+    # a parameter some runs do not set (a case's) is "" there: NaN would not group reliably
+    base = df.assign(**{p: df[p].astype(object).where(df[p].notna(), "") for p in group if df[p].isna().any()})
     if not figs:
         return pd.DataFrame(columns=[*group, "figure", "runs", "n"])
     long = base.melt(id_vars=group or None, value_vars=figs, var_name="figure", value_name="value")
     keys = [*group, "figure"]
-    g = long.groupby(keys, sort=False, dropna=False)["value"]
+    g = long.groupby(keys, sort=False)["value"]
     out = g.agg(runs="size", n="count", mean="mean", std="std", min="min", max="max")
     q = g.quantile([0.05, 0.5, 0.95]).unstack()
     q.columns = ["p5", "p50", "p95"]
