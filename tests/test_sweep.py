@@ -165,13 +165,16 @@ method = "rk4"
     assert c.runs[0].key != b.runs[0].key
 
 
-def test_every_simulate_option_is_sweepable_with_no_change_here(monkeypatch):
+def test_every_simulate_option_is_sweepable_with_no_change_here(monkeypatch, capsys):
     """The option set is read from `attitude simulate`'s parser: an option added there
     (as the accelerometer/magnetometer options will be) can be swept as it is."""
     from attitude_c.cli import simulate as cli_simulate
 
     opts = sweeps.simulate_options()
     assert {"method", "period", "ber", "gyro", "oversample", "cone_angle", "trajectory_file"} <= set(opts)
+    assert main(["sweep", "--list-options"]) == 0
+    listed = capsys.readouterr().out
+    assert "cone_angle       --cone-angle" in listed and "  integrator" in listed
     assert not {"out", "seed", "budget", "json", "no_plots"} & set(opts)  # the 'run' group: how, not what
     orig = cli_simulate.register
 
