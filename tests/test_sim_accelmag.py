@@ -252,3 +252,23 @@ def test_each_preset_noise_has_its_stated_level(part: VectorSensorModel) -> None
     assert abs(e.std() / math.sqrt(want) - 1) < 0.03
     # zero mean: bound 0.06σ, ten times the mean's own σ (σ/√60000 × √((1+a)/(1−a)) ≈ 0.006σ)
     assert abs(e.mean()) < 5 * math.sqrt(want / 20000 * 3)
+
+
+def test_chain_saturation_through_the_adc() -> None:
+    """A perfect ADXL202 (±2 g) on a translation reaching 3.6 g, through the
+    conditioning (±2 g ↦ 90 % of the ADC's half range: the part clips before the
+    ADC does) and the TLC2543: the host's readings never pass the range by more
+    than half a code, the periods flagged saturated include every period whose
+    exact mean is beyond the range, and none whose readings all stayed inside
+    (the flag is per reading: a period whose mean is inside may hold a clipped reading)."""
+    # 90 m at 0.1 Hz: peak 90·(0.2π)² = 35.5 m/s² = 3.6 g, changing by ≤ 1.8 m/s² within a period
+    tr = PaperTrajectory(translation=(90.0, 0.0, 0.0), translation_frequency=(0.1, 0.1, 0.1))
+    res = simulate(SimConfig(trajectory=tr, duration=6.0, calibration_s=1.0, sensors="quantized", link="none",
+                             accel=accel_preset("adxl202")))
+    s = res.aux["accel"]
+    upc = s.calibration.units_per_code
+    assert np.abs(s.values).max() <= 2 * G0 + 0.5 * upc
+    beyond = np.any(np.abs(s.truth) > 2 * G0, axis=1)
+    assert beyond.any() and np.all(s.saturated[beyond])
+    assert not s.saturated[np.all(np.abs(s.truth) < 2 * G0 * 0.9, axis=1)].any()
+    assert res.summary["sensors"]["accel"]["saturated_samples"] == int(s.saturated.sum())
