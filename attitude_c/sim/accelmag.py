@@ -63,6 +63,7 @@ __all__ = [
     "ar1",
     "filtered",
     "mag_preset",
+    "markov",
     "white_noise",
 ]
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal, get_args
 
@@ -108,7 +109,7 @@ class SimConfig:
     mag: VectorSensorModel | None = None
     environment: Environment = EARTH
     hard_iron: tuple[float, float, float] = (0.0, 0.0, 0.0)
-    soft_iron: Any = None  # (3, 3) or None: identity
+    soft_iron: np.ndarray | Sequence[Sequence[float]] | None = None  # (3, 3); None: identity
     disturbances: tuple[MagDisturbance, ...] = ()
     accel_channels: tuple[int, int, int] = (4, 5, 6)
     denoise: Denoise | None = None
