@@ -163,6 +163,13 @@ method = "rk4"
     assert [r.key for r in a.runs] == [r.key for r in b.runs]
     c = sweeps.load_spec({"grid": {"method": ["rv3"], "period": [0.08]}})
     assert c.runs[0].key != b.runs[0].key
+    # a repeatable option: a string is one occurrence, a list of strings several; the run's
+    # (canonical) parameters parse back to the same values on the worker
+    d = sweeps.load_spec({"fixed": {"mag": "hmr3000", "duration": 20},
+                          "grid": {"disturbance": ["5,8,20,0,0", ["5,8,20,0,0", "12,14,0,10,0,1,nav"]]}})
+    assert [len(r.params["disturbance"]) for r in d.runs] == [1, 2]
+    assert sweeps._simulate_namespace(d.runs[1].params).disturbance == [
+        (5.0, 8.0, (20.0, 0.0, 0.0), 0.0, "body"), (12.0, 14.0, (0.0, 10.0, 0.0), 1.0, "nav")]
 
 
 def test_every_simulate_option_is_sweepable_with_no_change_here(monkeypatch, capsys):

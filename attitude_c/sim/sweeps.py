@@ -133,7 +133,7 @@ class Option:
 
     dest: str             #: the parameter name in a spec and in the table (``cone_angle``)
     flag: str             #: the option on the command line (``--cone-angle``)
-    kind: Literal["value", "flag"]  #: ``flag``: a switch (true/false)
+    kind: Literal["value", "flag", "append"]  #: ``flag``: a switch (true/false); ``append``: repeatable
     choices: tuple[Any, ...] | None
     help: str
 
@@ -162,7 +162,8 @@ def _options() -> dict[str, Option]:
         if not a.option_strings or id(a) in control or isinstance(a, argparse._HelpAction):
             continue
         flag = max(a.option_strings, key=len)
-        kind: Literal["value", "flag"] = "flag" if a.nargs == 0 else "value"
+        kind: Literal["value", "flag", "append"] = (
+            "flag" if a.nargs == 0 else "append" if isinstance(a, argparse._AppendAction) else "value")
         out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "")
     return out
 
@@ -198,6 +199,9 @@ def _simulate_argv(params: Mapping[str, Any]) -> list[str]:
                 raise _ParseError(f"{o.flag} is a switch: give true or false, got {v!r}")
             if v:
                 argv.append(o.flag)
+        elif o.kind == "append":  # a string (or a list of numbers) is one occurrence; a list of them, several
+            many = isinstance(v, list) and all(isinstance(x, (str, list)) for x in v)
+            argv += [f"{o.flag}={_argv_value(x)}" for x in (v if many else [v])]
         else:
             argv.append(f"{o.flag}={_argv_value(v)}")
     argv += ["--seed", str(int(params.get("seed", 0)))]
@@ -559,7 +563,15 @@ def _canonical(kind: str, point: dict[str, Any], estimators: dict[str, Callable[
             build_config(ns).validate()
         except (AttitudeError, ValueError, TypeError) as exc:
             raise SpecError(f"run {_show(point)}: {exc}") from None
-        return {k: v if k == "case" else _jsonable(getattr(ns, k)) for k, v in point.items()}
+        out = {}
+        for k, v in point.items():
+            c = v if k == "case" else _jsonable(getattr(ns, k))
+            try:  # the parsed value when it has a JSON form, else the spec's own
+                json.dumps(c)
+            except (TypeError, ValueError):
+                c = _jsonable(v)
+            out[k] = c
+        return out
     name = point["estimator"]
     fn = ESTIMATORS.get(name)
     if fn is None:
@@ -583,19 +595,34 @@ def _show(point: Mapping[str, Any]) -> str:
 # one run (executed on a worker)
 # ---------------------------------------------------------------------------
 
+#: summary.json entries that are not figures of the run: parameters, constants, wall time
+_NOT_FIGURES = ("attitude_c_version", "parameters", "paper_maxima_rad", "backends", "elapsed_s")
+
+
 def _flat_figures(summary: Mapping[str, Any]) -> dict[str, float]:
+    """Every number of a run's summary.json, flattened: ``err_<angle>_<stat>`` for
+    ``errors_rad``, ``<section>_<key>[_<key>...]`` for the rest, 3-vectors as ``_0``,
+    ``_1``, ``_2``; parameters, constants and wall times left out (they are not results,
+    and a wall time would make the table depend on scheduling)."""
     figs: dict[str, float] = {}
-    for ang, st in summary.get("errors_rad", {}).items():
-        for k, v in st.items():
-            figs[f"err_{ang}_{k}"] = float(v)
-    for k in ("updates", "samples"):
-        if k in summary:
-            figs[k] = float(summary[k])
-    for k, v in summary.get("times_better_than_paper", {}).items():
-        figs[f"times_better_{k}"] = float(v)
-    for k, v in summary.get("link", {}).items():
-        if isinstance(v, (int, float)) and not isinstance(v, bool) and k not in ("seed", "ber"):
-            figs[f"link_{k}"] = float(v)
+
+    def walk(prefix: str, v: Any) -> None:
+        if isinstance(v, bool) or v is None:
+            return
+        if isinstance(v, (int, float)):
+            figs[prefix] = float(v)
+        elif isinstance(v, Mapping):
+            for k, x in v.items():
+                if "elapsed" in k or "wall" in k or (prefix == "link" and k in ("seed", "ber")):
+                    continue
+                walk(f"{prefix}_{k}" if prefix else str(k), x)
+        elif isinstance(v, (list, tuple)) and len(v) == 3 and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+            for i, x in enumerate(v):
+                figs[f"{prefix}_{i}"] = float(x)
+
+    walk("err", summary.get("errors_rad", {}))
+    walk("", {k: v for k, v in summary.items() if k not in _NOT_FIGURES and k != "errors_rad"})
     return figs
 
 
