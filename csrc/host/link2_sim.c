@@ -138,7 +138,8 @@ int att_link2_sim_run(const att_link2_sim_config *cfg, att_link_channel *ch, att
         }
         /* producer */
         while (offered < cfg->n_records && t >= next_offer) {
-            att_link2_sim_record(offered, cfg->report_every, rec);
+            /* numbered by records pushed: a record the source drops (ring full) is no gap in the stream */
+            att_link2_sim_record(res->offered, cfg->report_every, rec);
             if (att_link2_sender_push(&a, rec) == ATT_OK) {
                 res->offered++;
             } else if (cfg->period) {

@@ -42,7 +42,7 @@ typedef struct {
     att_link2_receiver_stats receiver;
 } att_link2_sim_result;
 
-/* The record number i offered by the producer (6 bytes at rec): a sample
+/* The record number i pushed into A (the i-th record A took) (6 bytes at rec): a sample
  * whose codes are a hash of i (0..4095), or every report_every-th an
  * OVERRUN-shaped report carrying i. */
 void att_link2_sim_record(uint64_t i, uint32_t report_every, uint8_t *rec);

@@ -96,6 +96,18 @@ void att_link2_sender_reset(att_link2_sender ATT_LINK_MEM *s)
     s->rx_len = 0;
 }
 
+/* Records whose slots are in use: from base, or from the frame being sent
+ * when B acknowledged some of its records meanwhile (its bytes are still read
+ * from the ring). */
+static uint8_t used(const att_link2_sender ATT_LINK_MEM *s)
+{
+    uint8_t n = (uint8_t)(s->head - s->base);
+    if (s->tx != (uint8_t)TX_IDLE && (uint8_t)(s->head - s->f_seq) > n) {
+        n = (uint8_t)(s->head - s->f_seq);
+    }
+    return n;
+}
+
 uint8_t att_link2_sender_pending(const att_link2_sender ATT_LINK_MEM *s)
 {
     return s == NULL ? 0u : (uint8_t)(s->head - s->base);
@@ -106,7 +118,7 @@ uint8_t att_link2_sender_room(const att_link2_sender ATT_LINK_MEM *s)
     if (s == NULL || s->session >= (uint8_t)SES_BAD) {
         return 0;
     }
-    return (uint8_t)(s->cfg.ring_size - (uint8_t)(s->head - s->base));
+    return (uint8_t)(s->cfg.ring_size - used(s));
 }
 
 int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *record)
@@ -119,7 +131,7 @@ int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LI
     if (s->session >= (uint8_t)SES_BAD) {
         return ATT_LINK2_E_STATE;
     }
-    if ((uint8_t)(s->head - s->base) >= s->cfg.ring_size) {
+    if (used(s) >= s->cfg.ring_size) {
         return ATT_LINK2_E_FULL;
     }
     d = slot(s, s->head);
