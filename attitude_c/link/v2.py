@@ -303,11 +303,13 @@ class Sender2:
             if self.session == "wait":
                 self.session = "syn"
                 return Result2.TIMEOUT, None
-            if self.hi != self.base:
+            if self.hi != self.base:  # no progress: go back to the first unacknowledged record
                 self.next = self.base
                 self.cur = (self.cur + 1) // 2
                 self.epoch ^= 1
+            if self._open(self.next):
                 return Result2.TIMEOUT, None
+            # B's limit blocks A, or A missed the ACK that opened it: ask with an empty frame
             return self._send(make_frame(T_DATA | E_BIT * self.epoch, self.next), self.next)  # probe
         if self.session == "run" and self.next != self.head and self._open(self.next):
             return self._send_data()

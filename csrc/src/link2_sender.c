@@ -442,8 +442,11 @@ static att_link2_result poll_idle(att_link2_sender ATT_LINK_MEM *s, uint16_t tic
             s->next = s->base; /* no progress: go back to the first unacknowledged record */
             s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1);
             s->flags ^= (uint8_t)FL_EPOCH;
-            return ATT_LINK2_TIMEOUT;
         }
+        if (window_open(s, s->next)) {
+            return ATT_LINK2_TIMEOUT; /* the next poll sends again */
+        }
+        /* B's limit blocks A (or A missed the ACK that opened it): ask with an empty frame */
         return start_frame(s, (uint8_t)(ATT_LINK2_T_DATA | (s->flags & FL_EPOCH)), s->next, 6u,
                            out); /* probe */
     }
