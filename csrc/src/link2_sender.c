@@ -31,7 +31,8 @@ uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte)
 
 static uint8_t ATT_LINK_MEM *slot(const att_link2_sender ATT_LINK_MEM *s, uint8_t seq)
 {
-    return s->ring + (uint16_t)((uint16_t)(uint8_t)(seq & (uint8_t)(s->cfg.ring_size - 1u)) * 6u);
+    uint16_t i = (uint8_t)(seq & (uint8_t)(s->cfg.ring_size - 1u));
+    return s->ring + (uint16_t)((uint16_t)(i << 2) + (uint16_t)(i << 1)); /* 6 i: no multiply on the 8051 */
 }
 
 /* A sample record whose three codes fit 12 bits travels packed. */
@@ -145,7 +146,8 @@ int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LI
 /* -- sink: ACK frames from B ----------------------------------------- */
 
 /* Apply a valid ACK: d[0] = 0xC0 | flags, d[1] = ack, d[2] = limit. */
-static att_link2_result apply_ack(att_link2_sender ATT_LINK_MEM *s, const uint8_t *d, uint16_t tick)
+static att_link2_result apply_ack(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *d,
+                                  uint16_t tick)
 {
     uint8_t fl = (uint8_t)(d[0] & 0x0Fu);
     uint8_t a = d[1];
@@ -273,18 +275,20 @@ att_link2_result att_link2_sender_sink(att_link2_sender ATT_LINK_MEM *s, uint8_t
 /* Code m (0..3n-1) of the DATA frame being sent: sample m / 3, channel m % 3. */
 static uint16_t code_at(const att_link2_sender ATT_LINK_MEM *s, uint8_t m)
 {
-    uint8_t k = (uint8_t)(m / 3u);
-    const uint8_t ATT_LINK_MEM *r = slot(s, (uint8_t)(s->f_seq + k)) + (uint8_t)(2u * (uint8_t)(m - 3u * k));
+    uint8_t k = (uint8_t)(m / (uint8_t)3); /* 8-bit division: DIV AB on the 8051 */
+    uint8_t c = (uint8_t)(m - (uint8_t)(k + (uint8_t)(k << 1)));
+    const uint8_t ATT_LINK_MEM *r = slot(s, (uint8_t)(s->f_seq + k)) + (uint8_t)(c << 1);
     return (uint16_t)((uint16_t)((uint16_t)r[0] << 8) | r[1]);
 }
 
 /* Byte j of the packed codes: pair j / 3 of codes, byte j % 3 of it. */
 static uint8_t packed_byte(const att_link2_sender ATT_LINK_MEM *s, uint8_t j)
 {
-    uint8_t p = (uint8_t)(j / 3u);
-    uint8_t r = (uint8_t)(j - 3u * p);
-    uint8_t m = (uint8_t)(2u * p);
-    uint8_t ncodes = (uint8_t)(3u * (uint8_t)(s->f_head & 0x1Fu));
+    uint8_t p = (uint8_t)(j / (uint8_t)3);
+    uint8_t r = (uint8_t)(j - (uint8_t)(p + (uint8_t)(p << 1)));
+    uint8_t m = (uint8_t)(p << 1);
+    uint8_t n = (uint8_t)(s->f_head & 0x1Fu);
+    uint8_t ncodes = (uint8_t)(n + (uint8_t)(n << 1));
     if (r == 0u) {
         return (uint8_t)(code_at(s, m) >> 4);
     }
