@@ -10,6 +10,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal
 
+import serial
+
 from ..errors import InvalidArgument, LinkError
 from .transport import _Clock, _read, _write
 from .v2 import RECORD, Receiver2, Result2, Sender2
@@ -42,9 +44,7 @@ def _out_waiting(port: Any) -> int:
     """Bytes written but not yet sent (TIOCOUTQ); 0 where a port cannot tell (sockets)."""
     try:
         return int(port.out_waiting)
-    except (AttributeError, OSError, NotImplementedError, ValueError):
-        return 0
-    except Exception:  # pyserial raises its own error types on some URL handlers
+    except (AttributeError, OSError, NotImplementedError, ValueError, serial.SerialException):
         return 0
 
 
