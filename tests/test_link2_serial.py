@@ -5,6 +5,9 @@ paced bridge, and back-pressure from a slow consumer."""
 from __future__ import annotations
 
 import itertools
+import json
+import subprocess
+import sys
 import threading
 
 import pytest
@@ -95,3 +98,32 @@ def test_slow_consumer_back_pressure() -> None:
     assert rep.ended_by == "done"
     assert taken + backlog == recs
     assert rx.stats["refused"] >= 0
+
+
+def _cli(*args: str, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "attitude_c", *args], capture_output=True, text=True,
+                          timeout=120, **kw)
+
+
+def test_cli_link_test_v2() -> None:
+    proc = _cli("link-test", "--protocol", "v2", "--blocks", "3000", "--ber", "1e-3", "--drop", "1e-3",
+                "--json")
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    assert (out["corrupt"], out["duplicates"], out["lost"], out["delivered"]) == (0, 0, 0, 3000)
+    proc = _cli("link-test", "--protocol", "v2", "--reboot", "1:sender", "--reboot", "2:sender")
+    assert proc.returncode == 2 and "at most one --reboot" in proc.stderr
+
+
+def test_cli_tx_rx_v2_over_pty() -> None:
+    with PtyPair() as (pa, pb):
+        rx = subprocess.Popen([sys.executable, "-m", "attitude_c", "link-rx", "--protocol", "v2", "--port", pb,
+                               "--count", "50", "--decode", "--impl", "python"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        tx = _cli("link-tx", "--protocol", "v2", "--port", pa, "--generate", "--count", "50", "--wait", "60")
+        out, err = rx.communicate(timeout=60)
+    assert tx.returncode == 0, tx.stderr
+    assert "50 of 50 record(s) acknowledged" in tx.stdout
+    assert rx.returncode == 0, err
+    lines = [json.loads(x) for x in out.splitlines()]
+    assert len(lines) == 50 and all("codes" in x and "error" not in x for x in lines)
