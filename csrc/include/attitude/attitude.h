@@ -16,5 +16,6 @@
 #include "attitude/fixed.h"
 #include "attitude/ad7927.h"
 #include "attitude/denoise.h"
+#include "attitude/aiding.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
