@@ -130,6 +130,12 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_BLOCK_E_KIND": (BlockFormatError, "unknown report kind"),
     "ATT_BLOCK_E_FIELD": (BlockFormatError, "report field out of range"),
     "ATT_BLOCK_E_SEQ": (BlockFormatError, "loss report disagrees with the sample count"),
+    # aiding.h
+    "ATT_AID_E_ZERO_F": (InvalidArgument, "specific force is zero: no up direction"),
+    "ATT_AID_E_ZERO_M": (InvalidArgument, "magnetic field is zero: no north direction"),
+    "ATT_AID_E_PARALLEL": (InvalidArgument, "specific force and field are parallel: heading undefined"),
+    "ATT_AID_E_MOVING": (InvalidArgument, "static window: spread above its limit (moving start)"),
+    "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
 }
 
 
