@@ -4,7 +4,7 @@
  * every step; attitude_c/ahrs_reference.py is the independent NumPy model.
  */
 #include "attitude/ahrs.h"
-#include "attitude/quat.h"
+#include "attitude/aiding.h"
 
 #include "att_math.h"
 
@@ -17,19 +17,23 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     }
     set->method = ATT_METHOD_RV3_REUSE;
     set->gravity = ATT_R(9.81);
-    set->gyr_noise = ATT_R(0.0087);
+    set->gyr_noise = ATT_R(0.01);
     set->bias_noise = ATT_R(1e-4);
     set->init_att_sigma = ATT_R(0.1);
     set->init_bias_sigma = ATT_R(0.01);
     set->acc_tau = ATT_R(2.0);
-    set->acc_noise = ATT_R(0.05);
+    set->acc_noise = ATT_R(0.015);
     set->acc_gate = ATT_R(0.2);
     set->acc_reject_max = ATT_R(3.0);
-    set->mag_noise = ATT_R(0.1);
+    set->mag_noise = ATT_R(0.09);
     set->mag_norm_tol = ATT_R(0.1);
     set->mag_dip_tol = ATT_R(0.1);
     set->mag_ref_tau = ATT_R(30.0);
     set->mag_reject_max = ATT_R(60.0);
+    set->mag_reject_factor = ATT_R(2.0);
+    set->mag_new_time = ATT_R(20.0);
+    set->mag_new_gyr = ATT_R(0.35);
+    set->mag_min_undisturbed = ATT_R(0.5);
     set->declination = ATT_R(0.0);
     set->rest_time = ATT_R(1.5);
     set->rest_tau = ATT_R(0.5);
@@ -60,15 +64,18 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set)
           && t->init_bias_sigma >= 0 && fin(t->acc_noise) && t->acc_noise > 0 && fin(t->mag_noise)
           && t->mag_noise > 0 && fin(t->mag_norm_tol) && t->mag_norm_tol > 0 && fin(t->mag_dip_tol)
           && t->mag_dip_tol > 0 && fin(t->mag_ref_tau) && t->mag_ref_tau > 0 && fin(t->mag_reject_max)
-          && t->mag_reject_max > 0 && fin(t->acc_reject_max) && t->acc_reject_max > 0 && fin(t->rest_tau)
-          && t->rest_tau > 0 && fin(t->rest_gyr_th) && t->rest_gyr_th > 0 && fin(t->rest_acc_th)
-          && t->rest_acc_th > 0 && fin(t->rest_noise) && t->rest_noise > 0 && fin(t->overrange_sigma)
-          && t->overrange_sigma >= 0)) {
+          && t->mag_reject_max > 0 && fin(t->mag_reject_factor) && t->mag_reject_factor >= 1
+          && fin(t->mag_new_time) && t->mag_new_time > 0 && fin(t->mag_new_gyr) && t->mag_new_gyr >= 0
+          && fin(t->mag_min_undisturbed) && t->mag_min_undisturbed >= 0 && fin(t->acc_reject_max)
+          && t->acc_reject_max > 0 && fin(t->rest_tau) && t->rest_tau > 0 && fin(t->rest_gyr_th)
+          && t->rest_gyr_th > 0 && fin(t->rest_acc_th) && t->rest_acc_th > 0 && fin(t->rest_noise)
+          && t->rest_noise > 0 && fin(t->overrange_sigma) && t->overrange_sigma >= 0)) {
         return ATT_E_AHRS_SETTINGS;
     }
     /* zero = off */
     if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
-          && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination))) {
+          && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
+          && att_fabs(t->declination) <= ATT_PI)) {
         return ATT_E_AHRS_SETTINGS;
     }
     return ATT_OK;
@@ -131,6 +138,10 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->mag_ref[0] = 0;
     s->mag_ref[1] = 0;
     s->mag_rej_time = 0;
+    s->mag_cand[0] = 0;
+    s->mag_cand[1] = 0;
+    s->mag_cand_t = 0;
+    s->mag_undist_t = 0;
     s->rest_t = 0;
     s->aligned = (q0 != NULL);
     s->acc_init = 0;
@@ -178,74 +189,19 @@ static att_real wrap_pi(att_real a)
     return a;
 }
 
-/* Initial attitude from one specific force (up) and, if given, one field
- * sample (magnetic north, rotated by the declination); heading 0 (the
- * body's forward axis toward north) without a field. */
+/* Initial attitude from one sample: att_align_accmag (aiding.h), six-axis
+ * (heading 0) when there is no field or it gives no heading. */
 static att_status align(const att_ahrs_settings *set, const att_real acc[3], const att_real mag[3],
                         att_real q[4])
 {
-    att_real u[3], e[3], nn[3], C[9], na, ne, ce, se, k;
-    int i;
-    na = norm3(acc);
-    if (!(na > 0)) {
-        return ATT_E_AHRS_ALIGN;
-    }
-    for (i = 0; i < 3; i++) {
-        u[i] = acc[i] / na;
-    }
-    ne = 0;
+    att_status st = ATT_AID_E_ZERO_M;
     if (mag != NULL) {
-        /* east = m × up */
-        e[0] = mag[1] * u[2] - mag[2] * u[1];
-        e[1] = mag[2] * u[0] - mag[0] * u[2];
-        e[2] = mag[0] * u[1] - mag[1] * u[0];
-        ne = norm3(e);
+        st = att_align_accmag(acc, mag, set->declination, q);
     }
-    if (!(ne > 0)) {
-        /* north = forward axis (y, else x) projected on the horizontal */
-        att_real f[3] = { 0, 1, 0 };
-        if (att_fabs(u[1]) > ATT_R(0.9)) {
-            f[0] = 1;
-            f[1] = 0;
-        }
-        k = f[0] * u[0] + f[1] * u[1] + f[2] * u[2];
-        for (i = 0; i < 3; i++) {
-            nn[i] = f[i] - k * u[i];
-        }
-        k = norm3(nn);
-        for (i = 0; i < 3; i++) {
-            nn[i] /= k;
-        }
-        /* east = north × up */
-        e[0] = nn[1] * u[2] - nn[2] * u[1];
-        e[1] = nn[2] * u[0] - nn[0] * u[2];
-        e[2] = nn[0] * u[1] - nn[1] * u[0];
-    } else {
-        for (i = 0; i < 3; i++) {
-            e[i] /= ne;
-        }
-        /* north = up × east */
-        nn[0] = u[1] * e[2] - u[2] * e[1];
-        nn[1] = u[2] * e[0] - u[0] * e[2];
-        nn[2] = u[0] * e[1] - u[1] * e[0];
-        if (set->declination != 0) {
-            /* true axes: rotate the magnetic ones by −D about up */
-            ce = att_cos(set->declination);
-            se = att_sin(set->declination);
-            for (i = 0; i < 3; i++) {
-                att_real ei = e[i], ni = nn[i];
-                e[i] = ce * ei - se * ni;
-                nn[i] = se * ei + ce * ni;
-            }
-        }
+    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
+        st = att_align_accmag(acc, NULL, set->declination, q);
     }
-    /* rows of C_b^n are the navigation axes in body coordinates */
-    for (i = 0; i < 3; i++) {
-        C[i] = e[i];
-        C[3 + i] = nn[i];
-        C[6 + i] = u[i];
-    }
-    return att_dcm_to_quat(C, q);
+    return st;
 }
 
 /* Scalar update of the error state x with measurement y of x[j]
@@ -497,7 +453,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
                 s->acc_rej_time = 0;
             }
             if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
-                att_real R = set->acc_noise * set->acc_noise;
+                att_real R = set->acc_noise * set->acc_noise / dt;
                 scalar_update(s->P, x, 0, y0, R, MASK_ACC);
                 scalar_update(s->P, x, 1, y1, R, MASK_ACC);
             }
@@ -506,7 +462,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 
     /* magnetometer: heading only, disturbance rejection on norm and dip */
     if (mag != NULL) {
-        att_real m[3], h, nm, dip;
+        att_real m[3], h, nm, dip, rm;
         int use = 0;
         mat_vec(C, mag, m);
         h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
@@ -516,37 +472,70 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
             if (!s->mag_ref_valid) {
                 s->mag_ref[0] = nm;
                 s->mag_ref[1] = dip;
+                s->mag_cand[0] = nm;
+                s->mag_cand[1] = dip;
                 s->mag_ref_valid = 1;
+                s->mag_undist_t = set->mag_min_undisturbed;
             }
+            /* candidate reference: the field while it stays consistent with
+             * itself; its time runs only while turning (a field fixed to the
+             * body would change with the attitude and fail the test) */
+            if (att_fabs(nm - s->mag_cand[0]) <= set->mag_norm_tol * s->mag_cand[0]
+                && att_fabs(dip - s->mag_cand[1]) <= set->mag_dip_tol) {
+                att_real k = dt / (set->mag_ref_tau + dt);
+                s->mag_cand[0] += k * (nm - s->mag_cand[0]);
+                s->mag_cand[1] += k * (dip - s->mag_cand[1]);
+                if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2]
+                    >= set->mag_new_gyr * set->mag_new_gyr) {
+                    s->mag_cand_t += dt;
+                }
+            } else {
+                s->mag_cand[0] = nm;
+                s->mag_cand[1] = dip;
+                s->mag_cand_t = 0;
+            }
+            rm = set->mag_noise * set->mag_noise / dt;
             if (att_fabs(nm - s->mag_ref[0]) <= set->mag_norm_tol * s->mag_ref[0]
                 && att_fabs(dip - s->mag_ref[1]) <= set->mag_dip_tol) {
                 att_real k = dt / (set->mag_ref_tau + dt);
                 s->mag_ref[0] += k * (nm - s->mag_ref[0]);
                 s->mag_ref[1] += k * (dip - s->mag_ref[1]);
-                s->mag_rej_time = 0;
-                use = 1;
-            } else {
-                s->mag_rej_time += dt;
-                if (s->mag_rej_time >= set->mag_reject_max) {
-                    s->mag_ref[0] = nm;
-                    s->mag_ref[1] = dip;
+                s->mag_undist_t += dt;
+                if (s->mag_undist_t >= set->mag_min_undisturbed) {
                     s->mag_rej_time = 0;
-                    flags |= ATT_AHRS_F_MAG_RELEARNED;
                     use = 1;
                 } else {
                     flags |= ATT_AHRS_F_MAG_DISTURBED;
+                    s->mag_rej_time += dt;
+                }
+            } else if (s->mag_cand_t >= set->mag_new_time) {
+                /* a new homogeneous field: it becomes the reference */
+                s->mag_ref[0] = s->mag_cand[0];
+                s->mag_ref[1] = s->mag_cand[1];
+                s->mag_rej_time = 0;
+                s->mag_undist_t = set->mag_min_undisturbed;
+                flags |= ATT_AHRS_F_MAG_RELEARNED;
+                use = 1;
+            } else {
+                s->mag_undist_t = 0;
+                flags |= ATT_AHRS_F_MAG_DISTURBED;
+                s->mag_rej_time += dt;
+                if (s->mag_rej_time >= set->mag_reject_max) {
+                    /* bounded rejection: weak updates again */
+                    rm *= set->mag_reject_factor * set->mag_reject_factor;
+                    use = 1;
                 }
             }
             if (use) {
                 att_real y = wrap_pi(att_atan2(m[0], m[1]) - set->declination);
-                scalar_update(s->P, x, 2, y, set->mag_noise * set->mag_noise, MASK_MAG);
+                scalar_update(s->P, x, 2, y, rm, MASK_MAG);
             }
         }
     }
 
     /* rest: zero-rate update of the bias */
     if (rest) {
-        att_real R = set->rest_noise * set->rest_noise;
+        att_real R = set->rest_noise * set->rest_noise / dt;
         flags |= ATT_AHRS_F_REST;
         for (i = 0; i < 3; i++) {
             scalar_update(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], R, MASK_BIAS);

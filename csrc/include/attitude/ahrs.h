@@ -28,8 +28,10 @@
  *     update touches δθ_z and the bias only (never roll or pitch). The
  *     field's norm and dip are compared with a reference learned while
  *     undisturbed; a sample outside mag_norm_tol / mag_dip_tol is
- *     rejected; after mag_reject_max seconds of continuous rejection the
- *     current field becomes the reference (bounded rejection time);
+ *     rejected; a new field that stays consistent with itself for
+ *     mag_new_time seconds of turning becomes the reference; after
+ *     mag_reject_max seconds of continuous rejection updates resume with
+ *     the noise scaled by mag_reject_factor (bounded rejection time);
  *   - rest: when the gyro and accelerometer stay within rest_gyr_th /
  *     rest_acc_th of their low-pass values for rest_time seconds, the
  *     low-passed rate measures the bias directly (zero-rate update; bias
@@ -67,38 +69,46 @@ enum {
 /* Settings. Units in brackets; defaults are att_ahrs_default_settings()'s.
  * Domain: every value finite; times > 0 unless "0 = off"; noises > 0. */
 typedef struct {
-    int method;               /* att_method, any increment method (not rk4); default rv3-reuse */
-    att_real gravity;         /* [m/s²] local gravity, 9.81; unit check: the specific force's norm
+    int method;                   /* att_method, any increment method (not rk4); default rv3-reuse */
+    att_real gravity;             /* [m/s²] local gravity, 9.81; unit check: the specific force's norm
                                  must be within [0.25, 4]·gravity at alignment and its slow
                                  (10 s) average within [0.5, 8]·gravity, else ATT_E_AHRS_UNITS */
-    att_real gyr_noise;       /* [rad/s/√Hz] attitude process noise density σ_g, 0.0087 */
-    att_real bias_noise;      /* [rad/s/√s] gyro-bias random walk σ_b, 1e-4 */
-    att_real init_att_sigma;  /* [rad] 1σ of the initial attitude error (each axis), 0.1 */
-    att_real init_bias_sigma; /* [rad/s] 1σ of the initial bias (each axis), 0.01 */
-    att_real acc_tau;         /* [s] low-pass time constant of the specific force in the
+    att_real gyr_noise;           /* [rad/√s] attitude process noise density σ_g (gyro noise plus
+                                 model error), 0.01 */
+    att_real bias_noise;          /* [rad/s/√s] gyro-bias random walk σ_b, 1e-4 */
+    att_real init_att_sigma;      /* [rad] 1σ of the initial attitude error (each axis), 0.1 */
+    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis), 0.01 */
+    att_real acc_tau;             /* [s] low-pass time constant of the specific force in the
                                  navigation frame, 2.0 (0 = off: raw specific force) */
-    att_real acc_noise;       /* [rad] 1σ of the inclination measurement, 0.05 */
-    att_real acc_gate;        /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
+    att_real acc_noise;           /* [rad·√s] inclination measurement noise density (R = σ²/dt;
+                                 σ/σ_g is the correction's time constant, s), 0.015 */
+    att_real acc_gate;            /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
                                  (0 = off) */
-    att_real acc_reject_max;  /* [s] continuous rejection after which updates resume, 3.0 */
-    att_real mag_noise;       /* [rad] 1σ of the heading measurement, 0.1 */
-    att_real mag_norm_tol;    /* [1] relative field-norm tolerance vs the reference, 0.1 */
-    att_real mag_dip_tol;     /* [rad] dip tolerance vs the reference, 0.1 (≈5.7°) */
-    att_real mag_ref_tau;     /* [s] time constant of the reference's adaptation while
+    att_real acc_reject_max;      /* [s] continuous rejection after which updates resume, 3.0 */
+    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.09 */
+    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.1 */
+    att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.1 (≈5.7°) */
+    att_real mag_ref_tau;         /* [s] time constant of the reference's adaptation while
                                  undisturbed, 30 */
-    att_real mag_reject_max;  /* [s] continuous rejection after which the current field becomes
-                                 the reference, 60 */
-    att_real declination;     /* [rad] magnetic declination (east positive), 0 */
-    att_real rest_time;       /* [s] time within the thresholds before rest is declared, 1.5
+    att_real mag_reject_max;      /* [s] continuous rejection after which updates resume with the
+                                 noise scaled by mag_reject_factor (bounded rejection), 60 */
+    att_real mag_reject_factor;   /* [1] ≥ 1, see mag_reject_max, 2 */
+    att_real mag_new_time;        /* [s] a candidate field (consistent with itself in norm and dip)
+                                 seen for this long while turning becomes the reference, 20 */
+    att_real mag_min_undisturbed; /* [s] the field must agree with the reference this long
+                                 before updates resume after a rejection, 0.5 */
+    att_real mag_new_gyr;         /* [rad/s] candidate time runs only while |ω| ≥ this, 0.35 (20°/s) */
+    att_real declination;         /* [rad] magnetic declination (east positive, |D| ≤ π), 0 */
+    att_real rest_time;           /* [s] time within the thresholds before rest is declared, 1.5
                                  (0 = rest detection off) */
-    att_real rest_tau;        /* [s] low-pass time constant of the rest detector, 0.5 */
-    att_real rest_gyr_th;     /* [rad/s] rest threshold on |ω − ω_lp| and |ω_lp|, 0.035 (2°/s) */
-    att_real rest_acc_th;     /* [m/s²] rest threshold on |a − a_lp|, 0.5 */
-    att_real rest_noise;      /* [rad/s] 1σ of the zero-rate bias measurement, 0.005 */
-    att_real gyro_range;      /* [rad/s] gyro full scale: an axis at or above it flags
+    att_real rest_tau;            /* [s] low-pass time constant of the rest detector, 0.5 */
+    att_real rest_gyr_th;         /* [rad/s] rest threshold on |ω − ω_lp| and |ω_lp|, 0.035 (2°/s) */
+    att_real rest_acc_th;         /* [m/s²] rest threshold on |a − a_lp|, 0.5 */
+    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 0.005 */
+    att_real gyro_range;          /* [rad/s] gyro full scale: an axis at or above it flags
                                  ATT_AHRS_F_OVERRANGE and inflates the attitude covariance by
                                  (overrange_sigma)² per flagged sample; 0 = no range */
-    att_real overrange_sigma; /* [rad] see gyro_range, 0.05 */
+    att_real overrange_sigma;     /* [rad] see gyro_range, 0.05 */
 } att_ahrs_settings;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. */
@@ -112,6 +122,9 @@ typedef struct {
     att_real acc_rej_time; /* [s] continuous accelerometer rejection */
     att_real mag_ref[2];   /* reference field norm (input units) and dip [rad] */
     att_real mag_rej_time; /* [s] continuous magnetometer rejection */
+    att_real mag_cand[2];  /* candidate reference norm and dip */
+    att_real mag_cand_t;   /* [s] time the candidate has held while turning */
+    att_real mag_undist_t; /* [s] time the field has agreed with the reference */
     att_real rest_gyr[3];  /* rest detector low-pass of ω [rad/s] */
     att_real rest_acc[3];  /* rest detector low-pass of a [m/s²] */
     att_real rest_t;       /* [s] time within the rest thresholds */
@@ -132,7 +145,8 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set);
 /* Initialize. set == NULL uses the defaults. q0 (body → ENU, normalized
  * here) gives the initial attitude; q0 == NULL leaves the filter
  * unaligned: the first update aligns it from that sample's specific
- * force (roll, pitch) and field (heading; without it heading 0). Errors:
+ * force (roll, pitch) and field (heading; without it, or with a field
+ * parallel to gravity, heading 0) by att_align_accmag (aiding.h). Errors:
  * ATT_E_NULL, ATT_E_AHRS_SETTINGS, ATT_E_NONFINITE / ATT_E_ARG (q0). */
 att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_real q0[4]);
 
