@@ -20,14 +20,14 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->gyr_noise = ATT_R(0.01);
     set->bias_noise = ATT_R(1e-4);
     set->init_att_sigma = ATT_R(0.1);
-    set->init_bias_sigma = ATT_R(0.01);
+    set->init_bias_sigma = ATT_R(0.03);
     set->acc_tau = ATT_R(2.0);
-    set->acc_noise = ATT_R(0.015);
+    set->acc_noise = ATT_R(0.025);
     set->acc_gate = ATT_R(0.2);
     set->acc_reject_max = ATT_R(3.0);
-    set->mag_noise = ATT_R(0.09);
-    set->mag_norm_tol = ATT_R(0.1);
-    set->mag_dip_tol = ATT_R(0.1);
+    set->mag_noise = ATT_R(0.05);
+    set->mag_norm_tol = ATT_R(0.05);
+    set->mag_dip_tol = ATT_R(0.17);
     set->mag_ref_tau = ATT_R(30.0);
     set->mag_reject_max = ATT_R(60.0);
     set->mag_reject_factor = ATT_R(2.0);
@@ -39,7 +39,7 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->rest_tau = ATT_R(0.5);
     set->rest_gyr_th = ATT_R(0.035);
     set->rest_acc_th = ATT_R(0.5);
-    set->rest_noise = ATT_R(0.005);
+    set->rest_noise = ATT_R(0.001);
     set->gyro_range = ATT_R(0.0);
     set->overrange_sigma = ATT_R(0.05);
 }
@@ -469,6 +469,10 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         nm = norm3(m);
         if (h > 0) {
             dip = att_atan2(-m[2], h);
+            if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
+                /* the inclination is not known well enough to learn the dip */
+                s->mag_ref_valid = 0;
+            }
             if (!s->mag_ref_valid) {
                 s->mag_ref[0] = nm;
                 s->mag_ref[1] = dip;

@@ -27,7 +27,8 @@
  *     rotated into the navigation frame gives the magnetic heading; the
  *     update touches δθ_z and the bias only (never roll or pitch). The
  *     field's norm and dip are compared with a reference learned while
- *     undisturbed; a sample outside mag_norm_tol / mag_dip_tol is
+ *     undisturbed (and only once the inclination's 1σ is below half of
+ *     mag_dip_tol: before that every sample is used and re-sets it); a sample outside mag_norm_tol / mag_dip_tol is
  *     rejected; a new field that stays consistent with itself for
  *     mag_new_time seconds of turning becomes the reference; after
  *     mag_reject_max seconds of continuous rejection updates resume with
@@ -77,17 +78,17 @@ typedef struct {
                                  model error), 0.01 */
     att_real bias_noise;          /* [rad/s/√s] gyro-bias random walk σ_b, 1e-4 */
     att_real init_att_sigma;      /* [rad] 1σ of the initial attitude error (each axis), 0.1 */
-    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis), 0.01 */
+    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis), 0.03 */
     att_real acc_tau;             /* [s] low-pass time constant of the specific force in the
                                  navigation frame, 2.0 (0 = off: raw specific force) */
     att_real acc_noise;           /* [rad·√s] inclination measurement noise density (R = σ²/dt;
-                                 σ/σ_g is the correction's time constant, s), 0.015 */
+                                 σ/σ_g is the correction's time constant, s), 0.025 */
     att_real acc_gate;            /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
                                  (0 = off) */
     att_real acc_reject_max;      /* [s] continuous rejection after which updates resume, 3.0 */
-    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.09 */
-    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.1 */
-    att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.1 (≈5.7°) */
+    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.05 */
+    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.05 */
+    att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.17 (≈10°) */
     att_real mag_ref_tau;         /* [s] time constant of the reference's adaptation while
                                  undisturbed, 30 */
     att_real mag_reject_max;      /* [s] continuous rejection after which updates resume with the
@@ -104,7 +105,7 @@ typedef struct {
     att_real rest_tau;            /* [s] low-pass time constant of the rest detector, 0.5 */
     att_real rest_gyr_th;         /* [rad/s] rest threshold on |ω − ω_lp| and |ω_lp|, 0.035 (2°/s) */
     att_real rest_acc_th;         /* [m/s²] rest threshold on |a − a_lp|, 0.5 */
-    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 0.005 */
+    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 0.001 */
     att_real gyro_range;          /* [rad/s] gyro full scale: an axis at or above it flags
                                  ATT_AHRS_F_OVERRANGE and inflates the attitude covariance by
                                  (overrange_sigma)² per flagged sample; 0 = no range */
