@@ -119,11 +119,23 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_FX_E_RANGE": (RangeError, "value outside its fixed-point format's range"),
     "ATT_FX_E_METHOD": (InvalidArgument, "unknown fixed-point method"),
     "ATT_FX_E_ZERO": (InvalidArgument, "zero quaternion"),
+    # ahrs.h
+    "ATT_E_AHRS_DT": (InvalidArgument, "time step not finite or not positive"),
+    "ATT_E_AHRS_UNITS": (InvalidArgument, "specific force far from gravity: accelerometer not in m/s²?"),
+    "ATT_E_AHRS_SETTINGS": (InvalidArgument, "filter setting outside its domain"),
+    "ATT_E_AHRS_DIVERGED": (RangeError, "filter state not finite"),
+    "ATT_E_AHRS_ALIGN": (AttitudeError, "no initial attitude: the sample cannot align the filter"),
     # block.h
     "ATT_BLOCK_E_CODE": (BlockFormatError, "sample code above its stream's limit"),
     "ATT_BLOCK_E_KIND": (BlockFormatError, "unknown report kind"),
     "ATT_BLOCK_E_FIELD": (BlockFormatError, "report field out of range"),
     "ATT_BLOCK_E_SEQ": (BlockFormatError, "loss report disagrees with the sample count"),
+    # aiding.h
+    "ATT_AID_E_ZERO_F": (InvalidArgument, "specific force is zero: no up direction"),
+    "ATT_AID_E_ZERO_M": (InvalidArgument, "magnetic field is zero: no north direction"),
+    "ATT_AID_E_PARALLEL": (InvalidArgument, "specific force and field are parallel: heading undefined"),
+    "ATT_AID_E_MOVING": (InvalidArgument, "static window: spread above its limit (moving start)"),
+    "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
 }
 
 

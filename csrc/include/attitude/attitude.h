@@ -16,5 +16,7 @@
 #include "attitude/fixed.h"
 #include "attitude/ad7927.h"
 #include "attitude/denoise.h"
+#include "attitude/aiding.h"
+#include "attitude/ahrs.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

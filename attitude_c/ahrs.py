@@ -1,0 +1,236 @@
+"""The attitude filter (AHRS): gyro + accelerometer (+ magnetometer) → attitude.
+
+Python side of ``csrc/include/attitude/ahrs.h``: an error-state Kalman filter
+(attitude error and gyro bias) on top of the rotation-vector integrator, with
+accelerometer aiding that survives linear acceleration, heading-only
+magnetometer aiding with disturbance rejection and rest detection. See
+docs/ahrs.md for the design and the measured accuracy.
+
+Units: gyro rad/s, specific force m/s² (+g upward at rest), field in any
+unit (µT typical; only its direction, norm ratios and dip are used).
+Quaternions scalar first, body → ENU (docs/conventions.md).
+
+* :class:`Ahrs` — streaming: one sample ``(3,)`` or a block ``(N, 3)`` per call;
+* :func:`ahrs` — batch: ``(N, 3)`` arrays in, ``(N, 4)`` quaternions out.
+
+Settings are keyword arguments named as the C struct's fields
+(:data:`SETTINGS`; ``method`` by name, e.g. ``"rv3-reuse"``).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import names
+from ._lib import ffi_lib
+from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+
+__all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings"]
+
+FloatArray = NDArray[np.float64]
+Precision = Literal["f64", "f32"]
+
+#: The real-valued settings (field names of ``att_ahrs_settings``), besides ``method``.
+SETTINGS: tuple[str, ...] = (
+    "gravity", "gyr_noise", "bias_noise", "init_att_sigma", "init_bias_sigma", "acc_tau",
+    "acc_noise", "acc_gate", "acc_reject_max", "mag_noise", "mag_norm_tol", "mag_dip_tol",
+    "mag_ref_tau", "mag_reject_max", "mag_reject_factor", "mag_new_time", "mag_new_gyr",
+    "mag_min_undisturbed", "declination", "rest_time", "rest_tau", "rest_gyr_th",
+    "rest_acc_th", "rest_noise", "gyro_range", "overrange_sigma",
+)
+
+_DTYPES = {"f64": np.float64, "f32": np.float32}
+
+
+def _check_precision(precision: Any) -> str:
+    if precision not in _DTYPES:
+        raise InvalidArgument(f"precision must be 'f64' or 'f32', got {precision!r}")
+    return str(precision)
+
+
+def default_settings() -> dict[str, Any]:
+    """The library's defaults (``att_ahrs_default_settings``), ``method`` by name."""
+    ffi, lib = ffi_lib("f64")
+    s = ffi.new("att_ahrs_settings *")
+    lib.att_ahrs_default_settings(s)
+    out: dict[str, Any] = {"method": names.method_names()[s.method]}
+    out.update({k: float(getattr(s, k)) for k in SETTINGS})
+    return out
+
+
+def _fill_settings(ffi: Any, lib: Any, settings: dict[str, Any]) -> Any:
+    s = ffi.new("att_ahrs_settings *")
+    lib.att_ahrs_default_settings(s)
+    for k, v in settings.items():
+        if k == "method":
+            if not isinstance(v, str):
+                raise InvalidType(f"method must be a method name (str), got {type(v).__name__}")
+            code = names.method_code(v)
+            if code == names.C["ATT_METHOD_RK4"]:
+                raise InvalidArgument("method: the filter needs an increment method, not 'rk4'")
+            s.method = code
+        elif k in SETTINGS:
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise InvalidType(f"{k} must be a real number, got {type(v).__name__}")
+            fv = float(v)
+            if not np.isfinite(fv):
+                raise InvalidArgument(f"{k} must be finite, got {fv}")
+            setattr(s, k, fv)
+        else:
+            raise InvalidArgument(f"unknown filter setting {k!r} (known: method, {', '.join(SETTINGS)})")
+    st = lib.att_ahrs_check_settings(s)
+    if st != 0:
+        raise InvalidArgument("settings: a value is outside its domain (ahrs.h: noises and times > 0, "
+                              f"'0 = off' fields ≥ 0): {settings!r}")
+    return s
+
+
+def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[np.float64] | None:
+    if x is None:
+        if optional:
+            return None
+        raise InvalidArgument(f"{name} is required")
+    a = np.asarray(x)
+    if a.dtype.kind not in "iuf":
+        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if a.ndim not in (1, 2) or a.shape[-1] != 3:
+        raise InvalidArgument(f"{name} must have shape (3,) or (N, 3), got {a.shape}")
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
+    ok = np.isfinite(a).all(axis=1)
+    if not ok.all():
+        i = int(np.argmin(ok))
+        raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
+    return a
+
+
+class Ahrs:
+    """Streaming attitude filter (one ``att_ahrs`` state).
+
+    ``rate`` (Hz) gives the default time step; ``dt`` given to :meth:`update`
+    overrides it per call (scalar or one per sample). ``q0`` (body → ENU)
+    sets the initial attitude; without it the first sample aligns the filter
+    (roll/pitch from the specific force, heading from the field, or 0).
+    """
+
+    def __init__(self, rate: float | None = None, q0: ArrayLike | None = None,
+                 precision: Precision = "f64", **settings: Any) -> None:
+        self.precision = _check_precision(precision)
+        if rate is not None:
+            if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
+                raise InvalidType(f"rate must be a number (Hz), got {type(rate).__name__}")
+            if not (np.isfinite(rate) and rate > 0):
+                raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
+        self.rate = None if rate is None else float(rate)
+        self._ffi, self._lib = ffi_lib(self.precision)
+        self._set = _fill_settings(self._ffi, self._lib, dict(settings))
+        self._s = self._ffi.new("att_ahrs *")
+        q = self._ffi.NULL
+        if q0 is not None:
+            qa = np.asarray(q0, dtype=np.float64)
+            if qa.shape != (4,):
+                raise InvalidArgument(f"q0 must have shape (4,), got {qa.shape}")
+            q = self._ffi.new("att_real[4]", [float(v) for v in qa])
+        st = self._lib.att_ahrs_init(self._s, self._set, q)
+        if st != 0:
+            raise_for_status(st, "q0")
+
+    @property
+    def settings(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"method": names.method_names()[self._set.method]}
+        out.update({k: float(getattr(self._set, k)) for k in SETTINGS})
+        return out
+
+    @property
+    def q(self) -> FloatArray:
+        """Current attitude (4,), float64 (raises before alignment)."""
+        out = self._ffi.new("att_real[4]")
+        st = self._lib.att_ahrs_attitude(self._s, out)
+        if st != 0:
+            raise_for_status(st, "q (the filter is not aligned yet)")
+        return np.array(list(out), dtype=np.float64)
+
+    @property
+    def bias(self) -> FloatArray:
+        """Gyro-bias estimate (3,), rad/s, body frame."""
+        out = self._ffi.new("att_real[3]")
+        self._lib.att_ahrs_bias(self._s, out)
+        return np.array(list(out), dtype=np.float64)
+
+    @property
+    def sigma(self) -> tuple[FloatArray, FloatArray]:
+        """1σ of the attitude error per ENU axis (rad) and of the bias (rad/s)."""
+        a = self._ffi.new("att_real[3]")
+        b = self._ffi.new("att_real[3]")
+        self._lib.att_ahrs_sigma(self._s, a, b)
+        return np.array(list(a)), np.array(list(b))
+
+    @property
+    def flags(self) -> int:
+        """``ATT_AHRS_F_*`` bits of the last sample."""
+        return int(self._lib.att_ahrs_flags(self._s))
+
+    def _dt(self, dt: ArrayLike | None, n: int) -> NDArray[Any]:
+        if dt is None:
+            if self.rate is None:
+                raise InvalidArgument("dt is required when the filter has no rate")
+            return np.array([1.0 / self.rate], dtype=_DTYPES[self.precision])
+        d = np.asarray(dt, dtype=np.float64).ravel()
+        if d.size not in (1, n):
+            raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
+        return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
+
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
+               dt: ArrayLike | None = None) -> FloatArray:
+        """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4))."""
+        single = np.ndim(gyr) == 1
+        g = _vectors(gyr, "gyr")
+        a = _vectors(acc, "acc")
+        m = _vectors(mag, "mag", optional=True)
+        assert g is not None and a is not None
+        n = g.shape[0]
+        if a.shape[0] != n or (m is not None and m.shape[0] != n):
+            raise InvalidArgument(f"gyr, acc and mag must have the same number of samples, got "
+                                  f"{n}, {a.shape[0]}" + ("" if m is None else f", {m.shape[0]}"))
+        d = self._dt(dt, n)
+        dtype = _DTYPES[self.precision]
+        ffi = self._ffi
+        gc = np.ascontiguousarray(g, dtype=dtype)
+        ac = np.ascontiguousarray(a, dtype=dtype)
+        mc = None if m is None else np.ascontiguousarray(m, dtype=dtype)
+        out = np.empty((n, 4), dtype=dtype)
+        err = ffi.new("size_t *")
+
+        def p(x: NDArray[Any] | None) -> Any:
+            return ffi.NULL if x is None else ffi.cast("att_real *", ffi.from_buffer(x))
+
+        st = self._lib.att_ahrs_batch(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
+        if st != 0:
+            i = int(err[0])
+            if st == self._lib.ATT_E_AHRS_DT:
+                raise InvalidArgument(f"dt: sample {i}: the time step must be finite and > 0")
+            raise_for_status(st, "ahrs", index=i)
+        res = out.astype(np.float64) if self.precision == "f64" else out
+        return res[0] if single else res
+
+    def __repr__(self) -> str:
+        return f"Ahrs(rate={self.rate}, precision={self.precision!r})"
+
+
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float | None = None,
+         dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
+         **settings: Any) -> FloatArray:
+    """Run the filter over N samples: (N, 3) arrays → (N, 4) quaternions (body → ENU).
+
+    ``rate`` (Hz) or ``dt`` (s, scalar or per sample) gives the time step;
+    ``mag=None`` is six-axis operation (heading from the gyro only).
+    """
+    if rate is None and dt is None:
+        raise InvalidArgument("give rate (Hz) or dt (s)")
+    g = np.asarray(gyr)
+    if g.ndim != 2:
+        raise InvalidArgument(f"gyr must have shape (N, 3), got {g.shape}")
+    f = Ahrs(rate=rate, q0=q0, precision=precision, **settings)
+    return f.update(gyr, acc, mag, dt=dt)

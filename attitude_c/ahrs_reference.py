@@ -1,0 +1,263 @@
+"""Independent NumPy model of the attitude filter (docs/ahrs.md), for tests.
+
+Written from the filter's equations in matrix form — the full 6×6
+transition F = [[I, −C dt], [0, I]], P ← F P Fᵀ + Q, scalar updates with an
+explicit selector row H, masked gain K and the Joseph form
+P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ, the attitude as an exactly normalized
+quaternion product — not from the C source, which works on 3×3 blocks and
+hand-expanded products. Slow (a Python loop per sample): for differential
+tests on short records, never for production use.
+
+Inputs as :func:`attitude_c.ahrs.ahrs`; settings as a dict with the C
+field names (``method`` by name).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from . import reference as ref
+
+__all__ = ["ReferenceAhrs", "ahrs_reference"]
+
+F = NDArray[np.float64]
+
+_DEFAULTS: dict[str, Any] = {
+    "method": "rv3-reuse", "gravity": 9.81, "gyr_noise": 0.01, "bias_noise": 1e-4,
+    "init_att_sigma": 0.1, "init_bias_sigma": 0.03, "acc_tau": 2.0, "acc_noise": 0.025,
+    "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.05, "mag_norm_tol": 0.05,
+    "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
+    "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
+    "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
+    "rest_noise": 0.001, "gyro_range": 0.0, "overrange_sigma": 0.05,
+}
+
+_FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
+
+
+def _qmul(a: F, b: F) -> F:
+    return np.asarray(ref.quat_multiply(a, b), dtype=np.float64)
+
+
+def _exp(phi: F) -> F:
+    """Unit quaternion of rotation vector phi (eq. 3), from sin and cos."""
+    a = float(np.linalg.norm(phi))
+    if a == 0.0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    return np.concatenate([[math.cos(a / 2)], math.sin(a / 2) / a * phi])
+
+
+def _dcm(q: F) -> F:
+    return np.asarray(ref.quat_to_dcm(q / np.linalg.norm(q)), dtype=np.float64)
+
+
+def _align(f: F, m: F | None, decl: float) -> F:
+    """Attitude from gravity (up) and the field (north), TRIAD form: the
+    navigation axes expressed in the body are the rows of C_b^n."""
+    up = f / np.linalg.norm(f)
+    east = None
+    if m is not None:
+        e = np.cross(m, up)
+        if np.linalg.norm(e) > 1e-4 * np.linalg.norm(m):
+            east = e / np.linalg.norm(e)
+    if east is None:  # heading 0: yaw ψ = 0 of the z-x-y Euler angles
+        theta = math.atan2(f[1], math.hypot(f[0], f[2]))
+        gamma = math.atan2(-f[0], f[2])
+        return np.asarray(ref.euler_to_quat(np.array([0.0, theta, gamma])), dtype=np.float64)
+    north = np.cross(up, east)
+    Cm = np.vstack([east, north, up])  # magnetic-north navigation frame
+    c, s = math.cos(-decl), math.sin(-decl)
+    Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return np.asarray(ref.dcm_to_quat(Rz @ Cm), dtype=np.float64)
+
+
+class ReferenceAhrs:
+    """One filter state; :meth:`update` takes one sample."""
+
+    def __init__(self, q0: ArrayLike | None = None, **settings: Any) -> None:
+        self.s = dict(_DEFAULTS)
+        self.s.update(settings)
+        self.q = None if q0 is None else np.asarray(q0, float) / np.linalg.norm(q0)
+        self.b = np.zeros(3)
+        va, vb = self.s["init_att_sigma"] ** 2, self.s["init_bias_sigma"] ** 2
+        self.P = np.diag([va, va, va, vb, vb, vb]).astype(float)
+        self.hist: list[F] = []
+        self.n_inc = 0
+        self.acc_lp: F | None = None
+        self.acc_norm_lp = 0.0
+        self.acc_rej = 0.0
+        self.mag_ref: F | None = None
+        self.mag_cand = np.zeros(2)
+        self.mag_cand_t = 0.0
+        self.mag_undist = 0.0
+        self.mag_rej = 0.0
+        self.rest_g: F | None = None
+        self.rest_a = np.zeros(3)
+        self.rest_t = 0.0
+        self.flags = 0
+
+    # -- the Kalman pieces -------------------------------------------------
+    def _predict(self, C: F, dt: float) -> None:
+        Fm = np.eye(6)
+        Fm[:3, 3:] = -C * dt
+        Q = np.diag([self.s["gyr_noise"] ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
+        self.P = Fm @ self.P @ Fm.T + Q
+
+    def _scalar(self, x: F, j: int, y: float, R: float, states: tuple[int, ...]) -> None:
+        H = np.zeros((1, 6))
+        H[0, j] = 1.0
+        S = float((H @ self.P @ H.T)[0, 0]) + R
+        K = (self.P @ H.T)[:, 0] / S
+        keep = np.zeros(6)
+        keep[list(states)] = 1.0
+        K = K * keep
+        x += K * (y - float((H @ x)[0]))
+        A = np.eye(6) - np.outer(K, H[0])
+        self.P = A @ self.P @ A.T + R * np.outer(K, K)
+
+    # -- one sample --------------------------------------------------------
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: float) -> F:
+        s = self.s
+        w = np.asarray(gyr, float)
+        f = np.asarray(acc, float)
+        m = None if mag is None else np.asarray(mag, float)
+        g = s["gravity"]
+        fn = float(np.linalg.norm(f))
+        if self.acc_lp is None and not (0.25 * g <= fn <= 4.0 * g):
+            raise ValueError("units")
+        if self.q is None:
+            self.q = _align(f, m, s["declination"])
+        flags = 0
+        if s["gyro_range"] > 0 and np.any(np.abs(w) >= s["gyro_range"]):
+            flags |= 1
+        # rest detector
+        rest = False
+        if s["rest_time"] > 0:
+            if self.rest_g is None:
+                self.rest_g, self.rest_a, self.rest_t = w.copy(), f.copy(), 0.0
+            else:
+                k = dt / (s["rest_tau"] + dt)
+                self.rest_g = self.rest_g + k * (w - self.rest_g)
+                self.rest_a = self.rest_a + k * (f - self.rest_a)
+                th = s["rest_gyr_th"] ** 2
+                still = (np.sum((w - self.rest_g) ** 2) < th and np.sum((self.rest_g - self.b) ** 2) < th
+                         and np.sum((f - self.rest_a) ** 2) < s["rest_acc_th"] ** 2)
+                self.rest_t = self.rest_t + dt if still else 0.0
+                rest = self.rest_t >= s["rest_time"]
+        # propagation
+        method = s["method"]
+        mf = _FRAME[method]
+        self.hist = (self.hist + [(w - self.b) * dt])[-3:]
+        self.n_inc += 1
+        if self.n_inc % mf == 0:  # an update completes (every increment for rv1 and the reuse forms)
+            phi = ref.rotation_vectors(np.array(self.hist[-3:] if mf == 1 else self.hist[-mf:]), method)[-1]
+            self.q = _qmul(self.q, _exp(phi))
+            self.q = self.q / np.linalg.norm(self.q)
+        C = _dcm(self.q)
+        self._predict(C, dt)
+        if flags & 1:
+            self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
+        x = np.zeros(6)
+        # accelerometer
+        fnav = C @ f
+        if self.acc_lp is None:
+            self.acc_lp, self.acc_norm_lp = fnav, fn
+        else:
+            a = dt / (s["acc_tau"] + dt) if s["acc_tau"] > 0 else 1.0
+            self.acc_lp = self.acc_lp + a * (fnav - self.acc_lp)
+            self.acc_norm_lp += dt / (10.0 + dt) * (fn - self.acc_norm_lp)
+        v = self.acc_lp / np.linalg.norm(self.acc_lp)
+        axis = np.cross(v, [0.0, 0.0, 1.0])  # rotation taking v to up
+        ang = math.atan2(float(np.linalg.norm(axis)), float(v[2]))
+        y = axis / np.linalg.norm(axis) * ang if np.linalg.norm(axis) > 0 else np.zeros(3)
+        use = True
+        if s["acc_gate"] > 0 and ang > s["acc_gate"]:
+            self.acc_rej += dt
+            if self.acc_rej < s["acc_reject_max"]:
+                use = False
+                flags |= 4
+            else:
+                self.acc_rej = 0.0
+        else:
+            self.acc_rej = 0.0
+        if use:
+            R = s["acc_noise"] ** 2 / dt
+            for j in (0, 1):
+                self._scalar(x, j, float(y[j]), R, (0, 1, 3, 4, 5))
+        # magnetometer
+        if m is not None:
+            mn = C @ m
+            h = math.hypot(mn[0], mn[1])
+            if h > 0:
+                cur = np.array([float(np.linalg.norm(mn)), math.atan2(-mn[2], h)])
+                if self.P[0, 0] + self.P[1, 1] > (s["mag_dip_tol"] / 2) ** 2:
+                    self.mag_ref = None  # inclination too uncertain to learn the dip from
+                if self.mag_ref is None:
+                    self.mag_ref, self.mag_cand = cur.copy(), cur.copy()
+                    self.mag_undist = s["mag_min_undisturbed"]
+
+                def near(r: F) -> bool:
+                    return bool(abs(cur[0] - r[0]) <= s["mag_norm_tol"] * r[0]
+                                and abs(cur[1] - r[1]) <= s["mag_dip_tol"])
+
+                kr = dt / (s["mag_ref_tau"] + dt)
+                if near(self.mag_cand):
+                    self.mag_cand = self.mag_cand + kr * (cur - self.mag_cand)
+                    if float(np.sum(w * w)) >= s["mag_new_gyr"] ** 2:
+                        self.mag_cand_t += dt
+                else:
+                    self.mag_cand, self.mag_cand_t = cur.copy(), 0.0
+                R = s["mag_noise"] ** 2 / dt
+                use = False
+                if near(self.mag_ref):
+                    self.mag_ref = self.mag_ref + kr * (cur - self.mag_ref)
+                    self.mag_undist += dt
+                    if self.mag_undist >= s["mag_min_undisturbed"]:
+                        self.mag_rej, use = 0.0, True
+                    else:
+                        flags |= 8
+                        self.mag_rej += dt
+                elif self.mag_cand_t >= s["mag_new_time"]:
+                    self.mag_ref = self.mag_cand.copy()
+                    self.mag_rej, self.mag_undist, use = 0.0, s["mag_min_undisturbed"], True
+                    flags |= 16
+                else:
+                    self.mag_undist = 0.0
+                    flags |= 8
+                    self.mag_rej += dt
+                    if self.mag_rej >= s["mag_reject_max"]:
+                        R *= s["mag_reject_factor"] ** 2
+                        use = True
+                if use:
+                    yh = math.atan2(mn[0], mn[1]) - s["declination"]
+                    yh = (yh + math.pi) % (2 * math.pi) - math.pi
+                    self._scalar(x, 2, yh, R, (2, 3, 4, 5))
+        if rest:
+            flags |= 2
+            assert self.rest_g is not None
+            for i in range(3):
+                self._scalar(x, 3 + i, float(self.rest_g[i] - self.b[i]), s["rest_noise"] ** 2 / dt,
+                             (3, 4, 5))
+        # injection
+        self.q = _qmul(_exp(x[:3]), self.q)
+        self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
+        self.b = self.b + x[3:]
+        self.flags = flags
+        return self.q.copy()
+
+
+def ahrs_reference(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float = 100.0,
+                   q0: ArrayLike | None = None, **settings: Any) -> F:
+    """(N, 4) attitudes of the model filter over N samples at ``rate`` Hz."""
+    g = np.asarray(gyr, float)
+    a = np.asarray(acc, float)
+    mm = None if mag is None else np.asarray(mag, float)
+    f = ReferenceAhrs(q0=q0, **settings)
+    out = np.empty((len(g), 4))
+    for i in range(len(g)):
+        out[i] = f.update(g[i], a[i], None if mm is None else mm[i], 1.0 / rate)
+    return out

@@ -1,0 +1,186 @@
+/*
+ * libattitude — the attitude filter (AHRS), prefix att_ahrs_.
+ *
+ * An error-state (multiplicative) Kalman filter with six error states:
+ * the attitude error δθ (rad, navigation frame ENU: the true attitude is
+ * exp(δθ) ⊗ q_est) and the gyro-bias error δb (rad/s, body frame: the
+ * true bias is b_est + δb). The attitude is propagated with the library's
+ * rotation-vector integrator (integrator.h) fed the bias-corrected angle
+ * increments Δθ = (ω − b_est)·dt, so the integrator's coning correction
+ * carries into the aided attitude. The error covariance P (6×6) is
+ * propagated with F = [[I, −C dt], [0, I]] (C = C_b^n of the current
+ * estimate), Q = diag(σ_g² dt I, σ_b² dt I).
+ *
+ * Aiding (sequential scalar updates, each with a selector H, so the cost
+ * is O(36) per scalar):
+ *   - accelerometer: the specific force is rotated into the navigation
+ *     frame of the estimate (almost inertial: it moves only by the slow
+ *     corrections, which are applied to the filtered vector too) and
+ *     low-pass filtered there with time constant acc_tau, which averages
+ *     out linear acceleration while gravity stays put. The inclination of
+ *     that vector measures δθ_x, δθ_y; the gain of the heading and (with
+ *     acc_bias = 0) nothing else is zeroed, so the accelerometer never
+ *     moves the heading. Innovations larger than acc_gate are rejected;
+ *     after acc_reject_max seconds of continuous rejection the update is
+ *     accepted again (recovery);
+ *   - magnetometer (optional per call: mag == NULL is six-axis): the field
+ *     rotated into the navigation frame gives the magnetic heading; the
+ *     update touches δθ_z and the bias only (never roll or pitch). The
+ *     field's norm and dip are compared with a reference learned while
+ *     undisturbed (and only once the inclination's 1σ is below half of
+ *     mag_dip_tol: before that every sample is used and re-sets it); a sample outside mag_norm_tol / mag_dip_tol is
+ *     rejected; a new field that stays consistent with itself for
+ *     mag_new_time seconds of turning becomes the reference; after
+ *     mag_reject_max seconds of continuous rejection updates resume with
+ *     the noise scaled by mag_reject_factor (bounded rejection time);
+ *   - rest: when the gyro and accelerometer stay within rest_gyr_th /
+ *     rest_acc_th of their low-pass values for rest_time seconds, the
+ *     low-passed rate measures the bias directly (zero-rate update; bias
+ *     states only).
+ * Corrections: q ← exp(δθ) ⊗ q, b ← b + δb, the error state reset to 0.
+ *
+ * The state is caller-owned; no malloc, no global state, no I/O. A batch
+ * call is exactly a sequence of single updates. See docs/ahrs.md for the
+ * derivation, the settings and the measured accuracy (BROAD).
+ */
+#ifndef ATTITUDE_AHRS_H
+#define ATTITUDE_AHRS_H
+
+#include "attitude/common.h"
+#include "attitude/integrator.h"
+
+/* Attitude-filter status codes (range -140..-159). */
+enum {
+    ATT_E_AHRS_DT = -140,       /* time step not finite or ≤ 0 */
+    ATT_E_AHRS_UNITS = -141,    /* specific force magnitude far from settings.gravity (units?) */
+    ATT_E_AHRS_SETTINGS = -142, /* a setting outside its documented domain */
+    ATT_E_AHRS_DIVERGED = -143, /* finite input, non-finite state (state left as at entry) */
+    ATT_E_AHRS_ALIGN = -144     /* no attitude yet and the sample cannot give one */
+};
+
+/* Flags of the last update (att_ahrs_flags()), a bit set. */
+enum {
+    ATT_AHRS_F_OVERRANGE = 1,     /* a gyro axis at or above settings.gyro_range */
+    ATT_AHRS_F_REST = 2,          /* rest detected: zero-rate bias update made */
+    ATT_AHRS_F_ACC_REJECTED = 4,  /* accelerometer update gated out */
+    ATT_AHRS_F_MAG_DISTURBED = 8, /* magnetometer update rejected (norm/dip vs reference) */
+    ATT_AHRS_F_MAG_RELEARNED = 16 /* the magnetic reference was replaced in this update */
+};
+
+/* Settings. Units in brackets; defaults are att_ahrs_default_settings()'s.
+ * Domain: every value finite; times > 0 unless "0 = off"; noises > 0. */
+typedef struct {
+    int method;                   /* att_method, any increment method (not rk4); default rv3-reuse */
+    att_real gravity;             /* [m/s²] local gravity, 9.81; unit check: the specific force's norm
+                                 must be within [0.25, 4]·gravity at alignment and its slow
+                                 (10 s) average within [0.5, 8]·gravity, else ATT_E_AHRS_UNITS */
+    att_real gyr_noise;           /* [rad/√s] attitude process noise density σ_g (gyro noise plus
+                                 model error), 0.01 */
+    att_real bias_noise;          /* [rad/s/√s] gyro-bias random walk σ_b, 1e-4 */
+    att_real init_att_sigma;      /* [rad] 1σ of the initial attitude error (each axis), 0.1 */
+    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis), 0.03 */
+    att_real acc_tau;             /* [s] low-pass time constant of the specific force in the
+                                 navigation frame, 2.0 (0 = off: raw specific force) */
+    att_real acc_noise;           /* [rad·√s] inclination measurement noise density (R = σ²/dt;
+                                 σ/σ_g is the correction's time constant, s), 0.025 */
+    att_real acc_gate;            /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
+                                 (0 = off) */
+    att_real acc_reject_max;      /* [s] continuous rejection after which updates resume, 3.0 */
+    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.05 */
+    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.05 */
+    att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.17 (≈10°) */
+    att_real mag_ref_tau;         /* [s] time constant of the reference's adaptation while
+                                 undisturbed, 30 */
+    att_real mag_reject_max;      /* [s] continuous rejection after which updates resume with the
+                                 noise scaled by mag_reject_factor (bounded rejection), 60 */
+    att_real mag_reject_factor;   /* [1] ≥ 1, see mag_reject_max, 2 */
+    att_real mag_new_time;        /* [s] a candidate field (consistent with itself in norm and dip)
+                                 seen for this long while turning becomes the reference, 20 */
+    att_real mag_min_undisturbed; /* [s] the field must agree with the reference this long
+                                 before updates resume after a rejection, 0.5 */
+    att_real mag_new_gyr;         /* [rad/s] candidate time runs only while |ω| ≥ this, 0.35 (20°/s) */
+    att_real declination;         /* [rad] magnetic declination (east positive, |D| ≤ π), 0 */
+    att_real rest_time;           /* [s] time within the thresholds before rest is declared, 1.5
+                                 (0 = rest detection off) */
+    att_real rest_tau;            /* [s] low-pass time constant of the rest detector, 0.5 */
+    att_real rest_gyr_th;         /* [rad/s] rest threshold on |ω − ω_lp| and |ω_lp|, 0.035 (2°/s) */
+    att_real rest_acc_th;         /* [m/s²] rest threshold on |a − a_lp|, 0.5 */
+    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 0.001 */
+    att_real gyro_range;          /* [rad/s] gyro full scale: an axis at or above it flags
+                                 ATT_AHRS_F_OVERRANGE and inflates the attitude covariance by
+                                 (overrange_sigma)² per flagged sample; 0 = no range */
+    att_real overrange_sigma;     /* [rad] see gyro_range, 0.05 */
+} att_ahrs_settings;
+
+/* Caller-owned state. Treat as opaque; read it with the accessors. */
+typedef struct {
+    att_ahrs_settings set;
+    att_integ integ;       /* attitude q (body → ENU) and the integrator's buffers */
+    att_real bias[3];      /* gyro bias estimate b_est [rad/s], body frame */
+    att_real P[6][6];      /* error covariance [δθ (rad); δb (rad/s)] */
+    att_real acc_lp[3];    /* low-pass specific force, estimate's navigation frame [m/s²] */
+    att_real acc_norm_lp;  /* slow average of |a| [m/s²] (unit check) */
+    att_real acc_rej_time; /* [s] continuous accelerometer rejection */
+    att_real mag_ref[2];   /* reference field norm (input units) and dip [rad] */
+    att_real mag_rej_time; /* [s] continuous magnetometer rejection */
+    att_real mag_cand[2];  /* candidate reference norm and dip */
+    att_real mag_cand_t;   /* [s] time the candidate has held while turning */
+    att_real mag_undist_t; /* [s] time the field has agreed with the reference */
+    att_real rest_gyr[3];  /* rest detector low-pass of ω [rad/s] */
+    att_real rest_acc[3];  /* rest detector low-pass of a [m/s²] */
+    att_real rest_t;       /* [s] time within the rest thresholds */
+    int aligned;           /* 1 once the attitude is set (q0 given or aligned) */
+    int acc_init;          /* 1 once acc_lp holds a value */
+    int mag_ref_valid;     /* 1 once mag_ref holds a value */
+    int rest_init;         /* 1 once the rest low-passes hold a value */
+    int flags;             /* ATT_AHRS_F_* of the last update */
+} att_ahrs;
+
+/* The defaults listed above. */
+void att_ahrs_default_settings(att_ahrs_settings *set);
+
+/* Check a settings struct against the domains above: ATT_OK or
+ * ATT_E_AHRS_SETTINGS (ATT_E_NULL for NULL). */
+att_status att_ahrs_check_settings(const att_ahrs_settings *set);
+
+/* Initialize. set == NULL uses the defaults. q0 (body → ENU, normalized
+ * here) gives the initial attitude; q0 == NULL leaves the filter
+ * unaligned: the first update aligns it from that sample's specific
+ * force (roll, pitch) and field (heading; without it, or with a field
+ * parallel to gravity, heading 0) by att_align_accmag (aiding.h). Errors:
+ * ATT_E_NULL, ATT_E_AHRS_SETTINGS, ATT_E_NONFINITE / ATT_E_ARG (q0). */
+att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_real q0[4]);
+
+/* One sample: gyr [rad/s] (required), acc [m/s², specific force: +g up
+ * at rest] (NULL = no accelerometer this sample), mag [any unit, e.g. µT]
+ * (NULL = six-axis), dt [s] the time since the previous sample (> 0).
+ * Writes the attitude after the update to q_out (may be NULL). Errors
+ * (state unchanged): ATT_E_NULL (s or gyr), ATT_E_AHRS_DT,
+ * ATT_E_NONFINITE (any input), ATT_E_AHRS_UNITS, ATT_E_AHRS_ALIGN
+ * (unaligned and acc == NULL, or zero vectors), ATT_E_AHRS_DIVERGED.
+ * Accuracy on real data: docs/ahrs.md (BROAD, mean total RMS ≈ 2°). */
+att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
+                           att_real dt, att_real q_out[4]);
+
+/* n samples (gyr, acc n×3; mag n×3 or NULL; acc must not be NULL), dt:
+ * n_dt values, n_dt == 1 (constant step) or n_dt == n (per sample).
+ * q_out: n×4 (may be NULL). Exactly n att_ahrs_update() calls; on error
+ * *err_index (may be NULL) is the failing sample, samples before it are
+ * processed and written, and the state is that after them. */
+att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
+                          size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index);
+
+/* Current attitude q (body → ENU, unit; ATT_E_STATE before alignment). */
+att_status att_ahrs_attitude(const att_ahrs *s, att_real q[4]);
+
+/* Current gyro-bias estimate [rad/s], body frame. */
+att_status att_ahrs_bias(const att_ahrs *s, att_real b[3]);
+
+/* 1σ of the attitude error per navigation axis [rad] and of the bias
+ * per body axis [rad/s] (square roots of P's diagonal). */
+att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bias_sigma[3]);
+
+/* ATT_AHRS_F_* of the last update (0 when s is NULL). */
+int att_ahrs_flags(const att_ahrs *s);
+
+#endif /* ATTITUDE_AHRS_H */

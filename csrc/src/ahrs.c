@@ -1,0 +1,634 @@
+/*
+ * libattitude — the attitude filter (ahrs.h): an error-state Kalman
+ * filter on top of the rotation-vector integrator. docs/ahrs.md derives
+ * every step; attitude_c/ahrs_reference.py is the independent NumPy model.
+ */
+#include "attitude/ahrs.h"
+#include "attitude/aiding.h"
+
+#include "att_math.h"
+
+#define NX 6
+
+void att_ahrs_default_settings(att_ahrs_settings *set)
+{
+    if (set == NULL) {
+        return;
+    }
+    set->method = ATT_METHOD_RV3_REUSE;
+    set->gravity = ATT_R(9.81);
+    set->gyr_noise = ATT_R(0.01);
+    set->bias_noise = ATT_R(1e-4);
+    set->init_att_sigma = ATT_R(0.1);
+    set->init_bias_sigma = ATT_R(0.03);
+    set->acc_tau = ATT_R(2.0);
+    set->acc_noise = ATT_R(0.025);
+    set->acc_gate = ATT_R(0.2);
+    set->acc_reject_max = ATT_R(3.0);
+    set->mag_noise = ATT_R(0.05);
+    set->mag_norm_tol = ATT_R(0.05);
+    set->mag_dip_tol = ATT_R(0.17);
+    set->mag_ref_tau = ATT_R(30.0);
+    set->mag_reject_max = ATT_R(60.0);
+    set->mag_reject_factor = ATT_R(2.0);
+    set->mag_new_time = ATT_R(20.0);
+    set->mag_new_gyr = ATT_R(0.35);
+    set->mag_min_undisturbed = ATT_R(0.5);
+    set->declination = ATT_R(0.0);
+    set->rest_time = ATT_R(1.5);
+    set->rest_tau = ATT_R(0.5);
+    set->rest_gyr_th = ATT_R(0.035);
+    set->rest_acc_th = ATT_R(0.5);
+    set->rest_noise = ATT_R(0.001);
+    set->gyro_range = ATT_R(0.0);
+    set->overrange_sigma = ATT_R(0.05);
+}
+
+static int fin(att_real x)
+{
+    return isfinite(x);
+}
+
+att_status att_ahrs_check_settings(const att_ahrs_settings *set)
+{
+    const att_ahrs_settings *t = set;
+    if (t == NULL) {
+        return ATT_E_NULL;
+    }
+    if (t->method < 0 || t->method >= ATT_METHOD_COUNT || t->method == ATT_METHOD_RK4) {
+        return ATT_E_AHRS_SETTINGS;
+    }
+    /* strictly positive */
+    if (!(fin(t->gravity) && t->gravity > 0 && fin(t->gyr_noise) && t->gyr_noise > 0 && fin(t->bias_noise)
+          && t->bias_noise >= 0 && fin(t->init_att_sigma) && t->init_att_sigma > 0 && fin(t->init_bias_sigma)
+          && t->init_bias_sigma >= 0 && fin(t->acc_noise) && t->acc_noise > 0 && fin(t->mag_noise)
+          && t->mag_noise > 0 && fin(t->mag_norm_tol) && t->mag_norm_tol > 0 && fin(t->mag_dip_tol)
+          && t->mag_dip_tol > 0 && fin(t->mag_ref_tau) && t->mag_ref_tau > 0 && fin(t->mag_reject_max)
+          && t->mag_reject_max > 0 && fin(t->mag_reject_factor) && t->mag_reject_factor >= 1
+          && fin(t->mag_new_time) && t->mag_new_time > 0 && fin(t->mag_new_gyr) && t->mag_new_gyr >= 0
+          && fin(t->mag_min_undisturbed) && t->mag_min_undisturbed >= 0 && fin(t->acc_reject_max)
+          && t->acc_reject_max > 0 && fin(t->rest_tau) && t->rest_tau > 0 && fin(t->rest_gyr_th)
+          && t->rest_gyr_th > 0 && fin(t->rest_acc_th) && t->rest_acc_th > 0 && fin(t->rest_noise)
+          && t->rest_noise > 0 && fin(t->overrange_sigma) && t->overrange_sigma >= 0)) {
+        return ATT_E_AHRS_SETTINGS;
+    }
+    /* zero = off */
+    if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
+          && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
+          && att_fabs(t->declination) <= ATT_PI)) {
+        return ATT_E_AHRS_SETTINGS;
+    }
+    return ATT_OK;
+}
+
+static void set_initial_cov(att_ahrs *s)
+{
+    int i, j;
+    att_real va = s->set.init_att_sigma * s->set.init_att_sigma;
+    att_real vb = s->set.init_bias_sigma * s->set.init_bias_sigma;
+    for (i = 0; i < NX; i++) {
+        for (j = 0; j < NX; j++) {
+            s->P[i][j] = 0;
+        }
+    }
+    for (i = 0; i < 3; i++) {
+        s->P[i][i] = va;
+        s->P[i + 3][i + 3] = vb;
+    }
+}
+
+att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_real q0[4])
+{
+    att_ahrs_settings d;
+    att_status st;
+    int i;
+    if (s == NULL) {
+        return ATT_E_NULL;
+    }
+    if (set == NULL) {
+        att_ahrs_default_settings(&d);
+        set = &d;
+    }
+    st = att_ahrs_check_settings(set);
+    if (st != ATT_OK) {
+        return st;
+    }
+    if (q0 != NULL) {
+        if (!att__finite4(q0)) {
+            return ATT_E_NONFINITE;
+        }
+        if (q0[0] == 0 && q0[1] == 0 && q0[2] == 0 && q0[3] == 0) {
+            return ATT_E_ARG;
+        }
+    }
+    st = att_integ_init(&s->integ, (att_method)set->method, q0);
+    if (st != ATT_OK) {
+        return st;
+    }
+    s->set = *set;
+    for (i = 0; i < 3; i++) {
+        s->bias[i] = 0;
+        s->acc_lp[i] = 0;
+        s->rest_gyr[i] = 0;
+        s->rest_acc[i] = 0;
+    }
+    set_initial_cov(s);
+    s->acc_norm_lp = 0;
+    s->acc_rej_time = 0;
+    s->mag_ref[0] = 0;
+    s->mag_ref[1] = 0;
+    s->mag_rej_time = 0;
+    s->mag_cand[0] = 0;
+    s->mag_cand[1] = 0;
+    s->mag_cand_t = 0;
+    s->mag_undist_t = 0;
+    s->rest_t = 0;
+    s->aligned = (q0 != NULL);
+    s->acc_init = 0;
+    s->mag_ref_valid = 0;
+    s->rest_init = 0;
+    s->flags = 0;
+    return ATT_OK;
+}
+
+/* C = C_b^n of a unit quaternion (docs/conventions.md eq. 1). */
+static void q2C(const att_real q[4], att_real C[9])
+{
+    att_real w = q[0], x = q[1], y = q[2], z = q[3];
+    C[0] = w * w + x * x - y * y - z * z;
+    C[1] = 2 * (x * y - w * z);
+    C[2] = 2 * (x * z + w * y);
+    C[3] = 2 * (x * y + w * z);
+    C[4] = w * w - x * x + y * y - z * z;
+    C[5] = 2 * (y * z - w * x);
+    C[6] = 2 * (x * z - w * y);
+    C[7] = 2 * (y * z + w * x);
+    C[8] = w * w - x * x - y * y + z * z;
+}
+
+static void mat_vec(const att_real C[9], const att_real v[3], att_real out[3])
+{
+    out[0] = C[0] * v[0] + C[1] * v[1] + C[2] * v[2];
+    out[1] = C[3] * v[0] + C[4] * v[1] + C[5] * v[2];
+    out[2] = C[6] * v[0] + C[7] * v[1] + C[8] * v[2];
+}
+
+static att_real norm3(const att_real v[3])
+{
+    return att_sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+}
+
+static att_real wrap_pi(att_real a)
+{
+    while (a > ATT_PI) {
+        a -= ATT_TWO_PI;
+    }
+    while (a < -ATT_PI) {
+        a += ATT_TWO_PI;
+    }
+    return a;
+}
+
+/* Initial attitude from one sample: att_align_accmag (aiding.h), six-axis
+ * (heading 0) when there is no field or it gives no heading. */
+static att_status align(const att_ahrs_settings *set, const att_real acc[3], const att_real mag[3],
+                        att_real q[4])
+{
+    att_status st = ATT_AID_E_ZERO_M;
+    if (mag != NULL) {
+        st = att_align_accmag(acc, mag, set->declination, q);
+    }
+    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
+        st = att_align_accmag(acc, NULL, set->declination, q);
+    }
+    return st;
+}
+
+/* Scalar update of the error state x with measurement y of x[j]
+ * (H = e_j), variance R; the gain is kept only on the states in `mask`
+ * (bit i = state i) and P follows the Joseph form for that gain:
+ * P ← P − K Pj' − Pj K' + K K' S, S = P[j][j] + R, Pj = column j. */
+static void scalar_update(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R, unsigned mask)
+{
+    att_real pj[NX], K[NX], S, innov;
+    int r, c;
+    S = P[j][j] + R;
+    innov = y - x[j];
+    for (r = 0; r < NX; r++) {
+        pj[r] = P[r][j];
+        K[r] = ((mask >> r) & 1u) ? pj[r] / S : 0;
+        x[r] += K[r] * innov;
+    }
+    for (r = 0; r < NX; r++) {
+        for (c = r; c < NX; c++) {
+            att_real v = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S;
+            P[r][c] = v;
+            P[c][r] = v;
+        }
+    }
+}
+
+enum {
+    MASK_ACC = 0x3Bu, /* δθx, δθy, δb */
+    MASK_MAG = 0x3Cu, /* δθz, δb */
+    MASK_BIAS = 0x38u /* δb */
+};
+
+/* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
+ * D = Pbb): A ← A − dt (C B' + B C') + dt² C D C' + qa I,
+ * B ← B − dt C D, D ← D + qb I. */
+static void propagate_cov(att_real P[NX][NX], const att_real C[9], att_real dt, att_real qa, att_real qb)
+{
+    att_real M[9], G[9], A[9];
+    int i, j, k;
+    for (i = 0; i < 3; i++) {
+        for (j = 0; j < 3; j++) {
+            att_real m = 0, g = 0;
+            for (k = 0; k < 3; k++) {
+                m += C[3 * i + k] * P[3 + k][3 + j]; /* (C D)ij */
+                g += C[3 * i + k] * P[3 + k][j];     /* (C B')ij, B' = Pbθ */
+            }
+            M[3 * i + j] = m;
+            G[3 * i + j] = g;
+        }
+    }
+    for (i = 0; i < 3; i++) {
+        for (j = i; j < 3; j++) {
+            att_real mc = 0;
+            for (k = 0; k < 3; k++) {
+                mc += M[3 * i + k] * C[3 * j + k]; /* (C D C')ij */
+            }
+            A[3 * i + j] = P[i][j] - dt * (G[3 * i + j] + G[3 * j + i]) + dt * dt * mc;
+        }
+    }
+    for (i = 0; i < 3; i++) {
+        for (j = i; j < 3; j++) {
+            att_real v = A[3 * i + j] + ((i == j) ? qa : 0);
+            P[i][j] = v;
+            P[j][i] = v;
+        }
+        for (j = 0; j < 3; j++) {
+            att_real v = P[i][3 + j] - dt * M[3 * i + j];
+            P[i][3 + j] = v;
+            P[3 + j][i] = v;
+        }
+        P[3 + i][3 + i] += qb;
+    }
+}
+
+static int finite_state(const att_ahrs *s)
+{
+    int i;
+    if (!att__finite4(s->integ.q) || !att__finite3(s->bias) || !att__finite3(s->acc_lp)) {
+        return 0;
+    }
+    for (i = 0; i < NX; i++) {
+        if (!fin(s->P[i][i])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static att_status write_q(const att_ahrs *s, att_real q_out[4])
+{
+    if (q_out != NULL) {
+        q_out[0] = s->integ.q[0];
+        q_out[1] = s->integ.q[1];
+        q_out[2] = s->integ.q[2];
+        q_out[3] = s->integ.q[3];
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
+                           att_real dt, att_real q_out[4])
+{
+    const att_ahrs_settings *set;
+    att_ahrs save;
+    att_real C[9], dth[3], x[NX], an, a_alpha, v[3];
+    int i, rest, flags = 0, r;
+    if (s == NULL || gyr == NULL) {
+        return ATT_E_NULL;
+    }
+    set = &s->set;
+    if (!(fin(dt) && dt > 0)) {
+        return ATT_E_AHRS_DT;
+    }
+    if (!att__finite3(gyr) || (acc != NULL && !att__finite3(acc)) || (mag != NULL && !att__finite3(mag))) {
+        return ATT_E_NONFINITE;
+    }
+    an = 0;
+    a_alpha = 0;
+    if (acc != NULL) {
+        an = norm3(acc);
+        if (!s->acc_init && !(an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity)) {
+            return ATT_E_AHRS_UNITS;
+        }
+        if (s->acc_init) {
+            att_real lp = s->acc_norm_lp + dt / (ATT_R(10.0) + dt) * (an - s->acc_norm_lp);
+            if (!(lp >= ATT_R(0.5) * set->gravity && lp <= ATT_R(8.0) * set->gravity)) {
+                return ATT_E_AHRS_UNITS;
+            }
+        }
+    }
+    if (!s->aligned) {
+        att_real q0[4];
+        att_status st;
+        if (acc == NULL) {
+            return ATT_E_AHRS_ALIGN;
+        }
+        st = align(set, acc, mag, q0);
+        if (st != ATT_OK) {
+            return ATT_E_AHRS_ALIGN;
+        }
+        st = att_integ_reset(&s->integ, q0);
+        if (st != ATT_OK) {
+            return ATT_E_AHRS_ALIGN;
+        }
+        s->aligned = 1;
+    }
+    save = *s;
+
+    /* gyro over-range */
+    if (set->gyro_range > 0
+        && (att_fabs(gyr[0]) >= set->gyro_range || att_fabs(gyr[1]) >= set->gyro_range
+            || att_fabs(gyr[2]) >= set->gyro_range)) {
+        flags |= ATT_AHRS_F_OVERRANGE;
+    }
+
+    /* rest detector (first-order low-passes of ω and a) */
+    rest = 0;
+    if (set->rest_time > 0 && acc != NULL) {
+        if (!s->rest_init) {
+            for (i = 0; i < 3; i++) {
+                s->rest_gyr[i] = gyr[i];
+                s->rest_acc[i] = acc[i];
+            }
+            s->rest_init = 1;
+            s->rest_t = 0;
+        } else {
+            att_real k = dt / (set->rest_tau + dt), dg = 0, da = 0, dw = 0, e;
+            for (i = 0; i < 3; i++) {
+                s->rest_gyr[i] += k * (gyr[i] - s->rest_gyr[i]);
+                s->rest_acc[i] += k * (acc[i] - s->rest_acc[i]);
+                e = gyr[i] - s->rest_gyr[i];
+                dg += e * e;
+                e = acc[i] - s->rest_acc[i];
+                da += e * e;
+                e = s->rest_gyr[i] - s->bias[i];
+                dw += e * e;
+            }
+            if (dg < set->rest_gyr_th * set->rest_gyr_th && dw < set->rest_gyr_th * set->rest_gyr_th
+                && da < set->rest_acc_th * set->rest_acc_th) {
+                s->rest_t += dt;
+            } else {
+                s->rest_t = 0;
+            }
+            rest = s->rest_t >= set->rest_time;
+        }
+    }
+
+    /* propagation: bias-corrected increment through the integrator */
+    for (i = 0; i < 3; i++) {
+        dth[i] = (gyr[i] - s->bias[i]) * dt;
+    }
+    r = att_integ_update(&s->integ, dth, NULL);
+    if (r < 0) {
+        *s = save;
+        return ATT_E_AHRS_DIVERGED;
+    }
+    q2C(s->integ.q, C);
+    propagate_cov(s->P, C, dt, set->gyr_noise * set->gyr_noise * dt, set->bias_noise * set->bias_noise * dt);
+    if (flags & ATT_AHRS_F_OVERRANGE) {
+        att_real o = set->overrange_sigma * set->overrange_sigma;
+        s->P[0][0] += o;
+        s->P[1][1] += o;
+        s->P[2][2] += o;
+    }
+    for (i = 0; i < NX; i++) {
+        x[i] = 0;
+    }
+
+    /* accelerometer: low-pass in the navigation frame, inclination update */
+    if (acc != NULL) {
+        att_real an_n[3], nv, hs, ang, y0, y1;
+        mat_vec(C, acc, an_n);
+        if (!s->acc_init) {
+            for (i = 0; i < 3; i++) {
+                s->acc_lp[i] = an_n[i];
+            }
+            s->acc_norm_lp = an;
+            s->acc_init = 1;
+        } else {
+            a_alpha = (set->acc_tau > 0) ? dt / (set->acc_tau + dt) : ATT_R(1.0);
+            for (i = 0; i < 3; i++) {
+                s->acc_lp[i] += a_alpha * (an_n[i] - s->acc_lp[i]);
+            }
+            s->acc_norm_lp += dt / (ATT_R(10.0) + dt) * (an - s->acc_norm_lp);
+        }
+        nv = norm3(s->acc_lp);
+        if (nv > 0) {
+            for (i = 0; i < 3; i++) {
+                v[i] = s->acc_lp[i] / nv;
+            }
+            /* correction δθ = angle · (v × e_z)/|v × e_z|, v × e_z = (v_y, −v_x, 0) */
+            hs = att_sqrt(v[0] * v[0] + v[1] * v[1]);
+            ang = att_atan2(hs, v[2]);
+            if (hs > 0) {
+                y0 = ang * v[1] / hs;
+                y1 = -ang * v[0] / hs;
+            } else {
+                y0 = 0;
+                y1 = 0;
+            }
+            if (set->acc_gate > 0 && ang > set->acc_gate) {
+                s->acc_rej_time += dt;
+                if (s->acc_rej_time < set->acc_reject_max) {
+                    flags |= ATT_AHRS_F_ACC_REJECTED;
+                } else {
+                    s->acc_rej_time = 0;
+                }
+            } else {
+                s->acc_rej_time = 0;
+            }
+            if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
+                att_real R = set->acc_noise * set->acc_noise / dt;
+                scalar_update(s->P, x, 0, y0, R, MASK_ACC);
+                scalar_update(s->P, x, 1, y1, R, MASK_ACC);
+            }
+        }
+    }
+
+    /* magnetometer: heading only, disturbance rejection on norm and dip */
+    if (mag != NULL) {
+        att_real m[3], h, nm, dip, rm;
+        int use = 0;
+        mat_vec(C, mag, m);
+        h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
+        nm = norm3(m);
+        if (h > 0) {
+            dip = att_atan2(-m[2], h);
+            if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
+                /* the inclination is not known well enough to learn the dip */
+                s->mag_ref_valid = 0;
+            }
+            if (!s->mag_ref_valid) {
+                s->mag_ref[0] = nm;
+                s->mag_ref[1] = dip;
+                s->mag_cand[0] = nm;
+                s->mag_cand[1] = dip;
+                s->mag_ref_valid = 1;
+                s->mag_undist_t = set->mag_min_undisturbed;
+            }
+            /* candidate reference: the field while it stays consistent with
+             * itself; its time runs only while turning (a field fixed to the
+             * body would change with the attitude and fail the test) */
+            if (att_fabs(nm - s->mag_cand[0]) <= set->mag_norm_tol * s->mag_cand[0]
+                && att_fabs(dip - s->mag_cand[1]) <= set->mag_dip_tol) {
+                att_real k = dt / (set->mag_ref_tau + dt);
+                s->mag_cand[0] += k * (nm - s->mag_cand[0]);
+                s->mag_cand[1] += k * (dip - s->mag_cand[1]);
+                if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2]
+                    >= set->mag_new_gyr * set->mag_new_gyr) {
+                    s->mag_cand_t += dt;
+                }
+            } else {
+                s->mag_cand[0] = nm;
+                s->mag_cand[1] = dip;
+                s->mag_cand_t = 0;
+            }
+            rm = set->mag_noise * set->mag_noise / dt;
+            if (att_fabs(nm - s->mag_ref[0]) <= set->mag_norm_tol * s->mag_ref[0]
+                && att_fabs(dip - s->mag_ref[1]) <= set->mag_dip_tol) {
+                att_real k = dt / (set->mag_ref_tau + dt);
+                s->mag_ref[0] += k * (nm - s->mag_ref[0]);
+                s->mag_ref[1] += k * (dip - s->mag_ref[1]);
+                s->mag_undist_t += dt;
+                if (s->mag_undist_t >= set->mag_min_undisturbed) {
+                    s->mag_rej_time = 0;
+                    use = 1;
+                } else {
+                    flags |= ATT_AHRS_F_MAG_DISTURBED;
+                    s->mag_rej_time += dt;
+                }
+            } else if (s->mag_cand_t >= set->mag_new_time) {
+                /* a new homogeneous field: it becomes the reference */
+                s->mag_ref[0] = s->mag_cand[0];
+                s->mag_ref[1] = s->mag_cand[1];
+                s->mag_rej_time = 0;
+                s->mag_undist_t = set->mag_min_undisturbed;
+                flags |= ATT_AHRS_F_MAG_RELEARNED;
+                use = 1;
+            } else {
+                s->mag_undist_t = 0;
+                flags |= ATT_AHRS_F_MAG_DISTURBED;
+                s->mag_rej_time += dt;
+                if (s->mag_rej_time >= set->mag_reject_max) {
+                    /* bounded rejection: weak updates again */
+                    rm *= set->mag_reject_factor * set->mag_reject_factor;
+                    use = 1;
+                }
+            }
+            if (use) {
+                att_real y = wrap_pi(att_atan2(m[0], m[1]) - set->declination);
+                scalar_update(s->P, x, 2, y, rm, MASK_MAG);
+            }
+        }
+    }
+
+    /* rest: zero-rate update of the bias */
+    if (rest) {
+        att_real R = set->rest_noise * set->rest_noise / dt;
+        flags |= ATT_AHRS_F_REST;
+        for (i = 0; i < 3; i++) {
+            scalar_update(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], R, MASK_BIAS);
+        }
+    }
+
+    /* inject the error state: q ← exp(δθ) ⊗ q, b ← b + δb, acc_lp ← (I + [δθ×]) acc_lp */
+    if (x[0] != 0 || x[1] != 0 || x[2] != 0) {
+        att_real d[4], q0 = s->integ.q[0], q1 = s->integ.q[1], q2 = s->integ.q[2], q3 = s->integ.q[3];
+        att_real l0 = s->acc_lp[0], l1 = s->acc_lp[1], l2 = s->acc_lp[2];
+        att__rotvec_delta(x, d);
+        s->integ.q[0] = q0 + (d[0] * q0 - d[1] * q1 - d[2] * q2 - d[3] * q3);
+        s->integ.q[1] = q1 + (d[0] * q1 + d[1] * q0 + d[2] * q3 - d[3] * q2);
+        s->integ.q[2] = q2 + (d[0] * q2 - d[1] * q3 + d[2] * q0 + d[3] * q1);
+        s->integ.q[3] = q3 + (d[0] * q3 + d[1] * q2 - d[2] * q1 + d[3] * q0);
+        s->acc_lp[0] = l0 + (x[1] * l2 - x[2] * l1);
+        s->acc_lp[1] = l1 + (x[2] * l0 - x[0] * l2);
+        s->acc_lp[2] = l2 + (x[0] * l1 - x[1] * l0);
+    }
+    s->bias[0] += x[3];
+    s->bias[1] += x[4];
+    s->bias[2] += x[5];
+    s->flags = flags;
+    if (!finite_state(s)) {
+        *s = save;
+        return ATT_E_AHRS_DIVERGED;
+    }
+    return write_q(s, q_out);
+}
+
+att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
+                          size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index)
+{
+    size_t k;
+    if (s == NULL || gyr == NULL || acc == NULL || dt == NULL) {
+        return ATT_E_NULL;
+    }
+    if (n_dt != 1 && n_dt != n) {
+        return ATT_E_ARG;
+    }
+    for (k = 0; k < n; k++) {
+        att_status st = att_ahrs_update(s, gyr + 3 * k, acc + 3 * k, mag != NULL ? mag + 3 * k : NULL,
+                                        n_dt == 1 ? dt[0] : dt[k], q_out != NULL ? q_out + 4 * k : NULL);
+        if (st != ATT_OK) {
+            if (err_index != NULL) {
+                *err_index = k;
+            }
+            return st;
+        }
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_attitude(const att_ahrs *s, att_real q[4])
+{
+    if (s == NULL || q == NULL) {
+        return ATT_E_NULL;
+    }
+    if (!s->aligned) {
+        return ATT_E_STATE;
+    }
+    return write_q(s, q);
+}
+
+att_status att_ahrs_bias(const att_ahrs *s, att_real b[3])
+{
+    if (s == NULL || b == NULL) {
+        return ATT_E_NULL;
+    }
+    b[0] = s->bias[0];
+    b[1] = s->bias[1];
+    b[2] = s->bias[2];
+    return ATT_OK;
+}
+
+att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bias_sigma[3])
+{
+    int i;
+    if (s == NULL || att_sigma == NULL || bias_sigma == NULL) {
+        return ATT_E_NULL;
+    }
+    for (i = 0; i < 3; i++) {
+        att_sigma[i] = att_sqrt(s->P[i][i] > 0 ? s->P[i][i] : 0);
+        bias_sigma[i] = att_sqrt(s->P[3 + i][3 + i] > 0 ? s->P[3 + i][3 + i] : 0);
+    }
+    return ATT_OK;
+}
+
+int att_ahrs_flags(const att_ahrs *s)
+{
+    return s == NULL ? 0 : s->flags;
+}
