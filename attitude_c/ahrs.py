@@ -39,7 +39,7 @@ SETTINGS: tuple[str, ...] = (
     "acc_noise", "acc_gate", "acc_reject_max", "mag_noise", "mag_norm_tol", "mag_dip_tol",
     "mag_ref_tau", "mag_reject_max", "mag_reject_factor", "mag_new_time", "mag_new_gyr",
     "mag_min_undisturbed", "declination", "rest_time", "rest_tau", "rest_gyr_th",
-    "rest_acc_th", "rest_noise", "gyro_range", "overrange_sigma",
+    "rest_acc_th", "rest_noise", "gyro_range", "overrange_sigma", "sensor_delay",
 )
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}

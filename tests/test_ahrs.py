@@ -60,7 +60,7 @@ def test_c_matches_reference_synthetic(method):
 def test_c_matches_reference_six_axis_and_gate():
     gyr, acc, mag, _ = motion(600, 100.0, (0.0, 0.0, 0.8), noise=0.003)
     acc[200:260] += [6.0, 0.0, 0.0]  # a linear-acceleration burst: exercises the gate
-    kw = {"acc_tau": 0.2, "acc_gate": 0.05, "acc_reject_max": 0.3}
+    kw = {"acc_tau": 0.2, "acc_gate": 0.05, "acc_reject_max": 0.3, "sensor_delay": 0.003}
     qc = ahrs(gyr, acc, None, rate=100.0, **kw)
     qr = ahrs_reference(gyr, acc, None, rate=100.0, **kw)
     assert np.abs(qc - qr).max() < 1e-12  # as above

@@ -12,7 +12,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from . import demo, link, simulate, view
+from . import ahrs, demo, link, simulate, view
 
 
 class _VersionAction(argparse.Action):
@@ -29,7 +29,7 @@ class _VersionAction(argparse.Action):
         parser.exit(message=f"{parser.prog} {attitude_c.__version__}\n")
 
 # The subcommand modules, in the order their commands are listed.
-_MODULES = (simulate, link, demo, view)
+_MODULES = (simulate, link, demo, view, ahrs)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -42,6 +42,7 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->rest_noise = ATT_R(0.001);
     set->gyro_range = ATT_R(0.0);
     set->overrange_sigma = ATT_R(0.05);
+    set->sensor_delay = ATT_R(0.0);
 }
 
 static int fin(att_real x)
@@ -75,6 +76,7 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set)
     /* zero = off */
     if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
           && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
+          && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0)
           && att_fabs(t->declination) <= ATT_PI)) {
         return ATT_E_AHRS_SETTINGS;
     }
@@ -566,6 +568,19 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     if (!finite_state(s)) {
         *s = save;
         return ATT_E_AHRS_DIVERGED;
+    }
+    if (q_out != NULL && set->sensor_delay != 0) {
+        /* output predicted over the sensor delay with the corrected rate */
+        att_real ph[3], d[4], *q = s->integ.q;
+        for (i = 0; i < 3; i++) {
+            ph[i] = (gyr[i] - s->bias[i]) * set->sensor_delay;
+        }
+        att__rotvec_delta(ph, d);
+        q_out[0] = q[0] + (q[0] * d[0] - q[1] * d[1] - q[2] * d[2] - q[3] * d[3]);
+        q_out[1] = q[1] + (q[0] * d[1] + q[1] * d[0] + q[2] * d[3] - q[3] * d[2]);
+        q_out[2] = q[2] + (q[0] * d[2] - q[1] * d[3] + q[2] * d[0] + q[3] * d[1]);
+        q_out[3] = q[3] + (q[0] * d[3] + q[1] * d[2] - q[2] * d[1] + q[3] * d[0]);
+        return ATT_OK;
     }
     return write_q(s, q_out);
 }

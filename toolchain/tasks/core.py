@@ -190,9 +190,12 @@ def assemble_bench_doc() -> None:
 @task(help={
     "only": "run only this benchmark module (bench/NAME.py); 'assemble' just rebuilds the table",
     "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
+    "data": "a data folder for the benchmarks that take one (broad: an upstream BROAD data_mat/ folder)",
 })
-def bench(c, only="", quick=False):
+def bench(c, only="", quick=False, data=""):
     """Run every benchmark and write the figures into docs/benchmarks.md."""
+    import inspect
+
     if only == "assemble":  # just rebuild docs/benchmarks.md from docs/bench/*.md
         assemble_bench_doc()
         return
@@ -204,7 +207,10 @@ def bench(c, only="", quick=False):
         try:
             mod = importlib.import_module(f"bench.{name}")
             print(f"== bench {name}: {mod.TITLE}", flush=True)
-            body = mod.run(quick=quick)
+            if data and "data" in inspect.signature(mod.run).parameters:
+                body = mod.run(quick=quick, data=data)
+            else:
+                body = mod.run(quick=quick)
         except Exception as exc:  # noqa: BLE001 - any failure of one module
             import traceback
 
@@ -212,7 +218,8 @@ def bench(c, only="", quick=False):
             print(f"== bench {name}: FAILED ({type(exc).__name__}: {exc})", flush=True)
             failed.append(name)
             continue
-        cmd = "invoke bench" + (f" --only {name}" if only else "") + (" --quick" if quick else "")
+        cmd = ("invoke bench" + (f" --only {name}" if only else "") + (" --quick" if quick else "")
+               + (f" --data {data}" if data and "data" in inspect.signature(mod.run).parameters else ""))
         write_bench_section(name, mod.TITLE, body, cmd)
         print(body)
     assemble_bench_doc()

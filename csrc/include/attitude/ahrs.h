@@ -110,6 +110,11 @@ typedef struct {
                                  ATT_AHRS_F_OVERRANGE and inflates the attitude covariance by
                                  (overrange_sigma)² per flagged sample; 0 = no range */
     att_real overrange_sigma;     /* [rad] see gyro_range, 0.05 */
+    att_real sensor_delay;        /* [s] |d| ≤ 1: the samples lag the time the output should refer
+                                 to by this much; q_out of att_ahrs_update is predicted forward
+                                 by it, q ⊗ exp((ω − b)·d) (the state is not: see
+                                 att_ahrs_attitude). 0 (off) by default: a property of a
+                                 recording set-up, not of the filter (docs/ahrs.md) */
 } att_ahrs_settings;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. */
@@ -170,7 +175,9 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
                           size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index);
 
-/* Current attitude q (body → ENU, unit; ATT_E_STATE before alignment). */
+/* Current attitude q of the state (body → ENU, unit, at the time of the
+ * last sample, without the sensor_delay prediction; ATT_E_STATE before
+ * alignment). */
 att_status att_ahrs_attitude(const att_ahrs *s, att_real q[4]);
 
 /* Current gyro-bias estimate [rad/s], body frame. */

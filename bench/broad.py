@@ -1,0 +1,387 @@
+"""The attitude filter on real recordings (BROAD), side by side with open filters.
+
+BROAD: D. Laidig, M. Caruso, A. Cereatti, T. Seel, "BROAD — A Benchmark for
+Robust Inertial Orientation Estimation", Data 6(7), 2021,
+doi:10.3390/data6070072 (CC BY 4.0). The error metric is BROAD's
+(``attitude_c.broad``): per trial the RMS over the movement phases of the
+total, heading and inclination error of q_est ⊗ q_ref⁻¹, then the mean over
+trials (all, undisturbed, disturbed).
+
+Filters, all on the same trials in one run, each started from its own
+first sample (no filter is given the reference attitude):
+
+* ``attitude_c`` — this library's filter (``attitude_c.ahrs``), frozen
+  defaults, double and float builds;
+* VQF (``vqf`` on PyPI, Laidig & Seel 2023): ``VQF(1/rate)`` with its
+  default parameters, ``updateBatch`` (C++), 9-D output ``quat9D``;
+  same units and frames as BROAD (its authors');
+* x-io Fusion (``imufusion``): ``AhrsSettings(sample_rate=rate,
+  convention=ENU, gain=0.5, gyroscope_range=2000°/s,
+  acceleration_rejection=10°, magnetic_rejection=10°,
+  rejection_timeout=5 s)`` — the values of Fusion's README example — and
+  its gyro offset corrector (``imufusion.Bias``); gyro in °/s, specific
+  force in g (÷ 9.81), field as given;
+* ``ahrs`` package EKF: ``EKF(frame="ENU", frequency=rate,
+  magnetic_ref=68°)`` (Berlin's dip, where BROAD was recorded) with its
+  default noises; Madgwick: ``Madgwick(frequency=rate)``, default MARG
+  gain 0.041 (field in µT, normalized inside). Their quaternion
+  conventions are checked, not assumed: among q, q* and those turned by a
+  multiple of 90° about the vertical, the one that agrees with the
+  reference on the first static second of the first trial is used for
+  every trial (the mapping, printed below, is a frame convention, the same
+  for all trials).
+
+Cross-validation: the filter's settings are chosen by coordinate descent
+on a grid (the same procedure that chose the frozen defaults) on one half
+of the trials (alternate trials of the sorted list) and scored on the
+other half, and the other way round; the held-out scores of all trials
+are averaged.
+
+    python -m bench.broad [--quick] [--no-timing] [--no-cv] [--data DIR]
+    invoke bench --only broad              # docs/bench/broad.md
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+TITLE = "The attitude filter on BROAD, against VQF, Fusion, the ahrs package's EKF and Madgwick"
+
+PLOT = ROOT / "docs" / "img" / "broad-trials.png"
+DIP_BERLIN_DEG = 68.0
+FILTERS = ("attitude_c f64", "attitude_c f32", "VQF", "Fusion", "ahrs EKF", "ahrs Madgwick")
+
+# the grid of the settings search (coordinate descent from the defaults)
+GRID: dict[str, list[float]] = {
+    "acc_noise": [0.015, 0.025, 0.04],
+    "acc_tau": [1.0, 2.0, 3.0],
+    "mag_noise": [0.03, 0.05, 0.09],
+    "bias_noise": [3e-5, 1e-4, 3e-4],
+    "mag_norm_tol": [0.03, 0.05, 0.1],
+    "mag_dip_tol": [0.1, 0.17, 0.25],
+    "rest_noise": [0.001, 0.005],
+}
+
+
+def _qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    from attitude_c import reference as ref
+
+    return np.asarray(ref.quat_multiply(a, b))
+
+
+def _qz(deg: float) -> np.ndarray:
+    h = math.radians(deg) / 2
+    return np.array([math.cos(h), 0.0, 0.0, math.sin(h)])
+
+
+# -- the filters --------------------------------------------------------------------------
+
+def run_ours(tr: Any, precision: str = "f64", **settings: Any) -> np.ndarray:
+    from attitude_c.ahrs import ahrs
+
+    return np.asarray(ahrs(tr.gyr, tr.acc, tr.mag, rate=tr.rate, precision=precision, **settings), float)
+
+
+def run_vqf(tr: Any) -> np.ndarray:
+    from vqf import VQF
+
+    v = VQF(1.0 / tr.rate)
+    out = v.updateBatch(np.ascontiguousarray(tr.gyr), np.ascontiguousarray(tr.acc),
+                        np.ascontiguousarray(tr.mag))
+    return np.asarray(out["quat9D"])
+
+
+def run_fusion(tr: Any) -> np.ndarray:
+    import imufusion
+
+    s = imufusion.AhrsSettings(sample_rate=tr.rate, convention=imufusion.CONVENTION_ENU, gain=0.5,
+                               gyroscope_range=2000.0, acceleration_rejection=10.0,
+                               magnetic_rejection=10.0, rejection_timeout=5.0)
+    a = imufusion.Ahrs()
+    a.set_settings(s)
+    bias = imufusion.Bias()
+    bias.set_settings(imufusion.BiasSettings(sample_rate=tr.rate))
+    g = np.degrees(tr.gyr)
+    f = tr.acc / 9.81
+    out = np.empty((tr.n, 4))
+    for i in range(tr.n):
+        gi = bias.update(g[i])
+        a.update(gi, f[i], tr.mag[i])
+        out[i] = a.get_quaternion()
+    return out
+
+
+def run_ekf(tr: Any) -> np.ndarray:
+    from ahrs.filters import EKF
+
+    return np.asarray(EKF(gyr=tr.gyr, acc=tr.acc, mag=tr.mag, frequency=tr.rate, frame="ENU",
+                          magnetic_ref=DIP_BERLIN_DEG).Q)
+
+
+def run_madgwick(tr: Any) -> np.ndarray:
+    from ahrs.filters import Madgwick
+
+    return np.asarray(Madgwick(gyr=tr.gyr, acc=tr.acc, mag=tr.mag, frequency=tr.rate).Q)
+
+
+def convention(q: np.ndarray, tr: Any) -> tuple[str, Callable[[np.ndarray], np.ndarray]]:
+    """The frame mapping (q or q*, turned by k·90° about up) that agrees with the
+    reference over the first static second with a valid reference."""
+    from attitude_c import broad
+
+    ok = np.flatnonzero(np.isfinite(tr.quat).all(axis=1) & ~tr.movement)[: int(tr.rate)]
+    best: tuple[float, str, Callable[[np.ndarray], np.ndarray]] | None = None
+    for conj in (False, True):
+        for deg in (0.0, 90.0, 180.0, -90.0):
+            def m(x: np.ndarray, conj: bool = conj, deg: float = deg) -> np.ndarray:
+                y = x * np.array([1.0, -1.0, -1.0, -1.0]) if conj else x
+                return _qmul(_qz(deg), y) if deg else y
+            e = float(np.mean(broad.error_angles(m(q[ok]), tr.quat[ok])[0]))
+            name = ("q*" if conj else "q") + (f" turned {deg:+.0f}° about up" if deg else "")
+            if best is None or e < best[0]:
+                best = (e, name, m)
+    assert best is not None
+    return best[1], best[2]
+
+
+# -- scoring ------------------------------------------------------------------------------
+
+def score(trials: list[Any], qs: list[np.ndarray]) -> list[Any]:
+    from attitude_c import broad
+
+    return [broad.errors(q, t.quat, t.movement) for t, q in zip(trials, qs)]
+
+
+def group_means(trials: list[Any], figs: list[Any]) -> dict[str, dict[str, float]]:
+    from attitude_c import broad
+
+    out = {"all": broad.mean_figures(figs)}
+    for g in ("undisturbed", "disturbed"):
+        sel = [f for t, f in zip(trials, figs) if g in t.groups or f"_{g}_" in t.name]
+        if sel:
+            out[g] = broad.mean_figures(sel)
+    return out
+
+
+def tune(trials: list[Any], rounds: int = 2) -> tuple[dict[str, float], float]:
+    """Coordinate descent over GRID from the defaults, minimizing the mean total error."""
+    from attitude_c import broad
+
+    def total(kw: dict[str, float]) -> float:
+        return broad.mean_figures(score(trials, [run_ours(t, **kw) for t in trials]))["total"]
+
+    cur: dict[str, float] = {}
+    best = total(cur)
+    for _ in range(rounds):
+        changed = False
+        for k, vals in GRID.items():
+            for v in vals:
+                if cur.get(k) == v:
+                    continue
+                c = dict(cur)
+                c[k] = v
+                s = total(c)
+                if s < best - 1e-4:
+                    best, cur, changed = s, c, True
+        if not changed:
+            break
+    return cur, best
+
+
+def cross_validate(trials: list[Any], rounds: int) -> tuple[list[tuple[str, dict[str, float], float]], float]:
+    """Two folds (alternate trials); returns per-fold (held-out names, settings, held-out
+    mean total) and the held-out mean total over all trials."""
+    from attitude_c import broad
+
+    folds = [trials[0::2], trials[1::2]]
+    rows = []
+    held: list[Any] = []
+    for i in (0, 1):
+        kw, _ = tune(folds[i], rounds)
+        test = folds[1 - i]
+        figs = score(test, [run_ours(t, **kw) for t in test])
+        held += figs
+        rows.append((", ".join(t.name[:2] for t in test), kw, broad.mean_figures(figs)["total"]))
+    return rows, broad.mean_figures(held)["total"]
+
+
+# -- cost -----------------------------------------------------------------------------------
+
+def armv4t_counts() -> list[tuple[str, float]]:
+    """Instructions per sample (acc + mag every sample) on the emulated ARM920T."""
+    from toolchain import targets as T
+    from toolchain.qemu_count import per_iteration
+
+    t = T.load("armv4t-bare")
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        for prec in ("f32", "f64"):
+            exe = t.build_program([ROOT / "csrc" / "vectors" / "bench_ahrs.c"], Path(d) / f"bench_ahrs_{prec}",
+                                  defines=["ATT_REAL_F32"] if prec == "f32" else [])
+            rows.append((prec, per_iteration(exe, lambda m: [str(m)], 300, 556)))
+    return rows
+
+
+def throughput(trials: list[Any], reps: int) -> list[tuple[str, float]]:
+    from vqf import VQF
+
+    from attitude_c.ahrs import Ahrs
+
+    from .host import _best
+
+    g = np.ascontiguousarray(np.vstack([t.gyr for t in trials]))
+    a = np.ascontiguousarray(np.vstack([t.acc for t in trials]))
+    m = np.ascontiguousarray(np.vstack([t.mag for t in trials]))
+    rate = trials[0].rate
+    n = len(g)
+    rows = []
+    for prec in ("f64", "f32"):
+        def ours(prec: str = prec) -> None:
+            Ahrs(rate=rate, precision=prec).update(g, a, m)  # type: ignore[arg-type]
+        rows.append((f"attitude_c.Ahrs.update, {prec}, one block", n / _best(ours, reps)))
+    rows.append(("VQF.updateBatch (C++)", n / _best(lambda: VQF(1.0 / rate).updateBatch(g, a, m), reps)))
+    return rows
+
+
+# -- plot -------------------------------------------------------------------------------------
+
+def plot(trials: list[Any], figs: dict[str, list[Any]]) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [t.name[:2] for t in trials]
+    x = np.arange(len(trials))
+    keys = [k for k in FILTERS if k in figs and k != "attitude_c f32"]
+    w = 0.8 / len(keys)
+    fig, ax = plt.subplots(figsize=(11, 4))
+    for i, k in enumerate(keys):
+        ax.bar(x + (i - (len(keys) - 1) / 2) * w, [f.total for f in figs[k]], w, label=k)
+    ax.set_xticks(x, names)
+    ax.set_yscale("log")
+    ax.set_ylabel("total error, RMS over movement (°)")
+    ax.set_xlabel("BROAD trial")
+    ax.set_title("BROAD (Laidig et al., Data 2021, CC BY 4.0): per-trial total error")
+    ax.legend(ncol=3, fontsize=8)
+    ax.grid(axis="y", alpha=0.3)
+    fig.tight_layout()
+    PLOT.parent.mkdir(parents=True, exist_ok=True)
+    tmp = PLOT.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(PLOT)
+
+
+# -- report -----------------------------------------------------------------------------------
+
+def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | None = None) -> str:
+    from attitude_c import broad
+    from attitude_c.ahrs import default_settings
+
+    folder = data or None
+    trials = [broad.load_trial(p) for p in broad.find_trials(folder)]
+    out: list[str] = []
+    out.append(f"BROAD: {broad.CITATION}. {len(trials)} trials from "
+               f"`{'the upstream data_mat folder given' if data else '../shared/data/broad'}`; metric of the "
+               "BROAD paper (`attitude_c.broad`), degrees, mean of per-trial RMS over movement phases. "
+               "Peers' configuration: module docstring of `bench/broad.py`.\n")
+    qs: dict[str, list[np.ndarray]] = {k: [] for k in FILTERS}
+    conv: dict[str, tuple[str, Callable[[np.ndarray], np.ndarray]]] = {}
+    runners: dict[str, Callable[[Any], np.ndarray]] = {
+        "attitude_c f64": lambda t: run_ours(t, "f64"), "attitude_c f32": lambda t: run_ours(t, "f32"),
+        "VQF": run_vqf, "Fusion": run_fusion, "ahrs EKF": run_ekf, "ahrs Madgwick": run_madgwick}
+    skipped: dict[str, str] = {}
+    for k, fn in runners.items():
+        try:
+            for t in trials:
+                q = fn(t)
+                if k in ("Fusion", "ahrs EKF", "ahrs Madgwick"):
+                    if k not in conv:
+                        conv[k] = convention(q, t)
+                    q = conv[k][1](q)
+                qs[k].append(q)
+        except ImportError as exc:
+            skipped[k] = str(exc)
+            qs.pop(k)
+    figs = {k: score(trials, v) for k, v in qs.items()}
+    keys = list(figs)
+    out.append("**Per trial** (total / heading / inclination, °):\n")
+    out.append("| trial | " + " | ".join(keys) + " |")
+    out.append("|---|" + "---|" * len(keys))
+    for i, t in enumerate(trials):
+        out.append(f"| {t.name} | " + " | ".join(
+            f"{figs[k][i].total:.2f} / {figs[k][i].heading:.2f} / {figs[k][i].inclination:.2f}" for k in keys) + " |")
+    out.append("\n**Means** (total / heading / inclination, °):\n")
+    out.append("| group | " + " | ".join(keys) + " |")
+    out.append("|---|" + "---|" * len(keys))
+    gm = {k: group_means(trials, figs[k]) for k in keys}
+    for g in gm[keys[0]]:
+        out.append(f"| {g} | " + " | ".join(
+            f"{gm[k][g]['total']:.3f} / {gm[k][g]['heading']:.3f} / {gm[k][g]['inclination']:.3f}"
+            for k in keys) + " |")
+    if "attitude_c f32" in qs:
+        d = max(abs(a.total - b.total) for a, b in zip(figs["attitude_c f64"], figs["attitude_c f32"]))
+        ang = max(float(np.degrees(np.max(broad.error_angles(a, b)[0])))
+                  for a, b in zip(qs["attitude_c f64"], qs["attitude_c f32"]))
+        out.append(f"\nFloat build vs double: largest per-trial difference of the total RMS {d:.4f}°; "
+                   f"largest angle between the two attitudes at any sample {ang:.4f}°.")
+    for k, (name, _) in conv.items():
+        out.append(f"\n{k}: quaternion mapping found on the first static second of {trials[0].name}: {name}.")
+    for k, why in skipped.items():
+        out.append(f"\n{k}: not run ({why}).")
+    plot(trials, figs)
+    out.append(f"\nPlot: `{PLOT.relative_to(ROOT)}` (total error per trial, log scale).\n")
+    d = default_settings()
+    out.append("Frozen defaults of the filter: " + ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                                                           for k, v in d.items()) + ".\n")
+    if cv:
+        rows, held = cross_validate(trials, rounds=1 if quick else 2)
+        out.append("**Cross-validated** (settings chosen by coordinate descent over the grid "
+                   f"{ {k: v for k, v in GRID.items()} } on one half of the trials, scored on the other):\n")
+        out.append("| held-out trials | settings chosen on the other half (changes from the defaults) | "
+                   "held-out mean total ° |")
+        out.append("|---|---|---|")
+        for names_, kw, tot in rows:
+            out.append(f"| {names_} | {kw or 'defaults'} | {tot:.3f} |")
+        out.append(f"\nHeld-out mean total over all {len(trials)} trials: **{held:.3f}°**.\n")
+    try:
+        counts = armv4t_counts()
+        out.append("**ARMv4T (ARM920T) instructions per sample**, gyro + accelerometer + magnetometer update "
+                   "every sample (`qemu-arm -cpu ti925t`, exact counts, `csrc/vectors/bench_ahrs.c`, "
+                   "soft-float newlib, `-O2`; difference of two run lengths):\n")
+        out.append("| precision | instructions/sample | µs/sample @400 MHz, CPI 1.5 | load at 200 Hz |")
+        out.append("|---|---|---|---|")
+        for prec, c in counts:
+            us = c * 1.5 / 400e6 * 1e6
+            out.append(f"| {prec} | {c:,.0f} | {us:.1f} | {us * 200 / 1e6 * 100:.1f} % |")
+    except Exception as exc:  # noqa: BLE001 - a missing cross toolchain must not lose the rest
+        out.append(f"\nARMv4T counts: not measured ({type(exc).__name__}: {exc}).")
+    if timing:
+        out.append("\n**Host throughput** (all trials concatenated, one call, best of "
+                   f"{2 if quick else 5} runs, `time.perf_counter`, on a shared machine):\n")
+        out.append("| what | samples/s |")
+        out.append("|---|---|")
+        for label, sps in throughput(trials, 2 if quick else 5):
+            out.append(f"| {label} | {sps:,.0f} |")
+    return "\n".join(out)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    data = None
+    if "--data" in sys.argv:
+        data = sys.argv[sys.argv.index("--data") + 1]
+    t0 = time.time()
+    print(run(quick="--quick" in sys.argv, timing="--no-timing" not in sys.argv, cv="--no-cv" not in sys.argv,
+              data=data))
+    print(f"\n({time.time() - t0:.0f} s)", file=sys.stderr)
