@@ -18,6 +18,7 @@ ns = Collection(
     cross.cross_build,
     link.fuzz,
     sim.sim,
+    sim.sim_acceptance,
     view.view_soak,
     view.view_firmware,
     view.view_screenshot,
