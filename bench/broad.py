@@ -38,6 +38,10 @@ other half, and the other way round; the held-out scores of all trials
 are averaged.
 
     python -m bench.broad [--quick] [--no-timing] [--no-cv] [--data DIR]
+
+The peers' attitudes are cached in ``results/bench-cache/broad`` (the ahrs
+package's EKF runs at about 1.5 ms per sample here: a first full run takes
+about half an hour; later runs a few minutes).
     invoke bench --only broad              # docs/bench/broad.md
 """
 
@@ -58,6 +62,10 @@ ROOT = Path(__file__).resolve().parents[1]
 TITLE = "The attitude filter on BROAD, against VQF, Fusion, the ahrs package's EKF and Madgwick"
 
 PLOT = ROOT / "docs" / "img" / "broad-trials.png"
+#: peers' attitudes are kept here between runs (the ahrs package's filters are pure
+#: Python, ~1 ms per sample: the first full run takes long), keyed by filter,
+#: package version and trial file (name, size, mtime)
+CACHE = ROOT / "results" / "bench-cache" / "broad"
 DIP_BERLIN_DEG = 68.0
 FILTERS = ("attitude_c f64", "attitude_c f32", "VQF", "Fusion", "ahrs EKF", "ahrs Madgwick")
 
@@ -132,6 +140,31 @@ def run_madgwick(tr: Any) -> np.ndarray:
     from ahrs.filters import Madgwick
 
     return np.asarray(Madgwick(gyr=tr.gyr, acc=tr.acc, mag=tr.mag, frequency=tr.rate).Q)
+
+
+def _version(filt: str) -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    pkg = {"VQF": "vqf", "Fusion": "imufusion", "ahrs EKF": "ahrs", "ahrs Madgwick": "ahrs"}[filt]
+    try:
+        return version(pkg)
+    except PackageNotFoundError:
+        return "unknown"
+
+
+def cached(filt: str, tr: Any, path: Path, fn: Callable[[Any], np.ndarray]) -> np.ndarray:
+    """fn(tr), from the cache when this filter version already ran on this file."""
+    st = path.stat()
+    key = f"{filt.replace(' ', '_')}-{_version(filt)}-{tr.name}-{st.st_size}-{int(st.st_mtime)}.npy"
+    f = CACHE / key
+    if f.is_file():
+        return np.asarray(np.load(f))
+    q = fn(tr)
+    CACHE.mkdir(parents=True, exist_ok=True)
+    tmp = f.with_suffix(".tmp.npy")
+    np.save(tmp, q)
+    tmp.replace(f)
+    return q
 
 
 def convention(q: np.ndarray, tr: Any) -> tuple[str, Callable[[np.ndarray], np.ndarray]]:
@@ -290,7 +323,8 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
     from attitude_c.ahrs import default_settings
 
     folder = data or None
-    trials = [broad.load_trial(p) for p in broad.find_trials(folder)]
+    paths = broad.find_trials(folder)
+    trials = [broad.load_trial(p) for p in paths]
     out: list[str] = []
     out.append(f"BROAD: {broad.CITATION}. {len(trials)} trials from "
                f"`{'the upstream data_mat folder given' if data else '../shared/data/broad'}`; metric of the "
@@ -304,8 +338,8 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
     skipped: dict[str, str] = {}
     for k, fn in runners.items():
         try:
-            for t in trials:
-                q = fn(t)
+            for t, p in zip(trials, paths):
+                q = fn(t) if k.startswith("attitude_c") else cached(k, t, p, fn)
                 if k in ("Fusion", "ahrs EKF", "ahrs Madgwick"):
                     if k not in conv:
                         conv[k] = convention(q, t)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+
 import numpy as np
 from test_ahrs import motion  # tests/ is on the path (pytest's rootdir conftest)
 

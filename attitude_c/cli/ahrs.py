@@ -178,7 +178,7 @@ def _main(args: argparse.Namespace) -> int:
     table = np.column_stack([rec["t"], q, e])
     _write_atomic(out / "attitude.csv", lambda tmp: np.savetxt(
         tmp, table, delimiter=",", fmt="%.9g", header="t,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg", comments=""))
-    summary: dict[str, Any] = {"file": str(path), "samples": int(len(q)), "rate_hz": float(rec["rate"]),
+    summary: dict[str, Any] = {"file": str(path), "samples": len(q), "rate_hz": float(rec["rate"]),
                                "six_axis": mag is None, "precision": args.precision, "settings": settings,
                                "out": str(out)}
     written = ["attitude.csv"]
