@@ -18,6 +18,7 @@ ns = Collection(
     cross.cross_build,
     link.fuzz,
     sim.sim,
+    sim.sim_acceptance,
     sweep.sweep,
     view.view_soak,
     view.view_firmware,

@@ -115,6 +115,28 @@ def _disturbance(text: str) -> tuple[float, float, tuple[float, float, float], f
     return v[0], v[1], (v[2], v[3], v[4]), v[5] if len(v) == 6 else 0.0, frame
 
 
+def _ahrs_setting(text: str) -> tuple[str, Any]:
+    """NAME=VALUE of the attitude filter's settings (names checked against the filter's)."""
+    from ..ahrs import SETTINGS
+
+    name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name or not value:
+        raise argparse.ArgumentTypeError(f"--ahrs-setting expects NAME=VALUE, got {text!r}")
+    if name == "method":
+        return name, value
+    if name not in SETTINGS:
+        raise argparse.ArgumentTypeError(f"unknown filter setting {name!r} (known: method, "
+                                         f"{', '.join(SETTINGS)}; docs/ahrs.md)")
+    try:
+        v = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--ahrs-setting {name}: expected a number, got {value!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"--ahrs-setting {name}: must be finite, got {value!r}")
+    return name, v
+
+
 def _methods(text: str) -> tuple[str, ...]:
     ms = tuple(m.strip() for m in text.split(",") if m.strip())
     bad = [m for m in ms if m not in _METHODS]
@@ -175,9 +197,21 @@ def register(subparsers: Any) -> None:
     g.add_argument("--rest", type=_nonneg("--rest"), default=10.0, metavar="S",
                    help="level-turn trajectory: rest before and after the turn (s)")
     g = p.add_argument_group("system")
+    g.add_argument("--estimator", default="integrator", choices=("integrator", "ahrs"),
+                   help="integrator: the paper's strapdown integrator of the gyros (--method, --precision); "
+                   "ahrs: the attitude filter (docs/ahrs.md) fed the gyro rates, the accelerometer (needs "
+                   "--accel) and the magnetometer (--mag; six-axis without)")
+    g.add_argument("--ahrs-setting", type=_ahrs_setting, action="append", default=None, metavar="NAME=VALUE",
+                   help="a setting of the attitude filter (attitude_c.ahrs keywords, SI units: rad, s; "
+                   "method by name); may be repeated; declination and gravity default to the simulated "
+                   "environment's")
+    g.add_argument("--ahrs-init", default="truth", choices=("truth", "align"),
+                   help="ahrs start: truth (the true initial attitude, as the integrator) or align (the "
+                   "filter aligns itself on its first sample: tilt from the accelerometer, heading from "
+                   "the magnetometer, or 0 without one)")
     g.add_argument("--method", default="rv3", choices=_METHODS, help="integrator method")
     g.add_argument("--precision", default="f64", choices=("f64", "f32", "fixed"),
-                   help="integrator arithmetic")
+                   help="integrator arithmetic (ahrs: f64 or f32)")
     g.add_argument("--sensors", default="full", choices=("ideal", "quantized", "full"),
                    help="ideal: exact increments; quantized: perfect gyro through ADC and board; "
                    "full: plus gyro noise, bias, filter, saturation")
@@ -326,6 +360,21 @@ def _magnetometer(args: argparse.Namespace) -> dict[str, Any]:
     return kw
 
 
+def _estimator(args: argparse.Namespace, has_accel: bool) -> dict[str, Any]:
+    """The --estimator options as SimConfig keywords (one-line errors for the CLI)."""
+    if args.estimator == "integrator":
+        if args.ahrs_setting or args.ahrs_init != "truth":
+            raise ValueError("--ahrs-setting and --ahrs-init need --estimator ahrs")
+        return {}
+    if args.budget:
+        raise ValueError("--budget compares the integrator's methods: drop --estimator ahrs")
+    if not has_accel:
+        raise ValueError("--estimator ahrs needs an accelerometer: give --accel PART (e.g. --accel adis16405)")
+    if args.precision == "fixed":
+        raise ValueError("--estimator ahrs runs in --precision f64 or f32, not fixed")
+    return {"estimator": "ahrs", "ahrs_settings": dict(args.ahrs_setting or ()), "ahrs_init": args.ahrs_init}
+
+
 def build_config(args: argparse.Namespace) -> Any:
     from ..sim import (
         AdcModel,
@@ -389,6 +438,7 @@ def build_config(args: argparse.Namespace) -> Any:
     extra: dict[str, Any] = _magnetometer(args)
     if accel_name != "none":
         extra["accel"] = accel_preset(accel_name)
+    extra.update(_estimator(args, has_accel=accel_name != "none"))
     return SimConfig(trajectory=traj, duration=duration, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(gyro_name), adc=AdcModel(backend=adc),
@@ -415,7 +465,7 @@ def _run(args: argparse.Namespace) -> int:
 
     cfg = build_config(args)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    name = f"{stamp}-{'budget' if args.budget else cfg.method}-{cfg.trajectory.name}-s{cfg.seed}"
+    name = f"{stamp}-{'budget' if args.budget else cfg.method if cfg.estimator == 'integrator' else 'ahrs'}-{cfg.trajectory.name}-s{cfg.seed}"
     out = Path(args.out) if args.out else Path("results") / name
     prog = _Progress(enabled=not args.no_progress)
     t0 = time.perf_counter()

@@ -44,7 +44,7 @@ from .chain import (
 )
 from .conditioning import Conditioning
 from .denoising import DENOISE_TIMINGS, Denoise
-from .estimator import Estimate, Integrate
+from .estimator import AhrsFilter, Estimate, Integrate
 from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
 from .link import Delivered, Link
 from .outputs import Errors, attitude_angle, compare, wrap_angle
@@ -80,6 +80,7 @@ __all__ = [
     "TRAJECTORIES",
     "Acquired",
     "AdcModel",
+    "AhrsFilter",
     "AuxCalibration",
     "AuxStream",
     "Board",

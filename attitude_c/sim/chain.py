@@ -34,7 +34,14 @@ from .adc import ADC_BACKENDS, AdcModel
 from .board import Board
 from .conditioning import Conditioning
 from .denoising import Denoise
-from .estimator import Estimate, Integrate
+from .estimator import (
+    ESTIMATORS,
+    AhrsFilter,
+    Estimate,
+    EstimatorName,
+    Integrate,
+    check_ahrs_settings,
+)
 from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
 from .link import Delivered, Link
 from .outputs import compare
@@ -87,6 +94,14 @@ class SimConfig:
     perfect part through its digitization. ``denoise`` — the wavelet
     denoiser stage on the gyro rates between host and estimator
     (:mod:`.denoising`, None: off).
+
+    ``estimator``: ``"integrator"`` (the paper's system: ``method``,
+    ``precision``) or ``"ahrs"`` — the attitude filter (:class:`.AhrsFilter`,
+    needs ``accel``; six-axis without ``mag``) with ``ahrs_settings`` (the
+    keywords of :func:`attitude_c.ahrs`; ``declination`` and ``gravity``
+    default to ``environment``'s), ``precision`` f64/f32 and ``ahrs_init``
+    ("truth": the true initial attitude, as the integrator; "align": the
+    filter's own alignment on its first sample).
     """
 
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
@@ -113,6 +128,9 @@ class SimConfig:
     disturbances: tuple[MagDisturbance, ...] = ()
     accel_channels: tuple[int, int, int] = (4, 5, 6)
     denoise: Denoise | None = None
+    estimator: EstimatorName = "integrator"
+    ahrs_settings: dict[str, Any] = field(default_factory=dict)
+    ahrs_init: Literal["truth", "align"] = "truth"
 
     def validate(self) -> None:
         if self.method not in METHODS:
@@ -160,11 +178,31 @@ class SimConfig:
         if self.adc.backend == "ad7927" and self.accel is not None and set(self.accel_channels) & {0, 1, 2}:
             raise InvalidArgument(f"accel_channels {self.accel_channels} overlap the gyros' VIN0-2")
         self.magnetometer_install()  # shapes and values
+        if self.estimator not in ESTIMATORS:
+            raise InvalidArgument(f"estimator must be one of {ESTIMATORS}, got {self.estimator!r}")
+        if self.estimator == "integrator" and (self.ahrs_settings or self.ahrs_init != "truth"):
+            raise InvalidArgument("ahrs settings need the ahrs estimator (estimator='ahrs')")
+        if self.estimator == "ahrs":
+            if self.accel is None:
+                raise InvalidArgument("the ahrs estimator needs an accelerometer: give accel (--accel PART)")
+            if self.precision == "fixed":
+                raise InvalidArgument("the ahrs estimator runs in f64 or f32, not fixed")
+            stage = self.estimator_stage()
+            assert isinstance(stage, AhrsFilter)
+            check_ahrs_settings(stage.filter_settings())
         if self.firmware is not None:
             source(self.firmware).check(self)
             if self.accel is not None or self.mag is not None:
                 raise InvalidArgument(f"the {self.firmware} source carries only the gyros: drop the "
                                       "accelerometer and magnetometer")
+
+    def estimator_stage(self) -> Integrate | AhrsFilter:
+        """The estimator stage of the run (stage 8)."""
+        if self.estimator == "ahrs":
+            prec: Literal["f64", "f32"] = "f32" if self.precision == "f32" else "f64"  # validate refuses fixed
+            return AhrsFilter(tuple(sorted(self.ahrs_settings.items())), prec, self.ahrs_init,
+                              self.environment.declination, self.environment.gravity)
+        return Integrate(self.method, self.precision)
 
     def magnetometer_install(self) -> tuple[np.ndarray, np.ndarray]:
         """(hard iron (3,) µT, soft iron (3, 3)) as arrays, checked."""
@@ -216,6 +254,10 @@ class SimConfig:
                           "disturbances": [d.to_dict() for d in self.disturbances]}
         if self.conditioning.follower:
             out["conditioning_follower"] = True
+        if self.estimator != "integrator":
+            out["estimator"] = self.estimator
+            out["ahrs_settings"] = dict(self.ahrs_settings)
+            out["ahrs_init"] = self.ahrs_init
         if self.denoise is not None:
             c = self.denoise.config
             out["denoise"] = {"wavelet": c.wavelet, "levels": c.levels, "threshold": c.threshold,
@@ -246,6 +288,8 @@ class SimResult:
     summary: dict[str, Any]
     aux: dict[str, AuxStream] = field(default_factory=dict)  # "accel", "mag": one row per sample period
     period_t: np.ndarray | None = None  # (n,) start of each sample period (s)
+    bias_t: np.ndarray | None = None  # (K,) times of the filter's gyro-bias estimates (s); None: no filter
+    bias: np.ndarray | None = None  # (K, 3) the filter's gyro-bias estimate (rad/s, body)
 
     @property
     def err_heading(self) -> np.ndarray:
@@ -484,7 +528,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     t_wall = time.perf_counter()
     cfg.validate()
     acq = acquired if acquired is not None else acquire(cfg, progress)
-    estimator = Integrate(cfg.method, cfg.precision)
+    estimator = cfg.estimator_stage()
     dec = acq.decoded if acq.decoded is not None else Decoded(acq.increments, acq.sample_index,
                                                               np.zeros((len(acq.increments), 3), dtype=np.int64))
     denoise_summary: dict[str, Any] | None = None
@@ -495,7 +539,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
         est = Estimate(est.t + cfg.denoise.delay(cfg.period), est.q)
     res = compare(est, cfg.trajectory)
     backends = dict(acq.backends)
-    backends["integrator"] = estimator.backend
+    backends["integrator" if cfg.estimator == "integrator" else "estimator"] = estimator.backend
     errors = res.summary()
     summary: dict[str, Any] = {
         "attitude_c_version": _package_version(),
@@ -517,9 +561,31 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
         summary["sensors"] = {k: v.summary() for k, v in acq.aux.items()}
     if denoise_summary is not None:
         summary["denoise"] = denoise_summary
+    if est.info:
+        summary["estimator"] = _estimator_summary(est, dec, cfg)
     summary["elapsed_s"] = time.perf_counter() - t_wall
     period_t = cfg.trajectory.t_start + np.arange(acq.samples) * cfg.period
     return SimResult(config=cfg, t=res.t, q_est=res.q_est, q_true=res.q_true, euler_est=res.euler_est,
                      euler_true=res.euler_true, err=res.err, err_angle=res.err_angle,
                      increments=dec.increments, sample_index=dec.sample_index, link_stats=acq.link_stats,
-                     summary=summary, aux=acq.aux, period_t=period_t)
+                     summary=summary, aux=acq.aux, period_t=period_t, bias_t=est.bias_t, bias=est.bias)
+
+
+def residual_bias(dec: Decoded, cfg: SimConfig) -> np.ndarray:
+    """The gyro bias the estimator actually sees (rad/s, body, (3,)): the mean
+    over the run of the host's rates minus the exact period-mean rates (what
+    the host's calibration left, plus the drift and the noise's mean)."""
+    if len(dec.increments) == 0:
+        return np.zeros(3)
+    h = cfg.period
+    n = int(dec.sample_index.max()) + 1
+    true = cfg.trajectory.increments(cfg.trajectory.t_start, h, n)[dec.sample_index] / h
+    return np.asarray(np.mean(dec.increments / h - true, axis=0), dtype=float)
+
+
+def _estimator_summary(est: Estimate, dec: Decoded, cfg: SimConfig) -> dict[str, Any]:
+    """The filter's own figures for the summary: its settings, the final gyro-bias
+    estimate beside the residual bias of the host's rates (rad/s), flags."""
+    out = dict(est.info)
+    out["bias_residual_rad_s"] = residual_bias(dec, cfg).tolist()
+    return out

@@ -67,7 +67,8 @@ def _plt():
 
 def _title(res: SimResult) -> str:
     c = res.config
-    return (f"{c.trajectory.name} trajectory, {c.method}, {c.precision}, sensors {c.sensors}, "
+    est = c.method if c.estimator == "integrator" else c.estimator
+    return (f"{c.trajectory.name} trajectory, {est}, {c.precision}, sensors {c.sensors}, "
             f"h = {c.period:g} s")
 
 
@@ -114,6 +115,29 @@ def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[0].legend(loc="upper right", fontsize=8)
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Attitude — " + _title(res), fontsize=9.5)
+    fig.tight_layout()
+    with _replacing(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format="png")
+    plt.close(fig)
+
+
+def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
+    """The filter's gyro-bias estimate per body axis (°/s) beside the bias the
+    estimator's rates actually carry (their mean minus the true rates' over the run)."""
+    if res.bias is None or res.bias_t is None:
+        raise ValueError("plot_bias: the run has no filter bias estimate (estimator 'integrator')")
+    plt = _plt()
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
+    resid = res.summary.get("estimator", {}).get("bias_residual_rad_s")
+    for i, (ax, axis) in enumerate(zip(axes, "xyz")):
+        ax.plot(res.bias_t, np.degrees(res.bias[:, i]), color="black", linewidth=0.9, label="estimate")
+        if resid is not None:
+            ax.axhline(math.degrees(resid[i]), color="0.55", linewidth=2.0, label="rates − truth, run mean")
+        ax.set_ylabel(f"b_{axis} / (°/s)")
+        ax.grid(True, linestyle=":", linewidth=0.6)
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[-1].set_xlabel("t / s")
+    fig.suptitle("Gyro bias estimate — " + _title(res), fontsize=9.5)
     fig.tight_layout()
     with _replacing(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
@@ -198,8 +222,10 @@ def format_ratio(ratio: float) -> str:
 def format_table(summary: dict[str, Any]) -> str:
     e = summary["errors_rad"]
     p = summary["parameters"]
+    est = f"method {p['method']}" if p.get("estimator", "integrator") == "integrator" else \
+        f"estimator {p['estimator']}"
     lines = [
-        (f"attitude simulate: {p['trajectory']['trajectory']} trajectory, method {p['method']}, "
+        (f"attitude simulate: {p['trajectory']['trajectory']} trajectory, {est}, "
          f"precision {p['precision']}, sensors {p['sensors']} ({p['gyro']['name']}), "
          f"period {p['period_s']:g} s, {p['duration_s']:g} s, seed {p['seed']}"),
         "",
@@ -236,6 +262,13 @@ def format_table(summary: dict[str, Any]) -> str:
                      f"{dn['timing']}, latency {dn['latency_s']:.3g} s): gyro rate ptp ratio "
                      + "/".join(f"{v:.3f}" for v in r["ptp_ratio"]) + ", RMS ratio "
                      + "/".join(f"{v:.3f}" for v in r["rms_ratio"]) + f", mean change {r['mean_change_rel']:.1e}")
+    es = summary.get("estimator")
+    if es:
+        b = ", ".join(f"{math.degrees(v):.4f}" for v in es["bias_final_rad_s"])
+        r = ", ".join(f"{math.degrees(v):.4f}" for v in es["bias_residual_rad_s"])
+        lines.append(f"{es['estimator']} ({es['axes']}-axis, init {es['init']}): gyro bias estimate at the end "
+                     f"{b} °/s (the rates' bias over the run: {r} °/s); rest "
+                     f"{es['rest_fraction']:.0%}, magnetometer rejected {es['mag_rejected_fraction']:.0%}")
     lines.append(f"updates {summary['updates']}, elapsed {summary.get('elapsed_s', 0):.2f} s")
     return "\n".join(lines)
 
@@ -254,6 +287,9 @@ def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
         files["attitude_png"] = out / "attitude.png"
         plot_errors(res, files["errors_png"])
         plot_attitude(res, files["attitude_png"])
+        if res.bias is not None:
+            files["bias_png"] = out / "bias.png"
+            plot_bias(res, files["bias_png"])
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
     with _open_replacing(files["summary"]) as fh:

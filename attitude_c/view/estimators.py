@@ -8,11 +8,13 @@ them -- and returns the attitude quaternion (scalar first, body -> ENU)
 when the sample completes an attitude update, else None (an rv3 frame
 being filled).
 
-Today the registry holds the strapdown integrator (``integrator``: every
-:data:`attitude_c.core.METHODS`). The attitude filter plugs in by one
-:func:`register` call with a factory building an object with this
-``update`` (its ``needs_acc`` tells the sources without an accelerometer,
-such as the legacy serial link, to refuse it with a clear message).
+The registry holds the strapdown integrator (``integrator``: every
+:data:`attitude_c.core.METHODS`) and the attitude filter (``ahrs``:
+:class:`attitude_c.Ahrs`, docs/ahrs.md, with the library's default
+settings; it needs the accelerometer, so ``needs_acc`` makes the sources
+without one, such as the legacy serial link, refuse it with a clear
+message). Another estimator plugs in by one :func:`register` call with a
+factory building an object with this ``update``.
 """
 
 from __future__ import annotations
@@ -27,7 +29,8 @@ from numpy.typing import ArrayLike, NDArray
 from .. import core
 from ..errors import InvalidArgument
 
-__all__ = ["ESTIMATORS", "Estimator", "EstimatorSpec", "IntegratorEstimator", "make_estimator", "register"]
+__all__ = ["ESTIMATORS", "AhrsEstimator", "Estimator", "EstimatorSpec", "IntegratorEstimator", "make_estimator",
+           "register"]
 
 
 class Estimator(Protocol):
@@ -69,6 +72,30 @@ class IntegratorEstimator:
         return out[-1].astype(np.float64) if len(out) else None
 
 
+class AhrsEstimator:
+    """The attitude filter (:class:`attitude_c.Ahrs`, default settings; its own
+    increment method, so ``method`` is not used): one attitude per sample.
+    Six-axis for a sample whose field is absent or not finite; a sample whose
+    rate or specific force is not finite is skipped (None)."""
+
+    def __init__(self, q0: ArrayLike | None = None, rate: float | None = None, **_: Any) -> None:
+        from ..ahrs import Ahrs
+
+        self.filter = Ahrs(rate=rate, q0=q0)
+        self.label = f"ahrs ({self.filter.settings['method']})"
+
+    def update(self, gyr: NDArray[np.float64], dt: float, acc: NDArray[np.float64] | None = None,
+               mag: NDArray[np.float64] | None = None) -> NDArray[np.float64] | None:
+        if acc is None:
+            raise InvalidArgument("the ahrs estimator needs the accelerometer sample (acc)")
+        g = np.asarray(gyr, dtype=np.float64)
+        a = np.asarray(acc, dtype=np.float64)
+        if not (np.isfinite(g).all() and np.isfinite(a).all()):
+            return None
+        m = None if mag is None or not np.isfinite(mag).all() else np.asarray(mag, dtype=np.float64)
+        return np.asarray(self.filter.update(g, a, m, dt=dt), dtype=np.float64)
+
+
 ESTIMATORS: dict[str, EstimatorSpec] = {}
 
 
@@ -79,6 +106,8 @@ def register(spec: EstimatorSpec) -> None:
 
 register(EstimatorSpec("integrator", "strapdown integrator of the gyro rates (--method)", False,
                        IntegratorEstimator))
+register(EstimatorSpec("ahrs", "the attitude filter: gyro + accelerometer (+ magnetometer), default settings "
+                       "(docs/ahrs.md)", True, AhrsEstimator))
 
 
 def make_estimator(name: str, *, has_acc: bool, **kw: Any) -> Estimator:

@@ -69,7 +69,8 @@ class SimulatorSource(Source):
         self.speed = speed
         self.result: Any = None
         self.description = (f"simulator: {cfg.trajectory.name} trajectory, {cfg.duration:g} s, period "
-                            f"{cfg.period:g} s, {cfg.method} ({cfg.precision}), sensors {cfg.sensors}, "
+                            f"{cfg.period:g} s, {cfg.method if cfg.estimator == 'integrator' else cfg.estimator} "
+                            f"({cfg.precision}), sensors {cfg.sensors}, "
                             f"link {cfg.link}, at {speed:g}x")
 
     def run(self, hub: Hub) -> None:

@@ -1,6 +1,7 @@
-"""Simulation task: `invoke sim` runs `attitude simulate` from this tree, with the
+"""Simulation tasks: `invoke sim` runs `attitude simulate` from this tree, with the
 tooling layer's acquisition sources (``--firmware s51``) registered
-(``python -m toolchain.simulate``)."""
+(``python -m toolchain.simulate``); `invoke sim-acceptance` runs the attitude
+filter's simulated acceptance tests at full length (toolchain/ahrs_acceptance.py)."""
 
 from __future__ import annotations
 
@@ -28,3 +29,26 @@ def sim(c, budget=False, args=""):
         c.run(" ".join(shlex.quote(x) for x in cmd), pty=sys.stdout.isatty())
 
 
+
+
+@task(help={
+    "short": "the shortened runs of the default test suite instead of the full lengths (30 min static, "
+             "360 s turntable)",
+    "seed": "simulator seed (default 0, the tests')",
+    "only": "comma-separated scenarios: static,turntable,bias_step,disturbance (default all)",
+    "setting": "filter settings to try, NAME=VALUE[,NAME=VALUE...] (attitude_c.ahrs keywords)",
+    "json": "also write the figures to this JSON file",
+})
+def sim_acceptance(c, short=False, seed=0, only="", setting="", json=""):
+    """The attitude filter's simulated acceptance tests (issue 15) at full length; exit 1 if a target is missed."""
+    cmd = [sys.executable, "-m", "toolchain.ahrs_acceptance", "--seed", str(int(seed))]
+    if short:
+        cmd.append("--short")
+    if only:
+        cmd += ["--only", only]
+    for s in (x for x in setting.split(",") if x):
+        cmd += ["--setting", s]
+    if json:
+        cmd += ["--json", json]
+    with c.cd(str(ROOT)):
+        c.run(" ".join(shlex.quote(x) for x in cmd), pty=sys.stdout.isatty())
