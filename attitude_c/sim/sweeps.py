@@ -282,6 +282,29 @@ def integrate_trial(trial: Any, method: Method = "rv3", precision: Precision = "
 register_estimator("integrator", integrate_trial)
 
 
+def ahrs_trial(trial: Any, six_axis: bool = False, precision: Precision = "f64", **settings: Any) -> np.ndarray:
+    """The attitude filter (:func:`attitude_c.ahrs.ahrs`, docs/ahrs.md) on a BROAD trial.
+
+    It aligns itself from the first samples (no reference needed); ``six_axis``
+    leaves the magnetometer out; every other setting is a filter setting
+    (``acc_noise``, ``rest_noise``, ...: ``attitude_c.ahrs.default_settings()``).
+    """
+    from ..ahrs import ahrs
+
+    return ahrs(trial.gyr, trial.acc, None if six_axis else trial.mag, rate=trial.rate,
+                precision=precision, **settings)
+
+
+def _ahrs_settings() -> frozenset[str]:
+    from ..ahrs import default_settings
+
+    return frozenset(default_settings()) | {"six_axis", "precision"}
+
+
+ahrs_trial.settings = _ahrs_settings()  # type: ignore[attr-defined]
+register_estimator("ahrs", ahrs_trial)
+
+
 @lru_cache(maxsize=4)
 def _trial(path: str) -> Any:
     from .. import broad
@@ -294,7 +317,13 @@ def _trial_files(folder: Path) -> dict[str, Path]:
 
 
 def _accepts(fn: Callable[..., Any], name: str) -> bool | None:
-    """Whether fn takes keyword ``name`` (None: it takes any keyword, or cannot be inspected)."""
+    """Whether fn takes keyword ``name`` (None: it takes any keyword, or cannot be inspected).
+
+    A function taking ``**settings`` may list the names it knows in a ``settings`` attribute.
+    """
+    known = getattr(fn, "settings", None)
+    if known is not None:
+        return name in known
     try:
         sig = inspect.signature(fn)
     except (TypeError, ValueError):
