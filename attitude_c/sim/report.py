@@ -6,7 +6,7 @@ import csv
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -152,16 +152,22 @@ def format_table(summary: dict[str, Any]) -> str:
 
 
 def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
-    """Write summary.json, timeseries.csv, errors.png and attitude.png into out."""
+    """Write timeseries.csv, errors.png, attitude.png and summary.json (last)
+    into out, each complete or not at all (attitude_c._io: temp file, fsync,
+    rename); an OSError names the files complete and absent."""
+    from .._io import write_results
+
     out.mkdir(parents=True, exist_ok=True)
     files = {"summary": out / "summary.json", "csv": out / "timeseries.csv"}
-    write_csv(res, files["csv"])
     if plots:
         files["errors_png"] = out / "errors.png"
         files["attitude_png"] = out / "attitude.png"
-        plot_errors(res, files["errors_png"])
-        plot_attitude(res, files["attitude_png"])
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
-    files["summary"].write_text(json.dumps(to_jsonable(summary), indent=2) + "\n")
+    steps: list[tuple[Path, Callable[[Path], object]]] = [(files["csv"], lambda p: write_csv(res, p))]
+    if plots:
+        steps += [(files["errors_png"], lambda p: plot_errors(res, p)),
+                  (files["attitude_png"], lambda p: plot_attitude(res, p))]
+    steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n")))
+    write_results(steps)
     return files
