@@ -78,6 +78,8 @@ def main(args: argparse.Namespace) -> int:
         n = round(args.seconds / T)
         if n < 3:
             raise InvalidArgument("--seconds must cover at least 3 periods")
+        if n > 10_000_000:  # 7 arrays of n × 3 float64: ~1.7 GB beyond this
+            raise InvalidArgument(f"--seconds / --period = {n} samples: at most 10,000,000 (a demo, not a run)")
         b = args.beta
         print(f"classical coning: beta = {b} rad, {args.freq} Hz, T = {T * 1e3:g} ms "
               f"(lambda = {omega * T:.3f} rad), {args.seconds:g} s, precision {args.precision}")
