@@ -159,7 +159,8 @@ def test_simulate_on_a_full_filesystem_leaves_complete_files_or_none(tmp_path: P
         proc = _attitude(*SIM, "--duration", "60", "--out", str(out))
         line = _one_line(proc, EXIT_OS, "No space left on device", "timeseries.csv")
         assert "complete: none" in line and "not written: timeseries.csv, summary.json" in line
-        assert sorted(p.name for p in out.iterdir()) == []  # no truncated CSV, no temporary file
+        # no truncated CSV, no temporary file; the directory made for the run removed, being empty
+        assert not out.exists() and sorted(p.name for p in d.iterdir()) == []
         # a filesystem already full: refused before the run
         (d / "filler").write_bytes(b"\0" * 60_000)
         with contextlib.suppress(OSError):

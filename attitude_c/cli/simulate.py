@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime
 import json
 import math
@@ -216,9 +217,11 @@ def _run(args: argparse.Namespace) -> int:
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
     name = f"{stamp}-{'budget' if args.budget else cfg.method}-{cfg.trajectory.name}-s{cfg.seed}"
     out = Path(args.out) if args.out else Path("results") / name
+    made = not out.exists()
     check_output_dir(out)  # before the run: a wrong --out costs nothing
     prog = _Progress(enabled=not args.no_progress)
     t0 = time.perf_counter()
+    ok = False
     try:
         if args.budget:
             b = run_budget(cfg, methods=args.methods, ber=args.budget_ber, progress=prog)
@@ -239,11 +242,16 @@ def _run(args: argparse.Namespace) -> int:
                 print(format_budget(b))
                 print(f"wrote {out}/ (budget.json, budget.md{', budget.png' if not args.no_plots else ''})"
                       f" in {time.perf_counter() - t0:.1f} s")
+            ok = True
             return 0
         res = simulate(cfg, progress=prog)
         files = write_run(res, out, plots=not args.no_plots)
+        ok = True
     finally:
         prog.close()
+        if not ok and made:
+            with contextlib.suppress(OSError):  # the directory made for this run, if left empty
+                out.rmdir()
     if args.json:
         print(json.dumps(to_jsonable(res.summary), indent=2))
     else:
