@@ -440,11 +440,12 @@ static att_status feed_single(att_integ *s, const att_real *dth, size_t i0, size
     return ATT_OK;
 }
 
-static size_t first_nonfinite(const att_real *dth, size_t i0, size_t i1)
+/* First increment in [i0, i1) that is not finite or beyond |Δθ| ≤ π, or i1. */
+static size_t first_unchecked(const att_real *dth, size_t i0, size_t i1)
 {
     size_t i;
     for (i = i0; i < i1; i++) {
-        if (!att__finite3(dth + 3 * i)) {
+        if (!within_pi(dth + 3 * i)) {
             return i;
         }
     }
@@ -468,25 +469,20 @@ static size_t frames_fast(att_integ *s, const att_real *dth, size_t i0, size_t n
     for (f = 0; f < nframes; f++) {
         const att_real *a = dth + 3 * (i0 + (size_t)m * f);
         att_real *o = q_out + 4 * no;
-        for (i = 0; i < m; i++) {
-            att_status c = check_inc(a + 3 * i);
-            if (c != ATT_OK) {
-                *st = c;
-                *err_index = i0 + (size_t)m * f + (size_t)i;
-                return 0;
-            }
-        }
+        int ok = within_pi(a); /* |Δθ| ≤ π for each increment of the frame (NaN fails too) */
         if (m == 1) {
             phi[0] = a[0];
             phi[1] = a[1];
             phi[2] = a[2];
         } else if (m == 2) {
             const att_real *b = a + 3;
+            ok &= within_pi(b);
             phi[0] = a[0] + b[0] + k12 * (a[1] * b[2] - a[2] * b[1]);
             phi[1] = a[1] + b[1] + k12 * (a[2] * b[0] - a[0] * b[2]);
             phi[2] = a[2] + b[2] + k12 * (a[0] * b[1] - a[1] * b[0]);
         } else {
             const att_real *b = a + 3, *c = a + 6;
+            ok &= within_pi(b) & within_pi(c);
             phi[0] = a[0] + b[0] + c[0] + k12 * (a[1] * b[2] - a[2] * b[1])
                      + k13 * (a[1] * c[2] - a[2] * c[1]) + k23 * (b[1] * c[2] - b[2] * c[1]);
             phi[1] = a[1] + b[1] + c[1] + k12 * (a[2] * b[0] - a[0] * b[2])
@@ -495,10 +491,10 @@ static size_t frames_fast(att_integ *s, const att_real *dth, size_t i0, size_t n
                      + k13 * (a[0] * c[1] - a[1] * c[0]) + k23 * (b[0] * c[1] - b[1] * c[0]);
         }
         step_q(q, phi, &sn);
-        if (!att__finite4(q)) {
+        if (!ok || !att__finite4(q)) {
             size_t lo = i0 + (size_t)m * f, hi = lo + (size_t)m;
-            size_t bad = first_nonfinite(dth, lo, hi);
-            *st = (bad < hi) ? ATT_E_NONFINITE : (att_status)ATT_E_INTEG_DIVERGED;
+            size_t bad = first_unchecked(dth, lo, hi);
+            *st = (bad < hi) ? check_inc(dth + 3 * bad) : (att_status)ATT_E_INTEG_DIVERGED;
             *err_index = (bad < hi) ? bad : hi - 1;
             return 0;
         }
@@ -534,16 +530,10 @@ static size_t reuse_fast(att_integ *s, const att_real *dth, size_t i0, size_t n,
     for (j = 0; j < n; j++) {
         const att_real *c = dth + 3 * (i0 + j);
         att_real *o = q_out + 4 * no;
-        att_status cs = check_inc(c);
-        if (cs != ATT_OK) {
-            *st = cs;
-            *err_index = i0 + j;
-            return 0;
-        }
         reuse_phi(method, s->k, a, b, c, phi);
         step_q(q, phi, &sn);
-        if (!att__finite4(q)) {
-            *st = att__finite3(c) ? (att_status)ATT_E_INTEG_DIVERGED : ATT_E_NONFINITE;
+        if (!within_pi(c) || !att__finite4(q)) {
+            *st = within_pi(c) ? (att_status)ATT_E_INTEG_DIVERGED : check_inc(c);
             *err_index = i0 + j;
             return 0;
         }
