@@ -6,7 +6,7 @@ settings live in toolchain/*.toml, not in code. This file only lists them.
 
 from invoke import Collection
 
-from toolchain.tasks import core, cross, firmware, link, sim, view
+from toolchain.tasks import core, cross, firmware, link, sim, sweep, view
 
 ns = Collection(
     core.build,
@@ -18,6 +18,7 @@ ns = Collection(
     cross.cross_build,
     link.fuzz,
     sim.sim,
+    sweep.sweep,
     view.view_soak,
     view.view_firmware,
     view.view_screenshot,

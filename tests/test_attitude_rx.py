@@ -250,11 +250,20 @@ def test_rx_jsonl_axes_and_calibration(rx_builds, tmp_path: Path) -> None:
         feeder.send(_block(c))
     rc, out, err = rx.finish(sig=None)
     assert rc == 0, err
-    recs = [json.loads(ln) for ln in out.strip().splitlines()]
+    lines = [json.loads(ln) for ln in out.strip().splitlines()]
+    recs = [r for r in lines if "q" in r]
+    links = [r["link"] for r in lines if "link" in r]
     assert len(recs) == n and "rv3-reuse" in err
     assert [r["codes"] for r in recs] == codes.tolist()
     rates = (codes - np.array(zero)) * np.array(scale)
     body = np.column_stack([-rates[:, 1], rates[:, 0], rates[:, 2]])
+    # each line carries the body rate it integrated (what attitude view's rate charts draw)
+    np.testing.assert_allclose([r["rate_dps"] for r in recs], np.degrees(body), rtol=1e-15, atol=1e-12)
+    # the link's counters as JSON: the last record is the final count, the same as stderr's statistics
+    st = _stats(err)
+    assert links and lines[-1] == {"t": lines[-1]["t"], "link": links[-1]}
+    assert links[-1]["blocks"] == st["blocks_accepted"] == n
+    assert links[-1]["naks"] == st["naks"] and links[-1]["timeouts"] == st["timeouts"]
     q_ref = attitude_c.integrate(body * 0.02, method="rv3-reuse")
     np.testing.assert_allclose([r["q"] for r in recs], q_ref, atol=1e-12)  # as above
     np.testing.assert_allclose([r["heading_deg"] for r in recs],
@@ -576,7 +585,7 @@ def test_rx_reports_are_logged_and_losses_held_not_integrated(rx_builds) -> None
     feeder.drain(300)
     rc, out, err = rx.finish(signal.SIGINT)
     assert rc == 0, err
-    recs = _jsonl(out)
+    recs = [r for r in _jsonl(out) if "link" not in r]  # the link counters: checked elsewhere
     updates = [r for r in recs if "q" in r]
     reports = [r for r in recs if "report" in r]
     errors = [r for r in recs if "error" in r]

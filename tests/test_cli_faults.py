@@ -225,7 +225,7 @@ def _numeric_options() -> list[tuple[str, str, str]]:
             assert a.type not in (int, float), f"{cmd} {a.option_strings[0]}: type={a.type.__name__}, " \
                 "not the shared validator (attitude_c/cli/options.py)"
             name = getattr(a.type, "__name__", "")
-            if name in ("number", "integer", "triple"):
+            if name in ("number", "signed number", "integer", "triple"):
                 out.append((cmd, a.option_strings[-1], name))
     return out
 
@@ -242,8 +242,8 @@ def test_every_command_has_its_numeric_options_validated() -> None:
 @pytest.mark.parametrize("cmd, option, kind", NUMERIC, ids=[f"{c} {o}" for c, o, _ in NUMERIC])
 def test_numeric_option_rejects_nan_and_garbage(cmd: str, option: str, kind: str, capsys) -> None:
     bad = ["nan", "x", "inf"] if kind != "triple" else ["nan", "x", "1,2"]
-    if kind != "triple":
-        bad.append("-5")  # every scalar numeric option has a lower bound of 0 or more
+    if kind in ("number", "integer"):
+        bad.append("-5")  # these have a lower bound of 0 or more ("signed number": any sign, e.g. --turns)
     for value in bad:
         with pytest.raises(SystemExit) as ei:
             main([cmd, f"{option}={value}"])

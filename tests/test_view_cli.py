@@ -61,6 +61,21 @@ class View:
         with urllib.request.urlopen(self.url + path.lstrip("/"), timeout=10) as r:
             return r.read()
 
+    def counters(self, timeout: float = 10) -> dict:
+        """The source's counters, as the page receives them (the first status frame on /ws)."""
+        import asyncio
+
+        import aiohttp
+
+        async def first() -> dict:
+            async with aiohttp.ClientSession() as s, s.ws_connect(self.url + "ws") as ws:
+                while True:
+                    msg = json.loads((await ws.receive(timeout=timeout)).data)
+                    if "counters" in msg:
+                        return msg["counters"]
+
+        return asyncio.run(first())
+
     def stop(self, sig: int = signal.SIGINT, timeout: float = 10) -> tuple[int, str]:
         self.proc.send_signal(sig)
         try:
@@ -209,6 +224,9 @@ def test_attitude_rx_jsonl_piped_into_view(tmp_path: Path) -> None:
                 time.sleep(0.1)
             rx.send_signal(signal.SIGINT)
             rx.wait(timeout=10)
+            rx_err = rx.stderr.read().decode()
+            time.sleep(0.5)  # the view reads attitude-rx's last line (its final link counters)
+            counters = v.counters()
             rc, err = v.stop()
         finally:
             for p in (rx, v.proc if v else None):
@@ -216,6 +234,11 @@ def test_attitude_rx_jsonl_piped_into_view(tmp_path: Path) -> None:
                     os.killpg(p.pid, signal.SIGKILL)
                     p.wait()
     assert rc == 0, err
+    # attitude-rx's link counters reach the page (its {"link": ...} JSON Lines record), equal to
+    # the statistics it prints on stderr: BOOT and 90 samples, one record per block, no NAK
+    stats = dict(kv.split("=") for kv in re.search(r"link: (.*)", rx_err).group(1).split())
+    assert counters["blocks"] == int(stats["blocks_accepted"]) == 91, (counters, rx_err)
+    assert counters["naks"] == int(stats["naks"]) == 0 and counters["timeouts"] == int(stats["timeouts"])
     rows = list(csv.DictReader(io.StringIO(body.decode())))
     assert rows[0]["event"] == "BOOT" and json.loads(rows[0]["detail"])["period_s"] == 0.02
     smp = [r for r in rows if not r["event"]]

@@ -23,7 +23,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from . import demo, link, simulate, view
+from . import demo, link, simulate, sweep, view
 
 
 class _VersionAction(argparse.Action):
@@ -79,7 +79,7 @@ def _quiet_stdout(stream: Any) -> None:
 
 
 # The subcommand modules, in the order their commands are listed.
-_MODULES = (simulate, link, demo, view)
+_MODULES = (simulate, sweep, link, demo, view)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -46,7 +46,8 @@ def real(option: str, *, gt: float | None = None, ge: float | None = None, lt: f
             raise argparse.ArgumentTypeError(f"{option}: must be {want}, got {text!r}")
         return v
 
-    conv.__name__ = "number"  # argparse names the type in some messages
+    # argparse names the type in some messages; tests/test_cli_faults.py reads whether it has a lower bound
+    conv.__name__ = "number" if gt is not None or ge is not None else "signed number"
     return conv
 
 

@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..core import METHODS as _METHODS
+from ..sim.accelmag import ACCEL_PRESETS, MAG_PRESETS
+from ..sim.sensors import GYRO_PRESETS
 from ..sim.trajectory import TRAJECTORIES
 from . import options
 
@@ -26,6 +28,40 @@ _nonneg = options.nonneg
 _int_range = options.integer
 _triple = options.triple
 _ber = options.probability("BER", below=0.5)
+
+
+def _floats(kind: str, counts: tuple[int, ...]) -> Callable[[str], tuple[float, ...]]:
+    def conv(text: str) -> tuple[float, ...]:
+        parts = [p for p in text.replace(" ", "").split(",") if p != ""]
+        if len(parts) not in counts:
+            raise argparse.ArgumentTypeError(f"{kind}: give {' or '.join(map(str, counts))} comma-separated "
+                                             f"values, got {text!r}")
+        try:
+            vals = tuple(float(p) for p in parts)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{kind}: not a number in {text!r}") from None
+        if not all(math.isfinite(v) for v in vals):
+            raise argparse.ArgumentTypeError(f"{kind}: values must be finite, got {text!r}")
+        return vals
+    return conv
+
+
+def _disturbance(text: str) -> tuple[float, float, tuple[float, float, float], float, str]:
+    """START,END,X,Y,Z[,RAMP[,FRAME]] → (start, end, field, ramp, frame)."""
+    parts = [p for p in text.replace(" ", "").split(",") if p != ""]
+    frame = "body"
+    if parts and parts[-1] in ("body", "nav"):
+        frame = parts.pop()
+    if len(parts) not in (5, 6):
+        raise argparse.ArgumentTypeError(f"--disturbance: give START,END,X,Y,Z[,RAMP][,body|nav] (s, µT), "
+                                         f"got {text!r}")
+    try:
+        v = [float(p) for p in parts]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--disturbance: not a number in {text!r}") from None
+    if not all(math.isfinite(x) for x in v):
+        raise argparse.ArgumentTypeError(f"--disturbance: values must be finite, got {text!r}")
+    return v[0], v[1], (v[2], v[3], v[4]), v[5] if len(v) == 6 else 0.0, frame
 
 
 def _methods(text: str) -> tuple[str, ...]:
@@ -75,6 +111,18 @@ def register(subparsers: Any) -> None:
     g.add_argument("--rate", type=_triple("--rate"), default="10,-5,20", metavar="X,Y,Z",
                    help="constant-rate trajectory: body rate (deg/s; write --rate=-10,5,0 when "
                    "it starts with a minus)")
+    g.add_argument("--translation", type=_triple("--translation"), default="5,5,1", metavar="E,N,U",
+                   help="paper-translation trajectory: sinusoidal translation amplitudes (m, ENU)")
+    g.add_argument("--translation-frequency", type=_triple("--translation-frequency"), default="0.15,0.10,0.25",
+                   metavar="E,N,U", help="paper-translation trajectory: translation frequencies (Hz)")
+    g.add_argument("--turntable-rate", type=options.real("--turntable-rate"), default=5.0, metavar="DEG_S",
+                   help="turntable trajectory: rate about body z (deg/s; the FPGA+DSP paper's 5)")
+    g.add_argument("--turn-rate", type=_positive("--turn-rate"), default=10.0, metavar="DEG_S",
+                   help="level-turn trajectory: peak turn rate (deg/s)")
+    g.add_argument("--turns", type=options.real("--turns"), default=1.0, metavar="N",
+                   help="level-turn trajectory: turns (negative: clockwise)")
+    g.add_argument("--rest", type=_nonneg("--rest"), default=10.0, metavar="S",
+                   help="level-turn trajectory: rest before and after the turn (s)")
     g = p.add_argument_group("system")
     g.add_argument("--method", default="rv3", choices=_METHODS, help="integrator method")
     g.add_argument("--precision", default="f64", choices=("f64", "f32", "fixed"),
@@ -82,8 +130,9 @@ def register(subparsers: Any) -> None:
     g.add_argument("--sensors", default="full", choices=("ideal", "quantized", "full"),
                    help="ideal: exact increments; quantized: perfect gyro through ADC and board; "
                    "full: plus gyro noise, bias, filter, saturation")
-    g.add_argument("--gyro", default="cg-l53", choices=("cg-l53", "adxrs150", "ideal"),
-                   help="gyro model preset (docs/simulation.md gives the figures and sources)")
+    g.add_argument("--gyro", default=None, choices=tuple(GYRO_PRESETS),
+                   help="gyro model preset (docs/simulation.md gives the figures and sources; default "
+                   "cg-l53, adxrs150 with --adc ad7927)")
     g.add_argument("--oversample", type=_int_range("--oversample", 1, 16), default=16, metavar="N",
                    help="ADC conversions per axis summed by the board per period")
     g.add_argument("--sample-at", default="mid", choices=("mid", "start"),
@@ -91,9 +140,11 @@ def register(subparsers: Any) -> None:
                    "start (one rate sample at the start: the naive design)")
     g.add_argument("--calibration", type=_nonneg("--calibration"), default=60.0, metavar="S",
                    help="static zero-rate calibration before the run (s)")
-    g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ideal"),
-                   help="tlc2543: C driver against the device model; ideal: vectorized quantizer; "
-                   "auto: tlc2543")
+    g.add_argument("--adc", default="auto", choices=("auto", "tlc2543", "ad7927", "ideal"),
+                   help="tlc2543: C driver against the device model; ad7927: the UAV thesis's board "
+                   "(C AD7927 driver against its model, 0-5 V, a unity-gain follower in front, "
+                   "ADXRS150 gyros and ADXL202 accelerometers unless --gyro/--accel say otherwise); "
+                   "ideal: vectorized quantizer; auto: tlc2543")
     g.add_argument("--firmware", choices=("none", "s51"), default="none",
                    help="s51: the acquisition side is the real AT89S51 firmware running in s51 "
                    "(a source checkout with sdcc, s51 and socat: run it as python -m toolchain.simulate "
@@ -103,6 +154,36 @@ def register(subparsers: Any) -> None:
     g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
     g.add_argument("--attempts", type=_int_range("--attempts", 1, 255), default=5,
                    help="link sender attempts per block before giving up")
+    g = p.add_argument_group("accelerometer and magnetometer (read by the host beside the gyros; "
+                             "docs/simulation.md)")
+    g.add_argument("--accel", default=None, choices=("none", *ACCEL_PRESETS),
+                   help="accelerometer preset (default none; adxl202 with --adc ad7927)")
+    g.add_argument("--mag", default="none", choices=("none", *MAG_PRESETS), help="magnetometer preset")
+    g.add_argument("--field", type=_floats("--field", (3,)), default=None, metavar="F,I,D",
+                   help="local geomagnetic field: total intensity (µT), inclination and declination (deg) "
+                   "(default 50.6,46.9,-5.1: Nanjing, an assumption)")
+    g.add_argument("--gravity", type=_positive("--gravity"), default=None, metavar="M_S2",
+                   help="magnitude of gravity (default 9.80665)")
+    g.add_argument("--hard-iron", type=_triple("--hard-iron"), default=None, metavar="X,Y,Z",
+                   help="magnetometer hard iron: an offset in the body frame (µT)")
+    g.add_argument("--soft-iron", type=_floats("--soft-iron", (3, 9)), default=None, metavar="S",
+                   help="magnetometer soft iron: 3 diagonal or 9 row-major matrix elements")
+    g.add_argument("--disturbance", type=_disturbance, action="append", default=None,
+                   metavar="START,END,X,Y,Z[,RAMP][,FRAME]",
+                   help="a field (µT) added to the magnetometer's from START to END (s), raised-cosine "
+                   "edges of RAMP s, in the body (default) or nav frame; may be repeated")
+    g = p.add_argument_group("wavelet denoising of the gyro rates (docs/denoise.md)")
+    g.add_argument("--denoise", default="none", choices=("none", "haar", "db2", "db4"),
+                   help="denoise the host's gyro rates with this wavelet before the estimator")
+    g.add_argument("--denoise-levels", type=_int_range("--denoise-levels", 1, 8), default=None, metavar="L",
+                   help="decomposition levels (default: the library's, 4)")
+    g.add_argument("--denoise-mode", default=None, choices=("soft", "hard"),
+                   help="thresholding (default: the library's, soft)")
+    g.add_argument("--denoise-block", type=_int_range("--denoise-block", 8, 4096), default=None, metavar="N",
+                   help="window length (default 128; the dropped window edges scale with it)")
+    g.add_argument("--denoise-timing", default="aligned", choices=("aligned", "realtime"),
+                   help="aligned: post-processing (sample k stays at k); realtime: each attitude judged "
+                   "the denoiser's latency later")
     g = p.add_argument_group("run")
     g.add_argument("--seed", type=_int_range("--seed", 0, 2**63 - 1), default=0,
                    help="random seed (noise, bias, channel errors)")
@@ -146,20 +227,78 @@ class _Progress:
             b.close()
 
 
+def _denoise(args: argparse.Namespace) -> Any:
+    """The --denoise options as a Denoise stage (None: off)."""
+    if args.denoise == "none":
+        if any(v is not None for v in (args.denoise_levels, args.denoise_mode, args.denoise_block)):
+            raise ValueError("--denoise-levels/-mode/-block need --denoise WAVELET")
+        return None
+    from ..denoise import DenoiseConfig
+    from ..sim import Denoise
+
+    kw: dict[str, Any] = {"wavelet": args.denoise}
+    if args.denoise_levels is not None:
+        kw["levels"] = args.denoise_levels
+    if args.denoise_mode is not None:
+        kw["threshold"] = args.denoise_mode
+    if args.denoise_block is not None:
+        d = DenoiseConfig()
+        n = args.denoise_block
+        kw.update(block=n, edge_start=round(d.edge_start * n / d.block), edge_end=round(d.edge_end * n / d.block))
+    return Denoise(DenoiseConfig(**kw), timing=args.denoise_timing)
+
+
+def _magnetometer(args: argparse.Namespace) -> dict[str, Any]:
+    from ..sim import Environment, MagDisturbance, mag_preset
+    from ..sim.trajectory import EARTH
+
+    kw: dict[str, Any] = {}
+    env = EARTH
+    if args.field is not None or args.gravity is not None:
+        f, i, d = args.field if args.field is not None else (EARTH.field_ut, math.degrees(EARTH.inclination),
+                                                             math.degrees(EARTH.declination))
+        env = Environment(gravity=args.gravity if args.gravity is not None else EARTH.gravity, field_ut=f,
+                          inclination=math.radians(i), declination=math.radians(d))
+    kw["environment"] = env
+    if args.mag != "none":
+        kw["mag"] = mag_preset(args.mag)
+    if args.hard_iron is not None:
+        kw["hard_iron"] = tuple(args.hard_iron)
+    if args.soft_iron is not None:
+        v = args.soft_iron
+        kw["soft_iron"] = [[v[0], 0, 0], [0, v[1], 0], [0, 0, v[2]]] if len(v) == 3 else \
+            [list(v[0:3]), list(v[3:6]), list(v[6:9])]
+    if args.disturbance:
+        kw["disturbances"] = tuple(MagDisturbance(a, b, f, frame, ramp) for a, b, f, ramp, frame in args.disturbance)
+    if args.mag == "none" and ("hard_iron" in kw or "soft_iron" in kw or "disturbances" in kw):
+        raise ValueError("--hard-iron, --soft-iron and --disturbance need a magnetometer: give --mag PART")
+    return kw
+
+
 def build_config(args: argparse.Namespace) -> Any:
-    from ..sim import AdcModel, Board, SimConfig, gyro_preset, make_trajectory
+    from ..sim import (
+        AdcModel,
+        Board,
+        Conditioning,
+        SimConfig,
+        accel_preset,
+        gyro_preset,
+        make_trajectory,
+    )
     from ..sim.adc import AdcBackend
 
     given = getattr(args, "trajectory", None)
     trajectory = given or ("csv" if args.trajectory_file else "paper")
     duration: float | None = getattr(args, "duration", None)
+    thesis_board = args.adc == "ad7927"
+    gyro_name = args.gyro or ("adxrs150" if thesis_board else "cg-l53")
     if args.firmware != "none":
-        from ..sim import Conditioning, source
+        from ..sim import source
 
         if given or args.trajectory_file:
             raise ValueError(f"--firmware {args.firmware} uses the firmware's own motion: drop --trajectory")
         # a source registered by the tooling layer (toolchain/firmware.py): its own motion
-        traj: Any = source(args.firmware).trajectory(args.period, gyro_preset(args.gyro), Conditioning(),
+        traj: Any = source(args.firmware).trajectory(args.period, gyro_preset(gyro_name), Conditioning(),
                                                      duration or DEFAULT_DURATION_S)
     elif trajectory == "csv":
         if not args.trajectory_file:
@@ -174,24 +313,39 @@ def build_config(args: argparse.Namespace) -> Any:
                              "out to run the whole file")
     elif args.trajectory_file:
         raise ValueError("--trajectory-file is only used with --trajectory csv")
-    elif trajectory == "paper":
-        traj = make_trajectory("paper", amplitude=[math.radians(v) for v in args.amplitude],
-                               frequency=list(args.frequency),
-                               phase=[math.radians(v) for v in args.phase])
+    elif trajectory in ("paper", "paper-translation"):
+        kw: dict[str, Any] = {"amplitude": [math.radians(v) for v in args.amplitude],
+                              "frequency": list(args.frequency), "phase": [math.radians(v) for v in args.phase]}
+        if trajectory == "paper-translation":
+            kw.update(translation=list(args.translation), translation_frequency=list(args.translation_frequency))
+        traj = make_trajectory("paper-translation" if trajectory == "paper-translation" else "paper", **kw)
     elif trajectory == "coning":
         traj = make_trajectory("coning", half_angle=math.radians(args.cone_angle),
                                frequency=args.cone_frequency)
     elif trajectory == "constant-rate":
         traj = make_trajectory("constant-rate", rate=[math.radians(v) for v in args.rate])
+    elif trajectory == "turntable":
+        traj = make_trajectory("turntable", rate=[0.0, 0.0, math.radians(args.turntable_rate)])
+    elif trajectory == "level-turn":
+        traj = make_trajectory("level-turn", peak_rate=math.radians(args.turn_rate), turns=args.turns,
+                               rest=args.rest)
     else:
         traj = make_trajectory("static")
+    if duration is None:
+        duration = getattr(traj, "default_duration", None) or DEFAULT_DURATION_S
     adc: AdcBackend = "tlc2543" if args.adc == "auto" else args.adc
-    return SimConfig(trajectory=traj, duration=duration or DEFAULT_DURATION_S, period=args.period,
+    accel_name = args.accel if args.accel is not None else ("adxl202" if thesis_board else "none")
+    extra: dict[str, Any] = _magnetometer(args)
+    if accel_name != "none":
+        extra["accel"] = accel_preset(accel_name)
+    return SimConfig(trajectory=traj, duration=duration, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
-                     gyro=gyro_preset(args.gyro), adc=AdcModel(backend=adc),
+                     gyro=gyro_preset(gyro_name), adc=AdcModel(backend=adc),
+                     conditioning=Conditioning(follower=thesis_board),
                      board=Board(oversample=args.oversample, sample_at=args.sample_at), calibration_s=args.calibration,
                      link=args.link, ber=args.ber, link_attempts=args.attempts, seed=args.seed,
-                     firmware=None if args.firmware == "none" else args.firmware)
+                     firmware=None if args.firmware == "none" else args.firmware,
+                     denoise=_denoise(args), **extra)
 
 
 def run(args: argparse.Namespace) -> int:

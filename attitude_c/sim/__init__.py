@@ -2,17 +2,31 @@
 pipeline of stages (docs/architecture.md, docs/simulation.md):
 
     trajectory → sensors → conditioning → ADC → board → link → host → estimator → outputs
+                 (accelmag: accelerometer, magnetometer    (denoising: between
+                  beside the gyro, read by the host)        host and estimator)
 
-one module each (:mod:`.trajectory`, :mod:`.sensors`, :mod:`.conditioning`,
-:mod:`.adc`, :mod:`.board`, :mod:`.link`, :mod:`.host`, :mod:`.estimator`,
-:mod:`.outputs`); :mod:`.chain` composes them (``simulate``, ``acquire``),
+one module each (:mod:`.trajectory`, :mod:`.sensors`, :mod:`.accelmag`,
+:mod:`.conditioning`, :mod:`.adc`, :mod:`.board`, :mod:`.link`, :mod:`.host`,
+:mod:`.denoising`, :mod:`.estimator`, :mod:`.outputs`); :mod:`.chain`
+composes them (``simulate``, ``acquire``),
 :mod:`.budget` switches the error sources on one at a time, :mod:`.report`
-writes a run's plots and files.
+writes a run's plots and files, :mod:`.sweeps` runs many scenarios on Dask
+(``sweep``, docs/sweep.md).
 """
 
 from __future__ import annotations
 
-from .adc import AdcModel, quantize_ideal
+from .accelmag import (
+    ACCEL_PRESETS,
+    MAG_PRESETS,
+    MagDisturbance,
+    SensorErrors,
+    VectorSensor,
+    VectorSensorModel,
+    accel_preset,
+    mag_preset,
+)
+from .adc import ADC_BACKENDS, AdcModel, quantize_ideal
 from .board import Board, BoardStream
 from .budget import STAGES, BudgetResult, format_budget, plot_budget, run_budget
 from .chain import (
@@ -29,32 +43,45 @@ from .chain import (
     source,
 )
 from .conditioning import Conditioning
+from .denoising import DENOISE_TIMINGS, Denoise
 from .estimator import Estimate, Integrate
-from .host import Calibration, Decoded, HostDecoder
+from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
 from .link import Delivered, Link
 from .outputs import Errors, attitude_angle, compare, wrap_angle
 from .report import format_table, plot_attitude, plot_errors, write_run
 from .sensors import GYRO_PRESETS, Gyro, GyroModel, gyro_preset
+from .sweeps import load_spec, register_estimator, sweep
 from .trajectory import (
+    EARTH,
     TRAJECTORIES,
     ConingTrajectory,
     ConstantRateTrajectory,
     CsvTrajectory,
+    Environment,
+    LevelTurnTrajectory,
     PaperTrajectory,
     StaticTrajectory,
     Trajectory,
+    TurntableTrajectory,
     euler_rates_to_body,
     make_trajectory,
 )
 
 __all__ = [
+    "ACCEL_PRESETS",
+    "ADC_BACKENDS",
+    "DENOISE_TIMINGS",
+    "EARTH",
     "GYRO_PRESETS",
+    "MAG_PRESETS",
     "PAPER_MAXIMA",
     "SENSOR_MODES",
     "STAGES",
     "TRAJECTORIES",
     "Acquired",
     "AdcModel",
+    "AuxCalibration",
+    "AuxStream",
     "Board",
     "BoardStream",
     "BudgetResult",
@@ -65,20 +92,29 @@ __all__ = [
     "CsvTrajectory",
     "Decoded",
     "Delivered",
+    "Denoise",
+    "Environment",
     "Errors",
     "Estimate",
     "Gyro",
     "GyroModel",
     "HostDecoder",
     "Integrate",
+    "LevelTurnTrajectory",
     "Link",
+    "MagDisturbance",
     "PaperTrajectory",
+    "SensorErrors",
     "SimConfig",
     "SimResult",
     "Source",
     "SourceOutput",
     "StaticTrajectory",
     "Trajectory",
+    "TurntableTrajectory",
+    "VectorSensor",
+    "VectorSensorModel",
+    "accel_preset",
     "acquire",
     "attitude_angle",
     "compare",
@@ -86,15 +122,19 @@ __all__ = [
     "format_budget",
     "format_table",
     "gyro_preset",
+    "load_spec",
+    "mag_preset",
     "make_trajectory",
     "plot_attitude",
     "plot_budget",
     "plot_errors",
     "quantize_ideal",
+    "register_estimator",
     "register_source",
     "run_budget",
     "simulate",
     "source",
+    "sweep",
     "wrap_angle",
     "write_run",
 ]

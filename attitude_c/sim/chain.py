@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal, get_args
 
@@ -28,15 +29,17 @@ import numpy as np
 
 from ..core import METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
-from .adc import AdcModel
+from .accelmag import MagDisturbance, SensorErrors, VectorSensor, VectorSensorModel
+from .adc import ADC_BACKENDS, AdcModel
 from .board import Board
 from .conditioning import Conditioning
-from .estimator import Integrate
-from .host import Calibration, Decoded, HostDecoder
+from .denoising import Denoise
+from .estimator import Estimate, Integrate
+from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
 from .link import Delivered, Link
 from .outputs import compare
 from .sensors import DEG, Gyro, GyroModel, gyro_preset
-from .trajectory import PaperTrajectory, Trajectory
+from .trajectory import EARTH, Environment, PaperTrajectory, Trajectory
 
 __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "Source", "acquire",
            "register_source", "simulate", "source"]
@@ -71,6 +74,19 @@ class SimConfig:
     the records over directly. ``firmware``: the name of a registered
     acquisition source that replaces the modeled board (``"s51"``, from the
     tooling layer), or None.
+
+    Beside the gyros (all optional; None: the paper's gyro-only system):
+    ``accel`` and ``mag`` — the part models of an accelerometer and a
+    magnetometer (:mod:`.accelmag`), read by the host directly (not over the
+    link); ``environment`` — gravity and the local field they read;
+    ``hard_iron`` (µT), ``soft_iron`` (3×3), ``disturbances`` — the
+    magnetometer's installation and the fields placed in time;
+    ``accel_channels`` — the ADC inputs of the accelerometer's three axes
+    (the AD7927's VIN4–6 on the thesis's board). ``sensors`` applies to them
+    too: "ideal" hands the estimator the exact period means, "quantized" a
+    perfect part through its digitization. ``denoise`` — the wavelet
+    denoiser stage on the gyro rates between host and estimator
+    (:mod:`.denoising`, None: off).
     """
 
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
@@ -89,6 +105,14 @@ class SimConfig:
     link_attempts: int = 5
     seed: int = 0
     firmware: str | None = None
+    accel: VectorSensorModel | None = None
+    mag: VectorSensorModel | None = None
+    environment: Environment = EARTH
+    hard_iron: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    soft_iron: np.ndarray | Sequence[Sequence[float]] | None = None  # (3, 3); None: identity
+    disturbances: tuple[MagDisturbance, ...] = ()
+    accel_channels: tuple[int, int, int] = (4, 5, 6)
+    denoise: Denoise | None = None
 
     def validate(self) -> None:
         if self.method not in METHODS:
@@ -122,8 +146,36 @@ class SimConfig:
         if not (math.isfinite(self.calibration_s) and self.calibration_s >= 0):
             raise InvalidArgument(f"calibration_s must be >= 0, got {self.calibration_s!r}")
         self.board.check(self.adc.bits)
+        if self.adc.backend not in ADC_BACKENDS:
+            raise InvalidArgument(f"adc backend must be one of {ADC_BACKENDS}, got {self.adc.backend!r}")
+        if self.accel is not None and self.accel.kind != "accel":
+            raise InvalidArgument(f"accel must be an accelerometer model, got a {self.accel.kind!r} model")
+        if self.mag is not None and self.mag.kind != "mag":
+            raise InvalidArgument(f"mag must be a magnetometer model, got a {self.mag.kind!r} model")
+        if (self.disturbances or any(self.hard_iron) or self.soft_iron is not None) and self.mag is None:
+            raise InvalidArgument("hard iron, soft iron and disturbances need a magnetometer (mag)")
+        if sorted(set(self.accel_channels)) != sorted(self.accel_channels) or len(self.accel_channels) != 3 \
+                or not all(0 <= c <= 7 for c in self.accel_channels):
+            raise InvalidArgument(f"accel_channels must be 3 distinct ADC inputs 0..7, got {self.accel_channels}")
+        if self.adc.backend == "ad7927" and self.accel is not None and set(self.accel_channels) & {0, 1, 2}:
+            raise InvalidArgument(f"accel_channels {self.accel_channels} overlap the gyros' VIN0-2")
+        self.magnetometer_install()  # shapes and values
         if self.firmware is not None:
             source(self.firmware).check(self)
+            if self.accel is not None or self.mag is not None:
+                raise InvalidArgument(f"the {self.firmware} source carries only the gyros: drop the "
+                                      "accelerometer and magnetometer")
+
+    def magnetometer_install(self) -> tuple[np.ndarray, np.ndarray]:
+        """(hard iron (3,) µT, soft iron (3, 3)) as arrays, checked."""
+        h = np.asarray(self.hard_iron, dtype=float)
+        soft = np.eye(3) if self.soft_iron is None else np.asarray(self.soft_iron, dtype=float)
+        if h.shape != (3,) or soft.shape != (3, 3) or not (np.all(np.isfinite(h)) and np.all(np.isfinite(soft))):
+            raise InvalidArgument(f"hard_iron must be 3 finite values (µT) and soft_iron a finite 3×3 "
+                                  f"matrix, got {self.hard_iron!r}, {self.soft_iron!r}")
+        if abs(np.linalg.det(soft)) < 1e-6:
+            raise InvalidArgument(f"soft_iron must be invertible, got {soft.tolist()}")
+        return h, soft
 
     def params(self) -> dict[str, Any]:
         return {
@@ -145,7 +197,31 @@ class SimConfig:
             "link_attempts": self.link_attempts,
             "seed": self.seed,
             "firmware": self.firmware,
+            **self._extra_params(),
         }
+
+    def _extra_params(self) -> dict[str, Any]:
+        """Parameters of the stages beside the paper's (only those in use: the
+        default run's parameters stay what they were)."""
+        out: dict[str, Any] = {}
+        if self.accel is not None or self.mag is not None:
+            out["environment"] = self.environment.to_dict()
+        if self.accel is not None:
+            out["accel"] = self.accel.to_dict()
+            if self.adc.backend == "ad7927" and self.accel.output == "analog":
+                out["accel"]["adc_channels"] = list(self.accel_channels)
+        if self.mag is not None:
+            h, soft = self.magnetometer_install()
+            out["mag"] = {**self.mag.to_dict(), "hard_iron_ut": h.tolist(), "soft_iron": soft.tolist(),
+                          "disturbances": [d.to_dict() for d in self.disturbances]}
+        if self.conditioning.follower:
+            out["conditioning_follower"] = True
+        if self.denoise is not None:
+            c = self.denoise.config
+            out["denoise"] = {"wavelet": c.wavelet, "levels": c.levels, "threshold": c.threshold,
+                              "block": c.block, "edge_start": c.edge_start, "edge_end": c.edge_end,
+                              "detrend": c.detrend, "timing": self.denoise.timing}
+        return out
 
     def rad_per_s_per_code(self) -> float:
         """The nominal rad/s per code of one conversion through the gyro's scale,
@@ -168,6 +244,8 @@ class SimResult:
     sample_index: np.ndarray  # (n,) true sample index of each fed increment
     link_stats: dict[str, Any]
     summary: dict[str, Any]
+    aux: dict[str, AuxStream] = field(default_factory=dict)  # "accel", "mag": one row per sample period
+    period_t: np.ndarray | None = None  # (n,) start of each sample period (s)
 
     @property
     def err_heading(self) -> np.ndarray:
@@ -190,6 +268,7 @@ class SourceOutput:
     calibration: Calibration
     backends: dict[str, Any]
     stream_sample: np.ndarray | None = None
+    aux: dict[str, AuxStream] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -237,8 +316,10 @@ def source(name: str) -> Source:
 def _spawn(seed: int) -> dict[str, np.random.Generator]:
     # independent streams per error source, so that switching one source off
     # (error budget) leaves the random draws of the others unchanged
+    # (the first four streams are those of the gyro-only chain: adding streams
+    # after them leaves its draws, and so the default run, unchanged)
     ss = np.random.SeedSequence(seed)
-    names = ("bias", "noise_cal", "noise_run", "link")
+    names = ("bias", "noise_cal", "noise_run", "link", "accel_errors", "accel_noise", "mag_errors", "mag_noise")
     return {n: np.random.default_rng(s) for n, s in zip(names, ss.spawn(len(names)))}
 
 
@@ -258,6 +339,77 @@ def _words(cfg: SimConfig, gyro: Gyro, t0: float, n: int, rng: np.random.Generat
     return board.sums(cfg.adc.convert(v_adc, cb))
 
 
+def _vector_sensor(cfg: SimConfig, name: str, rngs: dict[str, np.random.Generator]) -> VectorSensor | None:
+    """The accelerometer or magnetometer stage of the run, errors drawn (None: absent)."""
+    model = cfg.accel if name == "accel" else cfg.mag
+    if model is None:
+        return None
+    errors = SensorErrors.draw(model, rngs[f"{name}_errors"])  # drawn even when switched off: same streams
+    if cfg.sensors != "full":
+        model, errors = model.perfect(), SensorErrors.none()
+    if name == "accel":
+        return VectorSensor(model, errors, cfg.environment)
+    h, soft = cfg.magnetometer_install()
+    return VectorSensor(model, errors, cfg.environment, h, soft, tuple(cfg.disturbances))
+
+
+def aux_stream(cfg: SimConfig, sensor: VectorSensor, name: str, n: int, rng: np.random.Generator,
+               progress: Progress | None = None) -> AuxStream:
+    """One accelerometer or magnetometer stream of n periods, as the host reads it.
+
+    The part is sampled at the board's conversion instants (``oversample`` per
+    period, delayed by the part's own filter delay when the board compensates);
+    an analog part goes through the conditioning, the ADC (its own inputs:
+    ``accel_channels`` on the AD7927) and the board's per-period sums, and the
+    host converts the sums with the C converter and the part's nominal zero and
+    scale; a digital part's readings are averaged per period. With
+    ``sensors="ideal"`` the stream is the exact period mean."""
+    traj, h, board = cfg.trajectory, cfg.period, cfg.board
+    model = sensor.model
+    t0 = traj.t_start
+    m = board.oversample
+    truth = traj.period_means(lambda t: sensor.truth(traj, t), t0, h, n)
+    dist = (traj.period_means(lambda t: sensor.disturbance(traj, t), t0, h, n) if model.kind == "mag"
+            else np.zeros((n, 3)))
+    if cfg.sensors == "ideal":
+        if model.kind == "mag":
+            values = (truth + dist) @ sensor.soft_iron.T + sensor.hard_iron
+        else:
+            values = truth.copy()
+        return AuxStream(name, model.name, model.unit, values, truth, dist, np.zeros(n, dtype=bool),
+                         errors=sensor.errors.to_dict())
+    ti = board.instants(t0, n, h, model.tau)
+    readings = sensor.measure(traj, ti, h / m, rng)
+    saturated = np.asarray(sensor.saturated(readings).reshape(n, m).any(axis=1), dtype=bool)
+    if model.output == "digital":
+        return AuxStream(name, model.name, model.unit, readings.reshape(n, m, 3).mean(axis=1), truth, dist,
+                         saturated, errors=sensor.errors.to_dict())
+    v_adc = cfg.conditioning.apply(sensor.volts(readings), model)
+    cb = None
+    if progress is not None:
+        total = len(ti)
+
+        def cb(done: int) -> None:
+            progress(f"adc ({name})", done, total)
+    chans = cfg.accel_channels if name == "accel" else None
+    words = board.sums(cfg.adc.convert(v_adc, cb, channels=chans))
+    full = 1 << cfg.adc.bits
+    upc = 1.0 / (model.scale_v * cfg.conditioning.gain(model) * full / cfg.adc.vref)
+    calib = AuxCalibration(np.full(3, cfg.adc.nominal_code(cfg.conditioning.null_at_adc(model))), upc)
+    return AuxStream(name, model.name, model.unit, calib.convert(words, m), truth, dist, saturated, calib,
+                     sensor.errors.to_dict())
+
+
+def _aux(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
+         progress: Progress | None) -> dict[str, AuxStream]:
+    out: dict[str, AuxStream] = {}
+    for name in ("accel", "mag"):
+        sensor = _vector_sensor(cfg, name, rngs)
+        if sensor is not None:
+            out[name] = aux_stream(cfg, sensor, name, n, rngs[f"{name}_noise"], progress)
+    return out
+
+
 def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
            progress: Progress | None) -> SourceOutput:
     model = cfg.gyro if cfg.sensors == "full" else cfg.gyro.without(
@@ -271,15 +423,15 @@ def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
     if n_cal > 0:
         calib = Calibration.from_static(_words(cfg, gyro, t0 - cfg.calibration_s, n_cal, rngs["noise_cal"], True,
                                                progress, "calibration"), m, k)
-    else:  # nominal zero: mid-scale
-        calib = Calibration(np.full(3, cfg.adc.vref / 2 * (1 << cfg.adc.bits) / cfg.adc.vref), k, m)
+    else:  # nominal zero: the conditioned null's code
+        calib = Calibration(np.full(3, cfg.adc.nominal_code(cfg.conditioning.null_at_adc(cfg.gyro))), k, m)
     words = _words(cfg, gyro, t0, n, rngs["noise_run"], False, progress, "adc")
     stream = cfg.board.stream(words, cfg.period)
     delivered = Link(cfg.link, cfg.ber, cfg.link_attempts).carry(stream, rngs["link"], cfg.period)
     backends: dict[str, Any] = {"adc": cfg.adc.backend}
     if cfg.link == "c":
         backends["link"] = delivered.stats.get("backend", "c")
-    return SourceOutput(delivered, calib, backends, stream.sample)
+    return SourceOutput(delivered, calib, backends, stream.sample, _aux(cfg, n, rngs, progress))
 
 
 @dataclass
@@ -293,6 +445,7 @@ class Acquired:
     backends: dict[str, Any]
     samples: int
     decoded: Decoded | None = None
+    aux: dict[str, AuxStream] = field(default_factory=dict)
 
 
 def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
@@ -303,8 +456,10 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
     if cfg.sensors == "ideal" and cfg.firmware is None:
         inc = cfg.trajectory.increments(cfg.trajectory.t_start, cfg.period, n)
         idx = np.arange(n)
+        aux = _aux(cfg, n, _spawn(cfg.seed), progress)
         return Acquired(inc, idx, {"link": "none"}, None, {"sensors": "exact increments"}, n,
-                        Decoded(inc, idx, np.zeros((n, 3), dtype=np.int64)))
+                        Decoded(inc, idx, np.zeros((n, 3), dtype=np.int64),
+                                aux={k: v.values[idx] for k, v in aux.items()}), aux)
     if cfg.firmware is not None:
         out = source(cfg.firmware).acquire(cfg, n, progress)
     else:
@@ -312,12 +467,13 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
     dec = HostDecoder(out.calibration, cfg.period).decode(out.delivered, out.stream_sample)
     keep = dec.sample_index < n  # a source may deliver past the run (the firmware stops on blocks)
     dec = Decoded(dec.increments[keep], dec.sample_index[keep], dec.words[keep],
-                  [k for k in dec.held if k < n], dec.reports)
+                  [k for k in dec.held if k < n], dec.reports,
+                  {k: v.values[dec.sample_index[keep]] for k, v in out.aux.items()})
     stats = dict(out.delivered.stats)
     if out.stream_sample is None:  # the stream's own numbering: count what it says
         good = len(dec.sample_index) - len(dec.held)
         stats.update(delivered=good, delivered_ok=good, lost=n - good, held=dec.held, reports=dec.reports)
-    return Acquired(dec.increments, dec.sample_index, stats, out.calibration, out.backends, n, dec)
+    return Acquired(dec.increments, dec.sample_index, stats, out.calibration, out.backends, n, dec, out.aux)
 
 
 def simulate(cfg: SimConfig, progress: Progress | None = None,
@@ -331,7 +487,12 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     estimator = Integrate(cfg.method, cfg.precision)
     dec = acq.decoded if acq.decoded is not None else Decoded(acq.increments, acq.sample_index,
                                                               np.zeros((len(acq.increments), 3), dtype=np.int64))
+    denoise_summary: dict[str, Any] | None = None
+    if cfg.denoise is not None:  # the stage between host and estimator
+        dec, denoise_summary = cfg.denoise.run(dec, cfg.period)
     est = estimator.run(dec, cfg.trajectory.quat, cfg.trajectory.t_start, cfg.period)
+    if cfg.denoise is not None and cfg.denoise.delay(cfg.period) > 0:  # real time: judged when available
+        est = Estimate(est.t + cfg.denoise.delay(cfg.period), est.q)
     res = compare(est, cfg.trajectory)
     backends = dict(acq.backends)
     backends["integrator"] = estimator.backend
@@ -352,8 +513,13 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     }
     if acq.calibration is not None:
         summary["calibration"] = acq.calibration.to_dict()
+    if acq.aux:
+        summary["sensors"] = {k: v.summary() for k, v in acq.aux.items()}
+    if denoise_summary is not None:
+        summary["denoise"] = denoise_summary
     summary["elapsed_s"] = time.perf_counter() - t_wall
+    period_t = cfg.trajectory.t_start + np.arange(acq.samples) * cfg.period
     return SimResult(config=cfg, t=res.t, q_est=res.q_est, q_true=res.q_true, euler_est=res.euler_est,
                      euler_true=res.euler_true, err=res.err, err_angle=res.err_angle,
-                     increments=acq.increments, sample_index=acq.sample_index, link_stats=acq.link_stats,
-                     summary=summary)
+                     increments=dec.increments, sample_index=dec.sample_index, link_stats=acq.link_stats,
+                     summary=summary, aux=acq.aux, period_t=period_t)

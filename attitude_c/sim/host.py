@@ -15,6 +15,16 @@ simply missing.
 :class:`Calibration` is the host's knowledge of the gyros: the zero-rate
 reading per channel (measured while the gyros sit still) and the nominal
 rad/s per code.
+
+The accelerometer and the magnetometer (:mod:`attitude_c.sim.accelmag`) do
+not travel over the paper's link, which carries the three gyro words: the
+host reads them itself, as the UAV thesis's S3C2440 reads its AD7927 over
+SPI and its HMR3000 over a UART. An analog part's per-period sums of codes
+are converted with the same C converter and the part's nominal zero and
+scale (:class:`AuxCalibration`: a gravity or field reference cannot be
+zeroed by keeping still, so no calibration run); a digital part's readings
+are averaged per period. :class:`AuxStream` holds one such stream, one row
+per sample period, beside its exact truth.
 """
 
 from __future__ import annotations
@@ -28,7 +38,7 @@ from ..link import block
 from ..sensor import Sensor
 from .link import Delivered
 
-__all__ = ["Calibration", "Decoded", "HostDecoder"]
+__all__ = ["AuxCalibration", "AuxStream", "Calibration", "Decoded", "HostDecoder"]
 
 
 @dataclass
@@ -55,17 +65,75 @@ class Calibration:
 
 
 @dataclass
+class AuxCalibration:
+    """An analog vector sensor as the host converts it: ``zero`` the nominal code
+    of its zero output per channel (one conversion), ``units_per_code`` (m/s² or
+    µT per code)."""
+
+    zero: np.ndarray
+    units_per_code: float
+
+    def sensor(self) -> Sensor:
+        return Sensor(self.zero, self.units_per_code)
+
+    def convert(self, words: np.ndarray, oversample: int) -> np.ndarray:
+        """Words (n, 3), sums of ``oversample`` codes → values (n, 3) (the C converter)."""
+        return np.asarray(self.sensor().convert(words, oversample), dtype=float)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"zero_code": np.asarray(self.zero).tolist(), "units_per_code": self.units_per_code}
+
+
+@dataclass
+class AuxStream:
+    """One accelerometer or magnetometer stream as the host has it, one row per
+    sample period k (spanning [t0 + k h, t0 + (k+1) h]): ``values`` (n, 3) the
+    host's reading (the period's mean), ``truth`` (n, 3) the exact mean of the
+    measured quantity over the period (specific force, or the geomagnetic field
+    without disturbances), ``disturbance`` (n, 3) the mean disturbance field
+    (magnetometer; zeros otherwise), ``saturated`` (n,) whether any reading of
+    the period hit the range, ``unit``, ``part`` (the model's name), the
+    ``calibration`` of an analog part (None: digital) and the part's ``errors``
+    drawn for the run (bias, scale, misalignment: the truth of its errors)."""
+
+    name: str
+    part: str
+    unit: str
+    values: np.ndarray
+    truth: np.ndarray
+    disturbance: np.ndarray
+    saturated: np.ndarray
+    calibration: AuxCalibration | None = None
+    errors: dict[str, Any] = field(default_factory=dict)
+
+    def summary(self) -> dict[str, Any]:
+        """Error statistics of the readings against the truth (+ disturbance), per axis."""
+        e = self.values - self.truth - self.disturbance
+        return {"part": self.part, "unit": self.unit, "samples": len(e),
+                "mean_error": e.mean(axis=0).tolist() if len(e) else [0.0] * 3,
+                "rms_error": np.sqrt((e * e).mean(axis=0)).tolist() if len(e) else [0.0] * 3,
+                "max_abs_error": np.abs(e).max(axis=0).tolist() if len(e) else [0.0] * 3,
+                "saturated_samples": int(np.count_nonzero(self.saturated)),
+                "disturbed_samples": int(np.count_nonzero(np.any(self.disturbance != 0, axis=1))),
+                "calibration": None if self.calibration is None else self.calibration.to_dict(),
+                "errors": self.errors}
+
+
+@dataclass
 class Decoded:
     """The host's increments: ``increments`` (m, 3) rad, one per sample period it
     integrates; ``sample_index`` (m,) the true sample number of each; ``words``
     (m, 3) the words behind each; ``held`` the sample numbers filled by holding;
-    ``reports`` the kinds of the report records, in order."""
+    ``reports`` the kinds of the report records, in order; ``aux`` the other
+    sensors' readings on the same rows (``"accel"`` m/s², ``"mag"`` µT; (m, 3)
+    each, the period of ``sample_index``)."""
 
     increments: np.ndarray
     sample_index: np.ndarray
     words: np.ndarray
     held: list[int] = field(default_factory=list)
     reports: list[str] = field(default_factory=list)
+    aux: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)

@@ -1,18 +1,39 @@
-"""Run outputs: Fig. 8-style error plots, attitude plot, CSV, JSON, tables."""
+"""Run outputs: Fig. 8-style error plots, attitude plot, CSV, JSON, tables.
+
+Every file is written to a temporary name beside it and renamed into place,
+so a run interrupted half-way never leaves a truncated result file.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any, Callable
+from typing import IO, Any, Callable
 
 import numpy as np
 
 from .chain import PAPER_MAXIMA, SimResult
 
-__all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "to_jsonable", "write_run"]
+__all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "sensor_rows", "to_jsonable",
+           "write_run"]
+
+
+def _replacing(path: Path) -> contextlib.AbstractContextManager[Path]:
+    """A temporary path beside ``path``, fsynced and renamed onto it when the
+    block succeeds, removed when it fails (attitude_c._io.atomic_path)."""
+    from .._io import atomic_path
+
+    return atomic_path(path)
+
+
+@contextlib.contextmanager
+def _open_replacing(path: Path) -> Iterator[IO[str]]:
+    with _replacing(path) as tmp, open(tmp, "w", newline="") as fh:
+        yield fh
 
 
 def to_jsonable(x: Any) -> Any:
@@ -66,7 +87,8 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Attitude error curves — " + _title(res), fontsize=9.5)
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    with _replacing(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format="png")
     plt.close(fig)
 
 
@@ -88,12 +110,13 @@ def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Attitude — " + _title(res), fontsize=9.5)
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    with _replacing(path) as tmp:
+        fig.savefig(tmp, dpi=dpi, format="png")
     plt.close(fig)
 
 
 def write_csv(res: SimResult, path: Path) -> None:
-    with open(path, "w", newline="") as fh:
+    with _open_replacing(path) as fh:
         w = csv.writer(fh)
         w.writerow(["t_s", "yaw_true", "pitch_true", "roll_true", "yaw_est", "pitch_est", "roll_est",
                     "err_yaw", "err_pitch", "err_roll", "err_heading", "err_angle",
@@ -102,6 +125,52 @@ def write_csv(res: SimResult, path: Path) -> None:
             row = [res.t[k], *res.euler_true[k], *res.euler_est[k], *res.err[k], -res.err[k, 0],
                    res.err_angle[k], *res.q_est[k], *res.q_true[k]]
             w.writerow([f"{v:.6f}" if j == 0 else f"{v:.12e}" for j, v in enumerate(row)])
+
+
+def sensor_rows(res: SimResult) -> tuple[list[str], np.ndarray]:
+    """The per-period sensor streams of a run: header and rows (n, columns).
+
+    One row per sample period k: ``sample``, ``t_start_s``, ``t_mid_s``; the
+    gyro rates the estimator got (``gyro_x..z``, rad/s: the host's increments
+    over h, after the denoiser when it runs; NaN for a sample never delivered)
+    beside the exact mean rates (``gyro_true_x..z``); then for each extra
+    sensor its host readings (``accel_x..z`` m/s², ``mag_x..z`` µT) beside the
+    exact period means (``accel_true_*``: specific force; ``mag_true_*``: the
+    geomagnetic field in the body frame) and, for the magnetometer, the
+    disturbance field (``mag_disturbance_*``)."""
+    c = res.config
+    n = 0 if res.period_t is None else len(res.period_t)
+    h = c.period
+    t0 = c.trajectory.t_start
+    k = np.arange(n)
+    cols: list[np.ndarray] = [k.astype(float), t0 + k * h, t0 + (k + 0.5) * h]
+    head = ["sample", "t_start_s", "t_mid_s"]
+    gyro = np.full((n, 3), np.nan)
+    idx = np.asarray(res.sample_index, dtype=np.int64)
+    first = np.unique(idx, return_index=True)[1]  # a duplicated sample: its first delivery
+    ok = idx[first] < n
+    gyro[idx[first][ok]] = np.asarray(res.increments)[first][ok] / h
+    true = c.trajectory.increments(t0, h, n) / h if n else np.zeros((0, 3))
+    for name, arr in (("gyro", gyro), ("gyro_true", true)):
+        head += [f"{name}_{a}" for a in "xyz"]
+        cols += list(arr.T)
+    for name, s in res.aux.items():
+        parts = [(name, s.values), (f"{name}_true", s.truth)]
+        if name == "mag":
+            parts.append(("mag_disturbance", s.disturbance))
+        for label, arr in parts:
+            head += [f"{label}_{a}" for a in "xyz"]
+            cols += list(np.asarray(arr, dtype=float).T)
+    return head, np.column_stack(cols) if n else np.zeros((0, len(head)))
+
+
+def write_sensors_csv(res: SimResult, path: Path) -> None:
+    head, rows = sensor_rows(res)
+    with _open_replacing(path) as fh:
+        w = csv.writer(fh)
+        w.writerow(head)
+        for r in rows:
+            w.writerow([str(int(r[0])), f"{r[1]:.6f}", f"{r[2]:.6f}", *(f"{v:.12e}" for v in r[3:])])
 
 
 def format_ratio(ratio: float) -> str:
@@ -147,24 +216,44 @@ def format_table(summary: dict[str, Any]) -> str:
                        f"delivered {lk.get('delivered')} (ok {lk.get('delivered_ok')}, duplicated "
                        f"{lk.get('duplicated')}, corrupted undetected "
                        f"{lk.get('corrupted_undetected')}), lost {lk.get('lost')}")]
+    for name, st in summary.get("sensors", {}).items():
+        rms = ", ".join(f"{v:.3g}" for v in st["rms_error"])
+        mean = ", ".join(f"{v:.3g}" for v in st["mean_error"])
+        extra = f", saturated {st['saturated_samples']}" if st["saturated_samples"] else ""
+        if st.get("disturbed_samples"):
+            extra += f", disturbed {st['disturbed_samples']}"
+        lines.append(f"{name} ({st['part']}): reading − truth per axis ({st['unit']}): mean {mean}; "
+                     f"RMS {rms} ({st['samples']} samples{extra})")
+    dn = summary.get("denoise")
+    if dn:
+        r = dn["rates"]
+        lines.append(f"denoise ({dn['wavelet']}, L{dn['levels']}, {dn['threshold']}, N {dn['block']}, "
+                     f"{dn['timing']}, latency {dn['latency_s']:.3g} s): gyro rate ptp ratio "
+                     + "/".join(f"{v:.3f}" for v in r["ptp_ratio"]) + ", RMS ratio "
+                     + "/".join(f"{v:.3f}" for v in r["rms_ratio"]) + f", mean change {r['mean_change_rel']:.1e}")
     lines.append(f"updates {summary['updates']}, elapsed {summary.get('elapsed_s', 0):.2f} s")
     return "\n".join(lines)
 
 
 def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
-    """Write timeseries.csv, errors.png, attitude.png and summary.json (last)
-    into out, each complete or not at all (attitude_c._io: temp file, fsync,
-    rename); an OSError names the files complete and absent."""
+    """Write timeseries.csv (sensors.csv when the run has an accelerometer or a
+    magnetometer), errors.png, attitude.png and summary.json (last) into out,
+    each complete or not at all (attitude_c._io: temp file, fsync, rename); an
+    OSError names the files complete and absent."""
     from .._io import write_results
 
     out.mkdir(parents=True, exist_ok=True)
     files = {"summary": out / "summary.json", "csv": out / "timeseries.csv"}
+    if res.aux:
+        files["sensors_csv"] = out / "sensors.csv"
     if plots:
         files["errors_png"] = out / "errors.png"
         files["attitude_png"] = out / "attitude.png"
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
     steps: list[tuple[Path, Callable[[Path], object]]] = [(files["csv"], lambda p: write_csv(res, p))]
+    if res.aux:
+        steps.append((files["sensors_csv"], lambda p: write_sensors_csv(res, p)))
     if plots:
         steps += [(files["errors_png"], lambda p: plot_errors(res, p)),
                   (files["attitude_png"], lambda p: plot_attitude(res, p))]

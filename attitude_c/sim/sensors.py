@@ -81,6 +81,11 @@ class GyroModel:
         return 0.0 if not self.bandwidth_hz else 1.0 / (2 * math.pi * self.bandwidth_hz)
 
     @property
+    def span_v(self) -> float:
+        """Output swing from null to full range (V) — what the conditioning maps."""
+        return self.range_dps * self.scale_v_per_dps
+
+    @property
     def volts_per_rad_s(self) -> float:
         """Nominal output change per rad/s (V)."""
         return self.scale_v_per_dps / DEG

@@ -11,15 +11,31 @@ Every trajectory gives, for any time ``t`` (s):
   ``Δθ_k = ∫ ω dt`` over ``[t0 + k h, t0 + (k+1) h]``, shape ``(n, 3)``: what a
   perfect integrating gyro would deliver.
 
-Trajectories: ``paper`` (sinusoidal Euler angles, rates from the exact z-x-y
-Euler-rate kinematics), ``coning`` (classical coning, closed form),
-``static``, ``constant-rate`` and ``csv`` (user data, slerp between rows).
+and, for the accelerometer and the magnetometer, in closed form from the
+same attitude:
 
-The sensor stage (:mod:`attitude_c.sim.sensors`) reads ``omega``; sensors of
-other quantities read further truth methods added here beside it (a
-trajectory then also gives, e.g., the specific force and the Earth's field
-in the body frame). The truth's rotation math is the NumPy reference
-(:mod:`attitude_c.reference`), never the C library the chain tests.
+* ``accel_nav(t)`` — the linear acceleration of the body (m/s², ENU; zero
+  unless the trajectory translates);
+* ``specific_force(t, env)`` — what a perfect accelerometer reads,
+  ``f_b = Cᵀ (a_n − g_n)`` with ``g_n = [0, 0, −g]`` (at rest, level: +g on
+  body z);
+* ``mag_field(t, env)`` — the local geomagnetic field in the body frame,
+  ``m_b = Cᵀ m_n`` with ``m_n`` from the :class:`Environment`'s total
+  intensity, inclination and declination;
+* ``period_means(fn, t0, h, n)`` — the exact mean of such a quantity over
+  each sample period (what a perfect averaging sensor delivers).
+
+Trajectories: ``paper`` (sinusoidal Euler angles, rates from the exact z-x-y
+Euler-rate kinematics; optionally a sinusoidal translation,
+``paper-translation``), ``coning`` (classical coning, closed form),
+``static`` (the MEMS AHRS paper's 30-minute test), ``turntable`` (the
+FPGA+DSP paper's z-axis turntable, 5 °/s for 360 s), ``level-turn`` (a level
+360° turn between two rests: the heading-repeatability test),
+``constant-rate`` and ``csv`` (user data, slerp between rows).
+
+The sensor stages (:mod:`attitude_c.sim.sensors`) read ``omega``,
+``specific_force`` and ``mag_field``. The truth's rotation math is the NumPy
+reference (:mod:`attitude_c.reference`), never the C library the chain tests.
 """
 
 from __future__ import annotations
@@ -39,21 +55,28 @@ from ..reference import (
     euler_to_quat,
     quat_conj,
     quat_multiply,
+    quat_to_dcm,
     quat_to_euler,
     quat_to_rotvec,
     rotvec_to_quat,
 )
 
 __all__ = [
+    "EARTH",
+    "STANDARD_GRAVITY",
     "TRAJECTORIES",
     "ConingTrajectory",
     "ConstantRateTrajectory",
     "CsvTrajectory",
+    "Environment",
+    "LevelTurnTrajectory",
     "PaperTrajectory",
     "StaticTrajectory",
     "Trajectory",
+    "TurntableTrajectory",
     "euler_rates_to_body",
     "make_trajectory",
+    "to_body",
 ]
 
 # Gauss–Legendre nodes used to integrate smooth rates over one interval: 8
@@ -71,6 +94,71 @@ def _vec3(value: Any, name: str) -> np.ndarray:
     if not np.all(np.isfinite(a)):
         raise NonFiniteError(f"{name} must be finite, got {a.tolist()}")
     return a
+
+
+#: Standard gravity (m/s², CGPM 1901): the default magnitude of g.
+STANDARD_GRAVITY = 9.80665
+
+
+@dataclass(frozen=True)
+class Environment:
+    """Gravity and the local geomagnetic field (the truth the accelerometer and
+    the magnetometer read).
+
+    ``gravity`` (m/s², magnitude; g_n = [0, 0, −g] in ENU); ``field_ut`` total
+    intensity F (µT); ``inclination`` I (rad, positive when the field points
+    down: northern hemisphere); ``declination`` D (rad, magnetic north east of
+    true north positive). The field in ENU is
+    ``m_n = [F cos I sin D, F cos I cos D, −F sin I]``.
+
+    Defaults (:data:`EARTH`): standard gravity; F = 50.6 µT, I = 46.9°,
+    D = −5.1° — an **assumption**: values of the order a geomagnetic model
+    gives for Nanjing (the UAV thesis's site) around 2010, rounded; any other
+    site is one ``Environment`` (``attitude simulate --field F,I,D``) away.
+    """
+
+    gravity: float = STANDARD_GRAVITY
+    field_ut: float = 50.6
+    inclination: float = math.radians(46.9)
+    declination: float = math.radians(-5.1)
+
+    def __post_init__(self) -> None:
+        for name in ("gravity", "field_ut", "inclination", "declination"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise InvalidArgument(f"{name} must be a finite number, got {v!r}")
+        if self.gravity < 0 or self.field_ut < 0:
+            raise InvalidArgument(f"gravity and field_ut must be >= 0, got {self.gravity!r}, {self.field_ut!r}")
+        if abs(self.inclination) > math.pi / 2:
+            raise InvalidArgument(f"inclination must be in [-90°, 90°], got {math.degrees(self.inclination):g}°")
+
+    @property
+    def gravity_nav(self) -> np.ndarray:
+        """g_n (m/s², ENU)."""
+        return np.array([0.0, 0.0, -self.gravity])
+
+    @property
+    def field_nav(self) -> np.ndarray:
+        """m_n (µT, ENU)."""
+        h = self.field_ut * math.cos(self.inclination)
+        return np.array([h * math.sin(self.declination), h * math.cos(self.declination),
+                         -self.field_ut * math.sin(self.inclination)])
+
+    def to_dict(self) -> dict[str, float]:
+        return {"gravity_m_s2": self.gravity, "field_ut": self.field_ut,
+                "inclination_deg": math.degrees(self.inclination),
+                "declination_deg": math.degrees(self.declination)}
+
+
+#: The default environment (see :class:`Environment`).
+EARTH = Environment()
+
+
+def to_body(q: np.ndarray, v_nav: np.ndarray) -> np.ndarray:
+    """Navigation-frame vectors → body frame: ``v_b = Cᵀ v_n`` with ``C`` the
+    attitude matrix of ``q`` (the NumPy reference's, docs/conventions.md)."""
+    c = quat_to_dcm(q)
+    return np.einsum("...ji,...j->...i", c, np.broadcast_to(v_nav, c.shape[:-1]))
 
 
 def euler_rates_to_body(euler: np.ndarray, euler_dot: np.ndarray) -> np.ndarray:
@@ -116,6 +204,33 @@ class Trajectory:
         w = self.omega(tt)  # (n, 8, 3)
         return 0.5 * h * np.einsum("j,njk->nk", _GL_W, w)
 
+    def accel_nav(self, t: Any) -> np.ndarray:
+        """Linear acceleration of the body (m/s², ENU): zero unless the trajectory translates."""
+        t = np.asarray(t, dtype=float)
+        return np.zeros(t.shape + (3,))
+
+    def specific_force(self, t: Any, env: Environment = EARTH) -> np.ndarray:
+        """What a perfect accelerometer reads (m/s², body axes): ``Cᵀ (a_n − g_n)``."""
+        return to_body(self.quat(t), self.accel_nav(t) - env.gravity_nav)
+
+    def mag_field(self, t: Any, env: Environment = EARTH) -> np.ndarray:
+        """The geomagnetic field in the body frame (µT): ``Cᵀ m_n``."""
+        return to_body(self.quat(t), env.field_nav)
+
+    def period_means(self, fn: Any, t0: float, h: float, n: int) -> np.ndarray:
+        """The mean of ``fn(t)`` (…, 3) over n consecutive periods h from t0, (n, 3):
+        8-point Gauss–Legendre per period (the truth of a perfect averaging sensor;
+        exact to rounding for the smooth motions here, like :meth:`increments`)."""
+        k = np.arange(n, dtype=float)
+        mid = t0 + (k + 0.5) * h
+        tt = mid[:, None] + 0.5 * h * _GL_X[None, :]
+        return 0.5 * np.einsum("j,njk->nk", _GL_W, fn(tt))
+
+    @property
+    def default_duration(self) -> float | None:
+        """The test's own length (s) when the motion defines one (None: the caller's default)."""
+        return None
+
     def params(self) -> dict[str, Any]:
         return {"trajectory": self.name}
 
@@ -131,21 +246,35 @@ class PaperTrajectory(Trajectory):
     incommensurate-looking frequencies so that the motion is not a rotation
     about a fixed axis (the non-commutativity the rotation-vector methods
     compensate). The paper gives no numbers for its sinusoids.
+
+    Translation (``paper-translation``): the body's position in ENU is
+    ``p_i(t) = translation_i · sin(2π g_i t + ψ_i)`` (m), so
+    ``a_n = −translation · (2π g)² · sin(2π g t + ψ)``; the accelerometer then
+    reads the motion as well as gravity. Defaults of ``paper-translation``:
+    5, 5, 1 m at 0.15, 0.10, 0.25 Hz (peaks 4.4, 2.0, 2.5 m/s²: a specific
+    force up to 1.3 g, inside an ADXL202's ±2 g), phases 0.
     """
 
     amplitude: Any = (math.radians(30.0), math.radians(20.0), math.radians(25.0))
     frequency: Any = (0.20, 0.25, 0.30)
     phase: Any = (0.0, math.radians(30.0), math.radians(60.0))
     offset: Any = (0.0, 0.0, 0.0)
+    translation: Any = (0.0, 0.0, 0.0)
+    translation_frequency: Any = (0.15, 0.10, 0.25)
+    translation_phase: Any = (0.0, 0.0, 0.0)
 
     def __post_init__(self) -> None:
-        self.name = "paper"
         self.amplitude = _vec3(self.amplitude, "amplitude")
         self.frequency = _vec3(self.frequency, "frequency")
         self.phase = _vec3(self.phase, "phase")
         self.offset = _vec3(self.offset, "offset")
-        if np.any(self.frequency < 0):
-            raise InvalidArgument(f"frequency must be >= 0 Hz, got {self.frequency.tolist()}")
+        self.translation = _vec3(self.translation, "translation")
+        self.translation_frequency = _vec3(self.translation_frequency, "translation_frequency")
+        self.translation_phase = _vec3(self.translation_phase, "translation_phase")
+        self.name = "paper-translation" if np.any(self.translation != 0) else "paper"
+        if np.any(self.frequency < 0) or np.any(self.translation_frequency < 0):
+            raise InvalidArgument(f"frequencies must be >= 0 Hz, got {self.frequency.tolist()}, "
+                                  f"{self.translation_frequency.tolist()}")
         worst = abs(self.offset[1]) + abs(self.amplitude[1])
         if worst >= math.pi / 2 - 1e-3:
             raise InvalidArgument(
@@ -168,14 +297,35 @@ class PaperTrajectory(Trajectory):
     def omega(self, t: Any) -> np.ndarray:
         return euler_rates_to_body(self.euler(t), self.euler_dot(t))
 
+    def _targ(self, t: Any) -> np.ndarray:
+        t = np.asarray(t, dtype=float)[..., None]
+        return 2 * np.pi * self.translation_frequency * t + self.translation_phase
+
+    def position(self, t: Any) -> np.ndarray:
+        """Position of the body (m, ENU)."""
+        return self.translation * np.sin(self._targ(t))
+
+    def velocity(self, t: Any) -> np.ndarray:
+        """Velocity of the body (m/s, ENU)."""
+        return self.translation * 2 * np.pi * self.translation_frequency * np.cos(self._targ(t))
+
+    def accel_nav(self, t: Any) -> np.ndarray:
+        w = 2 * np.pi * self.translation_frequency
+        return -self.translation * w * w * np.sin(self._targ(t))
+
     def params(self) -> dict[str, Any]:
-        return {
+        out = {
             "trajectory": self.name,
             "amplitude_deg": np.degrees(self.amplitude).tolist(),
             "frequency_hz": self.frequency.tolist(),
             "phase_deg": np.degrees(self.phase).tolist(),
             "offset_deg": np.degrees(self.offset).tolist(),
         }
+        if np.any(self.translation != 0):
+            out.update(translation_m=self.translation.tolist(),
+                       translation_frequency_hz=self.translation_frequency.tolist(),
+                       translation_phase_deg=np.degrees(self.translation_phase).tolist())
+        return out
 
 
 @dataclass
@@ -273,8 +423,107 @@ class StaticTrajectory(ConstantRateTrajectory):
         if np.any(self.rate != 0):
             raise InvalidArgument("a static trajectory has zero rate")
 
+    @property
+    def default_duration(self) -> float | None:
+        """30 minutes: the MEMS AHRS paper's static test (sec. 4, Fig. 6–8)."""
+        return 1800.0
+
     def params(self) -> dict[str, Any]:
         return {"trajectory": self.name, "euler0_deg": np.degrees(self.euler0).tolist()}
+
+
+@dataclass
+class TurntableTrajectory(ConstantRateTrajectory):
+    """A single-axis turntable turning about the body z axis at a constant
+    rate, from level north: the FPGA+DSP paper's test (sec. 4.2: z axis,
+    5 °/s, 360 s; its default duration)."""
+
+    rate: Any = (0.0, 0.0, math.radians(5.0))
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        self.name = "turntable"
+        if self.rate[0] != 0 or self.rate[1] != 0:
+            raise InvalidArgument(f"a turntable turns about body z only, got rate {self.rate.tolist()} rad/s")
+
+    @property
+    def default_duration(self) -> float | None:
+        return 360.0
+
+    def params(self) -> dict[str, Any]:
+        return {"trajectory": self.name, "rate_dps": math.degrees(float(self.rate[2])),
+                "euler0_deg": np.degrees(self.euler0).tolist()}
+
+
+@dataclass
+class LevelTurnTrajectory(Trajectory):
+    """A level turn through ``turns`` · 360° between two rests: the MEMS AHRS
+    paper's heading-repeatability test (a manual turntable turned through a
+    full circle, sec. 4, Fig. 9).
+
+    At rest for ``rest`` s, then a turn about the vertical whose rate rises and
+    falls as a raised cosine, ``ψ̇(τ) = Ω (1 − cos 2πτ/T) / 2`` for ``τ`` in
+    ``[0, T]`` (peak ``Ω = peak_rate``; ``T = 2 · 2π|turns| / Ω`` so that
+    the turn covers the whole angle), then at rest again for ``rest`` s.
+    Closed forms: ``ψ(τ) = ψ₀ ± (Ω/2)(τ − T/(2π) sin 2πτ/T)``, body rate
+    ``[0, 0, ψ̇]`` (level), increments the differences of ψ. Defaults: 10 s
+    rests, Ω = 10 °/s (T = 72 s), one counter-clockwise turn from north;
+    92 s in all (the default duration). The start and the end heading are the
+    same: what a magnetometer-aided heading must repeat.
+    """
+
+    rest: float = 10.0
+    peak_rate: float = math.radians(10.0)
+    turns: float = 1.0
+    yaw0: float = 0.0
+
+    def __post_init__(self) -> None:
+        self.name = "level-turn"
+        for nm in ("rest", "peak_rate", "turns", "yaw0"):
+            v = getattr(self, nm)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise InvalidArgument(f"{nm} must be a finite number, got {v!r}")
+        if self.rest < 0 or self.peak_rate <= 0 or self.turns == 0:
+            raise InvalidArgument("level-turn needs rest >= 0 s, peak_rate > 0 rad/s and turns != 0")
+
+    @property
+    def turn_time(self) -> float:
+        """T (s): how long the turn lasts."""
+        return 2 * 2 * math.pi * abs(self.turns) / self.peak_rate
+
+    @property
+    def default_duration(self) -> float | None:
+        return 2 * self.rest + self.turn_time
+
+    def yaw(self, t: Any) -> np.ndarray:
+        """ψ(t) (rad, not wrapped)."""
+        big_t = self.turn_time
+        tau = np.clip(np.asarray(t, dtype=float) - self.rest, 0.0, big_t)
+        sign = 1.0 if self.turns > 0 else -1.0
+        return self.yaw0 + sign * 0.5 * self.peak_rate * (tau - big_t / (2 * np.pi) * np.sin(2 * np.pi * tau / big_t))
+
+    def yaw_rate(self, t: Any) -> np.ndarray:
+        big_t = self.turn_time
+        tau = np.asarray(t, dtype=float) - self.rest
+        inside = (tau >= 0) & (tau <= big_t)
+        sign = 1.0 if self.turns > 0 else -1.0
+        return np.where(inside, sign * 0.5 * self.peak_rate * (1 - np.cos(2 * np.pi * tau / big_t)), 0.0)
+
+    def quat(self, t: Any) -> np.ndarray:
+        y = self.yaw(t)
+        return euler_to_quat(np.stack([y, np.zeros_like(y), np.zeros_like(y)], axis=-1))
+
+    def omega(self, t: Any) -> np.ndarray:
+        r = self.yaw_rate(t)
+        return np.stack([np.zeros_like(r), np.zeros_like(r), r], axis=-1)
+
+    def increments(self, t0: float, h: float, n: int) -> np.ndarray:
+        d = np.diff(self.yaw(t0 + np.arange(n + 1) * h))
+        return np.stack([np.zeros(n), np.zeros(n), d], axis=-1)
+
+    def params(self) -> dict[str, Any]:
+        return {"trajectory": self.name, "rest_s": self.rest, "peak_rate_dps": math.degrees(self.peak_rate),
+                "turns": self.turns, "yaw0_deg": math.degrees(self.yaw0), "turn_s": self.turn_time}
 
 
 class CsvTrajectory(Trajectory):
@@ -398,15 +647,30 @@ class CsvTrajectory(Trajectory):
                 "t_start": self.t_start, "t_end": self.t_end}
 
 
-TrajectoryKind = Literal["paper", "coning", "static", "constant-rate", "csv"]
+TrajectoryKind = Literal["paper", "paper-translation", "coning", "static", "turntable", "level-turn",
+                         "constant-rate", "csv"]
 TRAJECTORIES: tuple[TrajectoryKind, ...] = get_args(TrajectoryKind)
+
+#: The translation of ``paper-translation`` when none is given (m, ENU).
+PAPER_TRANSLATION_M = (5.0, 5.0, 1.0)
 
 
 def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
-    """Build a trajectory by name (``paper``, ``coning``, ``static``,
-    ``constant-rate``, ``csv`` with ``path=``)."""
+    """Build a trajectory by name (``paper``, ``paper-translation``, ``coning``,
+    ``static``, ``turntable``, ``level-turn``, ``constant-rate``, ``csv`` with
+    ``path=``)."""
     if kind == "paper":
         return PaperTrajectory(**kw)
+    if kind == "paper-translation":
+        kw.setdefault("translation", PAPER_TRANSLATION_M)
+        tr = PaperTrajectory(**kw)
+        if tr.name != "paper-translation":
+            raise InvalidArgument("paper-translation needs a non-zero translation")
+        return tr
+    if kind == "turntable":
+        return TurntableTrajectory(**kw)
+    if kind == "level-turn":
+        return LevelTurnTrajectory(**kw)
     if kind == "coning":
         return ConingTrajectory(**kw)
     if kind == "static":

@@ -48,12 +48,26 @@
 
 #include "rx.h"
 
+/* The link's counters, cumulative, as the wire saw them (what print_statistics
+ * prints at the end; with --format jsonl also a {"link":{...}} record at most
+ * once per --stats-interval and once at the end). */
+#define RX_LINK_RECORD_MS 1000u /* --format jsonl: a {"link":...} record at most once a second */
+
+typedef struct {
+    unsigned long syns, blocks, naks, timeouts, resyncs, bytes_discarded;
+    unsigned long busy_naks, count_naks, held_answers, unanswered;
+} rx_link_live;
+
 typedef struct {
     rx_config cfg;
     rx_queue queue;
     rx_stop stop;                 /* stop requests (signal handler, --count, stdout failure) */
     int fd;                       /* serial port (owned by the receiver thread once started) */
     att_link_receiver_stats link; /* copied by the receiver thread when it ends */
+    /* the link counters as they stand (receiver thread writes, attitude thread reads: live_lock) */
+    pthread_mutex_t live_lock;
+    rx_link_live live;
+    struct timespec live_next; /* attitude thread: when the next {"link":...} record is due */
     /* receiver thread */
     unsigned long samples;      /* sample records in acknowledged blocks (good or not) */
     unsigned long acks;         /* 0x00 answers sent: blocks acknowledged */
@@ -255,6 +269,31 @@ static int deliver(rx_app *app, rx_acked *x, const uint8_t *block)
     return ATT_LINK_ACK;
 }
 
+/* The counters of the link as they stand: the link machine's, with attitude-rx's
+ * own answers (it counts every good block as accepted; some were answered 0xFF). */
+static void link_live(const rx_app *app, const att_link_receiver_stats *l, rx_link_live *v)
+{
+    v->syns = (unsigned long)l->syns;
+    v->blocks = app->acks;
+    v->naks = (unsigned long)l->naks + app->busy_naks + app->count_naks;
+    v->timeouts = (unsigned long)l->timeouts;
+    v->resyncs = (unsigned long)l->resyncs;
+    v->bytes_discarded = (unsigned long)l->bytes_discarded;
+    v->busy_naks = app->busy_naks;
+    v->count_naks = app->count_naks;
+    v->held_answers = app->held_answers;
+    v->unanswered = app->unanswered;
+}
+
+static void publish_live(rx_app *app, const att_link_receiver_stats *l)
+{
+    rx_link_live v;
+    link_live(app, l, &v);
+    pthread_mutex_lock(&app->live_lock);
+    app->live = v;
+    pthread_mutex_unlock(&app->live_lock);
+}
+
 static void *receiver_thread(void *arg)
 {
     rx_app *app = arg;
@@ -333,8 +372,10 @@ static void *receiver_thread(void *arg)
                 break;
             port_lost(app, "write failed", errno);
         }
+        publish_live(app, &r.stats);
     }
     app->link = r.stats;
+    publish_live(app, &r.stats);
     return NULL;
 }
 
@@ -374,7 +415,8 @@ static void print_header(rx_app *app)
         out_line(app, h, (int)sizeof h - 1, 0);
 }
 
-static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real q[4])
+static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
+                         const att_real q[4])
 {
     att_real e[3], h = 0;
     const double r2d = 180.0 / 3.14159265358979323846;
@@ -393,10 +435,12 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
         len = snprintf(
             line, sizeof line,
             "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
-            "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu}\n",
+            "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu,"
+            "\"rate_dps\":[%.*g,%.*g,%.*g]}\n",
             t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits, (double)q[1],
             digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
-            (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held);
+            (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held, digits,
+            (double)v[0] * r2d, digits, (double)v[1] * r2d, digits, (double)v[2] * r2d);
     out_line(app, line, len, 1);
 }
 
@@ -443,7 +487,7 @@ static void integrate(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], c
     if (c->count && app->updates >= c->count)
         return; /* past --count (the rest of a block of several samples): integrated, not printed */
     app->updates++;
-    print_update(app, n, code, q);
+    print_update(app, n, code, v, q);
     if (c->count && app->updates == c->count)
         rx_stop_request(&app->stop);
 }
@@ -493,6 +537,36 @@ static void json_record(rx_app *app, const char *body)
     char line[RX_LINE_MAX];
     if (app->cfg.format == RX_FORMAT_JSONL)
         out_line(app, line, snprintf(line, sizeof line, "{\"t\":%.9g,%s}\n", app->t, body), 0);
+}
+
+/* --format jsonl: the link's counters as a {"link":{...}} record (cumulative). */
+static void link_record(rx_app *app)
+{
+    char body[RX_LINE_MAX / 2];
+    rx_link_live v;
+    pthread_mutex_lock(&app->live_lock);
+    v = app->live;
+    pthread_mutex_unlock(&app->live_lock);
+    snprintf(body, sizeof body,
+             "\"link\":{\"syns\":%lu,\"blocks\":%lu,\"naks\":%lu,\"timeouts\":%lu,\"resyncs\":%lu,"
+             "\"bytes_discarded\":%lu,\"busy_naks\":%lu,\"count_naks\":%lu,\"held_answers\":%lu,"
+             "\"unanswered\":%lu}",
+             v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks, v.count_naks,
+             v.held_answers, v.unanswered);
+    json_record(app, body);
+}
+
+/* A link record at most every RX_LINK_RECORD_MS, written between attitude lines. */
+static void link_record_due(rx_app *app)
+{
+    struct timespec now;
+    if (app->cfg.format != RX_FORMAT_JSONL)
+        return;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (before(&now, &app->live_next))
+        return;
+    after_ms(&app->live_next, RX_LINK_RECORD_MS);
+    link_record(app);
 }
 
 /* Warn when a sample every `period` s cannot fit the line. */
@@ -640,6 +714,7 @@ static void *attitude_thread(void *arg)
             sample(app, &a, &it);
         else
             report(app, &a, &it);
+        link_record_due(app);
     }
     return NULL;
 }
@@ -655,17 +730,15 @@ static int open_error_code(int err)
 
 static void print_statistics(rx_app *app)
 {
-    const att_link_receiver_stats *l = &app->link;
-    /* the link machine counts every good block as accepted; attitude-rx answered some of
-     * them 0xFF (queue full, --count done) or not at all (stop): count what went on the wire */
+    rx_link_live v; /* what went on the wire (link_live) */
+    link_live(app, &app->link, &v);
     if (g_signal)
         rx_log(&app->stop, "stopped by signal %d", (int)g_signal);
     rx_log(&app->stop,
            "link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu bytes_discarded=%lu "
            "busy_naks=%lu count_naks=%lu held_answers=%lu unanswered=%lu",
-           (unsigned long)l->syns, app->acks, (unsigned long)l->naks + app->busy_naks + app->count_naks,
-           (unsigned long)l->timeouts, (unsigned long)l->resyncs, (unsigned long)l->bytes_discarded,
-           app->busy_naks, app->count_naks, app->held_answers, app->unanswered);
+           v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks, v.count_naks,
+           v.held_answers, v.unanswered);
     rx_log(&app->stop,
            "samples: received=%lu integrated=%lu held=%lu missing=%lu code_errors=%lu pending=%lu "
            "undelivered=%lu lines_lost=%lu queue_high_water=%u updates=%lu integrator_errors=%lu "
@@ -710,7 +783,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "attitude-rx: %s\n", msg);
         return rc;
     }
-    if (rx_stop_init(&app.stop) != 0 || rx_queue_init(&app.queue, app.cfg.queue_size) != 0) {
+    if (rx_stop_init(&app.stop) != 0 || rx_queue_init(&app.queue, app.cfg.queue_size) != 0
+        || pthread_mutex_init(&app.live_lock, NULL) != 0) {
         fprintf(stderr, "attitude-rx: cannot set up threads: %s\n", strerror(errno));
         return RX_EXIT_INTERNAL;
     }
@@ -745,6 +819,8 @@ int main(int argc, char **argv)
     pthread_join(rx_thr, NULL);  /* ends at a stop request: at most one hold slice later */
     rx_queue_close(&app.queue);  /* the attitude thread handles what is queued (acknowledged) */
     pthread_join(att_thr, NULL); /* within the grace time if stdout blocks */
+    if (app.cfg.format == RX_FORMAT_JSONL)
+        link_record(&app); /* the final counters */
     if (app.fd >= 0)
         rx_serial_close(app.fd);
     print_statistics(&app);

@@ -1,0 +1,1096 @@
+"""Parameter sweeps and Monte Carlo studies on Dask (docs/sweep.md).
+
+A *spec* (TOML) names a kind of run and the values to run it with:
+
+* ``kind = "simulate"``: one run is one ``attitude simulate`` scenario. Any
+  option of that command can be fixed, gridded or drawn at random: the
+  options are read from the command's own parser
+  (:func:`simulate_options`), so an option added there is sweepable with no
+  change here. Each run's parameters go through that parser and the
+  command's ``build_config``, exactly as on the command line.
+* ``kind = "recordings"``: one run is one attitude estimator, with one set of
+  settings, on one recording (a BROAD trial, :mod:`attitude_c.broad`),
+  scored with BROAD's error metric. The estimator is a callable registered
+  by name (:func:`register_estimator`); the strapdown integrator is
+  registered (``integrator``: ``method``, ``precision``).
+
+Runs are expanded from the spec alone: every run's parameters, including
+its seed and any random draw, are fixed before anything runs, and a run is
+a pure function of its parameters, so results do not depend on where or in
+which order runs execute. A run is keyed by a hash of its parameters; the
+finished runs of a sweep are kept in a journal (``runs.jsonl`` in the
+output folder), so a sweep started again with the same output folder runs
+only what is missing.
+
+Dask (``distributed``) runs the runs: a local cluster of worker processes
+by default, an existing cluster by its scheduler address, or everything in
+this process (``client="serial"``). dask, distributed and pandas are
+optional dependencies (``pip install 'attitude-c[sweep]'``), imported when a
+sweep runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import inspect
+import itertools
+import json
+import math
+import os
+import sys
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import lru_cache
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+
+from ..core import Method, Precision
+from ..errors import InvalidArgument
+
+__all__ = [
+    "ESTIMATORS",
+    "KINDS",
+    "Run",
+    "Spec",
+    "SpecError",
+    "integrate_trial",
+    "load_spec",
+    "register_estimator",
+    "simulate_options",
+    "sweep",
+]
+
+Kind = Literal["simulate", "recordings"]
+KINDS: tuple[Kind, ...] = ("simulate", "recordings")
+
+#: The figure plotted when the spec names none, per kind.
+DEFAULT_FIGURE = {"simulate": "err_attitude_angle_rms", "recordings": "total_deg"}
+#: Parameters the summary aggregates over (replicates), per kind, when the spec names none.
+DEFAULT_OVER = {"simulate": ("seed",), "recordings": ("seed", "trial")}
+#: Parameter names the sweep itself sets.
+RESERVED = ("seed", "case")
+
+JOURNAL = "runs.jsonl"
+
+
+class SpecError(InvalidArgument):
+    """A spec that cannot be run: the message is one line naming what is wrong."""
+
+
+# ---------------------------------------------------------------------------
+# optional dependencies
+# ---------------------------------------------------------------------------
+
+def _need(module: str) -> Any:
+    """Import an optional dependency or say what to install."""
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError as exc:
+        raise ImportError(f"attitude sweep needs {module.split('.')[0]}: "
+                          "pip install 'attitude-c[sweep]' (dask, distributed, pandas)") from exc
+
+
+def _toml_loads(text: str) -> dict[str, Any]:
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover - Python 3.9/3.10
+        try:
+            import tomli as tomllib
+        except ImportError as exc:
+            raise ImportError("reading a sweep spec on Python < 3.11 needs tomli: "
+                              "pip install 'attitude-c[sweep]'") from exc
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(f"not valid TOML: {exc}") from None
+
+
+# ---------------------------------------------------------------------------
+# the simulate option set, read from the command's parser
+# ---------------------------------------------------------------------------
+
+class _ParseError(Exception):
+    pass
+
+
+class _RaisingParser(argparse.ArgumentParser):
+    """An ArgumentParser that raises instead of printing usage and exiting."""
+
+    def error(self, message: str) -> Any:  # type: ignore[override]
+        raise _ParseError(message)
+
+
+@dataclass(frozen=True)
+class Option:
+    """One sweepable option of ``attitude simulate``."""
+
+    dest: str             #: the parameter name in a spec and in the table (``cone_angle``)
+    flag: str             #: the option on the command line (``--cone-angle``)
+    kind: Literal["value", "flag", "append"]  #: ``flag``: a switch (true/false); ``append``: repeatable
+    choices: tuple[Any, ...] | None
+    help: str
+
+
+#: argument groups of ``attitude simulate`` that say how a run is shown or stored, not what
+#: runs: not sweepable (the sweep sets the seed itself)
+_CONTROL_GROUPS = ("run",)
+
+
+@lru_cache(maxsize=1)
+def _simulate_parser() -> Any:
+    from ..cli import simulate as cli_simulate
+
+    top = _RaisingParser(prog="attitude")
+    sub = top.add_subparsers(dest="command", parser_class=_RaisingParser)
+    cli_simulate.register(sub)
+    return sub.choices["simulate"]
+
+
+@lru_cache(maxsize=1)
+def _options() -> dict[str, Option]:
+    p = _simulate_parser()
+    control = {id(a) for g in p._action_groups if g.title in _CONTROL_GROUPS for a in g._group_actions}
+    out: dict[str, Option] = {}
+    for a in p._actions:
+        if not a.option_strings or id(a) in control or isinstance(a, argparse._HelpAction):
+            continue
+        flag = max(a.option_strings, key=len)
+        kind: Literal["value", "flag", "append"] = (
+            "flag" if a.nargs == 0 else "append" if isinstance(a, argparse._AppendAction) else "value")
+        out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "")
+    return out
+
+
+def simulate_options() -> dict[str, Option]:
+    """The options of ``attitude simulate`` a spec can set, by parameter name."""
+    return dict(_options())
+
+
+def _option_name(name: str) -> str:
+    return name.strip().lstrip("-").replace("-", "_")
+
+
+def _argv_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return str(v).lower()
+    if isinstance(v, float):
+        return repr(v)
+    if isinstance(v, (list, tuple)):
+        return ",".join(_argv_value(x) for x in v)
+    return str(v)
+
+
+def _simulate_argv(params: Mapping[str, Any]) -> list[str]:
+    opts = _options()
+    argv: list[str] = []
+    for k, v in params.items():
+        if k in RESERVED:
+            continue
+        o = opts[k]
+        if o.kind == "flag":
+            if not isinstance(v, bool):
+                raise _ParseError(f"{o.flag} is a switch: give true or false, got {v!r}")
+            if v:
+                argv.append(o.flag)
+        elif o.kind == "append":  # a string (or a list of numbers) is one occurrence; a list of them, several
+            many = isinstance(v, list) and all(isinstance(x, (str, list)) for x in v)
+            argv += [f"{o.flag}={_argv_value(x)}" for x in (v if many else [v])]
+        else:
+            argv.append(f"{o.flag}={_argv_value(v)}")
+    argv += ["--seed", str(int(params.get("seed", 0)))]
+    return argv
+
+
+def _simulate_namespace(params: Mapping[str, Any]) -> Any:
+    return _simulate_parser().parse_args(_simulate_argv(params))
+
+
+def _jsonable(v: Any) -> Any:
+    if isinstance(v, tuple):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, list):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+# ---------------------------------------------------------------------------
+# recordings: estimators over BROAD trials
+# ---------------------------------------------------------------------------
+
+#: Estimators of the ``recordings`` kind, by name: ``fn(trial, **settings)`` returns the
+#: attitude (N, 4) at every sample of the trial, or ``(q (M, 4), index (M,))`` with the
+#: sample index of each attitude. A setting named ``seed`` gets the run's seed.
+ESTIMATORS: dict[str, Callable[..., Any]] = {}
+
+
+def register_estimator(name: str, fn: Callable[..., Any]) -> None:
+    """Make ``fn`` available as ``estimator = "name"`` in a ``recordings`` spec.
+
+    The attitude filter plugs in with one line::
+
+        register_estimator("ahrs", lambda trial, **s: attitude_c.ahrs(
+            trial.gyr, trial.acc, trial.mag, rate=trial.rate, **s))
+
+    Dask ships the callable to the workers with each run (it must pickle:
+    a module-level function or a lambda defined in an importable module).
+    """
+    if not callable(fn):
+        raise TypeError(f"fn must be callable, got {type(fn).__name__}")
+    ESTIMATORS[name] = fn
+
+
+def integrate_trial(trial: Any, method: Method = "rv3", precision: Precision = "f64") -> tuple[np.ndarray, np.ndarray]:
+    """The strapdown integrator (gyro only) on a BROAD trial.
+
+    Starts at the first sample with a valid reference, from the reference
+    attitude there (a gyro alone cannot know its initial attitude); the
+    increment over each sample interval is the trapezoid of the two rate
+    samples times 1/rate (``rk4``: the rates themselves, two intervals per
+    step). Returns the attitudes and the sample index each one belongs to.
+    """
+    from .. import core, names
+
+    ok = np.flatnonzero(np.isfinite(trial.quat).all(axis=1))
+    if ok.size == 0:
+        raise InvalidArgument(f"trial {trial.name}: no sample has a reference attitude to start from")
+    s0 = int(ok[0])
+    q0 = trial.quat[s0]
+    gyr = trial.gyr[s0:]
+    dt = 1.0 / trial.rate
+    if method == "rk4":
+        q = core.integrate_rates(gyr, dt, method="rk4", q0=q0, precision=precision)
+        step = 2
+    else:
+        inc = 0.5 * (gyr[1:] + gyr[:-1]) * dt
+        if precision == "f32":
+            inc = inc.astype(np.float32)
+        q = core.integrate(inc, method=method, q0=q0, precision=precision)
+        step = names.samples_per_update(method)
+    q = np.asarray(q, dtype=np.float64)
+    return q, s0 + step * (np.arange(len(q)) + 1)
+
+
+register_estimator("integrator", integrate_trial)
+
+
+@lru_cache(maxsize=4)
+def _trial(path: str) -> Any:
+    from .. import broad
+
+    return broad.load_trial(path)
+
+
+def _trial_files(folder: Path) -> dict[str, Path]:
+    return {p.stem: p for p in sorted(folder.glob("*.mat"))}
+
+
+def _accepts(fn: Callable[..., Any], name: str) -> bool | None:
+    """Whether fn takes keyword ``name`` (None: it takes any keyword, or cannot be inspected)."""
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return None
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in sig.parameters.values()):
+        return None
+    p = sig.parameters.get(name)
+    return p is not None and p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+
+
+# ---------------------------------------------------------------------------
+# the spec
+# ---------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Run:
+    """One run: its key (hash of kind and parameters) and its parameters."""
+
+    key: str
+    params: dict[str, Any]
+
+
+@dataclass
+class Spec:
+    """A parsed and expanded sweep spec (:func:`load_spec`)."""
+
+    name: str
+    kind: Kind
+    runs: list[Run]
+    axes: list[str]                 #: swept parameters, in the spec's order (plots)
+    random_axes: list[str]          #: of those, the randomly drawn ones
+    over: list[str]                 #: replicate parameters the summary aggregates over
+    figure: str                     #: the figure plotted
+    text: str = ""                  #: the spec's TOML (copied into the output folder)
+    source: Path | None = None      #: the spec file
+    data: Path | None = None        #: recordings: the trials' folder
+    retries: int = 2
+    chunk: int = 1
+    estimators: dict[str, Callable[..., Any]] = field(default_factory=dict)
+
+    @property
+    def params(self) -> list[str]:
+        """Every parameter any run sets, in order of first appearance."""
+        seen: dict[str, None] = {}
+        for r in self.runs:
+            for k in r.params:
+                seen.setdefault(k, None)
+        return list(seen)
+
+
+_SWEEP_KEYS = {"name", "kind", "seeds", "data", "trials", "summary_over", "figure", "retries", "chunk"}
+_TOP_KEYS = {"sweep", "fixed", "grid", "random", "cases", "exclude"}
+
+
+def _key(kind: str, params: Mapping[str, Any]) -> str:
+    blob = json.dumps({"kind": kind, "params": params}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()[:16]
+
+
+_DISTRIBUTIONS = ("uniform", "log_uniform", "int", "normal", "choice")
+
+
+def _draw(name: str, dist: Any, rng: np.random.Generator, n: int) -> list[Any]:
+    if not isinstance(dist, dict) or len(dist) != 1 or next(iter(dist)) not in _DISTRIBUTIONS:
+        raise SpecError(f"[random] {name}: give one distribution, e.g. {{uniform = [lo, hi]}}, "
+                        "{log_uniform = [lo, hi]}, {int = [lo, hi]}, {normal = [mean, sd]}, {choice = [...]}")
+    (how, arg), = dist.items()
+    if how == "choice":
+        if not isinstance(arg, list) or not arg:
+            raise SpecError(f"[random] {name}: choice needs a non-empty list")
+        return [arg[i] for i in rng.integers(0, len(arg), n)]
+    if not (isinstance(arg, list) and len(arg) == 2 and all(isinstance(x, (int, float)) for x in arg)):
+        raise SpecError(f"[random] {name}: {how} needs two numbers, got {arg!r}")
+    a, b = float(arg[0]), float(arg[1])
+    if how == "uniform" and a < b:
+        return [float(x) for x in rng.uniform(a, b, n)]
+    if how == "log_uniform" and 0 < a < b:
+        return [float(x) for x in np.exp(rng.uniform(math.log(a), math.log(b), n))]
+    if how == "int" and a <= b and a == int(a) and b == int(b):
+        return [int(x) for x in rng.integers(int(a), int(b) + 1, n)]
+    if how == "normal" and b > 0:
+        return [float(x) for x in rng.normal(a, b, n)]
+    raise SpecError(f"[random] {name}: bad {how} {arg!r} (uniform/log_uniform: lo < hi, log_uniform lo > 0; "
+                    "int: integers lo <= hi; normal: sd > 0; choice: a list)")
+
+
+def _table(doc: Mapping[str, Any], name: str) -> dict[str, Any]:
+    t = doc.get(name, {})
+    if not isinstance(t, dict):
+        raise SpecError(f"[{name}] must be a table")
+    return t
+
+
+def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | None = None) -> Spec:
+    """Read and expand a spec: a TOML file's path, or the parsed document.
+
+    Raises :class:`SpecError` (one line) for anything that cannot run:
+    unknown keys or options, bad values (checked by the simulate command's
+    own parser and ``SimConfig.validate``), unknown estimators or trials.
+    """
+    source: Path | None = None
+    if isinstance(spec, Mapping):
+        doc, text = dict(spec), ""
+    else:
+        source = Path(spec)
+        try:
+            text = source.read_text()
+        except OSError as exc:
+            raise SpecError(f"cannot read {str(source)!r}: {exc.strerror or exc}") from None
+        doc = _toml_loads(text)
+        base = base or source.parent
+    base = base or Path.cwd()
+    unknown = set(doc) - _TOP_KEYS
+    if unknown:
+        raise SpecError(f"unknown section(s) {sorted(unknown)}; a spec has {sorted(_TOP_KEYS)}")
+    head = _table(doc, "sweep")
+    bad = set(head) - _SWEEP_KEYS
+    if bad:
+        raise SpecError(f"[sweep] unknown key(s) {sorted(bad)}; known: {sorted(_SWEEP_KEYS)}")
+    kind = head.get("kind", "simulate")
+    if kind not in KINDS:
+        raise SpecError(f"[sweep] kind must be one of {list(KINDS)}, got {kind!r}")
+    name = str(head.get("name") or (source.stem if source else "sweep"))
+    seeds_v = head.get("seeds", 1)
+    if isinstance(seeds_v, bool) or not (isinstance(seeds_v, int) and seeds_v >= 1 or isinstance(seeds_v, list)
+                                          and seeds_v and all(isinstance(s, int) and not isinstance(s, bool)
+                                                              and 0 <= s < 2**63 for s in seeds_v)):
+        raise SpecError(f"[sweep] seeds must be a count >= 1 or a list of integers >= 0, got {seeds_v!r}")
+    seeds = list(range(seeds_v)) if isinstance(seeds_v, int) else list(seeds_v)
+    retries, chunk = head.get("retries", 2), head.get("chunk", 1)
+    for k, v, lo in (("retries", retries, 0), ("chunk", chunk, 1)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise SpecError(f"[sweep] {k} must be an integer >= {lo}, got {v!r}")
+
+    # --- the parameter sets, before expansion -----------------------------------------------
+    fixed = _table(doc, "fixed")
+    grid = _table(doc, "grid")
+    rnd = dict(_table(doc, "random"))
+    cases = doc.get("cases", [{}])
+    excl = doc.get("exclude", [])
+    for nm, v in (("cases", cases), ("exclude", excl)):
+        if not (isinstance(v, list) and all(isinstance(x, dict) for x in v)):
+            raise SpecError(f"[[{nm}]] must be an array of tables")
+    for k, v in grid.items():
+        if not isinstance(v, list) or not v:
+            raise SpecError(f"[grid] {k}: give a non-empty list of values, got {v!r}")
+    draws = rnd.pop("draws", 0 if not rnd else None)
+    rseed = rnd.pop("seed", 0)
+    if rnd and (isinstance(draws, bool) or not isinstance(draws, int) or draws < 1):
+        raise SpecError(f"[random] draws must be an integer >= 1, got {draws!r}")
+    if isinstance(rseed, bool) or not isinstance(rseed, int) or rseed < 0:
+        raise SpecError(f"[random] seed must be an integer >= 0, got {rseed!r}")
+
+    def norm(section: str, d: Mapping[str, Any]) -> dict[str, Any]:
+        out = {}
+        for k, v in d.items():
+            n = _option_name(k)
+            if section == "cases" and n == "label":
+                n, v = "case", str(v)
+            if n == "seed" and section != "exclude":
+                raise SpecError(f"[{section}] seed: the sweep sets the seed; use [sweep] seeds = N or [list]")
+            if n == "case" and section not in ("cases", "exclude"):
+                raise SpecError(f"[{section}] case: reserved for the label of a [[cases]] entry")
+            if kind == "simulate" and n not in _options() and n not in RESERVED:
+                raise SpecError(f"[{section}] {k}: not an option of attitude simulate (sweepable: "
+                                f"{', '.join(sorted(_options()))})")
+            if n.endswith(("_file", "_path")) and section != "exclude":  # a path: from the spec's folder
+                v = [_path(base, x) for x in v] if section == "grid" and isinstance(v, list) else _path(base, v)
+            out[n] = v
+        return out
+
+    fixed, grid, rnd = norm("fixed", fixed), norm("grid", grid), norm("random", rnd)
+    cases = [norm("cases", c) for c in cases]
+    excl = [norm("exclude", e) for e in excl]
+    clash = set(grid) & set(rnd)
+    if clash:
+        raise SpecError(f"parameter(s) {sorted(clash)} both in [grid] and [random]")
+
+    random_axes = sorted(rnd)
+    drawn: list[dict[str, Any]] = [{}]
+    if rnd:
+        rng = np.random.default_rng(rseed)
+        cols = {k: _draw(k, rnd[k], rng, draws) for k in random_axes}
+        drawn = [{k: cols[k][i] for k in random_axes} for i in range(draws)]
+
+    data: Path | None = None
+    trial_files: dict[str, Path] = {}
+    estimators: dict[str, Callable[..., Any]] = {}
+    if kind == "recordings":
+        from .. import broad
+
+        d = head.get("data")
+        folder = (base / d) if d else broad.default_dir()
+        if folder is None or not folder.is_dir():
+            raise SpecError(f"[sweep] data: no folder of recordings at {str(folder)!r}")
+        data = folder.resolve()
+        trial_files = _trial_files(data)
+        if not trial_files:
+            raise SpecError(f"[sweep] data: no .mat recordings in {str(data)!r}")
+        trials = head.get("trials", sorted(trial_files))
+        if isinstance(trials, str):
+            trials = [t for t in sorted(trial_files) if Path(t).match(trials)]
+        if not isinstance(trials, list) or not trials:
+            raise SpecError("[sweep] trials: give a list of trial names or a glob matching some")
+        missing = [t for t in trials if t not in trial_files]
+        if missing:
+            raise SpecError(f"[sweep] trials: not in {str(data)!r}: {missing}")
+        if "trial" in grid or "trial" in fixed:
+            raise SpecError("trial: list the recordings in [sweep] trials")
+        grid = {"trial": list(trials), **grid}
+    elif head.get("data") is not None or head.get("trials") is not None:
+        raise SpecError("[sweep] data and trials belong to kind = \"recordings\"")
+
+    # --- expansion: cases × grid × draws × seeds ------------------------------------------
+    gkeys = list(grid)
+    runs: list[Run] = []
+    seen: set[str] = set()
+    for case in cases:
+        for combo in itertools.product(*(grid[k] for k in gkeys)):
+            for draw in drawn:
+                # a case pins what it names: over the grid and the draws
+                point = {**fixed, **dict(zip(gkeys, combo)), **draw, **case}
+                if kind == "recordings":
+                    point.setdefault("estimator", "integrator")
+                live = [s for s in seeds if not any(all({**point, "seed": s}.get(k, _MISSING) == v
+                                                        for k, v in e.items()) for e in excl)]
+                if not live:
+                    continue
+                canon = _canonical(kind, point, estimators)
+                for s in live:
+                    params = {**canon, "seed": s}
+                    key = _key(kind, params)
+                    if key not in seen:
+                        seen.add(key)
+                        runs.append(Run(key, params))
+    if not runs:
+        raise SpecError("the spec expands to no run (everything excluded?)")
+
+    axes = [k for k in gkeys if len({json.dumps(_jsonable(v)) for v in grid[k]}) > 1] + random_axes
+    if len(cases) > 1:
+        axes.insert(0, "case")
+    over_v = head.get("summary_over", list(DEFAULT_OVER[kind]))
+    if not (isinstance(over_v, list) and all(isinstance(x, str) for x in over_v)):
+        raise SpecError(f"[sweep] summary_over must be a list of parameter names, got {over_v!r}")
+    over = [_option_name(x) for x in over_v]
+    figure = str(head.get("figure", DEFAULT_FIGURE[kind]))
+    return Spec(name=name, kind=kind, runs=runs, axes=[a for a in axes if a not in over], random_axes=random_axes,
+                over=over, figure=figure, text=text, source=source, data=data, retries=retries, chunk=chunk,
+                estimators=estimators)
+
+
+_MISSING = object()
+
+
+def _canonical(kind: str, point: dict[str, Any], estimators: dict[str, Callable[..., Any]]) -> dict[str, Any]:
+    """The run's parameters as the run will see them; SpecError if they cannot run."""
+    if kind == "simulate":
+        from ..cli.simulate import build_config
+        from ..errors import AttitudeError
+
+        try:
+            ns = _simulate_namespace(point)
+        except _ParseError as exc:
+            raise SpecError(f"run {_show(point)}: {exc}") from None
+        try:  # the command's own checks: a combination that cannot run is a spec error
+            build_config(ns).validate()
+        except (AttitudeError, ValueError, TypeError) as exc:
+            raise SpecError(f"run {_show(point)}: {exc}") from None
+        out = {}
+        for k, v in point.items():
+            c = v if k == "case" else _jsonable(getattr(ns, k))
+            try:  # the parsed value when it has a JSON form, else the spec's own
+                json.dumps(c)
+            except (TypeError, ValueError):
+                c = _jsonable(v)
+            out[k] = c
+        return out
+    name = point["estimator"]
+    fn = ESTIMATORS.get(name)
+    if fn is None:
+        raise SpecError(f"estimator {name!r} is not registered (registered: {', '.join(sorted(ESTIMATORS))})")
+    estimators[name] = fn
+    for k in point:
+        if k not in ("trial", "estimator", "case") and _accepts(fn, k) is False:
+            raise SpecError(f"estimator {name!r} has no setting {k!r}")
+    return {k: _jsonable(v) for k, v in point.items()}
+
+
+def _path(base: Path, v: Any) -> Any:
+    return str((base / v).resolve()) if isinstance(v, str) and v else v
+
+
+def _show(point: Mapping[str, Any]) -> str:
+    return "{" + ", ".join(f"{k}={v!r}" for k, v in point.items()) + "}"
+
+
+# ---------------------------------------------------------------------------
+# one run (executed on a worker)
+# ---------------------------------------------------------------------------
+
+#: summary.json entries that are not figures of the run: parameters, constants, wall time
+_NOT_FIGURES = ("attitude_c_version", "parameters", "paper_maxima_rad", "backends", "elapsed_s")
+
+
+def _flat_figures(summary: Mapping[str, Any]) -> dict[str, float]:
+    """Every number of a run's summary.json, flattened: ``err_<angle>_<stat>`` for
+    ``errors_rad``, ``<section>_<key>[_<key>...]`` for the rest, 3-vectors as ``_0``,
+    ``_1``, ``_2``; parameters, constants and wall times left out (they are not results,
+    and a wall time would make the table depend on scheduling)."""
+    figs: dict[str, float] = {}
+
+    def walk(prefix: str, v: Any) -> None:
+        if isinstance(v, bool) or v is None:
+            return
+        if isinstance(v, (int, float)):
+            figs[prefix] = float(v)
+        elif isinstance(v, Mapping):
+            for k, x in v.items():
+                if "elapsed" in k or "wall" in k or (prefix == "link" and k in ("seed", "ber")):
+                    continue
+                walk(f"{prefix}_{k}" if prefix else str(k), x)
+        elif isinstance(v, (list, tuple)) and len(v) == 3 and all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+            for i, x in enumerate(v):
+                figs[f"{prefix}_{i}"] = float(x)
+
+    walk("err", summary.get("errors_rad", {}))
+    walk("", {k: v for k, v in summary.items() if k not in _NOT_FIGURES and k != "errors_rad"})
+    return figs
+
+
+def _run_simulate(params: Mapping[str, Any]) -> dict[str, float]:
+    from ..cli.simulate import build_config
+    from .chain import simulate
+
+    res = simulate(build_config(_simulate_namespace(params)))
+    return _flat_figures(res.summary)
+
+
+def _run_recording(params: Mapping[str, Any], data: str, fn: Callable[..., Any]) -> dict[str, float]:
+    from .. import broad
+
+    trial = _trial(str(Path(data) / f"{params['trial']}.mat"))
+    settings = {k: v for k, v in params.items() if k not in ("trial", "estimator", "case", "seed")}
+    if "seed" in params and _accepts(fn, "seed"):  # only to an estimator that names the setting
+        settings["seed"] = params["seed"]
+    out = fn(trial, **settings)
+    if isinstance(out, tuple):
+        q, idx = np.asarray(out[0], dtype=np.float64), np.asarray(out[1], dtype=np.int64)
+    else:
+        q = np.asarray(out, dtype=np.float64)
+        idx = np.arange(len(q))
+    if q.ndim != 2 or q.shape[1] != 4 or idx.shape != (len(q),) or (len(idx) and (idx.min() < 0
+                                                                                 or idx.max() >= trial.n)):
+        raise InvalidArgument(f"estimator returned attitudes of shape {q.shape} with indices "
+                              f"{idx.shape}: expected (M, 4) and (M,) within the trial's {trial.n} samples")
+    f = broad.errors(q, trial.quat[idx], trial.movement[idx])
+    return {"total_deg": f.total, "heading_deg": f.heading, "inclination_deg": f.inclination,
+            "samples": float(f.samples)}
+
+
+def _version() -> str:
+    import attitude_c
+
+    return str(attitude_c.__version__)
+
+
+def run_chunk(kind: str, runs: Sequence[tuple[str, dict[str, Any]]], data: str | None,
+              estimators: Mapping[str, Callable[..., Any]]) -> list[dict[str, Any]]:
+    """Execute runs; one record each. A run that raises is recorded with its error."""
+    out = []
+    for key, params in runs:
+        t0 = time.perf_counter()
+        rec: dict[str, Any] = {"key": key, "params": params, "figures": {}, "error": None}
+        try:
+            if kind == "simulate":
+                rec["figures"] = _run_simulate(params)
+            else:
+                rec["figures"] = _run_recording(params, str(data), estimators[params["estimator"]])
+        except Exception as exc:  # noqa: BLE001 - any failure of one run is its result
+            tb = traceback.extract_tb(exc.__traceback__)
+            where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
+            rec["error"] = f"{type(exc).__name__}: {exc}{where}"
+        rec["elapsed_s"] = time.perf_counter() - t0
+        rec["attitude_c_version"] = _version()
+        out.append(rec)
+    return out
+
+
+# ---------------------------------------------------------------------------
+# the journal (resume) and atomic files
+# ---------------------------------------------------------------------------
+
+def read_journal(path: Path, *, repair: bool = False) -> dict[str, dict[str, Any]]:
+    """The finished runs recorded in ``path``, by key (later lines win; a torn last
+    line is ignored, and with ``repair`` cut off so that appends start clean: only
+    the sweep that holds the folder's lock repairs)."""
+    done: dict[str, dict[str, Any]] = {}
+    if not path.exists():
+        return done
+    raw = path.read_bytes()
+    end = raw.rfind(b"\n") + 1
+    if repair and end < len(raw):  # killed while writing a line
+        with open(path, "r+b") as f:
+            f.truncate(end)
+    for line in raw[:end].splitlines():
+        try:
+            rec = json.loads(line)
+        except ValueError:
+            continue
+        if isinstance(rec, dict) and "key" in rec:
+            done[rec["key"]] = rec
+    return done
+
+
+class _Journal:
+    def __init__(self, path: Path) -> None:
+        self.f = open(path, "a", encoding="utf-8")  # noqa: SIM115 - held open for the whole sweep
+        self.last_sync = time.monotonic()
+
+    def write(self, recs: Iterable[dict[str, Any]]) -> None:
+        for r in recs:
+            self.f.write(json.dumps(r, separators=(",", ":"), allow_nan=True) + "\n")
+        self.f.flush()
+        if time.monotonic() - self.last_sync > 1.0:
+            os.fsync(self.f.fileno())
+            self.last_sync = time.monotonic()
+
+    def close(self) -> None:
+        self.f.flush()
+        os.fsync(self.f.fileno())
+        self.f.close()
+
+
+class _Lock:
+    """An exclusive advisory lock on the output folder (one sweep writes a journal at a time)."""
+
+    def __init__(self, folder: Path) -> None:
+        self.f = open(folder / ".sweep.lock", "a")  # noqa: SIM115 - held for the whole sweep
+        try:
+            import fcntl
+        except ImportError:  # pragma: no cover - not POSIX: no lock
+            return
+        try:
+            fcntl.flock(self.f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.f.close()
+            raise InvalidArgument(f"out: another sweep is running in {str(folder)!r} (it holds "
+                                  f"{str(folder / '.sweep.lock')!r})") from None
+
+    def release(self) -> None:
+        self.f.close()
+
+
+def _atomic(path: Path, write: Callable[[Path], None]) -> None:
+    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+# ---------------------------------------------------------------------------
+# execution
+# ---------------------------------------------------------------------------
+
+def _chunks(items: Sequence[Run], n: int) -> Iterator[list[tuple[str, dict[str, Any]]]]:
+    for i in range(0, len(items), n):
+        yield [(r.key, r.params) for r in items[i:i + n]]
+
+
+def default_workers() -> int:
+    """Worker processes of the default local cluster: the CPUs this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def _engine(client: Any, workers: int | None) -> tuple[Any, Callable[[], None], str]:
+    """(client or None for serial, close(), description)."""
+    if isinstance(client, str) and client == "serial":
+        return None, lambda: None, "serial (this process)"
+    distributed = _need("distributed")
+    if client is None:
+        n = workers or default_workers()
+        import logging
+
+        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                           dashboard_address=":0", silence_logs=logging.CRITICAL)
+        c = distributed.Client(cluster)
+
+        def close() -> None:
+            c.close()
+            cluster.close()
+        return c, close, f"local cluster, {n} worker process(es)"
+    if isinstance(client, str):
+        try:
+            c = distributed.Client(client, timeout="15s")
+        except (OSError, TimeoutError) as exc:
+            raise ConnectionError(f"no Dask scheduler at {client}: {exc}") from None
+        n = len(c.scheduler_info().get("workers", {}))
+        return c, c.close, f"scheduler {client}, {n} worker(s)"
+    return client, lambda: None, f"Dask client {getattr(client, 'scheduler', '')}"
+
+
+def _execute(spec: Spec, todo: list[Run], client: Any, journal: _Journal,
+             progress: Callable[[int], None]) -> int:
+    data = str(spec.data) if spec.data else None
+    chunks = list(_chunks(todo, spec.chunk))
+    done = 0
+    if client is None:
+        for ch in chunks:
+            recs = run_chunk(spec.kind, ch, data, spec.estimators)
+            journal.write(recs)
+            done += len(recs)
+            progress(len(recs))
+        return done
+    distributed = _need("distributed")
+    nthreads = max(1, sum(client.nthreads().values()))
+    window = max(8, 4 * nthreads)  # futures in flight: bounded, so 10^6 runs do not flood the scheduler
+    it = iter(chunks)
+    pending: dict[Any, list[tuple[str, dict[str, Any]]]] = {}
+
+    def submit(ch: list[tuple[str, dict[str, Any]]]) -> Any:
+        fut = client.submit(run_chunk, spec.kind, ch, data, spec.estimators,
+                            key=f"attitude-sweep-{ch[0][0]}-{len(ch)}", retries=spec.retries, pure=False)
+        pending[fut] = ch
+        return fut
+
+    ac = distributed.as_completed([submit(ch) for ch in itertools.islice(it, window)])
+    try:
+        for fut in ac:
+            ch = pending.pop(fut)
+            try:
+                recs = fut.result()
+            except Exception as exc:  # noqa: BLE001 - the engine gave up (e.g. KilledWorker too often)
+                recs = [{"key": k, "params": p, "figures": {}, "elapsed_s": float("nan"),
+                         "attitude_c_version": _version(), "error": f"{type(exc).__name__}: {exc}"}
+                        for k, p in ch]
+            fut.release()
+            journal.write(recs)
+            done += len(recs)
+            progress(len(recs))
+            nxt = next(it, None)
+            if nxt is not None:
+                ac.add(submit(nxt))
+    finally:
+        for f in list(pending):
+            f.cancel()
+    return done
+
+
+# ---------------------------------------------------------------------------
+# results: table, summary, plots
+# ---------------------------------------------------------------------------
+
+def _cell(v: Any) -> Any:
+    if isinstance(v, list):
+        return ",".join(_argv_value(x) for x in v)
+    return v
+
+
+def results_table(spec: Spec, records: Mapping[str, dict[str, Any]]) -> Any:
+    """One row per run of ``spec`` (in spec order): key, every parameter, every figure,
+    error, elapsed_s, attitude_c_version."""
+    pd = _need("pandas")
+    params = spec.params
+    figs: dict[str, None] = {}
+    for r in spec.runs:
+        rec = records.get(r.key)
+        if rec:
+            for k in rec["figures"]:
+                figs.setdefault(k, None)
+    rows = []
+    for r in spec.runs:
+        rec = records.get(r.key)
+        if rec is None:
+            continue
+        row: dict[str, Any] = {"key": r.key}
+        row.update({p: _cell(r.params.get(p)) for p in params})
+        row.update({f: rec["figures"].get(f, math.nan) for f in figs})
+        row["error"] = rec.get("error") or ""
+        row["elapsed_s"] = rec.get("elapsed_s", math.nan)
+        row["attitude_c_version"] = rec.get("attitude_c_version", "")
+        rows.append(row)
+    cols = ["key", *params, *figs, "error", "elapsed_s", "attitude_c_version"]
+    return pd.DataFrame(rows, columns=cols)
+
+
+def figure_columns(df: Any, spec: Spec) -> list[str]:
+    skip = {"key", "error", "elapsed_s", "attitude_c_version", *spec.params}
+    return [c for c in df.columns if c not in skip]
+
+
+def summarize(df: Any, spec: Spec) -> Any:
+    """Per grid point (every parameter but the replicates ``spec.over``) and figure:
+    runs, n (finished without error), mean, std, min, p5, p50, p95, max. Long format."""
+    pd = _need("pandas")
+    figs = figure_columns(df, spec)
+    group = [p for p in spec.params if p not in spec.over]
+    # a parameter some runs do not set (a case's) is "" there: NaN would not group reliably
+    base = df.assign(**{p: df[p].astype(object).where(df[p].notna(), "") for p in group if df[p].isna().any()})
+    if not figs:
+        return pd.DataFrame(columns=[*group, "figure", "runs", "n"])
+    long = base.melt(id_vars=group or None, value_vars=figs, var_name="figure", value_name="value")
+    keys = [*group, "figure"]
+    g = long.groupby(keys, sort=False)["value"]
+    out = g.agg(runs="size", n="count", mean="mean", std="std", min="min", max="max")
+    q = g.quantile([0.05, 0.5, 0.95]).unstack()
+    q.columns = ["p5", "p50", "p95"]
+    out = out.join(q)[["runs", "n", "mean", "std", "min", "p5", "p50", "p95", "max"]]
+    return out.reset_index()
+
+
+def _is_num(s: Any) -> bool:
+    pd = _need("pandas")
+    return bool(pd.api.types.is_numeric_dtype(s))
+
+
+_MAX_PANELS = 9
+_MAX_LINES = 10
+
+
+def _band(ax: Any, sub: Any, axis: str, fig_col: str, numeric: bool, pos: dict[Any, int], label: str) -> None:
+    st = sub.groupby(axis, sort=True)[fig_col].quantile([0.05, 0.5, 0.95]).unstack()
+    x = np.asarray(st.index, dtype=float) if numeric else np.array([pos[v] for v in st.index], float)
+    line, = ax.plot(x, st[0.5], "o-", label=label, lw=1.3, ms=3)
+    ax.fill_between(x, st[0.05], st[0.95], color=line.get_color(), alpha=0.15, lw=0)
+
+
+def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
+    """One PNG per swept parameter: ``spec.figure`` against it, median and 5–95 % band
+    over the replicates (``spec.over``). With two or more other swept parameters, one
+    panel per value of the first (up to 9) and one line per combination of the rest
+    (up to 10); a randomly drawn parameter is shown as a scatter of every run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig_col = spec.figure
+    files: list[Path] = []
+    if fig_col not in df.columns or df[fig_col].notna().sum() == 0:
+        return files
+    ok = df[df[fig_col].notna()]
+    reps = ", ".join(spec.over)
+    for axis in spec.axes:
+        numeric = _is_num(ok[axis])
+        others = [a for a in spec.axes if a != axis and a not in spec.random_axes]
+        facet, lines = (others[0], others[1:]) if len(others) >= 2 else (None, others)
+        panels = list(dict.fromkeys(ok[facet].tolist()))[:_MAX_PANELS] if facet else [None]
+        ncol = min(3, len(panels))
+        nrow = math.ceil(len(panels) / ncol)
+        fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol + 1.2, 3.3 * nrow + 0.6), sharey=True,
+                                squeeze=False)
+        xs_all = list(dict.fromkeys(ok[axis].tolist()))
+        pos = {x: i for i, x in enumerate(xs_all)}
+        for k, panel in enumerate(panels):
+            ax = axs[k // ncol][k % ncol]
+            sub = ok if facet is None else ok[ok[facet] == panel]
+            if axis in spec.random_axes:
+                ax.scatter(sub[axis], sub[fig_col], s=8, alpha=0.6)
+            else:
+                groups = sub.groupby(lines, sort=False, dropna=False) if lines else [((), sub)]
+                for i, (label, part) in enumerate(groups):
+                    if i >= _MAX_LINES:
+                        break
+                    vals = label if isinstance(label, tuple) else (label,)
+                    _band(ax, part, axis, fig_col, numeric, pos,
+                          ", ".join(f"{o}={v}" for o, v in zip(lines, vals)) or fig_col)
+                if not numeric:
+                    ax.set_xticks(range(len(xs_all)), [str(v) for v in xs_all], rotation=30, ha="right",
+                                  fontsize=7)
+            if (ok[fig_col] > 0).all():
+                ax.set_yscale("log")
+            if numeric and (ok[axis] > 0).all() and ok[axis].max() / ok[axis].min() >= 10:
+                ax.set_xscale("log")
+            if facet is not None:
+                ax.set_title(f"{facet}={panel}", fontsize=8)
+            ax.set_xlabel(axis, fontsize=8)
+            if k % ncol == 0:
+                ax.set_ylabel(fig_col, fontsize=8)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.tick_params(labelsize=7)
+        for k in range(len(panels), nrow * ncol):
+            axs[k // ncol][k % ncol].set_visible(False)
+        handles, labels = axs[0][0].get_legend_handles_labels()
+        if len(handles) > 1:
+            fig.legend(handles, labels, fontsize=7, loc="center right")
+            fig.tight_layout(rect=(0, 0, 0.80, 0.95))
+        else:
+            fig.tight_layout(rect=(0, 0, 1, 0.95))
+        fig.suptitle(f"{spec.name}: {fig_col} vs {axis} (median, 5–95 % over {reps})", fontsize=9)
+        path = out / f"{fig_col}-vs-{axis}.png"
+
+        def save(p: Path, fig: Any = fig) -> None:
+            fig.savefig(p, dpi=100)
+        _atomic(path, save)
+        plt.close(fig)
+        files.append(path)
+    return files
+
+
+# ---------------------------------------------------------------------------
+# the API
+# ---------------------------------------------------------------------------
+
+def sweep(spec: Spec | str | os.PathLike[str] | Mapping[str, Any], client: Any = None, *,
+          out: str | os.PathLike[str] | None = None, workers: int | None = None,
+          progress: bool | Callable[[int, int], None] = False, retry_failed: bool = False,
+          plots: bool = True) -> Any:
+    """Run a sweep; return its table (pandas.DataFrame, one row per run).
+
+    ``spec``: a :class:`Spec`, a TOML file's path or the parsed document.
+    ``client``: None for a local cluster of ``workers`` processes (default:
+    one per CPU), a ``distributed.Client``, a scheduler address
+    (``"tcp://host:8786"``), or ``"serial"`` (every run in this process, no
+    Dask). ``out``: the output folder (default ``results/sweep-<name>``);
+    finished runs are journaled there, and a sweep started again with the
+    same folder runs only the runs it has no record of (``retry_failed``:
+    also those recorded with an error). Writes ``runs.csv``, ``summary.csv``,
+    ``spec.toml`` and, with ``plots``, one PNG per swept parameter.
+    ``progress``: True for a bar on stderr, or ``fn(done, total)``.
+
+    ``df.attrs`` holds ``executed`` (runs run now), ``reused`` (taken from
+    the journal), ``failed``, ``out``, ``engine`` and ``plots`` (the PNG files).
+    """
+    _need("pandas")
+    sp = spec if isinstance(spec, Spec) else load_spec(spec)
+    folder = Path(out) if out is not None else Path("results") / f"sweep-{sp.name}"
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = _Lock(folder)
+    try:
+        if sp.text:
+            text = sp.text
+
+            def put(p: Path) -> None:
+                p.write_text(text)
+            _atomic(folder / "spec.toml", put)
+        return _sweep_locked(sp, folder, client, workers, progress, retry_failed, plots)
+    finally:
+        lock.release()
+
+
+def _sweep_locked(sp: Spec, folder: Path, client: Any, workers: int | None,
+                  progress: bool | Callable[[int, int], None], retry_failed: bool, plots: bool) -> Any:
+    jpath = folder / JOURNAL
+    records = read_journal(jpath, repair=True)
+    want = {r.key for r in sp.runs}
+    if retry_failed:
+        records = {k: v for k, v in records.items() if not v.get("error")}
+    todo = [r for r in sp.runs if r.key not in records]
+    reused = len(want) - len(todo)
+
+    bar: Any = None
+    if progress is True:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(sp.runs), initial=reused, desc=f"sweep {sp.name}", unit="run", file=sys.stderr,
+                   dynamic_ncols=True, mininterval=0.5)
+        report: Callable[[int], None] = bar.update
+    elif callable(progress):
+        count = [reused]
+
+        def report(n: int) -> None:
+            count[0] += n
+            progress(count[0], len(sp.runs))  # type: ignore[operator]
+    else:
+        def report(n: int) -> None:
+            return None
+
+    executed = 0
+    engine = "nothing to run"
+    if todo:
+        c, close, engine = _engine(client, workers)
+        journal = _Journal(jpath)
+        try:
+            executed = _execute(sp, todo, c, journal, report)
+        finally:
+            journal.close()
+            close()
+            if bar is not None:
+                bar.close()
+        records = read_journal(jpath)  # later lines win: a retried run replaces its failed record
+    elif bar is not None:
+        bar.close()
+
+    df = results_table(sp, records)
+    _atomic(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
+    summ = summarize(df, sp)
+    _atomic(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
+    files = plot_results(df, sp, folder) if plots else []
+    df.attrs.update(plots=[str(f) for f in files])
+    df.attrs.update(executed=executed, reused=reused, failed=int((df["error"] != "").sum()), out=str(folder),
+                    engine=engine)
+    return df

@@ -1,0 +1,433 @@
+"""attitude sweep (attitude_c.sim.sweeps): specs, engines, resume, failures.
+
+The same small sweep runs serially (no Dask), on a local cluster of 2 worker
+processes and through a scheduler started here on loopback (`dask
+scheduler` + 2 `dask worker` processes): the tables must be identical, bit
+for bit, because every run is a pure function of its parameters (seeded from
+the spec). Resumption, a worker killed mid-run and failing runs are checked
+against the same serial reference.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import _missing
+
+from attitude_c.cli import main
+from attitude_c.sim import sweeps
+
+
+def _need_dask() -> None:
+    for m in ("dask", "distributed", "pandas"):
+        try:
+            __import__(m)
+        except ImportError:
+            _missing(f"needs {m}: pip install -e '.[sweep]'")
+
+
+# 5 runs of ~0.1 s each (0.5 s on a loaded 2-core box): methods x 2 seeds, and one run that raises at run time
+# (the fixed-point integrator has no rk4: SimConfig.validate lets it through, the
+# integrator refuses it)
+SPEC = """
+[sweep]
+name = "small"
+seeds = 2
+[fixed]
+duration = 12
+period = 0.04
+calibration = 1
+[grid]
+method = ["rv1", "rv3"]
+[[cases]]
+label = "full"
+[[cases]]
+label = "fixed-rk4"
+precision = "fixed"
+method = "rk4"
+[[exclude]]
+case = "fixed-rk4"
+seed = 1
+"""
+
+
+def _write(tmp: Path, text: str, name: str = "spec.toml") -> Path:
+    p = tmp / name
+    p.write_text(text)
+    return p
+
+
+def _same(a, b) -> None:
+    import pandas as pd
+
+    cols = [c for c in a.columns if c != "elapsed_s"]  # wall time: the only field scheduling may change
+    pd.testing.assert_frame_equal(a[cols].reset_index(drop=True), b[cols].reset_index(drop=True),
+                                  check_exact=True)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    _need_dask()
+    d = tmp_path_factory.mktemp("ref")
+    spec = _write(d, SPEC)
+    df = sweeps.sweep(spec, "serial", out=d / "out", plots=False)
+    return spec, df
+
+
+@pytest.fixture(scope="module")
+def scheduler(tmp_path_factory):
+    """`dask scheduler` + 2 `dask worker` processes on loopback, started and ended here."""
+    _need_dask()
+    from distributed import Client
+
+    d = tmp_path_factory.mktemp("dask")
+    sf = d / "scheduler.json"
+    procs: list[subprocess.Popen] = []
+    log = open(d / "dask.log", "w")  # noqa: SIM115 - closed at teardown
+
+    def start(*args: str) -> None:
+        procs.append(subprocess.Popen([sys.executable, "-m", "dask", *args], cwd=d, stdout=log,
+                                      stderr=subprocess.STDOUT, start_new_session=True))
+
+    try:
+        start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard", "--scheduler-file", str(sf))
+        deadline = time.monotonic() + 60
+        addr = None
+        while addr is None and time.monotonic() < deadline:
+            try:
+                addr = json.loads(sf.read_text())["address"]
+            except (OSError, ValueError, KeyError):  # not there yet, or being written
+                time.sleep(0.1)
+        assert addr, (d / "dask.log").read_text()
+        for i in range(2):
+            start("worker", "--scheduler-file", str(sf), "--nthreads", "1", "--no-dashboard", "--name", f"w{i}")
+        with Client(addr, timeout="30s") as c:
+            c.wait_for_workers(2, timeout=60)
+        yield addr
+    finally:
+        for p in reversed(procs):  # each in its own session: its group is ours to end
+            try:
+                os.killpg(p.pid, signal.SIGTERM)
+                p.wait(15)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+                p.wait(5)
+            except ProcessLookupError:
+                pass
+        log.close()
+
+
+# ---------------------------------------------------------------------------
+# specs
+# ---------------------------------------------------------------------------
+
+def test_expansion_keys_and_draws(tmp_path):
+    spec = _write(tmp_path, """
+[sweep]
+seeds = [3, 4]
+[fixed]
+duration = 2
+[grid]
+method = ["rv1", "rv2", "rk4"]
+[random]
+draws = 3
+seed = 7
+ber = {log_uniform = [1e-5, 1e-3]}
+oversample = {int = [1, 16]}
+[[exclude]]
+method = "rk4"
+""")
+    s = sweeps.load_spec(spec)
+    assert len(s.runs) == 2 * 3 * 2  # methods (rk4 excluded) x draws x seeds
+    assert len({r.key for r in s.runs}) == len(s.runs)
+    assert s.axes == ["method", "ber", "oversample"] and s.random_axes == ["ber", "oversample"]
+    assert [r.params["seed"] for r in s.runs[:2]] == [3, 4]
+    again = sweeps.load_spec(spec)  # the draws come from the spec alone
+    assert [r.params for r in again.runs] == [r.params for r in s.runs]
+    bers = {r.params["ber"] for r in s.runs}
+    assert len(bers) == 3 and all(1e-5 <= b <= 1e-3 for b in bers)
+    assert all(isinstance(r.params["oversample"], int) and 1 <= r.params["oversample"] <= 16 for r in s.runs)
+    # a run's key is its parameters: where the spec sets them and in which form does not matter
+    a = sweeps.load_spec({"fixed": {"period": 0.04, "cone-angle": "10"}, "grid": {"method": ["rv3"]}})
+    b = sweeps.load_spec({"grid": {"method": ["rv3"], "period": [0.04]}, "fixed": {"cone_angle": 10}})
+    assert [r.key for r in a.runs] == [r.key for r in b.runs]
+    c = sweeps.load_spec({"grid": {"method": ["rv3"], "period": [0.08]}})
+    assert c.runs[0].key != b.runs[0].key
+    # a repeatable option: a string is one occurrence, a list of strings several; the run's
+    # (canonical) parameters parse back to the same values on the worker
+    d = sweeps.load_spec({"fixed": {"mag": "hmr3000", "duration": 20},
+                          "grid": {"disturbance": ["5,8,20,0,0", ["5,8,20,0,0", "12,14,0,10,0,1,nav"]]}})
+    assert [len(r.params["disturbance"]) for r in d.runs] == [1, 2]
+    assert sweeps._simulate_namespace(d.runs[1].params).disturbance == [
+        (5.0, 8.0, (20.0, 0.0, 0.0), 0.0, "body"), (12.0, 14.0, (0.0, 10.0, 0.0), 1.0, "nav")]
+
+
+def test_every_simulate_option_is_sweepable_with_no_change_here(monkeypatch, capsys):
+    """The option set is read from `attitude simulate`'s parser: an option added there
+    (as the accelerometer/magnetometer options will be) can be swept as it is."""
+    from attitude_c.cli import simulate as cli_simulate
+
+    opts = sweeps.simulate_options()
+    assert {"method", "period", "ber", "gyro", "oversample", "cone_angle", "trajectory_file"} <= set(opts)
+    assert main(["sweep", "--list-options"]) == 0
+    listed = capsys.readouterr().out
+    assert "cone_angle       --cone-angle" in listed and "  integrator" in listed
+    assert not {"out", "seed", "budget", "json", "no_plots"} & set(opts)  # the 'run' group: how, not what
+    orig = cli_simulate.register
+
+    def register(sub):
+        orig(sub)
+        p = sub.choices["simulate"]
+        p.add_argument("--acc-noise", type=float, default=0.0, help="a new option")
+
+    monkeypatch.setattr(cli_simulate, "register", register)
+    sweeps._simulate_parser.cache_clear()
+    sweeps._options.cache_clear()
+    try:
+        s = sweeps.load_spec({"fixed": {"duration": 1}, "grid": {"acc-noise": [0.1, 0.2]}})
+        assert [r.params["acc_noise"] for r in s.runs] == [0.1, 0.2]
+        assert sweeps._simulate_namespace(s.runs[1].params).acc_noise == 0.2
+    finally:
+        sweeps._simulate_parser.cache_clear()
+        sweeps._options.cache_clear()
+
+
+@pytest.mark.parametrize("text, words", [
+    ("[grid]\nperod = [0.1]\n", "perod: not an option"),
+    ("[grid]\nperiod = [-1]\n", "must be a finite number > 0"),
+    ("[grid\n", "not valid TOML"),
+    ("[grid]\nseed = [1, 2]\n", "the sweep sets the seed"),
+    ("[random]\ndraws = 2\nber = {gauss = [0, 1]}\n", "give one distribution"),
+    ("[fixed]\nsensors = \"ideal\"\nber = 1e-3\n", "needs the sensor chain"),
+    ("[sweep]\nkind = \"recordings\"\n[grid]\nestimator = [\"nope\"]\n", "'nope' is not registered"),
+    ("[sweep]\nkind = \"recordings\"\n[grid]\nmetod = [\"rv1\"]\n", "has no setting 'metod'"),
+    ("[sweep]\nseeds = 0\n", "seeds must be"),
+    ("[swep]\n", "unknown section"),
+])
+def test_spec_errors_are_one_line_and_exit_2(tmp_path, capsys, text, words):
+    rc = main(["sweep", str(_write(tmp_path, text)), "--dry-run"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2
+    assert len(err) == 1 and words in err[0] and err[0].startswith("attitude sweep: error: "), err
+    assert main(["sweep", str(tmp_path / "missing.toml")]) == 2
+    assert "cannot read" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------
+# engines: the same table everywhere
+# ---------------------------------------------------------------------------
+
+def test_serial_reference_records_the_failing_run(reference):
+    _spec, df = reference
+    assert len(df) == 5
+    bad = df[df["case"] == "fixed-rk4"]
+    assert len(bad) == 1 and "does not implement method 'rk4'" in bad["error"].iloc[0]
+    assert bad["err_attitude_angle_rms"].isna().all()
+    ok = df[df["case"] == "full"]
+    assert (ok["error"] == "").all() and (ok["err_attitude_angle_rms"] > 0).all()
+    # seeds change the noise; methods see the same noise (common random numbers)
+    rv1 = ok[ok["method"] == "rv1"]["err_attitude_angle_rms"].to_numpy()
+    assert rv1[0] != rv1[1]
+    out = Path(df.attrs["out"])
+    assert df.attrs["failed"] == 1 and df.attrs["executed"] == 5
+    import pandas as pd
+
+    summ = pd.read_csv(out / "summary.csv")
+    assert summ.columns[-9:].tolist() == ["runs", "n", "mean", "std", "min", "p5", "p50", "p95", "max"]
+    fig = summ[summ["figure"] == "err_attitude_angle_rms"]
+    assert len(fig) == 3 and fig["runs"].tolist() == [2, 2, 1]  # rv1, rv3 over 2 seeds; the failing run
+    got = fig[fig["n"] > 0]
+    assert got[["mean", "p5", "p50", "p95"]].notna().all().all()
+    rv3 = ok[ok["method"] == "rv3"]["err_attitude_angle_rms"]
+    row = got[got["method"] == "rv3"].iloc[0]
+    assert row["mean"] == pytest.approx(rv3.mean(), rel=1e-12) and row["min"] <= row["p50"] <= row["max"]
+
+
+def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
+    spec, ref = reference
+    df = sweeps.sweep(spec, None, workers=2, out=tmp_path / "out")
+    assert df.attrs["engine"].startswith("local cluster, 2 worker")
+    _same(df, ref)
+    assert {p.name for p in (tmp_path / "out").iterdir()} >= {
+        "runs.csv", "summary.csv", "spec.toml", "runs.jsonl", "err_attitude_angle_rms-vs-method.png",
+        "err_attitude_angle_rms-vs-case.png"}
+    import pandas as pd
+
+    _same(pd.read_csv(tmp_path / "out" / "runs.csv", keep_default_na=False, na_values=[""]).fillna({"error": ""}),
+          ref.fillna({"error": ""}))
+
+
+def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path, capsys):
+    spec, ref = reference
+    rc = main(["sweep", str(spec), "--scheduler", scheduler, "--out", str(tmp_path / "out"), "--no-plots"])
+    assert rc == 1  # finished, one run recorded as failed
+    assert "1 run(s) raised" in capsys.readouterr().err
+    import pandas as pd
+
+    df = pd.read_csv(tmp_path / "out" / "runs.csv", keep_default_na=False, na_values=[""])
+    _same(df.fillna({"error": ""}), ref.fillna({"error": ""}))
+
+
+def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tmp_path):
+    from distributed import Client
+
+    spec, ref = reference
+    killed: list[int] = []
+    with Client(scheduler, timeout="30s") as watch:
+        result: dict = {}
+        t = threading.Thread(target=lambda: result.update(df=sweeps.sweep(spec, scheduler, out=tmp_path / "o",
+                                                                          plots=False)))
+        t.start()
+        deadline = time.monotonic() + 60
+        while not killed and time.monotonic() < deadline and t.is_alive():
+            busy = [w for w, ks in watch.processing().items() if ks]
+            if busy:
+                pid = watch.run(os.getpid, workers=[busy[0]])[busy[0]]
+                os.kill(pid, signal.SIGKILL)  # the worker process (its nanny restarts it)
+                killed.append(pid)
+            time.sleep(0.05)
+        t.join(120)
+        assert killed, "no worker was seen busy"
+        watch.wait_for_workers(2, timeout=60)  # the nanny brought it back
+    df = result["df"]
+    _same(df, ref)  # the lost run was run again, elsewhere, to the same result
+    assert df.attrs["failed"] == 1  # only the run that raises by design
+
+
+# ---------------------------------------------------------------------------
+# resume
+# ---------------------------------------------------------------------------
+
+def test_interrupted_sweep_resumes_running_only_the_missing_runs(reference, scheduler, tmp_path):
+    """The command is killed (SIGKILL: no clean-up at all) mid-sweep on the loopback
+    cluster, then run again serially: only the runs it has no record of run."""
+    spec, ref = reference
+    out = tmp_path / "out"
+    journal = out / sweeps.JOURNAL
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    p = subprocess.Popen([sys.executable, "-m", "attitude_c", "sweep", str(spec), "--scheduler", scheduler, "--out",
+                          str(out), "--no-plots", "--no-progress"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, env=env, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and p.poll() is None:
+            if journal.exists() and journal.read_bytes().count(b"\n") >= 1:
+                break
+            time.sleep(0.02)
+        os.killpg(p.pid, signal.SIGKILL)  # the command, mid-sweep
+    finally:
+        p.wait(30)
+    done = journal.read_bytes().count(b"\n")
+    assert 1 <= done < len(ref), f"{done} runs recorded before the kill: the test needs some, not all"
+    with open(journal, "ab") as f:  # a line torn by the kill
+        f.write(b'{"key": "abc", "params": {"dur')
+    df = sweeps.sweep(spec, "serial", out=out, plots=False)
+    assert df.attrs["reused"] == done and df.attrs["executed"] == len(ref) - done
+    _same(df, ref)
+    keys = [json.loads(line)["key"] for line in journal.read_text().splitlines()]
+    assert sorted(keys) == sorted(ref["key"])  # every run recorded once: none ran twice
+    again = sweeps.sweep(spec, "serial", out=out, plots=False)
+    assert again.attrs["executed"] == 0
+    with open(out / ".sweep.lock", "a") as held:  # another sweep writing the folder
+        import fcntl
+
+        fcntl.flock(held.fileno(), fcntl.LOCK_EX)
+        with pytest.raises(sweeps.InvalidArgument, match="another sweep is running"):
+            sweeps.sweep(spec, "serial", out=out, plots=False)
+    retried = sweeps.sweep(spec, "serial", out=out, plots=False, retry_failed=True)
+    assert retried.attrs["executed"] == 1  # the failed run, on request
+    _same(retried, ref)
+
+
+# ---------------------------------------------------------------------------
+# recordings: an estimator over BROAD-format trials
+# ---------------------------------------------------------------------------
+
+def _synthetic_trial(folder: Path, name: str, rate_dps=(0.0, 0.0, 30.0), n=900, hz=100.0) -> None:
+    """A BROAD-format .mat: constant body rate from a tilted start, the exact attitude as reference."""
+    from scipy.io import savemat
+
+    w = np.radians(rate_dps)
+    t = np.arange(n) / hz
+    q0 = np.array([math.cos(0.2), math.sin(0.2), 0.0, 0.0])
+    ang = np.linalg.norm(w) * t
+    ax = w / np.linalg.norm(w)
+    dq = np.c_[np.cos(ang / 2), np.sin(ang / 2)[:, None] * ax]
+    w0, v0 = q0[0], q0[1:]
+    q = np.c_[w0 * dq[:, 0] - dq[:, 1:] @ v0,
+              w0 * dq[:, 1:] + dq[:, :1] * v0 + np.cross(v0, dq[:, 1:])]  # q0 ⊗ dq(t): body-frame rate
+    quat = q.copy()
+    quat[:5] = np.nan  # markers lost at the start: the integrator starts at the first valid sample
+    savemat(folder / f"{name}.mat", {"imu_gyr": np.tile(w, (n, 1)), "imu_acc": np.zeros((n, 3)),
+                                     "imu_mag": np.zeros((n, 3)), "opt_quat": quat,
+                                     "movement": np.ones((n, 1)), "sampling_rate": np.array([[hz]])})
+
+
+def test_recordings_kind_with_the_integrator_and_a_registered_estimator(tmp_path):
+    _need_dask()
+    pytest.importorskip("scipy", reason="scipy is a test dependency: pip install -e '.[test]'")
+    data = tmp_path / "data"
+    data.mkdir()
+    _synthetic_trial(data, "const_z", (0.0, 0.0, 30.0))
+    _synthetic_trial(data, "const_xyz", (10.0, -20.0, 15.0))
+
+    def reference_itself(trial, fail: bool = False):
+        if fail:
+            raise RuntimeError("asked to fail")
+        return trial.quat  # (N, 4), one per sample: the error is exactly zero where defined
+
+    sweeps.register_estimator("test-reference", reference_itself)
+    try:
+        spec = _write(tmp_path, """
+[sweep]
+kind = "recordings"
+data = "data"
+[grid]
+method = ["rv1", "rv3", "rk4"]
+precision = ["f64", "f32"]
+[[exclude]]
+method = "rk4"
+precision = "f32"
+""")
+        df = sweeps.sweep(spec, "serial", out=tmp_path / "out", plots=False)
+        assert len(df) == 2 * 5 and (df["error"] == "").all()
+        # constant rate: every method is exact up to rounding; the trapezoid of a constant rate is exact
+        f64 = df[df["precision"] == "f64"]
+        # float64 rounding of <= 900 updates is ~1e-13 rad, but BROAD's metric (2 acos|e_w|) resolves
+        # angles only to 2 sqrt(2 * 2^-52) = 4.2e-8 rad = 2.4e-6 deg (tests/test_broad.py): that is the bound
+        assert (f64["total_deg"] < 2.5e-6).all(), f64[["trial", "method", "total_deg"]]
+        f32 = df[df["precision"] == "f32"]
+        # float32: ~6e-8 rad per update (2^-24) over <= 900 updates, growing at most linearly: < 6e-5 rad = 3e-3 deg
+        assert (f32["total_deg"] < 3e-3).all(), f32[["trial", "method", "total_deg"]]
+        assert (df["samples"] > 0).all()
+
+        est = sweeps.sweep({"sweep": {"kind": "recordings", "data": str(data), "trials": ["const_z"]},
+                            "grid": {"estimator": ["test-reference"], "fail": [False, True]}},
+                           "serial", out=tmp_path / "out2", plots=False)
+        assert est["total_deg"].iloc[0] == 0.0
+        assert "RuntimeError: asked to fail" in est["error"].iloc[1]
+    finally:
+        sweeps.ESTIMATORS.pop("test-reference", None)
+
+
+def test_recordings_on_a_shipped_broad_trial(tmp_path):
+    _need_dask()
+    pytest.importorskip("scipy", reason="scipy is a test dependency: pip install -e '.[test]'")
+    from attitude_c import broad
+
+    if broad.default_dir() is None:
+        _missing("needs the BROAD subset in ../shared/data/broad")
+    df = sweeps.sweep({"sweep": {"kind": "recordings", "trials": ["01_undisturbed_slow_rotation_A"]},
+                       "grid": {"method": ["rv3"]}}, "serial", out=tmp_path / "out", plots=False)
+    assert (df["error"] == "").all()
+    assert np.isfinite(df[["total_deg", "heading_deg", "inclination_deg"]].to_numpy()).all()
