@@ -117,6 +117,10 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_LINK_E_CONFIG": (InvalidArgument, "link configuration out of range"),
     "ATT_LINK_E_BUSY": (LinkBusy, "sender busy with the previous block"),
     "ATT_LINK_E_STATE": (LinkError, "link state corrupted"),
+    "ATT_LINK2_E_NULL": (InvalidArgument, "NULL pointer"),
+    "ATT_LINK2_E_CONFIG": (InvalidArgument, "link v2 configuration out of range"),
+    "ATT_LINK2_E_FULL": (LinkBusy, "link v2 sender ring full"),
+    "ATT_LINK2_E_STATE": (LinkError, "link v2 state corrupted"),
     # fixed.h
     "ATT_FX_E_RANGE": (RangeError, "value outside its fixed-point format's range"),
     "ATT_FX_E_METHOD": (InvalidArgument, "unknown fixed-point method"),

@@ -837,3 +837,56 @@ def test_rx_warns_when_the_boot_period_cannot_fit_the_line(rx_builds) -> None:
         rc, _, err = rx.finish(signal.SIGINT)
         assert rc == 0, err
         assert ("needs 100.0 blocks/s" in err and "carries at most 96.0" in err) == warns, err
+
+
+class _PtyMaster:
+    """The master side of attitude-rx's pty as a port for run_sender2."""
+
+    timeout = 0.01
+    baudrate = None
+    in_waiting = 0
+
+    def __init__(self, fd: int) -> None:
+        self.fd = fd
+
+    def read(self, n: int) -> bytes:
+        r, _, _ = select.select([self.fd], [], [], self.timeout)
+        return os.read(self.fd, 4096) if r else b""
+
+    def write(self, data: bytes) -> None:
+        os.write(self.fd, data)
+
+    def flush(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize("link", ["v2", "auto"])
+def test_rx_link_v2(rx_builds, link: str) -> None:
+    """--link v2 (and auto, which detects it): a board speaking link v2 (the Python sender
+    A from attitude_c.link.transport2): BOOT + samples, every line printed, no loss."""
+    from attitude_c.link import block
+    from attitude_c.link.transport2 import run_sender2
+
+    codes = _gyro_codes(300)
+    recs = [block.encode_boot(36, 9600)] + [_block(c) for c in codes]
+    rx = Rx(rx_builds["host"], "--link", link, "--method", "rv1", "--count", "200", "--no-header")
+    rep = run_sender2(_PtyMaster(rx.master), recs, impl="python", timeout=15)
+    rc, out, err = rx.finish(sig=None)
+    assert rc == 0, err
+    assert len(out.splitlines()) == 200
+    assert rep.acknowledged >= 201  # BOOT + the 200 samples the count needs (a frame may carry more)
+    line = next(x for x in err.splitlines() if x.startswith("attitude-rx: link2:"))
+    stats = dict(kv.split("=") for kv in line.split(":", 2)[2].split())
+    assert int(stats["records"]) == rep.acknowledged and int(stats["syns"]) == 1
+    assert ("the board speaks link v2" in err) == (link == "auto")
+
+
+def test_rx_link_auto_hears_legacy(rx_builds) -> None:
+    rx = Rx(rx_builds["host"], "--link", "auto", "--method", "rv1", "--count", "20", "--no-header",
+            "--gap-ms", "2000")
+    feeder = Feeder(rx.master, impl="c", timeout_ms=300)
+    acked = _send_while_alive(feeder, rx, [list(c) for c in _gyro_codes(40)])
+    rc, out, err = rx.finish(sig=None)
+    assert len(acked) == 20
+    assert rc == 0, err
+    assert len(out.splitlines()) == 20 and "the board speaks the legacy protocol" in err

@@ -66,6 +66,13 @@ def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--baud", type=BAUD, default=9600, help="line rate (default 9600, 8N1)")
     p.add_argument("--block-size", type=BLOCK_SIZE, default=6, help="data bytes per block N (1..64, default 6)")
     p.add_argument("--impl", choices=("c", "python"), default="c", help="protocol end: the C machine or the Python one")
+    _add_protocol(p)
+
+
+def _add_protocol(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--protocol", choices=("legacy", "v2"), default="legacy",
+                   help="legacy: the paper's AA/BB handshake (default); v2: the streaming protocol "
+                        "(CRC-32C, windowed acknowledgements; 6-byte records, --block-size ignored)")
 
 
 def register(sub: Any) -> None:
@@ -122,6 +129,7 @@ def register(sub: Any) -> None:
                    help="that end reboots at TIME seconds (sim only, repeatable)")
     p.add_argument("--seed", type=integer("--seed", 0, 2**63 - 1), default=1)
     p.add_argument("--json", action="store_true", help="print the statistics as JSON")
+    _add_protocol(p)
     p.set_defaults(func=cmd_test)
 
 
@@ -168,6 +176,9 @@ def _block_printer() -> Any:
 
 def cmd_rx(args: argparse.Namespace) -> int:
     from ..link.transport import open_port, run_receiver
+
+    if args.protocol == "v2":
+        return _rx2(args)
 
     if args.decode:
         from ..link import block
@@ -218,6 +229,8 @@ def cmd_tx(args: argparse.Namespace) -> int:
         run_sender,
     )
 
+    if args.protocol == "v2":
+        return _tx2(args)
     stop = _stop_on_signals()
     if args.generate:
         blocks: Any = test_samples(args.count if args.count is not None else 100, args.block_size)
@@ -302,7 +315,9 @@ def cmd_test(args: argparse.Namespace) -> int:
                              dead=dead, seed=args.seed)  # type: ignore[arg-type]
         blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),
                                dtype=np.uint8).reshape(args.blocks, args.block_size)
-        if args.transport == "sim":
+        if args.protocol == "v2":
+            out = _test2(args, chan, reboots, [bytes(r) for r in blocks])
+        elif args.transport == "sim":
             run = simulate_link(blocks, channel=chan, sender=args.sender, receiver=args.receiver,
                                 baud=args.baud, reboots=reboots)
             out = run.summary()
@@ -367,3 +382,123 @@ def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) ->
         "receiver": rx.stats if rx else {},
         "channel": bridge.channel_stats(),
     }
+
+
+# ---------------------------------------------------------------- link v2 (docs/link.md, "Link v2")
+
+def _rx2(args: argparse.Namespace) -> int:
+    from ..link.transport import open_port
+    from ..link.transport2 import run_receiver2
+
+    stop = _stop_on_signals()
+    try:
+        port = open_port(args.port, args.baud)
+    except AttitudeError as exc:
+        print(f"link-rx: {exc}", file=sys.stderr)
+        return 1
+    show: Any = _block_printer() if args.decode else (lambda r: print(_hex_block(r), flush=True))
+    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, link v2, {args.impl})", file=sys.stderr, flush=True)
+    try:
+        rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
+                            stop=stop, eof_after=args.idle_eof, keep_records=False)
+    finally:
+        port.close()
+    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
+    if rep.error:
+        print(f"link-rx: {rep.error}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _tx2(args: argparse.Namespace) -> int:
+    from ..link.transport import open_port
+    from ..link.transport2 import run_sender2
+
+    stop = _stop_on_signals()
+    if args.generate:
+        records: Any = test_samples(args.count if args.count is not None else 100, 6)
+    else:
+        def from_stdin() -> Iterator[bytes]:
+            k = 0
+            for lineno, line in enumerate(sys.stdin, 1):
+                if not line.strip() or line.lstrip().startswith("#"):
+                    continue
+                if args.count is not None and k >= args.count:
+                    return
+                yield _parse_hex_line(line, 6, lineno)
+                k += 1
+        records = from_stdin()
+    try:
+        port = open_port(args.port, args.baud)
+    except AttitudeError as exc:
+        print(f"link-tx: {exc}", file=sys.stderr)
+        return EXIT_PORT
+    try:
+        rep = run_sender2(port, records, impl=args.impl, timeout=args.wait, stop=stop)
+    except ValueError as exc:
+        print(f"link-tx: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    finally:
+        port.close()
+    print("link-tx stats: " + json.dumps(rep.stats), file=sys.stderr)
+    print(f"link-tx: {rep.acknowledged} of {rep.pushed} record(s) acknowledged (ended by {rep.ended_by})",
+          flush=True)
+    if rep.ended_by == "error":
+        print(f"link-tx: {rep.error}", file=sys.stderr)
+        return EXIT_PORT
+    if rep.ended_by == "stop":
+        return EXIT_INTERRUPTED
+    if rep.ended_by == "timeout":
+        print(f"link-tx: {rep.pushed - rep.acknowledged} record(s) not acknowledged within --wait "
+              f"{args.wait:g} s", file=sys.stderr)
+        return EXIT_NO_RECEIVER
+    return EXIT_OK
+
+
+def _test2(args: argparse.Namespace, chan: Any, reboots: list[Any], records: list[bytes]) -> dict[str, Any]:
+    import time
+
+    from ..link.sim2 import simulate_link2
+    from ..link.transport import PtyPair, SocketRelay, open_port
+    from ..link.transport2 import run_receiver2, run_sender2
+
+    if args.transport == "sim":
+        when = {"sender": 0.0, "receiver": 0.0}
+        for t, who in reboots:
+            if who not in when or when[who]:
+                raise ValueError("--protocol v2: at most one --reboot per end, TIME:sender|receiver")
+            when[who] = t
+        python = "python" in (args.sender, args.receiver)
+        run = simulate_link2(args.blocks, chan, baud=args.baud, engine="python" if python else "c",
+                             sender=args.sender, receiver=args.receiver, reboot_sender_s=when["sender"],
+                             reboot_receiver_s=when["receiver"])
+        return {"protocol": "v2", **run.summary(), "channel": run.channel}
+    if reboots:
+        raise ValueError("--reboot is only available with --transport sim")
+    bridge: Any = PtyPair(baud=args.baud, channel=chan) if args.transport == "pty" \
+        else SocketRelay(baud=args.baud, channel=chan)
+    urls = bridge.paths if args.transport == "pty" else [bridge.url, bridge.url]
+    stop = threading.Event()
+    box: dict[str, Any] = {}
+    try:
+        pb = open_port(urls[1], args.baud)
+        th = threading.Thread(target=lambda: box.setdefault("rx", run_receiver2(pb, impl=args.receiver, stop=stop)),
+                              daemon=True)
+        th.start()
+        pa = open_port(urls[0], args.baud)
+        t0 = time.monotonic()
+        rep = run_sender2(pa, records, impl=args.sender, timeout=600)
+        dt = time.monotonic() - t0
+        time.sleep(0.1)
+        stop.set()
+        th.join(timeout=5)
+        pa.close()
+        pb.close()
+    finally:
+        bridge.close()
+    got = box["rx"].records if "rx" in box else []
+    return {"protocol": "v2", "records": len(records), "acknowledged": rep.acknowledged,
+            "delivered": len(got), "in_order_exactly_once": got == records[:len(got)],
+            "duration_s": dt, "records_per_s": rep.acknowledged / dt if dt > 0 else 0.0,
+            "sender": rep.stats, "receiver": box["rx"].stats if "rx" in box else {},
+            "channel": bridge.channel_stats()}

@@ -5,6 +5,9 @@ simulator, pyserial transports. See docs/link.md.
 - :class:`CSender` / :class:`CReceiver`: the C machines (attitude/link.h) via CFFI;
 - :func:`simulate_link` + :class:`ChannelConfig`: blocks through A -> bad line -> B
   in simulated 9600-baud time (fast all-C path, or any pair of ends);
+- link v2 (the hardened streaming protocol): :class:`Sender2` / :class:`Receiver2`
+  from the spec, :class:`CSender2` / :class:`CReceiver2` the C machines,
+  :func:`simulate_link2`;
 - :mod:`attitude_c.link.transport`: pyserial ports, pty pairs, a socket relay,
   and real-time loops running either end on a port.
 """
@@ -33,6 +36,9 @@ from .sim import (
     LinkRun,
     simulate_link,
 )
+from .sim2 import simulate_link2
+from .v2 import Receiver2, Result2, Sender2
+from .v2c import CReceiver2, CSender2, Link2Run
 
 __all__ = [
     "ACK",
@@ -44,18 +50,25 @@ __all__ = [
     "SYN",
     "SYN_ACK",
     "CReceiver",
+    "CReceiver2",
     "CSender",
+    "CSender2",
     "Channel",
     "ChannelConfig",
+    "Link2Run",
     "LinkBusy",
     "LinkRun",
     "Receiver",
+    "Receiver2",
     "ReceiverStats",
     "Result",
+    "Result2",
     "Sender",
+    "Sender2",
     "SenderStats",
     "checksum",
     "make_receiver",
     "make_sender",
     "simulate_link",
+    "simulate_link2",
 ]

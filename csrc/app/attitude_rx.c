@@ -56,14 +56,18 @@
 typedef struct {
     unsigned long syns, blocks, naks, timeouts, resyncs, bytes_discarded;
     unsigned long busy_naks, count_naks, held_answers, unanswered;
+    int mode;                    /* RX_LINK_LEGACY / _V2 / _AUTO (nothing heard yet) */
+    att_link2_receiver_stats l2; /* link v2's own counters */
 } rx_link_live;
 
 typedef struct {
     rx_config cfg;
     rx_queue queue;
-    rx_stop stop;                 /* stop requests (signal handler, --count, stdout failure) */
-    int fd;                       /* serial port (owned by the receiver thread once started) */
-    att_link_receiver_stats link; /* copied by the receiver thread when it ends */
+    rx_stop stop;                   /* stop requests (signal handler, --count, stdout failure) */
+    int fd;                         /* serial port (owned by the receiver thread once started) */
+    att_link_receiver_stats link;   /* copied by the receiver thread when it ends */
+    att_link2_receiver_stats link2; /* link v2's, likewise */
+    int link_used;                  /* RX_LINK_LEGACY / _V2 / _AUTO (nothing heard yet) at the end */
     /* the link counters as they stand (receiver thread writes, attitude thread reads: live_lock) */
     pthread_mutex_t live_lock;
     rx_link_live live;
@@ -269,10 +273,64 @@ static int deliver(rx_app *app, rx_acked *x, const uint8_t *block)
     return ATT_LINK_ACK;
 }
 
+/* ---- link v2 (attitude/link2.h): B acknowledges only records it delivered ---- */
+
+/* Records link v2 may deliver now: the queue's room, 0 once --count has enough. */
+static uint16_t room2(rx_app *app, rx_acked *x)
+{
+    unsigned r;
+    if (count_reached(app, x))
+        return 0;
+    r = rx_queue_room(&app->queue);
+    return (uint16_t)(r > 0xFFFFu ? 0xFFFFu : r);
+}
+
+/* Link v2 delivered n records: decode, number and queue them (the room said they fit)
+ * before the ACK that covers them goes out. */
+static void deliver2(rx_app *app, rx_acked *x, const uint8_t *out, unsigned n)
+{
+    rx_item items[ATT_LINK2_SAMPLES_MAX];
+    unsigned k, samples = 0;
+    unsigned long periods = 0;
+    struct timespec now;
+    for (k = 0; k < n; k++) {
+        rx_item *it = &items[k];
+        memset(it, 0, sizeof *it);
+        memcpy(it->raw, out + ATT_LINK2_RECORD * k, sizeof it->raw);
+        it->status = att_block_seq_decode(&x->seq, it->raw, &it->blk, &it->span);
+        if (it->status == ATT_BLOCK_E_SEQ) {
+            it->seq_status = it->status;
+            it->status = ATT_OK;
+        }
+        if (it->blk.kind == ATT_BLOCK_SAMPLE)
+            samples++;
+        periods += periods_of(it, &x->have_good);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    if (rx_queue_push_all(&app->queue, items, n, &now) != 0)
+        rx_log(&app->stop, "internal: %u acknowledged records found no room", n); /* room2 said they fit */
+    x->periods += periods;
+    app->samples += samples;
+    app->acks++;
+}
+
+/* Hand out link v2's ACK bytes: 0, 1 = a stop request came while the port did not take a byte,
+ * -1 = port error. */
+static int answer2(rx_app *app, att_link2_receiver *r)
+{
+    uint8_t out;
+    int rc;
+    while (att_link2_receiver_poll(r, &out) == ATT_LINK2_SEND)
+        if ((rc = rx_port_write(&app->stop, app->fd, &out, 1)) != 0)
+            return rc;
+    return 0;
+}
+
 /* The counters of the link as they stand: the link machine's, with attitude-rx's
  * own answers (it counts every good block as accepted; some were answered 0xFF). */
 static void link_live(const rx_app *app, const att_link_receiver_stats *l, rx_link_live *v)
 {
+    memset(v, 0, sizeof *v);
     v->syns = (unsigned long)l->syns;
     v->blocks = app->acks;
     v->naks = (unsigned long)l->naks + app->busy_naks + app->count_naks;
@@ -285,10 +343,13 @@ static void link_live(const rx_app *app, const att_link_receiver_stats *l, rx_li
     v->unanswered = app->unanswered;
 }
 
-static void publish_live(rx_app *app, const att_link_receiver_stats *l)
+static void publish_live(rx_app *app, const att_link_receiver_stats *l, const att_link2_receiver_stats *l2,
+                         int mode)
 {
     rx_link_live v;
     link_live(app, l, &v);
+    v.mode = mode;
+    v.l2 = *l2;
     pthread_mutex_lock(&app->live_lock);
     app->live = v;
     pthread_mutex_unlock(&app->live_lock);
@@ -303,13 +364,16 @@ static void *receiver_thread(void *arg)
     uint8_t buf[256];
     rx_acked x;
     int stop = 0;
+    att_link2_receiver r2;
+    uint8_t out2[ATT_LINK2_OUT_MAX];
+    int mode = app->cfg.link;
 
     att_block_seq_init(&x.seq);
     x.periods = 0;
     x.have_good = 0;
     att_link_receiver_config_init(&rc, (uint8_t)app->cfg.block_size);
     rc.gap_timeout = (uint16_t)app->cfg.gap_ms;
-    if (att_link_receiver_init(&r, &rc, block) != ATT_OK
+    if (att_link_receiver_init(&r, &rc, block) != ATT_OK || att_link2_receiver_init(&r2, out2) != ATT_OK
         || att_integ_init(&x.shape, app->cfg.method, NULL) != ATT_OK) {
         rx_log(&app->stop, "link receiver configuration rejected");
         rx_stop_request(&app->stop);
@@ -329,6 +393,7 @@ static void *receiver_thread(void *arg)
             rx_log(&app->stop, "port %s reopened", app->cfg.port);
             app->reopens++;
             att_link_receiver_reset(&r);
+            att_link2_receiver_reset(&r2);
         }
         left = att_link_receiver_ticks_left(&r, now_tick());
         timeout = (left == ATT_LINK_NO_TIMER || left > 100) ? 100 : (int)left;
@@ -357,8 +422,34 @@ static void *receiver_thread(void *arg)
             }
             for (i = 0; i < got && !stop; i++) {
                 int ack = ANSWER_AS_IS, w;
-                if (att_link_receiver_sink(&r, buf[i], now_tick()) == ATT_LINK_ACCEPTED)
+                if (mode != RX_LINK_LEGACY) {
+                    int st2;
+                    att_link2_receiver_set_room(&r2, room2(app, &x));
+                    st2 = att_link2_receiver_sink(&r2, buf[i]);
+                    if (mode == RX_LINK_AUTO && (st2 == ATT_LINK2_FRAME || st2 == ATT_LINK2_DELIVERED)) {
+                        mode = RX_LINK_V2;
+                        rx_log(&app->stop, "link: the board speaks link v2");
+                    }
+                    if (mode == RX_LINK_V2) {
+                        if (st2 == ATT_LINK2_DELIVERED)
+                            deliver2(app, &x, out2, r2.n_out);
+                        att_link2_receiver_set_room(&r2, room2(app, &x));
+                        w = answer2(app, &r2);
+                        if (w < 0) {
+                            port_lost(app, "write failed", errno);
+                            break;
+                        }
+                        stop = w > 0 || rx_stop_check(&app->stop);
+                        continue;
+                    }
+                }
+                if (att_link_receiver_sink(&r, buf[i], now_tick()) == ATT_LINK_ACCEPTED) {
+                    if (mode == RX_LINK_AUTO) {
+                        mode = RX_LINK_LEGACY;
+                        rx_log(&app->stop, "link: the board speaks the legacy protocol");
+                    }
                     ack = deliver(app, &x, block);
+                }
                 /* answer at once (the sender waits for 0xBB / 0x00 / 0xFF) */
                 w = answer(app, &r, ack);
                 if (w < 0) {
@@ -367,15 +458,24 @@ static void *receiver_thread(void *arg)
                 }
                 stop = w > 0 || ack == ANSWER_NONE;
             }
+        } else if (mode == RX_LINK_V2) { /* room may have grown: a window update */
+            att_link2_receiver_set_room(&r2, room2(app, &x));
+            if ((n = answer2(app, &r2)) != 0) {
+                if (n > 0)
+                    break;
+                port_lost(app, "write failed", errno);
+            }
         } else if ((n = answer(app, &r, ANSWER_AS_IS)) != 0) { /* gap timer */
             if (n > 0)
                 break;
             port_lost(app, "write failed", errno);
         }
-        publish_live(app, &r.stats);
+        publish_live(app, &r.stats, &r2.stats, mode);
     }
     app->link = r.stats;
-    publish_live(app, &r.stats);
+    app->link2 = r2.stats;
+    app->link_used = mode;
+    publish_live(app, &r.stats, &r2.stats, mode);
     return NULL;
 }
 
@@ -547,12 +647,22 @@ static void link_record(rx_app *app)
     pthread_mutex_lock(&app->live_lock);
     v = app->live;
     pthread_mutex_unlock(&app->live_lock);
-    snprintf(body, sizeof body,
-             "\"link\":{\"syns\":%lu,\"blocks\":%lu,\"naks\":%lu,\"timeouts\":%lu,\"resyncs\":%lu,"
-             "\"bytes_discarded\":%lu,\"busy_naks\":%lu,\"count_naks\":%lu,\"held_answers\":%lu,"
-             "\"unanswered\":%lu}",
-             v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks, v.count_naks,
-             v.held_answers, v.unanswered);
+    if (v.mode == RX_LINK_V2) /* link v2's counters; "blocks" = deliveries, as on the legacy link */
+        snprintf(body, sizeof body,
+                 "\"link\":{\"protocol\":\"v2\",\"blocks\":%lu,\"frames\":%lu,\"bad_frames\":%lu,"
+                 "\"records\":%lu,\"duplicates\":%lu,\"gaps\":%lu,\"refused\":%lu,\"syns\":%lu,"
+                 "\"no_session\":%lu,\"acks\":%lu,\"bytes_discarded\":%lu}",
+                 v.blocks, (unsigned long)v.l2.frames, (unsigned long)v.l2.bad_frames,
+                 (unsigned long)v.l2.records, (unsigned long)v.l2.duplicates, (unsigned long)v.l2.gaps,
+                 (unsigned long)v.l2.refused, (unsigned long)v.l2.syns, (unsigned long)v.l2.no_session,
+                 (unsigned long)v.l2.acks, (unsigned long)v.l2.bytes_discarded);
+    else
+        snprintf(body, sizeof body,
+                 "\"link\":{\"syns\":%lu,\"blocks\":%lu,\"naks\":%lu,\"timeouts\":%lu,\"resyncs\":%lu,"
+                 "\"bytes_discarded\":%lu,\"busy_naks\":%lu,\"count_naks\":%lu,\"held_answers\":%lu,"
+                 "\"unanswered\":%lu}",
+                 v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks,
+                 v.count_naks, v.held_answers, v.unanswered);
     json_record(app, body);
 }
 
@@ -734,11 +844,21 @@ static void print_statistics(rx_app *app)
     link_live(app, &app->link, &v);
     if (g_signal)
         rx_log(&app->stop, "stopped by signal %d", (int)g_signal);
-    rx_log(&app->stop,
-           "link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu bytes_discarded=%lu "
-           "busy_naks=%lu count_naks=%lu held_answers=%lu unanswered=%lu",
-           v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks, v.count_naks,
-           v.held_answers, v.unanswered);
+    if (app->link_used != RX_LINK_V2)
+        rx_log(&app->stop,
+               "link: syns=%lu blocks_accepted=%lu naks=%lu timeouts=%lu resyncs=%lu bytes_discarded=%lu "
+               "busy_naks=%lu count_naks=%lu held_answers=%lu unanswered=%lu",
+               v.syns, v.blocks, v.naks, v.timeouts, v.resyncs, v.bytes_discarded, v.busy_naks, v.count_naks,
+               v.held_answers, v.unanswered);
+    if (app->link_used != RX_LINK_LEGACY)
+        rx_log(&app->stop,
+               "link2: frames=%lu bad_frames=%lu records=%lu duplicates=%lu gaps=%lu refused=%lu syns=%lu "
+               "no_session=%lu acks=%lu bytes_discarded=%lu",
+               (unsigned long)app->link2.frames, (unsigned long)app->link2.bad_frames,
+               (unsigned long)app->link2.records, (unsigned long)app->link2.duplicates,
+               (unsigned long)app->link2.gaps, (unsigned long)app->link2.refused,
+               (unsigned long)app->link2.syns, (unsigned long)app->link2.no_session,
+               (unsigned long)app->link2.acks, (unsigned long)app->link2.bytes_discarded);
     rx_log(&app->stop,
            "samples: received=%lu integrated=%lu held=%lu missing=%lu code_errors=%lu pending=%lu "
            "undelivered=%lu lines_lost=%lu queue_high_water=%u updates=%lu integrator_errors=%lu "

@@ -75,7 +75,16 @@ typedef struct {
     double consumer_delay; /* s the attitude thread sleeps per sample (diagnostics/tests) */
     double reopen_delay;   /* s between attempts to reopen a port that went away */
     int header;            /* print the CSV header line */
+    int link;              /* RX_LINK_LEGACY (default), RX_LINK_V2, RX_LINK_AUTO */
 } rx_config;
+
+/* Link protocols (--link): the paper's handshake, link v2 (attitude/link2.h), or
+ * whichever is heard first (legacy: an accepted block; v2: a valid frame). */
+enum {
+    RX_LINK_LEGACY = 0,
+    RX_LINK_V2 = 1,
+    RX_LINK_AUTO = 2
+};
 
 /* Defaults: 9600 baud, period 0.02 s (RX_PERIOD_DEFAULT), zero 2048,
  * scale = 90 deg/s per 2048 codes, axes x,y,z, rv3, CSV, N = 6, queue 256,
@@ -147,6 +156,8 @@ void rx_queue_close(rx_queue *q);
 /* The attitude thread could not integrate one sample period. */
 void rx_queue_count_failed(rx_queue *q);
 unsigned long rx_queue_failed(rx_queue *q);
+/* Records that fit now whatever their kind (cap - count): the room link v2 advertises. */
+unsigned rx_queue_room(rx_queue *q);
 
 /* ---- stop requests and bounded I/O ---- */
 /* A self-pipe that a signal handler or a thread writes one byte into to

@@ -276,6 +276,15 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
             return fail(msg, len, RX_EXIT_CONFIG, "gap-ms: '%s' must be 1..%d ms", value,
                         ATT_LINK_TIMEOUT_MAX);
         c->gap_ms = (unsigned)u;
+    } else if (strcmp(name, "link") == 0) {
+        if (strcmp(value, "legacy") == 0)
+            c->link = RX_LINK_LEGACY;
+        else if (strcmp(value, "v2") == 0)
+            c->link = RX_LINK_V2;
+        else if (strcmp(value, "auto") == 0)
+            c->link = RX_LINK_AUTO;
+        else
+            return fail(msg, len, RX_EXIT_CONFIG, "link: '%s' must be legacy, v2 or auto", value);
     } else if (strcmp(name, "hold-ms") == 0) {
         if (parse_ulong(value, &u) != 0 || u > RX_HOLD_MS_MAX)
             return fail(msg, len, RX_EXIT_CONFIG, "hold-ms: '%s' must be 0..%d ms", value, RX_HOLD_MS_MAX);
@@ -375,6 +384,7 @@ static const struct option long_options[] = { { "help", no_argument, NULL, OPT_H
                                               { "config", required_argument, NULL, OPT_CONFIG },
                                               { "no-header", no_argument, NULL, OPT_NO_HEADER },
                                               { "port", required_argument, NULL, OPT_SETTING },
+                                              { "link", required_argument, NULL, OPT_SETTING },
                                               { "baud", required_argument, NULL, OPT_SETTING },
                                               { "period", required_argument, NULL, OPT_SETTING },
                                               { "gyro-zero", required_argument, NULL, OPT_SETTING },
@@ -485,6 +495,7 @@ void rx_usage(const char *prog, void *stream)
             "  --block-size N           link block bytes (multiple of 6), default 6\n"
             "  --queue N                records the inter-thread queue holds, default 256\n"
             "  --gap-ms MS              link gap timeout inside a block, default 20\n"
+            "  --link P                 legacy (AA/BB handshake, default), v2 (link v2) or auto\n"
             "  --hold-ms MS             a block that finds the queue full waits this long for room\n"
             "                           before it is answered 0xFF (send again), default 20\n"
             "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"

@@ -84,6 +84,15 @@ static int fits(const rx_queue *q, const rx_item *items, unsigned n)
     return q->count + samples <= q->cap && q->count + n <= q->cap + (unsigned)RX_REPORT_RESERVE;
 }
 
+unsigned rx_queue_room(rx_queue *q)
+{
+    unsigned room;
+    pthread_mutex_lock(&q->lock);
+    room = q->count < q->cap ? q->cap - q->count : 0u;
+    pthread_mutex_unlock(&q->lock);
+    return room;
+}
+
 int rx_queue_push_all(rx_queue *q, const rx_item *items, unsigned n, const struct timespec *deadline)
 {
     const unsigned size = sizeof q->buf / sizeof q->buf[0];

@@ -8,6 +8,7 @@
 
 #include "attitude/attitude.h"
 #include "link_sim.h"
+#include "link2_sim.h"
 #include "tlc2543_model.h"
 #include "ad7927_model.h"
 

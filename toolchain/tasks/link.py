@@ -1,5 +1,5 @@
 """Link tasks: `invoke fuzz` runs the libFuzzer targets of the link machines
-and the block format (csrc/fuzz/fuzz_link.c, fuzz_block.c) under ASan +
+(legacy and v2) and the block format (csrc/fuzz/fuzz_link.c, fuzz_link2.c, fuzz_block.c) under ASan +
 UBSan; `--coverage` then measures the line coverage their corpora give each
 source (clang source-based coverage)."""
 
@@ -16,13 +16,14 @@ from invoke import task
 ROOT = Path(__file__).resolve().parents[2]
 FUZZ_DIR = ROOT / "csrc" / "fuzz"
 #: target name -> its source; both link every source below
-TARGETS = {"link": FUZZ_DIR / "fuzz_link.c", "block": FUZZ_DIR / "fuzz_block.c"}
+TARGETS = {"link": FUZZ_DIR / "fuzz_link.c", "block": FUZZ_DIR / "fuzz_block.c", "link2": FUZZ_DIR / "fuzz_link2.c"}
 SRC = ROOT / "csrc" / "src"
 LIB = [SRC / n for n in ("link_sender.c", "link_sender_aux.c", "link_receiver.c", "block.c", "block_decode.c", "block_sums.c",
-                         "common.c")]
+                         "common.c", "link2_sender.c", "link2_sender_aux.c", "link2_receiver.c")]
 #: the sources each target is meant to cover (common.c only has att_status_str: not theirs)
 COVERS = {"link": ("link_sender.c", "link_sender_aux.c", "link_receiver.c"),
-          "block": ("block.c", "block_decode.c", "block_sums.c")}
+          "block": ("block.c", "block_decode.c", "block_sums.c"),
+          "link2": ("link2_sender.c", "link2_sender_aux.c", "link2_receiver.c")}
 APT_HINT = "apt-get install clang libclang-rt-14-dev llvm"
 
 
@@ -76,7 +77,7 @@ def line_coverage(target: str, corpus: Path, work: Path) -> dict[str, tuple[int,
 
 
 @task(help={"seconds": "how long to fuzz each target (default 60)",
-            "target": "link, block or all (default all)",
+            "target": "link, block, link2 or all (default all)",
             "corpus": "corpus directory, one subdirectory per target (default fuzz-corpus)",
             "coverage": "then report the line coverage the corpus gives each source"})
 def fuzz(c, seconds=60, target="all", corpus="", coverage=False):
@@ -84,7 +85,7 @@ def fuzz(c, seconds=60, target="all", corpus="", coverage=False):
     build = ROOT / "build" / "fuzz"
     names = list(TARGETS) if target == "all" else [target]
     if any(n not in TARGETS for n in names):
-        raise SystemExit(f"fuzz: unknown target {target!r} (link, block, all)")
+        raise SystemExit(f"fuzz: unknown target {target!r} (link, block, link2, all)")
     base = Path(corpus) if corpus else ROOT / "fuzz-corpus"
     for name in names:
         exe = build_fuzzer(build, name)

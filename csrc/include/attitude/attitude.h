@@ -11,6 +11,7 @@
 #include "attitude/quat.h"
 #include "attitude/integrator.h"
 #include "attitude/link.h"
+#include "attitude/link2.h"
 #include "attitude/block.h"
 #include "attitude/sensor.h"
 #include "attitude/fixed.h"
