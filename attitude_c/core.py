@@ -27,6 +27,7 @@ out for type checkers (tests/test_names.py proves they are the library's).
 from __future__ import annotations
 
 import math
+import threading
 from typing import Any, Literal, get_args
 
 import numpy as np
@@ -168,7 +169,7 @@ def _to_c(a: NDArray[np.float64], precision: str, name: str) -> NDArray[Any]:
         ok = np.isfinite(b).all(axis=1) if b.ndim == 2 else np.isfinite(b)
         if not np.all(ok):
             i = _first_bad(np.atleast_1d(np.asarray(ok, dtype=bool)))
-            raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')")
+            raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')", index=i)
         return b
     return np.ascontiguousarray(a, dtype=np.float64)
 
@@ -184,6 +185,10 @@ def _raise(status: int, what: str, index: int | None = None) -> None:
 # --------------------------------------------------------------------------
 # rotation math
 # --------------------------------------------------------------------------
+
+#: What ATT_E_ARG means for each conversion's input (quat.h).
+_ARG_MEANING = {"att_dcm_to_quat_n": "is not a rotation matrix (|CᵀC − I| above 0.01, or det C ≤ 0)"}
+
 
 def _convert(cname: str, x: ArrayLike, name: str, tail_in: tuple[int, ...],
              tail_out: tuple[int, ...], what: str, precision: str) -> FloatArray:
@@ -202,7 +207,12 @@ def _convert(cname: str, x: ArrayLike, name: str, tail_in: tuple[int, ...],
             i = int(err[0])
             where = np.unravel_index(i, lead) if len(lead) > 1 else i
             if st == lib.ATT_E_ARG:
-                raise InvalidArgument(f"{name}: sample {where} is a zero quaternion")
+                raise InvalidArgument(f"{name}: sample {where} "
+                                      f"{_ARG_MEANING.get(cname, 'is a zero quaternion')}")
+            if st == lib.ATT_E_RANGE and cname == "att_rotvec_to_quat_n":
+                raise RangeError(f"{name}: sample {where}: |phi| above {float(lib.att_rotvec_max()):g} rad "
+                                 "(quat.h: the input's own rounding would make the quaternion noise)",
+                                 index=i)
             _raise(st, name, i)
     return out.reshape(lead + tail_out)
 
@@ -263,8 +273,11 @@ def quat_multiply(a: ArrayLike, b: ArrayLike, precision: FloatPrecision = "f64")
     out = np.empty_like(ca)
     if ca.shape[0]:
         err = ffi.new("size_t *")
-        _raise(lib.att_quat_mul_n(_ptr(ffi, ca), _ptr(ffi, cb), _ptr(ffi, out), ca.shape[0], err),
-               "a, b")
+        st = lib.att_quat_mul_n(_ptr(ffi, ca), _ptr(ffi, cb), _ptr(ffi, out), ca.shape[0], err)
+        if st == lib.ATT_E_RANGE:
+            raise RangeError(f"a, b: the product of sample {int(err[0])} overflows {precision} "
+                             "(finite inputs, infinite result)", index=int(err[0]))
+        _raise(st, "a, b", int(err[0]) if st else None)
     return out.reshape(lead + (4,))
 
 
@@ -320,6 +333,17 @@ class Integrator:
     Q2.30 port (``att_fx_integ``, every increment method; float64 in and
     out, increments limited to ``fixedpoint.DTHETA_MAX``); "f64"/"f32" the
     float builds (``att_integ``).
+
+    Thread safety: one Integrator may be shared by threads. Every method
+    and property holds the object's lock for the whole call, so each
+    ``update`` is applied whole, in some order, and the counters
+    (``updates``, ``pending``) always agree with the samples fed. The
+    order of concurrent updates is the order the threads take the lock:
+    give each stream its own Integrator when the order matters (it always
+    does for attitude). The batch functions (:func:`integrate`,
+    :func:`integrate_rates`, the rotation functions) keep no shared state
+    and are thread-safe: concurrent calls give bit-identical results to
+    sequential ones (tests/test_api_faults.py).
     """
 
     def __init__(self, method: Method = "rv3", q0: ArrayLike | None = None,
@@ -327,6 +351,7 @@ class Integrator:
         self.method: Method = _check_method(method)
         self.precision: Precision = _check_precision(precision, allow_fixed=True)
         self._dtype = _DTYPES[self.precision]
+        self._lock = threading.RLock()  # the C state and the buffers below are shared by every call
         self._pending_dt: NDArray[np.float64] = np.empty(0)
         if self.precision == "fixed":
             if self.method == "rk4":
@@ -345,6 +370,10 @@ class Integrator:
 
     def reset(self, q0: ArrayLike | None = None) -> None:
         """Back to attitude ``q0`` (None = identity), buffered samples dropped."""
+        with self._lock:
+            self._reset(q0)
+
+    def _reset(self, q0: ArrayLike | None) -> None:
         if self._fx is not None:
             _check_q0(q0)
             self._fx.reset(q0)
@@ -363,27 +392,31 @@ class Integrator:
     @property
     def q(self) -> FloatArray:
         """Current attitude quaternion (4,), float64 or float32 after the precision."""
-        if self._fx is not None:
-            from .fixedpoint import from_q30
+        with self._lock:
+            if self._fx is not None:
+                from .fixedpoint import from_q30
 
-            return from_q30(self._fx.q_q30)
-        return np.array([float(self._state.q[i]) for i in range(4)], dtype=self._dtype)
+                return from_q30(self._fx.q_q30)
+            return np.array([float(self._state.q[i]) for i in range(4)], dtype=self._dtype)
 
     @property
     def pending(self) -> int:
         """Samples buffered in the state (rv2/rv3 frame, rv3-reuse history, rk4 rows)."""
-        return int(self._fx.pending if self._fx is not None else self._state.nbuf)
+        with self._lock:
+            return int(self._fx.pending if self._fx is not None else self._state.nbuf)
 
     @property
     def updates(self) -> int:
         """Attitude updates since construction or reset (C counter, wraps)."""
-        return int(self._fx.updates if self._fx is not None else self._state.updates)
+        with self._lock:
+            return int(self._fx.updates if self._fx is not None else self._state.updates)
 
     def outputs(self, n: int) -> int:
         """How many updates ``n`` more samples would complete."""
-        if self._fx is not None:
-            return self._fx.outputs(n)
-        return int(self._lib.att_integ_outputs(self._state, int(n)))
+        with self._lock:
+            if self._fx is not None:
+                return self._fx.outputs(n)
+            return int(self._lib.att_integ_outputs(self._state, int(n)))
 
     def update(self, x: ArrayLike, dt: ArrayLike | None = None) -> FloatArray:
         """Feed increments Δθ (rad, (3,) or (N, 3)) — or, for ``rk4``, body
@@ -395,6 +428,10 @@ class Integrator:
         alternate step start/end and midpoint; the step of an update is
         h = dt[start] + dt[midpoint].
         """
+        with self._lock:
+            return self._update(x, dt)
+
+    def _update(self, x: ArrayLike, dt: ArrayLike | None) -> FloatArray:
         if (self.method != "rk4" and dt is None and self._fx is None and isinstance(x, np.ndarray)
                 and x.shape == (3,) and x.dtype.kind == "f"):
             return self._update_one(x)
@@ -440,7 +477,7 @@ class Integrator:
                 i = int(err[0])
                 if st == lib.ATT_E_NONFINITE:
                     if np.isfinite(a[i]).all():  # finite as given: lost in the conversion
-                        raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')")
+                        raise RangeError(f"{name}: sample {i} overflows float32 (precision='f32')", index=i)
                     raise _nonfinite(name, i, lead)
                 _raise(st, name, i)
             m = int(nout[0])
@@ -455,7 +492,7 @@ class Integrator:
         buf[0], buf[1], buf[2] = float(x[0]), float(x[1]), float(x[2])
         if self._dtype is np.float32 and not all(map(math.isfinite, (buf[0], buf[1], buf[2]))) \
                 and all(map(math.isfinite, (float(x[0]), float(x[1]), float(x[2])))):
-            raise RangeError("dtheta: sample 0 overflows float32 (precision='f32')")
+            raise RangeError("dtheta: sample 0 overflows float32 (precision='f32')", index=0)
         r = self._lib.att_integ_update(self._state, buf, self._one_out)
         if r == 1:
             o = self._one_out
@@ -564,7 +601,8 @@ def integrate(dtheta: ArrayLike, method: Method = "rv3", q0: ArrayLike | None = 
     it = Integrator(method, q, precision)
     if out is not None:
         _check_out(out, it.outputs(a.shape[0]), precision, a, "dtheta")
-    return it._update_increments(a, lead, out)
+    with it._lock:  # a fresh object: uncontended; the lock only keeps the invariant simple
+        return it._update_increments(a, lead, out)
 
 
 def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "rk4",
@@ -608,4 +646,5 @@ def integrate_rates(omega: ArrayLike, dt: float | ArrayLike, method: Method = "r
     it = Integrator("rk4", q, precision)
     if out is not None:
         _check_out(out, it.outputs(a.shape[0]), precision, a, "omega")
-    return it._update_rates(a, lead, dt, out)
+    with it._lock:
+        return it._update_rates(a, lead, dt, out)

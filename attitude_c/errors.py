@@ -32,7 +32,13 @@ class NonFiniteError(InvalidArgument):
 
 
 class RangeError(InvalidArgument):
-    """A value lies outside the representable range (e.g. a fixed-point format)."""
+    """A value lies outside its documented range (a fixed-point format, the
+    integrator's |Δθ| ≤ π per sample, an overflowing result); ``index`` names
+    the first bad sample when the input has samples."""
+
+    def __init__(self, message: str, index: int | None = None) -> None:
+        super().__init__(message)
+        self.index = index
 
 
 class DeviceError(AttitudeError, RuntimeError):

@@ -107,7 +107,7 @@ def to_q30(x: ArrayLike, name: str = "x", limit: float = 2.0) -> NDArray[np.int3
     if np.any(over):
         idx = np.unravel_index(int(np.argmax(over.reshape(-1))), a.shape)
         raise RangeError(f"{name}: value {a[idx]!r} at index {tuple(int(i) for i in idx)} "
-                         f"outside the Q2.30 range ±{limit}")
+                         f"outside the Q2.30 range ±{limit}", index=int(np.argmax(over.reshape(-1))))
     return q.astype(np.int32)
 
 
@@ -139,7 +139,7 @@ def _dtheta_q30(dtheta: ArrayLike, name: str = "dtheta") -> NDArray[np.int32]:
     if np.any(over):
         i = int(np.argmax(over))
         raise RangeError(f"{name}: increment {i} = {a[i].tolist()} exceeds the fixed-point "
-                         f"limit |Δθ| ≤ {DTHETA_MAX:.6f} rad per component")
+                         f"limit |Δθ| ≤ {DTHETA_MAX:.6f} rad per component", index=i)
     return np.ascontiguousarray(q.astype(np.int32))
 
 
@@ -155,19 +155,52 @@ def _q0_q30(q0: ArrayLike | None) -> NDArray[np.int32] | None:
     return np.ascontiguousarray(np.floor(a / n * Q30_ONE + 0.5).astype(np.int32))
 
 
+def _raw_q30(x: ArrayLike, name: str, limit: int, what: str) -> NDArray[np.int32]:
+    """Raw Q2.30 integers, refused (never wrapped or truncated) unless every
+    value is an integer (integer dtype, or a float holding an integer) with
+    |value| ≤ ``limit``; :class:`RangeError` names the first bad record."""
+    try:
+        a = np.asarray(x)
+    except Exception as exc:  # ragged lists and the like
+        raise InvalidType(f"{name}: cannot be converted to an array ({exc})") from exc
+    if a.dtype.kind == "f":
+        recs = a.reshape(a.shape[0], -1) if a.ndim else a.reshape(1, 1)
+        ok = np.isfinite(recs) & (recs == np.floor(recs))
+        if not ok.all():
+            i = int(np.argmin(ok.all(axis=1)))
+            raise InvalidArgument(f"{name}: record {i} = {recs[i].tolist()} holds a non-integer: raw "
+                                  f"Q2.30 values are integers (use {what} for radians)")
+    elif a.dtype.kind not in "iu":
+        raise InvalidType(f"{name}: raw Q2.30 values must be integers, got dtype {a.dtype}")
+    flat = np.abs(a.astype(np.float64)).reshape(max(a.shape[0], 1) if a.ndim else 1, -1)
+    big_rec = (flat > limit).any(axis=1)  # float64: exact below 2^53, far above the limit beyond
+    if big_rec.any():
+        i = int(np.argmax(big_rec))
+        shown = a.reshape(flat.shape)[i].tolist()
+        raise RangeError(f"{name}: record {i} = {shown} outside |value| ≤ {limit} "
+                         f"({limit / Q30_ONE:.6f} in Q2.30)", index=i)
+    return np.ascontiguousarray(a.astype(np.int32))
+
+
 def integrate_q30(dtheta_q30: ArrayLike, method: str = "rv3",
                   q0_q30: ArrayLike | None = None) -> NDArray[np.int32]:
-    """Bit-exact integer form of :func:`integrate`: Q2.30 in, (M, 4) Q2.30 out."""
+    """Bit-exact integer form of :func:`integrate`: Q2.30 in, (M, 4) Q2.30 out.
+
+    The raw inputs are checked, never wrapped or truncated: integers (an
+    integer dtype, or floats holding integers), increments within
+    ``±ATT_FX_DTHETA_MAX`` (:data:`DTHETA_MAX` rad) per component, ``q0_q30``
+    within ``±ATT_FX_QUAT_MAX``; else :class:`RangeError` (``.index``: the
+    record) or :class:`InvalidArgument`/:class:`InvalidType`."""
     ffi, lib = _lib()
     m = _method(method)
-    d = np.ascontiguousarray(np.asarray(dtheta_q30, dtype=np.int32))
+    d = _raw_q30(dtheta_q30, "dtheta_q30", _DTHETA_MAX_Q30, "integrate()")
     if d.ndim != 2 or d.shape[1] != 3:
         raise InvalidArgument(f"dtheta_q30: expected shape (N, 3), got {d.shape}")
     s = ffi.new("att_fx_integ *")
     if q0_q30 is None:
         _check(lib.att_fx_integ_init(s, m, ffi.NULL), "q0")
     else:
-        q0 = np.ascontiguousarray(np.asarray(q0_q30, dtype=np.int32))
+        q0 = _raw_q30(q0_q30, "q0_q30", _QUAT_MAX_Q30, "integrate(q0=...)")
         if q0.shape != (4,):
             raise InvalidArgument(f"q0_q30: expected shape (4,), got {q0.shape}")
         _check(lib.att_fx_integ_init(s, m, ffi.cast("int32_t *", q0.ctypes.data)), "q0_q30")
@@ -179,7 +212,7 @@ def integrate_q30(dtheta_q30: ArrayLike, method: str = "rv3",
     st = lib.att_fx_integ_batch(s, ffi.cast("int32_t *", d.ctypes.data), n,
                                 ffi.cast("int32_t *", out.ctypes.data), n_out, err)
     if st != 0:
-        _check(st, f"dtheta_q30: increment {int(err[0])}")
+        raise_for_status(st, "dtheta_q30", index=int(err[0]))
     return out[: int(n_out[0])]
 
 
@@ -237,7 +270,7 @@ class _Stream:
         if n:
             st = self._lib_.att_fx_integ_batch(self._s, self._ffi.cast("int32_t *", d.ctypes.data), n,
                                                self._ffi.cast("int32_t *", qo.ctypes.data), n_out, err)
-            _check(st, f"dtheta: increment {int(err[0])}")
+            raise_for_status(st, "dtheta", index=int(err[0]))
         m = int(n_out[0]) if n else 0
         self.updates += m
         res = from_q30(qo[:m])
@@ -258,7 +291,8 @@ class Integrator(_Integrator):
     @property
     def q_q30(self) -> NDArray[np.int32]:
         """Current attitude quaternion (raw Q2.30)."""
-        return self._fx.q_q30
+        with self._lock:
+            return self._fx.q_q30
 
 
 # -- primitives (vectorized over leading axes by a loop over records) -------

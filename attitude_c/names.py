@@ -110,6 +110,8 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     # integrator.h
     "ATT_E_INTEG_METHOD": (InvalidArgument, "unknown method, or a call not valid for this method"),
     "ATT_E_INTEG_DIVERGED": (RangeError, "increment too large: the attitude update is not finite"),
+    "ATT_E_INTEG_RANGE": (RangeError, ("increment too large: more than pi rad per sample "
+                                      "(|dtheta| <= pi; rk4: |omega|*h/2 <= pi)")),
     # link.h
     "ATT_LINK_E_NULL": (InvalidArgument, "NULL pointer"),
     "ATT_LINK_E_CONFIG": (InvalidArgument, "link configuration out of range"),
@@ -175,7 +177,7 @@ def raise_for_status(status: int, what: str,
     cls, text = meaning or (AttitudeError, "unknown status")
     where = f" at sample {index}" if index is not None else ""
     msg = f"{what}: {text}{where} (status {status}{', ' + name if name else ''})"
-    if issubclass(cls, NonFiniteError):
+    if issubclass(cls, (NonFiniteError, RangeError)):
         raise cls(msg, index=index)
     if issubclass(cls, BlockFormatError):
         raise cls(msg, status, index)

@@ -188,8 +188,10 @@ def test_demo_command(capsys: pytest.CaptureFixture[str]) -> None:
     out = capsys.readouterr().out
     for m in ac.INCREMENT_METHODS:
         assert m in out
-    assert main(["demo", "--beta", "-1"]) == 2
-    assert "must be > 0" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as ei:  # the shared option validator: a usage error of the parser
+        main(["demo", "--beta", "-1"])
+    assert ei.value.code == 2
+    assert "--beta: must be a finite number > 0" in capsys.readouterr().err
 
 
 @settings(max_examples=30, deadline=None)

@@ -14,6 +14,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from . import options
+
 if TYPE_CHECKING:
     from .. import core
 
@@ -25,11 +27,11 @@ def register(subparsers: Any) -> None:
         description=__doc__,
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    p.add_argument("--beta", type=float, default=0.01, help="cone half-angle (rad)")
-    p.add_argument("--freq", type=float, default=10.0, help="coning frequency (Hz)")
-    p.add_argument("--period", type=float, default=0.004,
+    p.add_argument("--beta", type=options.real("--beta", gt=0, lt=1.5707963267948966), default=0.01, help="cone half-angle (rad)")
+    p.add_argument("--freq", type=options.positive("--freq"), default=10.0, help="coning frequency (Hz)")
+    p.add_argument("--period", type=options.positive("--period"), default=0.004,
                    help="sample interval T (s): increments, or rk4's rate rows")
-    p.add_argument("--seconds", type=float, default=12.0, help="duration (s)")
+    p.add_argument("--seconds", type=options.real("--seconds", gt=0, le=86400), default=12.0, help="duration (s)")
     p.add_argument("--precision", choices=("f64", "f32"), default="f64")
     p.set_defaults(func=main)
 
@@ -76,6 +78,8 @@ def main(args: argparse.Namespace) -> int:
         n = round(args.seconds / T)
         if n < 3:
             raise InvalidArgument("--seconds must cover at least 3 periods")
+        if n > 10_000_000:  # 7 arrays of n × 3 float64: ~1.7 GB beyond this
+            raise InvalidArgument(f"--seconds / --period = {n} samples: at most 10,000,000 (a demo, not a run)")
         b = args.beta
         print(f"classical coning: beta = {b} rad, {args.freq} Hz, T = {T * 1e3:g} ms "
               f"(lambda = {omega * T:.3f} rad), {args.seconds:g} s, precision {args.precision}")

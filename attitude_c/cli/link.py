@@ -13,7 +13,8 @@ from collections.abc import Iterator
 from typing import Any
 
 from ..errors import AttitudeError
-from .simulate import _nonneg
+from . import options
+from .options import integer, positive
 
 
 def _hex_block(b: bytes) -> str:
@@ -54,10 +55,16 @@ EXIT_INTERRUPTED = 130  # SIGINT / SIGTERM with a block in progress
 WAIT_NOTE_S = 5.0
 
 
+# numeric options (the shared validator, attitude_c/cli/options.py); ranges of csrc/include/attitude/link.h
+BAUD = integer("--baud", 50, 4_000_000)
+BLOCK_SIZE = integer("--block-size", 1, 64)
+TICKS_MS = (1, 32767)  # link timeouts: 1..32767 ticks of 1 ms
+
+
 def _add_common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", required=True, help="device or pyserial URL (/dev/ttyS1, socket://host:port, ...)")
-    p.add_argument("--baud", type=int, default=9600, help="line rate (default 9600, 8N1)")
-    p.add_argument("--block-size", type=int, default=6, help="data bytes per block N (1..64, default 6)")
+    p.add_argument("--baud", type=BAUD, default=9600, help="line rate (default 9600, 8N1)")
+    p.add_argument("--block-size", type=BLOCK_SIZE, default=6, help="data bytes per block N (1..64, default 6)")
     p.add_argument("--impl", choices=("c", "python"), default="c", help="protocol end: the C machine or the Python one")
     _add_protocol(p)
 
@@ -71,11 +78,13 @@ def _add_protocol(p: argparse.ArgumentParser) -> None:
 def register(sub: Any) -> None:
     p = sub.add_parser("link-rx", help="receiver B on a serial port: print accepted blocks as hex")
     _add_common(p)
-    p.add_argument("--count", type=int, default=None, help="stop after N accepted blocks")
-    p.add_argument("--gap-timeout-ms", type=int, default=20, help="max gap inside a block (ms)")
-    p.add_argument("--idle-eof", type=float, default=None,
+    p.add_argument("--count", type=integer("--count", 1), default=None, help="stop after N accepted blocks")
+    p.add_argument("--gap-timeout-ms", type=integer("--gap-timeout-ms", *TICKS_MS), default=20,
+                   help="max gap inside a block (ms, 1..32767)")
+    p.add_argument("--idle-eof", type=positive("--idle-eof"), default=None, metavar="S",
                    help="treat this many seconds without a byte as end of input")
-    p.add_argument("--duration", type=float, default=None, help="stop after this many seconds")
+    p.add_argument("--duration", type=positive("--duration"), default=None, metavar="S",
+                   help="stop after this many seconds")
     p.add_argument("--decode", action="store_true",
                    help="print each 6-byte record decoded with the block format (attitude/block.h) as a "
                         "JSON line: samples numbered, reports, records that break the format")
@@ -83,12 +92,15 @@ def register(sub: Any) -> None:
 
     p = sub.add_parser("link-tx", help="sender A on a serial port: blocks from stdin hex lines or test samples")
     _add_common(p)
-    p.add_argument("--count", type=int, default=None, help="send at most N blocks")
+    p.add_argument("--count", type=integer("--count", 1), default=None, help="send at most N blocks")
     p.add_argument("--generate", action="store_true", help="send generated test samples instead of stdin")
-    p.add_argument("--syn-timeout-ms", type=int, default=50)
-    p.add_argument("--answer-timeout-ms", type=int, default=50)
-    p.add_argument("--max-attempts", type=int, default=5)
-    p.add_argument("--wait", type=_nonneg("--wait"), default=None, metavar="S",
+    p.add_argument("--syn-timeout-ms", type=integer("--syn-timeout-ms", *TICKS_MS), default=50,
+                   help="ms to wait for 0xBB after 0xAA (1..32767, default 50)")
+    p.add_argument("--answer-timeout-ms", type=integer("--answer-timeout-ms", *TICKS_MS), default=50,
+                   help="ms to wait for the answer after the checksum (1..32767, default 50)")
+    p.add_argument("--max-attempts", type=integer("--max-attempts", 1, 255), default=5,
+                   help="attempts per block (1..255, default 5)")
+    p.add_argument("--wait", type=options.nonneg("--wait"), default=None, metavar="S",
                    help="wait at most S seconds for the receiver's first handshake (default: for ever, "
                    f"with a message every {WAIT_NOTE_S:g} s; 0: no wait)")
     p.add_argument("--on-give-up", choices=("fail", "skip"), default="fail",
@@ -97,22 +109,25 @@ def register(sub: Any) -> None:
     p.set_defaults(func=cmd_tx)
 
     p = sub.add_parser("link-test", help="N blocks through a pair of ends and a (bad) channel; print statistics")
-    p.add_argument("--blocks", type=int, default=1000, help="number of blocks (default 1000)")
-    p.add_argument("--block-size", type=int, default=6)
+    p.add_argument("--blocks", type=integer("--blocks", 1, 10_000_000), default=1000,
+                   help="number of blocks (default 1000)")
+    p.add_argument("--block-size", type=BLOCK_SIZE, default=6)
     p.add_argument("--sender", choices=("c", "python"), default="c")
     p.add_argument("--receiver", choices=("c", "python"), default="c")
     p.add_argument("--transport", choices=("sim", "pty", "socket"), default="sim",
                    help="sim: simulated line time (default); pty / socket: real time over a bridge")
-    p.add_argument("--baud", type=int, default=9600)
-    p.add_argument("--ber", type=float, default=0.0, help="bit error rate per data bit")
-    p.add_argument("--drop", type=float, default=0.0, help="probability a byte is lost")
-    p.add_argument("--insert", type=float, default=0.0, help="probability a garbage byte is inserted")
-    p.add_argument("--duplicate", type=float, default=0.0, help="probability a byte arrives twice")
+    p.add_argument("--baud", type=BAUD, default=9600)
+    p.add_argument("--ber", type=options.probability("--ber", 0.5), default=0.0, help="bit error rate per data bit")
+    p.add_argument("--drop", type=options.probability("--drop"), default=0.0, help="probability a byte is lost")
+    p.add_argument("--insert", type=options.probability("--insert"), default=0.0,
+                   help="probability a garbage byte is inserted")
+    p.add_argument("--duplicate", type=options.probability("--duplicate"), default=0.0,
+                   help="probability a byte arrives twice")
     p.add_argument("--dead", action="append", default=[], metavar="START:LENGTH",
                    help="line dead from START for LENGTH seconds (repeatable, at most 4)")
     p.add_argument("--reboot", action="append", default=[], metavar="TIME:sender|receiver",
                    help="that end reboots at TIME seconds (sim only, repeatable)")
-    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--seed", type=integer("--seed", 0, 2**63 - 1), default=1)
     p.add_argument("--json", action="store_true", help="print the statistics as JSON")
     _add_protocol(p)
     p.set_defaults(func=cmd_test)
@@ -282,11 +297,10 @@ def cmd_tx(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _pair(text: str, what: str) -> tuple[str, str]:
-    if ":" not in text:
-        raise ValueError(f"{what} must look like A:B, got {text!r}")
-    a, b = text.split(":", 1)
-    return a, b
+# repeatable pair options of link-test (checked in cmd_test, after the others)
+_DEAD = options.pair("--dead", options.nonneg("--dead START"), positive("--dead LENGTH"), "START:LENGTH")
+_REBOOT = options.pair("--reboot", options.nonneg("--reboot TIME"),
+                       options.choice("--reboot", ("sender", "receiver")), "TIME:sender|receiver")
 
 
 def cmd_test(args: argparse.Namespace) -> int:
@@ -295,8 +309,8 @@ def cmd_test(args: argparse.Namespace) -> int:
     from ..link.sim import ChannelConfig, simulate_link
 
     try:
-        dead = [tuple(float(x) for x in _pair(d, "--dead")) for d in args.dead]
-        reboots: list[Any] = [(float(t), who) for t, who in (_pair(r, "--reboot") for r in args.reboot)]
+        dead = [_DEAD(d) for d in args.dead]
+        reboots: list[Any] = [_REBOOT(r) for r in args.reboot]
         chan = ChannelConfig(ber=args.ber, drop=args.drop, insert=args.insert, duplicate=args.duplicate,
                              dead=dead, seed=args.seed)  # type: ignore[arg-type]
         blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),
@@ -313,7 +327,7 @@ def cmd_test(args: argparse.Namespace) -> int:
             if reboots:
                 raise ValueError("--reboot is only available with --transport sim")
             out = _real_time_test(args, chan, [bytes(r) for r in blocks])
-    except (ValueError, TypeError) as exc:
+    except (ValueError, TypeError, argparse.ArgumentTypeError) as exc:
         print(f"link-test: {exc}", file=sys.stderr)
         return 2
     except AttitudeError as exc:

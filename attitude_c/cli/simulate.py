@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime
 import json
 import math
@@ -15,70 +16,18 @@ from ..core import METHODS as _METHODS
 from ..sim.accelmag import ACCEL_PRESETS, MAG_PRESETS
 from ..sim.sensors import GYRO_PRESETS
 from ..sim.trajectory import TRAJECTORIES
+from . import options
 
 #: Simulated time when --duration is not given (and the trajectory is not a file).
 DEFAULT_DURATION_S = 60.0
 
 
-def _positive(kind: str) -> Callable[[str], float]:
-    def conv(text: str) -> float:
-        try:
-            v = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind}: expected a number, got {text!r}") from None
-        if not math.isfinite(v) or v <= 0:
-            raise argparse.ArgumentTypeError(f"{kind}: must be a finite number > 0, got {text!r}")
-        return v
-    return conv
-
-
-def _nonneg(kind: str) -> Callable[[str], float]:
-    def conv(text: str) -> float:
-        try:
-            v = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind}: expected a number, got {text!r}") from None
-        if not math.isfinite(v) or v < 0:
-            raise argparse.ArgumentTypeError(f"{kind}: must be a finite number >= 0, got {text!r}")
-        return v
-    return conv
-
-
-def _ber(text: str) -> float:
-    v = _nonneg("BER")(text)
-    if v >= 0.5:
-        raise argparse.ArgumentTypeError(f"BER: must be below 0.5, got {text!r}")
-    return v
-
-
-def _int_range(kind: str, lo: int, hi: int) -> Callable[[str], int]:
-    def conv(text: str) -> int:
-        try:
-            v = int(text, 0)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind}: expected an integer, got {text!r}") from None
-        if not lo <= v <= hi:
-            raise argparse.ArgumentTypeError(f"{kind}: must be in {lo}..{hi}, got {v}")
-        return v
-    return conv
-
-
-def _triple(kind: str) -> Callable[[str], tuple[float, float, float]]:
-    def conv(text: str) -> tuple[float, float, float]:
-        parts = [p for p in text.replace(" ", "").split(",") if p != ""]
-        if len(parts) == 1:
-            parts = parts * 3
-        if len(parts) != 3:
-            raise argparse.ArgumentTypeError(f"{kind}: give one value or three comma-separated "
-                                             f"values, got {text!r}")
-        try:
-            vals = tuple(float(p) for p in parts)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{kind}: not a number in {text!r}") from None
-        if not all(math.isfinite(v) for v in vals):
-            raise argparse.ArgumentTypeError(f"{kind}: values must be finite, got {text!r}")
-        return vals  # type: ignore[return-value]
-    return conv
+# numeric options: the shared validator (attitude_c/cli/options.py)
+_positive = options.positive
+_nonneg = options.nonneg
+_int_range = options.integer
+_triple = options.triple
+_ber = options.probability("BER", below=0.5)
 
 
 def _floats(kind: str, counts: tuple[int, ...]) -> Callable[[str], tuple[float, ...]]:
@@ -188,11 +137,11 @@ def register(subparsers: Any) -> None:
                    help="paper-translation trajectory: sinusoidal translation amplitudes (m, ENU)")
     g.add_argument("--translation-frequency", type=_triple("--translation-frequency"), default="0.15,0.10,0.25",
                    metavar="E,N,U", help="paper-translation trajectory: translation frequencies (Hz)")
-    g.add_argument("--turntable-rate", type=float, default=5.0, metavar="DEG_S",
+    g.add_argument("--turntable-rate", type=options.real("--turntable-rate"), default=5.0, metavar="DEG_S",
                    help="turntable trajectory: rate about body z (deg/s; the FPGA+DSP paper's 5)")
     g.add_argument("--turn-rate", type=_positive("--turn-rate"), default=10.0, metavar="DEG_S",
                    help="level-turn trajectory: peak turn rate (deg/s)")
-    g.add_argument("--turns", type=float, default=1.0, metavar="N",
+    g.add_argument("--turns", type=options.real("--turns"), default=1.0, metavar="N",
                    help="level-turn trajectory: turns (negative: clockwise)")
     g.add_argument("--rest", type=_nonneg("--rest"), default=10.0, metavar="S",
                    help="level-turn trajectory: rest before and after the turn (s)")
@@ -451,15 +400,20 @@ def build_config(args: argparse.Namespace) -> Any:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import AttitudeError
+    from . import EXIT_OS, EXIT_USAGE, os_error_line
 
     try:
         return _run(args)
+    except OSError as exc:  # the output location, a full disk (ResultsIncomplete says which files)
+        print(f"attitude simulate: error: {os_error_line(exc)}", file=sys.stderr)
+        return EXIT_OS
     except (AttitudeError, ValueError, TypeError) as exc:
         print(f"attitude simulate: error: {exc}", file=sys.stderr)
-        return 2
+        return EXIT_USAGE
 
 
 def _run(args: argparse.Namespace) -> int:
+    from .._io import check_output_dir, write_results
     from ..sim import format_budget, format_table, plot_budget, run_budget, simulate, write_run
     from ..sim.report import to_jsonable
 
@@ -467,19 +421,23 @@ def _run(args: argparse.Namespace) -> int:
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
     name = f"{stamp}-{'budget' if args.budget else cfg.method if cfg.estimator == 'integrator' else 'ahrs'}-{cfg.trajectory.name}-s{cfg.seed}"
     out = Path(args.out) if args.out else Path("results") / name
+    made = not out.exists()
+    check_output_dir(out)  # before the run: a wrong --out costs nothing
     prog = _Progress(enabled=not args.no_progress)
     t0 = time.perf_counter()
+    ok = False
     try:
         if args.budget:
             b = run_budget(cfg, methods=args.methods, ber=args.budget_ber, progress=prog)
-            out.mkdir(parents=True, exist_ok=True)
             d = b.to_dict()
             d["elapsed_s"] = time.perf_counter() - t0
-            (out / "budget.json").write_text(json.dumps(to_jsonable(d), indent=2) + "\n")
-            (out / "budget.md").write_text(format_budget(b, markdown=True) + "\n")
+            steps: list[tuple[Path, Callable[[Path], object]]] = [
+                (out / "budget.json", lambda p: p.write_text(json.dumps(to_jsonable(d), indent=2) + "\n")),
+                (out / "budget.md", lambda p: p.write_text(format_budget(b, markdown=True) + "\n"))]
             if not args.no_plots:
-                plot_budget(b, out / "budget.png")
+                steps.append((out / "budget.png", lambda p: plot_budget(b, p)))
             prog.close()
+            write_results(steps)
             if args.json:
                 print(json.dumps(to_jsonable(d), indent=2))
             else:
@@ -488,11 +446,16 @@ def _run(args: argparse.Namespace) -> int:
                 print(format_budget(b))
                 print(f"wrote {out}/ (budget.json, budget.md{', budget.png' if not args.no_plots else ''})"
                       f" in {time.perf_counter() - t0:.1f} s")
+            ok = True
             return 0
         res = simulate(cfg, progress=prog)
         files = write_run(res, out, plots=not args.no_plots)
+        ok = True
     finally:
         prog.close()
+        if not ok and made:
+            with contextlib.suppress(OSError):  # the directory made for this run, if left empty
+                out.rmdir()
     if args.json:
         print(json.dumps(to_jsonable(res.summary), indent=2))
     else:

@@ -7,10 +7,13 @@ import argparse
 import asyncio
 import signal
 import sys
-from typing import Any, Callable
+from typing import Any
 
 from ..errors import AttitudeError
-from .simulate import _int_range, _positive, _triple
+from . import options
+from .options import integer as _int_range
+from .options import positive as _positive
+from .options import triple as _triple
 
 #: ``attitude view`` exit statuses (docs/view.md, "Exit statuses").
 EXIT_OK = 0  # stopped with Ctrl-C / SIGTERM
@@ -19,15 +22,6 @@ EXIT_USAGE = 2  # bad option
 EXIT_SERVE = 3  # cannot serve: the address cannot be listened on, or aiohttp is missing
 
 DEFAULT_PORT = 8765
-
-
-def _max(kind: str, hi: float, conv: Callable[[str], float]) -> Callable[[str], float]:
-    def check(text: str) -> float:
-        v = conv(text)
-        if v > hi:
-            raise argparse.ArgumentTypeError(f"{kind}: must be at most {hi:g}, got {text!r}")
-        return v
-    return check
 
 
 def register(sub: Any) -> None:
@@ -58,7 +52,7 @@ def register(sub: Any) -> None:
                    "watch and download, with a warning)")
     g.add_argument("--port", type=_int_range("--port", 0, 65535), default=DEFAULT_PORT,
                    help=f"TCP port (default {DEFAULT_PORT}; 0: any free port)")
-    g.add_argument("--display-rate", type=_max("--display-rate", 100, _positive("--display-rate")),
+    g.add_argument("--display-rate", type=options.real("--display-rate", gt=0, le=100),
                    default=25.0, metavar="HZ", help="frames per second sent to the page (default 25, at most 100)")
     g.add_argument("--history", type=_positive("--history"), default=600.0, metavar="S",
                    help="seconds of chart history kept for the page (the longest window; default 600)")

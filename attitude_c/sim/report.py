@@ -10,10 +10,9 @@ import contextlib
 import csv
 import json
 import math
-import os
 from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Callable
 
 import numpy as np
 
@@ -23,16 +22,12 @@ __all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "sens
            "write_run"]
 
 
-@contextlib.contextmanager
-def _replacing(path: Path) -> Iterator[Path]:
-    """A temporary path beside ``path``, renamed onto it when the block succeeds."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            tmp.unlink()
+def _replacing(path: Path) -> contextlib.AbstractContextManager[Path]:
+    """A temporary path beside ``path``, fsynced and renamed onto it when the
+    block succeeds, removed when it fails (attitude_c._io.atomic_path)."""
+    from .._io import atomic_path
+
+    return atomic_path(path)
 
 
 @contextlib.contextmanager
@@ -274,24 +269,31 @@ def format_table(summary: dict[str, Any]) -> str:
 
 
 def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
-    """Write summary.json, timeseries.csv, errors.png and attitude.png into out
-    (and sensors.csv when the run has an accelerometer or a magnetometer)."""
+    """Write timeseries.csv (sensors.csv when the run has an accelerometer or a
+    magnetometer), errors.png, attitude.png and summary.json (last) into out,
+    each complete or not at all (attitude_c._io: temp file, fsync, rename); an
+    OSError names the files complete and absent."""
+    from .._io import write_results
+
     out.mkdir(parents=True, exist_ok=True)
     files = {"summary": out / "summary.json", "csv": out / "timeseries.csv"}
-    write_csv(res, files["csv"])
     if res.aux:
         files["sensors_csv"] = out / "sensors.csv"
-        write_sensors_csv(res, files["sensors_csv"])
     if plots:
         files["errors_png"] = out / "errors.png"
         files["attitude_png"] = out / "attitude.png"
-        plot_errors(res, files["errors_png"])
-        plot_attitude(res, files["attitude_png"])
         if res.bias is not None:
             files["bias_png"] = out / "bias.png"
-            plot_bias(res, files["bias_png"])
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
-    with _open_replacing(files["summary"]) as fh:
-        fh.write(json.dumps(to_jsonable(summary), indent=2) + "\n")
+    steps: list[tuple[Path, Callable[[Path], object]]] = [(files["csv"], lambda p: write_csv(res, p))]
+    if res.aux:
+        steps.append((files["sensors_csv"], lambda p: write_sensors_csv(res, p)))
+    if plots:
+        steps += [(files["errors_png"], lambda p: plot_errors(res, p)),
+                  (files["attitude_png"], lambda p: plot_attitude(res, p))]
+        if res.bias is not None:
+            steps.append((files["bias_png"], lambda p: plot_bias(res, p)))
+    steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n")))
+    write_results(steps)
     return files

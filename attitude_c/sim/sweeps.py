@@ -282,7 +282,8 @@ def integrate_trial(trial: Any, method: Method = "rv3", precision: Precision = "
 register_estimator("integrator", integrate_trial)
 
 
-def ahrs_trial(trial: Any, six_axis: bool = False, precision: Precision = "f64", **settings: Any) -> np.ndarray:
+def ahrs_trial(trial: Any, six_axis: bool = False, precision: Literal["f64", "f32"] = "f64",
+               **settings: Any) -> np.ndarray:
     """The attitude filter (:func:`attitude_c.ahrs.ahrs`, docs/ahrs.md) on a BROAD trial.
 
     It aligns itself from the first samples (no reference needed); ``six_axis``

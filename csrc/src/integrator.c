@@ -164,6 +164,38 @@ size_t att_integ_outputs(const att_integ *s, size_t n)
     }
 }
 
+att_real att_integ_dtheta_max(void)
+{
+    return ATT_PI;
+}
+
+/* |v|² ≤ π² (v finite or not: NaN and overflowing squares fail). */
+static inline int within_pi(const att_real v[3])
+{
+    att_real p2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    return p2 <= ATT_PI * ATT_PI;
+}
+
+/* |ω|·h/2 ≤ π: the angle turned between two rate rows. */
+static inline int rate_ok(const att_real w[3], att_real h)
+{
+    att_real v[3];
+    att_real hh = ATT_R(0.5) * h;
+    v[0] = w[0] * hh;
+    v[1] = w[1] * hh;
+    v[2] = w[2] * hh;
+    return within_pi(v);
+}
+
+/* Status of an increment: ATT_OK, ATT_E_NONFINITE or ATT_E_INTEG_RANGE. */
+static inline att_status check_inc(const att_real v[3])
+{
+    if (within_pi(v)) {
+        return ATT_OK;
+    }
+    return att__finite3(v) ? (att_status)ATT_E_INTEG_RANGE : ATT_E_NONFINITE;
+}
+
 /* Apply rotation vector phi to q (locals), renormalizing periodically. */
 static inline void step_q(att_real q[4], const att_real phi[3], unsigned int *since_norm)
 {
@@ -234,8 +266,9 @@ int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4])
     if (s->method == ATT_METHOD_RK4) {
         return ATT_E_INTEG_METHOD;
     }
-    if (!att__finite3(dtheta)) {
-        return ATT_E_NONFINITE;
+    r = check_inc(dtheta);
+    if (r != ATT_OK) {
+        return r;
     }
     copy3(phi, dtheta);
     switch (s->method) {
@@ -359,6 +392,9 @@ int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att
     if (!(h > ATT_R(0.0)) || !isfinite(h)) {
         return ATT_E_ARG;
     }
+    if (!rate_ok(s->buf[0], h) || !rate_ok(s->buf[1], h) || !rate_ok(omega, h)) {
+        return ATT_E_INTEG_RANGE;
+    }
     rk4_delta(s->buf[0], s->buf[1], omega, h, d);
     for (i = 0; i < 4; i++) {
         q[i] = s->q[i];
@@ -404,11 +440,12 @@ static att_status feed_single(att_integ *s, const att_real *dth, size_t i0, size
     return ATT_OK;
 }
 
-static size_t first_nonfinite(const att_real *dth, size_t i0, size_t i1)
+/* First increment in [i0, i1) that is not finite or beyond |Δθ| ≤ π, or i1. */
+static size_t first_unchecked(const att_real *dth, size_t i0, size_t i1)
 {
     size_t i;
     for (i = i0; i < i1; i++) {
-        if (!att__finite3(dth + 3 * i)) {
+        if (!within_pi(dth + 3 * i)) {
             return i;
         }
     }
@@ -432,17 +469,20 @@ static size_t frames_fast(att_integ *s, const att_real *dth, size_t i0, size_t n
     for (f = 0; f < nframes; f++) {
         const att_real *a = dth + 3 * (i0 + (size_t)m * f);
         att_real *o = q_out + 4 * no;
+        int ok = within_pi(a); /* |Δθ| ≤ π for each increment of the frame (NaN fails too) */
         if (m == 1) {
             phi[0] = a[0];
             phi[1] = a[1];
             phi[2] = a[2];
         } else if (m == 2) {
             const att_real *b = a + 3;
+            ok &= within_pi(b);
             phi[0] = a[0] + b[0] + k12 * (a[1] * b[2] - a[2] * b[1]);
             phi[1] = a[1] + b[1] + k12 * (a[2] * b[0] - a[0] * b[2]);
             phi[2] = a[2] + b[2] + k12 * (a[0] * b[1] - a[1] * b[0]);
         } else {
             const att_real *b = a + 3, *c = a + 6;
+            ok &= within_pi(b) & within_pi(c);
             phi[0] = a[0] + b[0] + c[0] + k12 * (a[1] * b[2] - a[2] * b[1])
                      + k13 * (a[1] * c[2] - a[2] * c[1]) + k23 * (b[1] * c[2] - b[2] * c[1]);
             phi[1] = a[1] + b[1] + c[1] + k12 * (a[2] * b[0] - a[0] * b[2])
@@ -451,10 +491,10 @@ static size_t frames_fast(att_integ *s, const att_real *dth, size_t i0, size_t n
                      + k13 * (a[0] * c[1] - a[1] * c[0]) + k23 * (b[0] * c[1] - b[1] * c[0]);
         }
         step_q(q, phi, &sn);
-        if (!att__finite4(q)) {
+        if (!ok || !att__finite4(q)) {
             size_t lo = i0 + (size_t)m * f, hi = lo + (size_t)m;
-            size_t bad = first_nonfinite(dth, lo, hi);
-            *st = (bad < hi) ? ATT_E_NONFINITE : (att_status)ATT_E_INTEG_DIVERGED;
+            size_t bad = first_unchecked(dth, lo, hi);
+            *st = (bad < hi) ? check_inc(dth + 3 * bad) : (att_status)ATT_E_INTEG_DIVERGED;
             *err_index = (bad < hi) ? bad : hi - 1;
             return 0;
         }
@@ -492,8 +532,8 @@ static size_t reuse_fast(att_integ *s, const att_real *dth, size_t i0, size_t n,
         att_real *o = q_out + 4 * no;
         reuse_phi(method, s->k, a, b, c, phi);
         step_q(q, phi, &sn);
-        if (!att__finite4(q)) {
-            *st = att__finite3(c) ? (att_status)ATT_E_INTEG_DIVERGED : ATT_E_NONFINITE;
+        if (!within_pi(c) || !att__finite4(q)) {
+            *st = within_pi(c) ? (att_status)ATT_E_INTEG_DIVERGED : check_inc(c);
             *err_index = i0 + j;
             return 0;
         }
@@ -622,9 +662,17 @@ att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, co
         att_real hj = h[n_h == 1 ? 0 : (nout < n_h ? nout : n_h - 1)];
         int r = att_integ_update_rate(s, omega + 3 * i, hj, q_out + 4 * nout);
         if (r < 0) {
+            size_t bad = i;
+            if (r == ATT_E_INTEG_RANGE) { /* name the first offending row of this call */
+                if (i >= 2 && !rate_ok(omega + 3 * (i - 2), hj)) {
+                    bad = i - 2;
+                } else if (i >= 1 && !rate_ok(omega + 3 * (i - 1), hj)) {
+                    bad = i - 1;
+                }
+            }
             *s = saved;
             if (err_index != NULL) {
-                *err_index = i;
+                *err_index = bad;
             }
             return (att_status)r;
         }

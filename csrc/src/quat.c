@@ -65,11 +65,25 @@ att_status att_quat_normalize(const att_real q[4], att_real out[4])
     return ATT_OK;
 }
 
+/* 2^16 rad: see quat.h */
+#define ATT_ROTVEC_MAX ATT_R(65536.0)
+
+att_real att_rotvec_max(void)
+{
+    return ATT_ROTVEC_MAX;
+}
+
 att_status att_rotvec_to_quat(const att_real phi[3], att_real q[4])
 {
     att_real d[4];
     if (!att__finite3(phi)) {
         return ATT_E_NONFINITE;
+    }
+    /* each component first (their squares cannot overflow then), the norm next */
+    if (att_fabs(phi[0]) > ATT_ROTVEC_MAX || att_fabs(phi[1]) > ATT_ROTVEC_MAX
+        || att_fabs(phi[2]) > ATT_ROTVEC_MAX
+        || phi[0] * phi[0] + phi[1] * phi[1] + phi[2] * phi[2] > ATT_ROTVEC_MAX * ATT_ROTVEC_MAX) {
+        return ATT_E_RANGE;
     }
     att__rotvec_delta(phi, d);
     q[0] = ATT_R(1.0) + d[0];
@@ -142,6 +156,35 @@ static int finite_n(const att_real *v, int n)
     return 1;
 }
 
+/* C is near a rotation: |(CᵀC − I)ij| ≤ ATT_DCM_ORTHO_TOL_PPM·1e-6 and
+ * det C > 0 (quat.h). Entries beyond 2 fail at once (their squares could
+ * overflow, and no near-orthogonal matrix has them). */
+static int near_rotation(const att_real C[9])
+{
+    const att_real tol = ATT_R(ATT_DCM_ORTHO_TOL_PPM) * ATT_R(1e-6);
+    att_real det;
+    int i, j, k;
+    for (i = 0; i < 9; i++) {
+        if (!(att_fabs(C[i]) <= ATT_R(2.0))) {
+            return 0;
+        }
+    }
+    for (i = 0; i < 3; i++) {
+        for (j = i; j < 3; j++) {
+            att_real g = (i == j) ? ATT_R(-1.0) : ATT_R(0.0);
+            for (k = 0; k < 3; k++) {
+                g += C[3 * k + i] * C[3 * k + j];
+            }
+            if (!(att_fabs(g) <= tol)) {
+                return 0;
+            }
+        }
+    }
+    det = C[0] * (C[4] * C[8] - C[5] * C[7]) - C[1] * (C[3] * C[8] - C[5] * C[6])
+          + C[2] * (C[3] * C[7] - C[4] * C[6]);
+    return det > ATT_R(0.0);
+}
+
 att_status att_dcm_to_quat(const att_real C[9], att_real q[4])
 {
     /* Shepperd: pick the largest of 4λ², 4p1², 4p2², 4p3². */
@@ -149,6 +192,9 @@ att_status att_dcm_to_quat(const att_real C[9], att_real q[4])
     int i, best = 0;
     if (!finite_n(C, 9)) {
         return ATT_E_NONFINITE;
+    }
+    if (!near_rotation(C)) {
+        return ATT_E_ARG;
     }
     tr = C[0] + C[4] + C[8];
     t[0] = ATT_R(1.0) + tr;
@@ -379,7 +425,20 @@ att_status att_quat_mul_n(const att_real *a, const att_real *b, att_real *out, s
             }
             return ATT_E_NONFINITE;
         }
-        att_quat_mul(a + 4 * i, b + 4 * i, out + 4 * i);
+        {
+            att_real r[4];
+            att_quat_mul(a + 4 * i, b + 4 * i, r);
+            if (!att__finite4(r)) { /* finite inputs, overflowing product */
+                if (err_index != NULL) {
+                    *err_index = i;
+                }
+                return ATT_E_RANGE;
+            }
+            out[4 * i] = r[0];
+            out[4 * i + 1] = r[1];
+            out[4 * i + 2] = r[2];
+            out[4 * i + 3] = r[3];
+        }
     }
     return ATT_OK;
 }

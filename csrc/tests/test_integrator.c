@@ -154,13 +154,17 @@ static void test_bad_input(void)
     d[2] = NAN;
     CHECK_EQ_INT(att_integ_update(&s, d, out), ATT_E_NONFINITE);
     CHECK(same_state(&before, &s));
-    /* finite but absurd increment: diverged, state unchanged */
+    /* finite but absurd increment: out of range, state unchanged */
     CHECK_EQ_INT(att_integ_init(&s, ATT_METHOD_RV1, NULL), ATT_OK);
     memcpy(&before, &s, sizeof s);
     d[0] = (att_real)HUGE_INC;
     d[1] = (att_real)HUGE_INC;
     d[2] = (att_real)HUGE_INC;
-    CHECK_EQ_INT(att_integ_update(&s, d, out), ATT_E_INTEG_DIVERGED);
+    CHECK_EQ_INT(att_integ_update(&s, d, out), ATT_E_INTEG_RANGE);
+    CHECK(same_state(&before, &s));
+    d[1] = d[2] = 0;
+    d[0] = (att_real)1e20; /* finite square, finite (meaningless) attitude before the limit */
+    CHECK_EQ_INT(att_integ_update(&s, d, out), ATT_E_INTEG_RANGE);
     CHECK(same_state(&before, &s));
     /* rate call on an increment method and vice versa */
     CHECK_EQ_INT(att_integ_update_rate(&s, d, (att_real)0.01, out), ATT_E_INTEG_METHOD);
@@ -168,6 +172,49 @@ static void test_bad_input(void)
     d[0] = d[1] = d[2] = 0;
     CHECK_EQ_INT(att_integ_update(&s, d, out), ATT_E_INTEG_METHOD);
     CHECK_EQ_INT(att_integ_batch(&s, dth, 3, out, &nout, &err), ATT_E_INTEG_METHOD);
+}
+
+/* |Δθ| ≤ π per sample (att_integ_dtheta_max): exactly π passes, just above
+ * fails; every method names the first offending increment in a batch. */
+static void test_increment_limit(void)
+{
+    att_integ s, before;
+    att_real d[3], q[4];
+    size_t nout = 7, err = 0;
+    int m;
+    CHECK(att_integ_dtheta_max() == (att_real)3.14159265358979323846);
+    for (m = 0; m < ATT_METHOD_COUNT; m++) {
+        if (m == ATT_METHOD_RK4) {
+            continue;
+        }
+        fill_constant((const double[3]){ 0.1, 0.2, 0.3 }, 0.01);
+        CHECK_EQ_INT(att_integ_init(&s, (att_method)m, NULL), ATT_OK);
+        memcpy(&before, &s, sizeof s);
+        dth[3 * 37 + 1] = (att_real)3.2; /* 0.002 .. 3.2: just above π */
+        CHECK_EQ_INT(att_integ_batch(&s, dth, N, out, &nout, &err), ATT_E_INTEG_RANGE);
+        CHECK_EQ_INT(err, 37);
+        CHECK_EQ_INT(nout, 0);
+        CHECK(same_state(&before, &s));
+        dth[3 * 37 + 1] = (att_real)3.1;
+        CHECK_EQ_INT(att_integ_batch(&s, dth, N, out, &nout, &err), ATT_OK);
+    }
+    CHECK_EQ_INT(att_integ_init(&s, ATT_METHOD_RV1, NULL), ATT_OK);
+    d[0] = att_integ_dtheta_max();
+    d[1] = d[2] = 0;
+    CHECK_EQ_INT(att_integ_update(&s, d, q), ATT_INTEG_UPDATED); /* half a turn: allowed */
+    CHECK(fabs((double)q[0]) < 1e-6 && fabs((double)q[1] - 1.0) < 1e-6);
+    /* rk4: |ω|·h/2 ≤ π; the offending row is named */
+    {
+        att_real om[5][3] = { { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 }, { 0, 700, 0 }, { 0, 0, 1 } };
+        att_real hh = (att_real)0.01; /* 700 rad/s × 0.005 s = 3.5 rad > π */
+        CHECK_EQ_INT(att_integ_init(&s, ATT_METHOD_RK4, NULL), ATT_OK);
+        CHECK_EQ_INT(att_integ_rk4_batch(&s, &om[0][0], 5, &hh, 1, out, &nout, &err), ATT_E_INTEG_RANGE);
+        CHECK_EQ_INT(err, 3);
+        CHECK_EQ_INT(s.nbuf, 0);
+        om[3][1] = 600; /* 3.0 rad */
+        CHECK_EQ_INT(att_integ_rk4_batch(&s, &om[0][0], 5, &hh, 1, out, &nout, &err), ATT_OK);
+        CHECK_EQ_INT(nout, 2);
+    }
 }
 
 static void test_rk4(void)
@@ -298,6 +345,7 @@ int main(void)
     test_constant_rate();
     test_batch_equals_stream();
     test_bad_input();
+    test_increment_limit();
     test_rk4();
     test_long_run();
     test_method_names();

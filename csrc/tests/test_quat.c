@@ -157,6 +157,33 @@ static void test_errors_and_arrays(void)
     CHECK_EQ_INT(att_euler_to_quat(e, q), ATT_E_NONFINITE);
     CHECK_EQ_INT(att_euler_to_dcm_n(e, C, 1, NULL), ATT_E_NONFINITE);
     CHECK_EQ_INT(att_quat_mul_n(q, q, q, 0, &bad), ATT_OK);
+    /* never a silent wrong number: out-of-domain inputs with finite values */
+    {
+        att_real big[8] = { 1, 0, 0, 0, (att_real)1e30, 0, 0, 0 }, prod[8], z[9] = { 0 }, r[4];
+        att_real v[3] = { (att_real)1e30, 0, 0 };
+        /* 1e30² overflows float; double: scale the product up to 1e300 */
+#if !defined(ATT_REAL_F32)
+        big[4] = (att_real)1e200;
+#endif
+        CHECK_EQ_INT(att_quat_mul_n(big, big, prod, 2, &bad), ATT_E_RANGE);
+        CHECK_EQ_INT(bad, 1);
+        CHECK_CLOSE(prod[0], 1, 0);                          /* record 0 written */
+        CHECK_EQ_INT(att_rotvec_to_quat(v, r), ATT_E_RANGE); /* |Φ|² overflows */
+        v[0] = att_rotvec_max();
+        CHECK_EQ_INT(att_rotvec_to_quat(v, r), ATT_OK);
+        v[0] = att_rotvec_max() * (att_real)1.01;
+        CHECK_EQ_INT(att_rotvec_to_quat(v, r), ATT_E_RANGE);
+        CHECK_EQ_INT(att_dcm_to_quat(z, r), ATT_E_ARG); /* zero matrix: no rotation */
+        z[0] = z[4] = 2;
+        z[8] = 2; /* 2·I */
+        CHECK_EQ_INT(att_dcm_to_quat(z, r), ATT_E_ARG);
+        z[0] = z[4] = 1;
+        z[8] = -1; /* a reflection: det −1 */
+        CHECK_EQ_INT(att_dcm_to_quat(z, r), ATT_E_ARG);
+        z[8] = (att_real)1.004; /* 0.4 % off: still the quaternion of a nearby rotation */
+        CHECK_EQ_INT(att_dcm_to_quat(z, r), ATT_OK);
+        CHECK_CLOSE(r[0], 1, 1e-2);
+    }
     CHECK(att_real_size() == (int)sizeof(att_real));
 }
 

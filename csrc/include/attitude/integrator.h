@@ -80,9 +80,25 @@ enum {
 
 /* Integrator status codes (range -20..-39). */
 enum {
-    ATT_E_INTEG_METHOD = -20,  /* unknown method, or a call not valid for this method */
-    ATT_E_INTEG_DIVERGED = -21 /* finite input but a non-finite result (increment too large) */
+    ATT_E_INTEG_METHOD = -20,   /* unknown method, or a call not valid for this method */
+    ATT_E_INTEG_DIVERGED = -21, /* finite input but a non-finite result (cannot happen within the
+                                  limits below; kept as the last line of defence) */
+    ATT_E_INTEG_RANGE = -22     /* an increment (or rate × half-step) beyond att_integ_dtheta_max() */
 };
+
+/* Largest accepted angle per sample (rad): π. Every increment must have
+ * |Δθ| ≤ π (Euclidean norm), every rk4 rate sample |ω|·h/2 ≤ π (the angle
+ * turned over the half-step between two rate rows); beyond it
+ * ATT_E_INTEG_RANGE names the sample. Why π: the algorithms model the
+ * rotation within one update by a truncated series in Δθ (docs/integrator.md),
+ * whose error terms are O(|Δθ|³..|Δθ|⁵) and exceed the angle itself long
+ * before π; and a body turning more than half a turn between two samples is
+ * undersampled (its rotation vector is unique only up to |φ| ≤ π, so the
+ * motion between samples cannot be recovered). A real gyro channel is far
+ * inside the bound (the paper's ±90 °/s at 0.08 s: 0.13 rad). The check also
+ * refuses increments whose squares overflow (|Δθ| = 1e200), which the
+ * series would turn into a NaN or, worse, a finite meaningless attitude. */
+att_real att_integ_dtheta_max(void);
 
 /* Caller-owned state. Treat as opaque; read the attitude with
  * att_integ_attitude(). */
@@ -126,23 +142,28 @@ size_t att_integ_outputs(const att_integ *s, size_t n);
 /* Feed one increment (increment methods). Returns ATT_INTEG_UPDATED and
  * writes the new attitude to q_out (may be NULL) when an update completes,
  * ATT_INTEG_PENDING when the increment was only buffered, or a negative
- * status (state unchanged): ATT_E_NONFINITE, ATT_E_INTEG_DIVERGED,
- * ATT_E_INTEG_METHOD (rk4 state). */
+ * status (state unchanged): ATT_E_NONFINITE, ATT_E_INTEG_RANGE (|Δθ| > π),
+ * ATT_E_INTEG_DIVERGED, ATT_E_INTEG_METHOD (rk4 state). The attitude
+ * written is always finite and of unit norm (to the renormalization's
+ * first order): outputs are checked before they are committed. */
 int att_integ_update(att_integ *s, const att_real dtheta[3], att_real q_out[4]);
 
 /* Feed one rate sample (rk4 only). The first sample after init/reset is
  * the rate at the start; then samples alternate midpoint (t+h/2) and end
  * (t+h, which is also the start of the next step). An update completes on
  * each end sample, with step h (s, > 0) given with that end sample (the h
- * given with the midpoint sample is ignored). */
+ * given with the midpoint sample is ignored). ATT_E_INTEG_RANGE when one
+ * of the step's three rates has |ω|·h/2 > att_integ_dtheta_max() (checked
+ * when the step's h is known: with the end sample). */
 int att_integ_update_rate(att_integ *s, const att_real omega[3], att_real h, att_real q_out[4]);
 
 /* n increments (n×3 values) in one call, exactly as n att_integ_update()
  * calls. q_out receives the attitude after each completed update (4
  * values each; room for att_integ_outputs(s, n) records), *n_out their
  * number. On error the state is left as it was at entry, *err_index is
- * the index of the offending increment (the first non-finite one, or the
- * last one of the diverged update) and *n_out is 0. n_out and err_index
+ * the index of the offending increment (the first non-finite one, the
+ * first one beyond att_integ_dtheta_max(), or the last one of a diverged
+ * update) and *n_out is 0. n_out and err_index
  * may be NULL. */
 att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_real *q_out, size_t *n_out,
                            size_t *err_index);
@@ -151,7 +172,10 @@ att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_r
  * att_integ_update_rate() calls; h holds n_h step sizes: n_h == 1 uses
  * h[0] for every update, otherwise h[j] is the step of the j-th update
  * completed in this call (n_h must be ≥ att_integ_outputs(s, n)). Errors
- * as att_integ_batch (ATT_E_ARG: bad h or n_h, err_index = the update). */
+ * as att_integ_batch (ATT_E_ARG: bad h or n_h, err_index = the update;
+ * ATT_E_INTEG_RANGE: err_index = the first row of this call whose
+ * |ω|·h/2 > π, or the step's end row when the bad row was buffered by an
+ * earlier call). */
 att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h, size_t n_h,
                                att_real *q_out, size_t *n_out, size_t *err_index);
 
