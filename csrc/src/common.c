@@ -1,5 +1,6 @@
 /* libattitude — common helpers. */
 #include "attitude/common.h"
+#include "attitude/integrator.h"
 
 const char *att_status_str(int status)
 {
@@ -20,6 +21,12 @@ const char *att_status_str(int status)
         return "timeout";
     case ATT_E_BUFFER:
         return "buffer too small";
+    case ATT_E_INTEG_METHOD:
+        return "unknown integration method, or a call not valid for it";
+    case ATT_E_INTEG_DIVERGED:
+        return "finite input but a non-finite result";
+    case ATT_E_INTEG_RANGE:
+        return "increment beyond pi rad per sample";
     default:
         return "unknown status";
     }

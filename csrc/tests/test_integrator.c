@@ -183,6 +183,9 @@ static void test_increment_limit(void)
     size_t nout = 7, err = 0;
     int m;
     CHECK(att_integ_dtheta_max() == (att_real)3.14159265358979323846);
+    /* attitude-rx logs the integrator's refusals by name */
+    CHECK(strstr(att_status_str(ATT_E_INTEG_RANGE), "beyond pi") != NULL);
+    CHECK(strstr(att_status_str(ATT_E_INTEG_DIVERGED), "non-finite") != NULL);
     for (m = 0; m < ATT_METHOD_COUNT; m++) {
         if (m == ATT_METHOD_RK4) {
             continue;
