@@ -33,7 +33,7 @@ _DEFAULTS: dict[str, Any] = {
     "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
-    "rest_noise": 0.001, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
+    "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}

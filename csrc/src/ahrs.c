@@ -39,7 +39,7 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->rest_tau = ATT_R(0.5);
     set->rest_gyr_th = ATT_R(0.035);
     set->rest_acc_th = ATT_R(0.5);
-    set->rest_noise = ATT_R(0.001);
+    set->rest_noise = ATT_R(3e-4);
     set->gyro_range = ATT_R(0.0);
     set->overrange_sigma = ATT_R(0.05);
     set->sensor_delay = ATT_R(0.0);

@@ -105,7 +105,7 @@ typedef struct {
     att_real rest_tau;            /* [s] low-pass time constant of the rest detector, 0.5 */
     att_real rest_gyr_th;         /* [rad/s] rest threshold on |ω − ω_lp| and |ω_lp|, 0.035 (2°/s) */
     att_real rest_acc_th;         /* [m/s²] rest threshold on |a − a_lp|, 0.5 */
-    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 0.001 */
+    att_real rest_noise;          /* [rad/s·√s] zero-rate measurement noise density (R = σ²/dt), 3e-4 */
     att_real gyro_range;          /* [rad/s] gyro full scale: an axis at or above it flags
                                  ATT_AHRS_F_OVERRANGE and inflates the attitude covariance by
                                  (overrange_sigma)² per flagged sample; 0 = no range */
