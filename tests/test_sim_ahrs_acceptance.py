@@ -9,7 +9,13 @@ steady: a longer run only samples more of the same noise, so the full run's
 maximum is the larger); the bias step is judged 10 s after the step as in
 the full run, after 30 s of rest instead of 60 (the filter's bias covariance
 is steady after ~20 s); the disturbance lasts 30 s as in the full run, judged
-until 30 s after it ends instead of 60."""
+until 30 s after it ends instead of 60.
+
+Not proof of every target: at full length (`invoke sim-acceptance`, which
+exits 1) the static tilt (0.062°) and the turntable tilt (0.113°) miss their
+0.05° and 0.1° by a noise peak (docs/simulation.md); the shortened runs here
+sample fewer peaks and pass, so they guard against regressions at the
+targets' thresholds."""
 
 from __future__ import annotations
 
