@@ -130,6 +130,8 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_AID_E_PARALLEL": (InvalidArgument, "specific force and field are parallel: heading undefined"),
     "ATT_AID_E_MOVING": (InvalidArgument, "static window: spread above its limit (moving start)"),
     "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
+    "ATT_AID_E_SINGULAR": (RangeError, "Gauss-Newton: Jacobian singular at an iterate"),
+    "ATT_AID_E_NOCONV": (RangeError, "Gauss-Newton: no convergence within the iteration limit"),
 }
 
 

@@ -140,8 +140,51 @@ static void test_window(void)
     CHECK_EQ_INT(att_align_window_init(NULL, NULL), ATT_E_NULL);
 }
 
+static void test_gauss_newton(void)
+{
+    att_real e[3] = { -2.0, 0.6, 1.2 }, f[3], m[3], qt[4], q0[4], q[4], d[3] = { 0.1, -0.15, 0.1 }, dq[4];
+    att_real par[3];
+    att_gn_settings s;
+    att_gn_result r;
+    att_real decl = (att_real)0.25;
+    body_vectors(e, decl, (att_real)1.2, f, m);
+    att_euler_to_quat(e, qt);
+    att_rotvec_to_quat(d, dq);
+    att_quat_mul(qt, dq, q0);
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_OK);
+    CHECK(qangle(q, qt) < 100 * TOL);
+    CHECK(r.iterations <= 6u);
+    att_gn_defaults(&s);
+    s.method = ATT_GN_SIMPLIFIED;
+    s.max_iter = 200;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_OK);
+    CHECK(qangle(q, qt) < 100 * TOL);
+    s.max_iter = 1; /* one step is not enough: no convergence, q untouched */
+    q[0] = 7;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_AID_E_NOCONV);
+    CHECK(q[0] == 7);
+    CHECK_EQ_INT(r.iterations, 1);
+    s.max_iter = 0;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_E_ARG);
+    att_gn_defaults(&s);
+    s.method = 7;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_E_ARG);
+    par[0] = -2 * f[0];
+    par[1] = -2 * f[1];
+    par[2] = -2 * f[2];
+    CHECK_EQ_INT(att_gn_solve(f, par, decl, q0, NULL, q, &r), ATT_AID_E_PARALLEL);
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, NULL, NULL, q, NULL), ATT_OK); /* identity start */
+    CHECK(qangle(q, qt) < 100 * TOL);
+    CHECK_EQ_INT(att_gn_solve(NULL, m, decl, q0, NULL, q, &r), ATT_E_NULL);
+    q0[2] = (att_real)INFINITY;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_E_NONFINITE);
+    q0[0] = q0[1] = q0[2] = q0[3] = 0;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_E_ARG);
+}
+
 int main(void)
 {
+    test_gauss_newton();
     test_align_and_triad_recover_the_attitude();
     test_degenerate_inputs_give_a_status();
     test_window();
