@@ -132,6 +132,8 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
     "ATT_AID_E_SINGULAR": (RangeError, "Gauss-Newton: Jacobian singular at an iterate"),
     "ATT_AID_E_NOCONV": (RangeError, "Gauss-Newton: no convergence within the iteration limit"),
+    "ATT_AID_E_SPAN": (InvalidArgument, "the samples do not span enough directions for this fit"),
+    "ATT_AID_E_FIT": (InvalidArgument, "the samples do not lie on an ellipsoid"),
 }
 
 

@@ -27,6 +27,9 @@ __all__ = [
     "align",
     "field_nav",
     "gauss_newton",
+    "magcal_apply",
+    "magcal_fit",
+    "magcal_minmax_2d",
     "triad",
 ]
 
@@ -131,3 +134,74 @@ def gauss_newton(f: ArrayLike, m: ArrayLike, q0: ArrayLike, declination: float =
     x = np.where((north < 0)[..., None], ref.quat_multiply(np.broadcast_to(flip, x.shape), x), x)
     q = ref.quat_multiply(np.broadcast_to(ref.quat_conj(qd), x.shape), x)
     return np.where(q[..., :1] < 0, -q, q), ok
+
+
+# ---------------------------------------------------------------------------
+# magnetometer calibration
+# ---------------------------------------------------------------------------
+
+#: The fit's unknowns per model (columns of the design matrix below).
+MAGCAL_COLUMNS = {"offset": (5, 6, 7, 8), "diagonal": (0, 1, 5, 6, 7, 8), "full": tuple(range(9))}
+
+
+def _design(u: F) -> tuple[F, F]:
+    """Design matrix of the trace-normalized quadric fit and its target:
+    |u|² = v1 (x² + y² − 2z²) + v2 (x² + z² − 2y²) + 2 v3 xy + 2 v4 xz
+           + 2 v5 yz + 2 v6 x + 2 v7 y + 2 v8 z + v9."""
+    x, y, z = u[:, 0], u[:, 1], u[:, 2]
+    D = np.stack([x * x + y * y - 2 * z * z, x * x + z * z - 2 * y * y, 2 * x * y, 2 * x * z, 2 * y * z,
+                  2 * x, 2 * y, 2 * z, np.ones_like(x)], axis=1)
+    return D, x * x + y * y + z * z
+
+
+def magcal_fit(m: ArrayLike, model: str = "full") -> dict[str, Any]:
+    """Least-squares ellipsoid (trace A = 3) of the samples m (N, 3), solved on
+    the explicit design matrix with ``lstsq`` after centering on the mean and
+    scaling by the RMS distance (the fit is invariant to both). The quadric
+    uᵀAu + 2bᵀu + d = 0 has centre h = −A⁻¹b and (u − h)ᵀ A (u − h) = k with
+    k = bᵀA⁻¹b − d; M = A/k, S = B M^½ (symmetric root), B = det(M)^(−1/6)
+    (det S = 1). Returns h, S, field B, residual (RMS algebraic residual
+    over 2k: ≈ RMS(|S(m − h)|/B − 1)) and span (√(λ_min/tr) of the samples'
+    covariance)."""
+    a = np.asarray(m, dtype=np.float64).reshape(-1, 3)
+    mean = a.mean(axis=0)
+    sc = float(np.sqrt(np.mean(np.sum((a - mean) ** 2, axis=1))))
+    u = (a - mean) / sc
+    D, t = _design(u)
+    cols = list(MAGCAL_COLUMNS[model])
+    sol, *_ = np.linalg.lstsq(D[:, cols], t, rcond=None)
+    v = np.zeros(9)
+    v[cols] = sol
+    A = np.array([[1 - v[0] - v[1], -v[2], -v[3]],
+                  [-v[2], 1 - v[0] + 2 * v[1], -v[4]],
+                  [-v[3], -v[4], 1 + 2 * v[0] - v[1]]])
+    b = -v[5:8]
+    d = -v[8]
+    hu = -np.linalg.solve(A, b)
+    k = float(b @ np.linalg.solve(A, b) - d)
+    lam, V = np.linalg.eigh(A / k)
+    Bu = float(np.prod(lam) ** (-1 / 6))
+    S = Bu * (V * np.sqrt(lam)) @ V.T
+    e = t - D[:, cols] @ sol
+    cov = np.cov(a.T, bias=True)
+    ev = np.linalg.eigvalsh(cov)
+    return {"h": mean + sc * hu, "S": S, "field": sc * Bu,
+            "residual": float(np.sqrt(np.mean(e * e)) / (2 * k)),
+            "span": float(np.sqrt(ev[0] / ev.sum())), "A": A / k}
+
+
+def magcal_apply(m: ArrayLike, h: ArrayLike, S: ArrayLike) -> F:
+    """m_cal = S (m − h), over leading axes."""
+    return np.einsum("ij,...j->...i", np.asarray(S, dtype=np.float64),
+                     np.asarray(m, dtype=np.float64) - np.asarray(h, dtype=np.float64))
+
+
+def magcal_minmax_2d(m: ArrayLike) -> dict[str, Any]:
+    """The 2-D min/max method: the mid-ranges of x and y are the offsets, the
+    axis of the smaller range is scaled up to the larger one."""
+    a = np.asarray(m, dtype=np.float64).reshape(-1, 3)
+    lo, hi = a[:, :2].min(axis=0), a[:, :2].max(axis=0)
+    rx, ry = hi - lo
+    kx, ky = max(1.0, ry / rx), max(1.0, rx / ry)
+    return {"h": np.array([(hi[0] + lo[0]) / 2, (hi[1] + lo[1]) / 2, 0.0]), "S": np.diag([kx, ky, 1.0]),
+            "field": kx * rx / 2}

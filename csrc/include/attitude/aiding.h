@@ -1,7 +1,7 @@
 /*
  * libattitude — aiding solvers: static attitude from the specific force and
  * the Earth's magnetic field (prefixes att_align_, att_triad, att_gn_,
- * att_magcal_). docs/aiding.md gives the derivations and the sources.
+ * att_magcal_, att_magcal2d_). docs/aiding.md gives the derivations and the sources.
  *
  * Frames and quaternion (docs/conventions.md): navigation ENU (x east,
  * y north, z up), body x right, y forward, z up; q = [λ, p1, p2, p3]
@@ -38,9 +38,14 @@ enum {
     ATT_AID_E_MOVING = -123,   /* static window: spread above its limit (moving start) */
     ATT_AID_E_FEW = -124,      /* static window: fewer samples than min_samples */
     ATT_AID_E_SINGULAR = -125, /* Gauss-Newton: Jacobian (nearly) singular at an iterate */
-    ATT_AID_E_NOCONV = -126    /* Gauss-Newton: no convergence within max_iter (or the
+    ATT_AID_E_NOCONV = -126,   /* Gauss-Newton: no convergence within max_iter (or the
                                   damping grew without bound, or the final residual is
                                   above accept_residual) */
+    ATT_AID_E_SPAN = -127,     /* magnetometer calibration: the samples do not span
+                                  enough directions (span below min_span, or the
+                                  normal equations are numerically singular) */
+    ATT_AID_E_FIT = -128       /* magnetometer calibration: the fitted quadric is not
+                                  an ellipsoid (data not on an ellipsoid) */
 };
 
 /* The parallel test: sin of the angle between f and m below
@@ -229,5 +234,112 @@ att_status att_gn_solve(const att_real f_b[3], const att_real m_b[3], att_real d
 att_status att_gn_solve_n(const att_real *f_b, const att_real *m_b, att_real declination_rad,
                           const att_real *q0, const att_gn_settings *s, att_real *q, size_t n, int *status,
                           unsigned int *iterations, att_real *residual);
+
+/* ------------------------------------------------------------------ */
+/* Magnetometer calibration: m_cal = S (m − h), h the hard-iron offset, S
+ * the soft-iron correction (symmetric positive definite, det S = 1), B the
+ * field strength, so that |m_cal| = B on the fitted ellipsoid. Streaming
+ * fit with fixed-size sufficient statistics (no sample buffer): the 35
+ * moments Σ x^a y^b z^c (a + b + c ≤ 4) of u = (m − c)/s, with c the first
+ * sample and s its norm (a shift and scale for conditioning). The solve
+ * is the linear least-squares quadric fit with the trace normalization
+ * tr A = 3 (docs/aiding.md):
+ *   x² + y² + z² = v1 (x² + y² − 2z²) + v2 (x² + z² − 2y²)
+ *                  + 2 v3 xy + 2 v4 xz + 2 v5 yz + 2 v6 x + 2 v7 y + 2 v8 z + v9
+ * with the model's subset of unknowns: OFFSET (v6..v9: a sphere, S = I),
+ * DIAGONAL (v1, v2, v6..v9: axis-aligned ellipsoid), FULL (all nine).
+ * S = B_u · M^½ (symmetric square root, no rotation of the axes) with M the
+ * ellipsoid's matrix; B = the geometric mean of its semi-axes.
+ *
+ * Span: √(λ_min(cov u) / tr(cov u)), the RMS spread of the samples along
+ * their least-spread direction relative to their total spread (uniform
+ * coverage of the sphere: 0.577; a level turn: ~0). Fits below min_span
+ * are refused (ATT_AID_E_SPAN).
+ *
+ * Fit quality (residual): the RMS algebraic residual over 2k (k the
+ * ellipsoid's constant): to first order the RMS of |m_cal|/B − 1.
+ * Accuracy (double, 500 samples, 1 % noise, cond(S) ≤ 2, |h| ≤ 2 B): the
+ * corrected norm's spread within 1.5× the noise (tests/test_magcal.py).
+ * The float build accumulates the moments in float: fine for a few
+ * thousand samples of ≤ 1 % noise, coarser beyond (docs/aiding.md). */
+typedef enum {
+    ATT_MAGCAL_OFFSET = 0,   /* hard iron only: sphere, S = I */
+    ATT_MAGCAL_DIAGONAL = 1, /* hard iron + per-axis scale (S diagonal) */
+    ATT_MAGCAL_FULL = 2,     /* hard + soft iron (S full symmetric) */
+    ATT_MAGCAL_MINMAX_2D = 3 /* the MEMS AHRS paper's 2-D min/max method (result only) */
+} att_magcal_model;
+
+typedef struct {
+    unsigned int min_samples; /* samples needed before a solve (≥ 10); default 20 */
+    att_real min_span;        /* refuse below this span (0..0.577); default 0.1 */
+} att_magcal_settings;
+
+typedef struct {
+    att_magcal_settings s;
+    unsigned long n;  /* samples added */
+    att_real c[3];    /* shift: the first sample */
+    att_real inv_s;   /* 1 / scale (1 / |first sample|, 1 if that is 0) */
+    att_real mom[35]; /* Σ x^a y^b z^c of u, degree 0..4 (ordered by degree) */
+} att_magcal;
+
+typedef struct {
+    int model;         /* att_magcal_model */
+    att_real h[3];     /* hard-iron offset (input units) */
+    att_real S[9];     /* soft-iron correction, row-major (det 1; diagonal for MINMAX_2D) */
+    att_real field;    /* B (input units): |S (m − h)| on the fitted ellipsoid */
+    att_real residual; /* ≈ RMS of |m_cal|/B − 1 (0 for MINMAX_2D) */
+    att_real span;     /* see above (MINMAX_2D: min(range)/max(range) of x and y) */
+    unsigned long n;   /* samples used */
+} att_magcal_result;
+
+/* The documented defaults. */
+void att_magcal_defaults(att_magcal_settings *s);
+
+/* Start an empty fit (s NULL: defaults). ATT_E_NULL, ATT_E_ARG (min_samples
+ * < 10, min_span outside [0, 0.577] or NaN). */
+att_status att_magcal_init(att_magcal *c, const att_magcal_settings *s);
+
+/* Add one raw sample (any unit). ATT_E_NULL, ATT_E_NONFINITE (not added). */
+att_status att_magcal_add(att_magcal *c, const att_real m[3]);
+
+/* Add n samples (3 values each); stops at the first non-finite one
+ * (ATT_E_NONFINITE, *err_index set when err_index is not NULL). */
+att_status att_magcal_add_n(att_magcal *c, const att_real *m, size_t n, size_t *err_index);
+
+/* Fit `model` (OFFSET, DIAGONAL or FULL) to the samples so far (the state
+ * is kept: add more and solve again). Status: ATT_E_NULL, ATT_E_ARG (bad
+ * model), ATT_AID_E_FEW (n < min_samples), ATT_AID_E_SPAN, ATT_AID_E_FIT;
+ * r is written only on ATT_OK. */
+att_status att_magcal_solve(const att_magcal *c, int model, att_magcal_result *r);
+
+/* m_cal = S (m − h). ATT_E_NULL, ATT_E_NONFINITE. out may alias m. */
+att_status att_magcal_apply(const att_magcal_result *r, const att_real m[3], att_real out[3]);
+
+/* n samples (3 values each); stops at the first non-finite one. */
+att_status att_magcal_apply_n(const att_magcal_result *r, const att_real *m, att_real *out, size_t n,
+                              size_t *err_index);
+
+/* The MEMS AHRS paper's 2-D method (sec. 3.1) for level-turn data: the
+ * offsets are the mid-ranges of x and y, the axis with the smaller range
+ * is scaled up to the larger: K_x = max(1, (y_max − y_min)/(x_max − x_min)),
+ * K_y = max(1, (x_max − x_min)/(y_max − y_min)). Result: h = [x_mid, y_mid, 0],
+ * S = diag(K_x, K_y, 1), field = K_x (x_max − x_min)/2 (the horizontal
+ * field), model ATT_MAGCAL_MINMAX_2D; apply with att_magcal_apply. z is
+ * left alone: only the heading of a level sensor is corrected. */
+typedef struct {
+    unsigned long n;
+    att_real min[2];
+    att_real max[2];
+} att_magcal2d;
+
+/* Start empty. ATT_E_NULL. */
+att_status att_magcal2d_init(att_magcal2d *c);
+
+/* Add one sample (x and y used). ATT_E_NULL, ATT_E_NONFINITE. */
+att_status att_magcal2d_add(att_magcal2d *c, const att_real m[3]);
+
+/* ATT_E_NULL, ATT_AID_E_FEW (fewer than 3 samples), ATT_AID_E_SPAN (an
+ * axis with no range). */
+att_status att_magcal2d_solve(const att_magcal2d *c, att_magcal_result *r);
 
 #endif /* ATTITUDE_AIDING_H */
