@@ -191,7 +191,7 @@ att_status att_align_window_solve(const att_align_window *w, att_real q[4]);
  * cond(J) > 1/singular_tol).
  *
  * Accuracy (noise-free, warm start within 0.3 rad, double): the truth to
- * < 1e-12 rad in ≤ 5 iterations (tests/test_aiding_gn.py); never non-finite. */
+ * < 1e-12 rad in ≤ 6 iterations (tests/test_aiding.py); never non-finite. */
 typedef enum {
     ATT_GN_GAUSS_NEWTON = 0, /* Jacobian at every iterate (eq. 3.39), damped */
     ATT_GN_SIMPLIFIED = 1    /* Jacobian of the start only (eq. 3.40), damped */
