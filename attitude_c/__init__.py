@@ -63,3 +63,8 @@ from . import magcal
 from .aiding import align, align_static, gauss_newton, triad
 
 __all__ += ["align", "align_static", "gauss_newton", "magcal", "triad"]
+
+# The attitude filter (docs/ahrs.md): attitude_c.Ahrs (streaming), attitude_c.ahrs (batch).
+from .ahrs_filter import Ahrs, ahrs
+
+__all__ += ["Ahrs", "ahrs"]

@@ -8,7 +8,7 @@ quaternion product — not from the C source, which works on 3×3 blocks and
 hand-expanded products. Slow (a Python loop per sample): for differential
 tests on short records, never for production use.
 
-Inputs as :func:`attitude_c.ahrs.ahrs`; settings as a dict with the C
+Inputs as :func:`attitude_c.ahrs_filter.ahrs`; settings as a dict with the C
 field names (``method`` by name).
 """
 

@@ -95,7 +95,7 @@ def _qz(deg: float) -> np.ndarray:
 # -- the filters --------------------------------------------------------------------------
 
 def run_ours(tr: Any, precision: str = "f64", **settings: Any) -> np.ndarray:
-    from attitude_c.ahrs import ahrs
+    from attitude_c.ahrs_filter import ahrs
 
     return np.asarray(ahrs(tr.gyr, tr.acc, tr.mag, rate=tr.rate, precision=precision, **settings), float)
 
@@ -268,7 +268,7 @@ def armv4t_counts() -> list[tuple[str, float]]:
 def throughput(trials: list[Any], reps: int) -> list[tuple[str, float]]:
     from vqf import VQF
 
-    from attitude_c.ahrs import Ahrs
+    from attitude_c.ahrs_filter import Ahrs
 
     from .host import _best
 
@@ -320,7 +320,7 @@ def plot(trials: list[Any], figs: dict[str, list[Any]]) -> None:
 
 def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | None = None) -> str:
     from attitude_c import broad
-    from attitude_c.ahrs import default_settings
+    from attitude_c.ahrs_filter import default_settings
 
     folder = data or None
     paths = broad.find_trials(folder)

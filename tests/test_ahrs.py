@@ -1,4 +1,4 @@
-"""attitude_c.ahrs: the attitude filter against its NumPy model and the truth.
+"""attitude_c.ahrs (attitude_c.ahrs_filter): the attitude filter against its NumPy model and the truth.
 
 Differential: the C filter (double) against attitude_c.ahrs_reference (matrix
 form of the same equations, written from docs/ahrs.md) on synthetic motion
@@ -16,7 +16,7 @@ import pytest
 
 from attitude_c import broad, names
 from attitude_c import reference as ref
-from attitude_c.ahrs import Ahrs, ahrs, default_settings
+from attitude_c.ahrs_filter import Ahrs, ahrs, default_settings
 from attitude_c.ahrs_reference import ahrs_reference
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
 
@@ -156,3 +156,12 @@ def test_defaults_documented():
     assert math.isclose(d["gravity"], 9.81)
     from attitude_c import ahrs_reference as mref
     assert d == pytest.approx(mref._DEFAULTS)  # the model uses the library's defaults
+
+
+def test_the_issue_names_are_the_package_api() -> None:
+    """`attitude_c.Ahrs` (streaming) and `attitude_c.ahrs(...)` (batch) as the docs name them."""
+    import attitude_c
+    from attitude_c import ahrs_filter
+
+    assert attitude_c.Ahrs is ahrs_filter.Ahrs and attitude_c.ahrs is ahrs_filter.ahrs
+    assert "Ahrs" in attitude_c.__all__ and "ahrs" in attitude_c.__all__

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import attitude_c
-from attitude_c.ahrs import Ahrs, default_settings
-from attitude_c.ahrs import ahrs as ahrs_batch
+from attitude_c.ahrs_filter import Ahrs, default_settings
+from attitude_c.ahrs_filter import ahrs as ahrs_batch
 from attitude_c.cli import main
 from attitude_c.cli.simulate import build_config, register
 from attitude_c.errors import InvalidArgument

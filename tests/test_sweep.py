@@ -448,7 +448,7 @@ def test_recordings_the_attitude_filter_on_a_shipped_broad_trial(tmp_path):
     assert (df["error"] == "").all() and len(df) == 2
     # the sweep's figure is BROAD's metric of the filter's own batch call (same data, same settings)
     t = broad.load_trial(broad.default_dir() / f"{trial}.mat")
-    from attitude_c.ahrs import ahrs
+    from attitude_c.ahrs_filter import ahrs
 
     for acc_noise, total in zip(df["acc_noise"], df["total_deg"]):
         q = ahrs(t.gyr, t.acc, t.mag, rate=t.rate, acc_noise=acc_noise)

@@ -158,7 +158,7 @@ def main(args: argparse.Namespace) -> int:
 
 def _main(args: argparse.Namespace) -> int:
     from .. import broad
-    from ..ahrs import ahrs
+    from ..ahrs_filter import ahrs
     from ..core import quat_to_euler
 
     path = Path(args.file)

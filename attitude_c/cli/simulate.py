@@ -66,7 +66,7 @@ def _disturbance(text: str) -> tuple[float, float, tuple[float, float, float], f
 
 def _ahrs_setting(text: str) -> tuple[str, Any]:
     """NAME=VALUE of the attitude filter's settings (names checked against the filter's)."""
-    from ..ahrs import SETTINGS
+    from ..ahrs_filter import SETTINGS
 
     name, sep, value = text.partition("=")
     name, value = name.strip(), value.strip()

@@ -96,10 +96,10 @@ class Integrate:
 
 
 def check_ahrs_settings(settings: dict[str, Any]) -> dict[str, Any]:
-    """``settings`` checked against the filter's (:data:`attitude_c.ahrs.SETTINGS`
+    """``settings`` checked against the filter's (:data:`attitude_c.ahrs_filter.SETTINGS`
     and ``method``): names, types and domains (InvalidArgument naming the bad one).
     Returns the filter's full settings with these applied."""
-    from ..ahrs import Ahrs
+    from ..ahrs_filter import Ahrs
 
     return Ahrs(**settings).settings
 
@@ -167,7 +167,7 @@ class AhrsFilter:
 
     def run(self, decoded: Decoded, q0_at: Callable[[float], np.ndarray], t0: float, period: float) -> Estimate:
         """Filter the samples of ``decoded``; ``q0_at(t)`` is the true attitude at t (s)."""
-        from ..ahrs import Ahrs
+        from ..ahrs_filter import Ahrs
 
         if "accel" not in decoded.aux:
             raise InvalidArgument("the ahrs estimator needs an accelerometer (give --accel PART)")

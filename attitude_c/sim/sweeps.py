@@ -284,20 +284,20 @@ register_estimator("integrator", integrate_trial)
 
 def ahrs_trial(trial: Any, six_axis: bool = False, precision: Literal["f64", "f32"] = "f64",
                **settings: Any) -> np.ndarray:
-    """The attitude filter (:func:`attitude_c.ahrs.ahrs`, docs/ahrs.md) on a BROAD trial.
+    """The attitude filter (:func:`attitude_c.ahrs_filter.ahrs`, docs/ahrs.md) on a BROAD trial.
 
     It aligns itself from the first samples (no reference needed); ``six_axis``
     leaves the magnetometer out; every other setting is a filter setting
-    (``acc_noise``, ``rest_noise``, ...: ``attitude_c.ahrs.default_settings()``).
+    (``acc_noise``, ``rest_noise``, ...: ``attitude_c.ahrs_filter.default_settings()``).
     """
-    from ..ahrs import ahrs
+    from ..ahrs_filter import ahrs
 
     return ahrs(trial.gyr, trial.acc, None if six_axis else trial.mag, rate=trial.rate,
                 precision=precision, **settings)
 
 
 def _ahrs_settings() -> frozenset[str]:
-    from ..ahrs import default_settings
+    from ..ahrs_filter import default_settings
 
     return frozenset(default_settings()) | {"six_axis", "precision"}
 

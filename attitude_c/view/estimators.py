@@ -79,7 +79,7 @@ class AhrsEstimator:
     rate or specific force is not finite is skipped (None)."""
 
     def __init__(self, q0: ArrayLike | None = None, rate: float | None = None, **_: Any) -> None:
-        from ..ahrs import Ahrs
+        from ..ahrs_filter import Ahrs
 
         self.filter = Ahrs(rate=rate, q0=q0)
         self.label = f"ahrs ({self.filter.settings['method']})"
