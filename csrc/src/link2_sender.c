@@ -186,9 +186,11 @@ int API(push)(SELF_ const uint8_t ATT_LINK_MEM *record)
 
 /* -- sink: ACK frames from B ----------------------------------------- */
 
-/* Apply a valid ACK: d[0] = 0xC0 | flags, d[1] = ack, d[2] = limit. */
-static att_link2_result apply_ack(SELF_ const uint8_t ATT_LINK_MEM *d, uint16_t tick)
+/* Apply the valid ACK decoded in place in rx[1..7] (d[0] = 0xC0 | flags,
+ * d[1] = ack, d[2] = limit). */
+static att_link2_result apply_ack(SELF_ uint16_t tick)
 {
+    const uint8_t ATT_LINK_MEM *d = S->rx + 1;
     uint8_t fl = (uint8_t)(d[0] & 0x0Fu);
     uint8_t a = d[1];
     uint8_t adv = (uint8_t)(a - S->base);
@@ -238,16 +240,37 @@ static att_link2_result apply_ack(SELF_ const uint8_t ATT_LINK_MEM *d, uint16_t 
     return ATT_LINK2_FRAME;
 }
 
-/* Decode the 8 encoded bytes in S->rx (rCOBS, backwards) into the 7 bytes
- * of an ACK and check it. */
-static att_link2_result ack_frame(SELF_ uint16_t tick)
+att_link2_result API(sink)(SELF_ uint8_t byte, uint16_t tick)
 {
-    uint8_t d[7];
-    uint8_t p = 8;
-    uint8_t q = 7;
+    uint8_t p;
+    uint8_t q;
     uint8_t code;
-    uint8_t first = 1;
+    uint8_t first;
     uint32_t crc;
+    CHECK_NULL(return ATT_LINK2_E_NULL);
+    CHECK_BAD(return ATT_LINK2_E_STATE);
+    p = S->rx_len;
+    if (byte != (uint8_t)ATT_LINK2_DELIM) {
+        if (p >= (uint8_t)sizeof(S->rx)) {
+            S->rx_len = 0xFFu; /* longer than an ACK: skip to the delimiter */
+            return ATT_LINK2_DISCARDED;
+        }
+        S->rx[p] = byte;
+        S->rx_len = (uint8_t)(p + 1u);
+        return ATT_LINK2_NONE;
+    }
+    S->rx_len = 0;
+    if (p == 0u) {
+        return ATT_LINK2_NONE; /* idle delimiter */
+    }
+    if (p != (uint8_t)sizeof(S->rx)) {
+        goto bad;
+    }
+    /* Decode the 8 encoded bytes (rCOBS, backwards) into the 7 bytes of an
+     * ACK, in place: decoded byte q lands in rx[q + 1], at or above the byte
+     * read last, so nothing is overwritten before it is read. */
+    q = 7;
+    first = 1;
     while (p != 0u) {
         code = S->rx[p - 1u];
         if (code > p || code == 0xFFu || (uint8_t)(code - 1u + (first ^ 1u)) > q) {
@@ -255,58 +278,32 @@ static att_link2_result ack_frame(SELF_ uint16_t tick)
         }
         p--;
         if (!first) {
-            d[--q] = 0;
+            S->rx[q--] = 0;
         }
         first = 0;
         while (--code != 0u) {
-            d[--q] = S->rx[--p];
+            S->rx[q--] = S->rx[--p];
         }
     }
-    if (q != 0u || (uint8_t)(d[0] & 0xF0u) != (uint8_t)ATT_LINK2_T_ACK) {
+    if (q != 0u || (uint8_t)(S->rx[1] & 0xF0u) != (uint8_t)ATT_LINK2_T_ACK) {
         goto bad;
     }
     crc = 0xFFFFFFFFul;
-    for (q = 0; q < 3u; q++) {
-        crc = att_link2_crc_byte(crc, d[q]);
+    for (q = 1; q < 4u; q++) {
+        crc = att_link2_crc_byte(crc, S->rx[q]);
     }
     crc = ~crc;
-    if (d[3] != (uint8_t)(crc >> 24) || d[4] != (uint8_t)(crc >> 16) || d[5] != (uint8_t)(crc >> 8)
-        || d[6] != (uint8_t)crc) {
+    if (S->rx[4] != (uint8_t)(crc >> 24) || S->rx[5] != (uint8_t)(crc >> 16)
+        || S->rx[6] != (uint8_t)(crc >> 8) || S->rx[7] != (uint8_t)crc) {
         goto bad;
     }
-    return apply_ack(ARG_ d, tick);
+    return apply_ack(ARG_ tick);
 bad:
     STAT_INC(bad_frames);
     return ATT_LINK2_BAD_FRAME;
 }
 
-att_link2_result API(sink)(SELF_ uint8_t byte, uint16_t tick)
-{
-    uint8_t n;
-    CHECK_NULL(return ATT_LINK2_E_NULL);
-    CHECK_BAD(return ATT_LINK2_E_STATE);
-    n = S->rx_len;
-    if (byte != (uint8_t)ATT_LINK2_DELIM) {
-        if (n >= (uint8_t)sizeof(S->rx)) {
-            S->rx_len = 0xFFu; /* longer than an ACK: skip to the delimiter */
-            return ATT_LINK2_DISCARDED;
-        }
-        S->rx[n] = byte;
-        S->rx_len = (uint8_t)(n + 1u);
-        return ATT_LINK2_NONE;
-    }
-    S->rx_len = 0;
-    if (n == 0u) {
-        return ATT_LINK2_NONE; /* idle delimiter */
-    }
-    if (n != (uint8_t)sizeof(S->rx)) {
-        STAT_INC(bad_frames);
-        return ATT_LINK2_BAD_FRAME;
-    }
-    return ack_frame(ARG_ tick);
-}
-
-/* -- poll: the emitter, one function per state ----------------------- */
+/* -- poll: the emitter ----------------------------------------------- */
 
 /* Code m (0..3n-1) of the DATA frame being sent: sample m / 3, channel m % 3. */
 static uint16_t code_at(SELF_ uint8_t m)
@@ -317,14 +314,26 @@ static uint16_t code_at(SELF_ uint8_t m)
     return (uint16_t)((uint16_t)((uint16_t)r[0] << 8) | r[1]);
 }
 
-/* Byte j of the packed codes: pair j / 3 of codes, byte j % 3 of it. */
-static uint8_t packed_byte(SELF_ uint8_t j)
+/* Decoded byte i of the frame being sent, i < f_len - 4 (the bytes the CRC covers). */
+static uint8_t frame_byte(SELF_ uint8_t i)
 {
-    uint8_t p = (uint8_t)(j / (uint8_t)3);
-    uint8_t r = (uint8_t)(j - (uint8_t)(p + (uint8_t)(p << 1)));
-    uint8_t m = (uint8_t)(p << 1);
-    uint8_t n = (uint8_t)(S->f_head & 0x1Fu);
-    uint8_t ncodes = (uint8_t)(n + (uint8_t)(n << 1));
+    uint8_t r;
+    uint8_t m;
+    uint8_t n;
+    if (i == 0u) {
+        return S->f_head;
+    }
+    if (i == 1u) {
+        return S->f_seq;
+    }
+    i = (uint8_t)(i - 2u);
+    if (S->f_head & (uint8_t)ATT_LINK2_T_RAW) {
+        return slot(ARG_ S->f_seq)[i];
+    }
+    /* byte i of the packed codes: pair i / 3 of codes, byte i % 3 of it */
+    m = (uint8_t)(i / (uint8_t)3);
+    r = (uint8_t)(i - (uint8_t)(m + (uint8_t)(m << 1)));
+    m = (uint8_t)(m << 1);
     if (r == 0u) {
         return (uint8_t)(code_at(ARG_ m) >> 4);
     }
@@ -332,123 +341,80 @@ static uint8_t packed_byte(SELF_ uint8_t j)
         return (uint8_t)code_at(ARG_(uint8_t)(m + 1u));
     }
     r = (uint8_t)(code_at(ARG_ m) << 4);
-    if ((uint8_t)(m + 1u) < ncodes) {
+    n = (uint8_t)(S->f_head & 0x1Fu);
+    if ((uint8_t)(m + 1u) < (uint8_t)(n + (uint8_t)(n << 1))) {
         r |= (uint8_t)(code_at(ARG_(uint8_t)(m + 1u)) >> 8);
     }
     return r;
 }
 
-/* Decoded byte i of the frame being sent (the CRC bytes once every byte before them went out). */
-static uint8_t frame_byte(SELF_ uint8_t i)
-{
-    uint8_t tail = (uint8_t)(S->f_len - 4u);
-    uint32_t v;
-    if (i == 0u) {
-        return S->f_head;
-    }
-    if (i == 1u) {
-        return S->f_seq;
-    }
-    if (i < tail) {
-        i = (uint8_t)(i - 2u);
-        if (S->f_head & (uint8_t)ATT_LINK2_T_RAW) {
-            return slot(ARG_ S->f_seq)[i];
-        }
-        return packed_byte(ARG_ i);
-    }
-    v = ~S->crc; /* the CRC, most significant byte first */
-    i = (uint8_t)(i - tail);
-    if (i == 0u) {
-        return (uint8_t)(v >> 24);
-    }
-    if (i == 1u) {
-        return (uint8_t)(v >> 16);
-    }
-    return i == 2u ? (uint8_t)(v >> 8) : (uint8_t)v;
-}
-
-static att_link2_result poll_body(SELF_ uint8_t ATT_LINK_MEM *out)
+/* The next encoded byte of the frame being sent (tx = TX_BODY). */
+static uint8_t body_byte(SELF)
 {
     uint8_t b;
+    uint8_t i = S->f_pos;
+    uint8_t tail = (uint8_t)(S->f_len - 4u);
     if (S->run == 254u) { /* 254 bytes without a zero: a code that stands for none */
         S->run = 0;
-        *out = 0xFFu;
-        return ATT_LINK2_SEND;
+        return 0xFFu;
     }
-    if (S->f_pos >= S->f_len) { /* final code, then the delimiter */
-        *out = (uint8_t)(S->run + 1u);
+    if (i >= S->f_len) { /* final code, then the delimiter */
         S->tx = (uint8_t)TX_DELIM;
-        return ATT_LINK2_SEND;
+        return (uint8_t)(S->run + 1u);
     }
-    b = frame_byte(ARG_ S->f_pos);
-    if (S->f_pos < (uint8_t)(S->f_len - 4u)) {
+    if (i < tail) {
+        b = frame_byte(ARG_ i);
         S->crc = att_link2_crc_byte(S->crc, b);
+    } else { /* the CRC, most significant byte first */
+        b = (uint8_t)((~S->crc) >> (uint8_t)((uint8_t)(3u - (uint8_t)(i - tail)) << 3));
     }
-    S->f_pos++;
+    S->f_pos = (uint8_t)(i + 1u);
     if (b == 0u) {
         b = (uint8_t)(S->run + 1u);
         S->run = 0;
     } else {
         S->run++;
     }
-    *out = b;
-    return ATT_LINK2_SEND;
+    return b;
 }
 
-static att_link2_result poll_lead(SELF_ uint8_t ATT_LINK_MEM *out)
+/* Start the frame whose f_head, f_seq and f_len are set: its first byte
+ * goes out at this poll (after a 0x00 if the line was idle). */
+static void start_frame(SELF)
 {
-    S->tx = (uint8_t)TX_BODY;
-    *out = (uint8_t)ATT_LINK2_DELIM;
-    return ATT_LINK2_SEND;
-}
-
-static att_link2_result poll_delim(SELF_ uint16_t tick, uint8_t ATT_LINK_MEM *out)
-{
-    S->tx = (uint8_t)TX_IDLE;
-    S->t0 = tick; /* the timer counts from the end of the last frame */
-    *out = (uint8_t)ATT_LINK2_DELIM;
-    return ATT_LINK2_SEND;
-}
-
-static att_link2_result start_frame(SELF_ uint8_t head, uint8_t seq, uint8_t len, uint8_t ATT_LINK_MEM *out)
-{
-    S->f_head = head;
-    S->f_seq = seq;
-    S->f_len = len;
     S->f_pos = 0;
     S->run = 0;
     S->crc = 0xFFFFFFFFul;
     STAT_INC(frames);
     if (S->flags & (uint8_t)FL_LINE_IDLE) {
         S->flags &= (uint8_t)~FL_LINE_IDLE;
-        return poll_lead(ARG_ out);
+        S->tx = (uint8_t)TX_LEAD;
+    } else {
+        S->tx = (uint8_t)TX_BODY;
     }
-    S->tx = (uint8_t)TX_BODY;
-    return poll_body(ARG_ out);
 }
 
 /* The next data frame from record `next`: one RAW record, or up to
  * max_samples packable samples below head and B's limit. */
-static att_link2_result start_data(SELF_ uint8_t ATT_LINK_MEM *out)
+static void start_data(SELF)
 {
     uint8_t seq = S->next;
     uint8_t n = 1;
     uint8_t old;
-    uint8_t head;
-    uint8_t len;
     if (!packable(slot(ARG_ seq))) {
-        head = (uint8_t)(ATT_LINK2_T_RAW | (S->flags & FL_EPOCH));
-        len = (uint8_t)(6u + (uint8_t)ATT_LINK2_RECORD);
+        S->f_head = (uint8_t)(ATT_LINK2_T_RAW | (S->flags & FL_EPOCH));
+        S->f_len = (uint8_t)(6u + (uint8_t)ATT_LINK2_RECORD);
     } else {
         while (n < S->cur && (uint8_t)(seq + n) != S->head && window_open(ARG_(uint8_t)(seq + n))
                && packable(slot(ARG_(uint8_t)(seq + n)))) {
             n++;
         }
-        head = (uint8_t)(n | (S->flags & FL_EPOCH));
-        len = (uint8_t)(6u + (uint8_t)((uint8_t)(9u * n + 1u) >> 1));
+        S->f_head = (uint8_t)(n | (S->flags & FL_EPOCH));
+        S->f_len = (uint8_t)(6u + (uint8_t)((uint8_t)(9u * n + 1u) >> 1));
     }
+    S->f_seq = seq;
     /* records below hi were sent before: they count as resent */
-    old = (uint8_t)(S->next - S->base) < (uint8_t)(S->hi - S->base) ? (uint8_t)(S->hi - S->next) : 0u;
+    old = (uint8_t)(seq - S->base) < (uint8_t)(S->hi - S->base) ? (uint8_t)(S->hi - seq) : 0u;
     if (old >= n) {
         STAT_ADD(resent, n);
     } else {
@@ -457,20 +423,21 @@ static att_link2_result start_data(SELF_ uint8_t ATT_LINK_MEM *out)
         S->hi = (uint8_t)(seq + n);
     }
     S->next = (uint8_t)(seq + n);
-    return start_frame(ARG_ head, seq, len, out);
+    start_frame(ARG);
 }
 
-static att_link2_result poll_idle(SELF_ uint16_t tick, uint8_t ATT_LINK_MEM *out)
+/* Between frames: start one (tx leaves TX_IDLE), or say why not. */
+static att_link2_result poll_idle(SELF_ uint16_t tick)
 {
-    uint8_t waiting;
     if (S->session == (uint8_t)SES_SYN_SEND) {
         S->session = (uint8_t)SES_SYN_WAIT;
         STAT_INC(syns);
-        return start_frame(ARG_(uint8_t) ATT_LINK2_T_SYN, S->base, 6u, out);
+        S->f_head = (uint8_t)ATT_LINK2_T_SYN;
+        goto empty_frame; /* SYN at base */
     }
-    waiting = (uint8_t)(S->session == (uint8_t)SES_SYN_WAIT || S->hi != S->base
-                        || (S->next != S->head && !window_open(ARG_ S->next)));
-    if (waiting && (uint16_t)(tick - S->t0) > RTO) {
+    if ((S->session == (uint8_t)SES_SYN_WAIT || S->hi != S->base
+         || (S->next != S->head && !window_open(ARG_ S->next)))
+        && (uint16_t)(tick - S->t0) > RTO) {
         STAT_INC(timeouts);
         S->t0 = tick;
         if (S->session == (uint8_t)SES_SYN_WAIT) {
@@ -486,33 +453,51 @@ static att_link2_result poll_idle(SELF_ uint16_t tick, uint8_t ATT_LINK_MEM *out
             return ATT_LINK2_TIMEOUT; /* the next poll sends again */
         }
         /* B's limit blocks A (or A missed the ACK that opened it): ask with an empty frame */
-        return start_frame(ARG_(uint8_t)(ATT_LINK2_T_DATA | (S->flags & FL_EPOCH)), S->next, 6u,
-                           out); /* probe */
+        S->f_head = (uint8_t)(ATT_LINK2_T_DATA | (S->flags & FL_EPOCH)); /* probe at next */
+        goto empty_frame;
     }
     if (S->session == (uint8_t)SES_RUN && S->next != S->head && window_open(ARG_ S->next)) {
-        return start_data(ARG_ out);
+        start_data(ARG);
+        return ATT_LINK2_SEND;
     }
     S->flags |= (uint8_t)FL_LINE_IDLE;
     return (S->session == (uint8_t)SES_RUN && S->head == S->base) ? ATT_LINK2_IDLE : ATT_LINK2_NONE;
+empty_frame:
+    S->f_seq = S->f_head == (uint8_t)ATT_LINK2_T_SYN ? S->base : S->next;
+    S->f_len = 6u;
+    start_frame(ARG);
+    return ATT_LINK2_SEND;
 }
 
 att_link2_result API(poll)(SELF_ uint16_t tick, uint8_t ATT_LINK_MEM *out_byte)
 {
+    att_link2_result r;
+    uint8_t b = (uint8_t)ATT_LINK2_DELIM;
     CHECK_NULL(return ATT_LINK2_E_NULL);
     if (out_byte == NULL) {
         return ATT_LINK2_E_NULL;
     }
     CHECK_BAD(return ATT_LINK2_E_STATE);
+    if (S->tx == (uint8_t)TX_IDLE) {
+        r = poll_idle(ARG_ tick);
+        if (r != ATT_LINK2_SEND) {
+            return r;
+        }
+    }
     switch (S->tx) {
-    case TX_IDLE:
-        return poll_idle(ARG_ tick, out_byte);
-    case TX_LEAD:
-        return poll_lead(ARG_ out_byte);
+    case TX_LEAD: /* the 0x00 before a frame after an idle line */
+        S->tx = (uint8_t)TX_BODY;
+        break;
     case TX_BODY:
-        return poll_body(ARG_ out_byte);
-    case TX_DELIM:
-        return poll_delim(ARG_ tick, out_byte);
+        b = body_byte(ARG);
+        break;
+    case TX_DELIM: /* the 0x00 that ends the frame */
+        S->tx = (uint8_t)TX_IDLE;
+        S->t0 = tick; /* the timer counts from the end of the last frame */
+        break;
     default:
         return ATT_LINK2_E_STATE;
     }
+    *out_byte = b;
+    return ATT_LINK2_SEND;
 }
