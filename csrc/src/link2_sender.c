@@ -34,6 +34,10 @@
 #define STAT_ADD(name, n)
 #define CHECK_NULL(action)
 #define CHECK_BAD(action)
+#define CUR MAX_SAMPLES /* frames always as long as the records allow */
+#define CUR_RESET()
+#define CUR_GROW()
+#define CUR_HALVE()
 #else
 #define S                 s
 #define SELF              att_link2_sender ATT_LINK_MEM *s
@@ -55,6 +59,13 @@
     if (s->session >= (uint8_t)SES_BAD) { \
         action;                           \
     }
+#define CUR         (s->cur) /* samples per frame now: halved on a loss, +1 per progress */
+#define CUR_RESET() (s->cur = MAX_SAMPLES)
+#define CUR_GROW()              \
+    if (s->cur < MAX_SAMPLES) { \
+        s->cur++;               \
+    }
+#define CUR_HALVE() (s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1))
 #endif
 
 uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte)
@@ -132,7 +143,7 @@ void API(reset)(SELF)
     S->hi = 0;
     S->limit = 0;
     S->t0 = 0;
-    S->cur = MAX_SAMPLES;
+    CUR_RESET();
     S->session = (uint8_t)SES_SYN_SEND;
     S->tx = (uint8_t)TX_IDLE;
     S->flags = (uint8_t)FL_LINE_IDLE;
@@ -221,18 +232,17 @@ static att_link2_result apply_ack(SELF_ uint16_t tick)
         }
         S->base = a;
         S->t0 = tick;
-        if (S->cur < MAX_SAMPLES) {
-            S->cur++; /* progress: longer frames again */
-        }
+        CUR_GROW(); /* progress: longer frames again */
     }
     if ((uint8_t)(d[2] - a) <= (uint8_t)ATT_LINK2_WINDOW_MAX) {
         S->limit = d[2];
     }
     if ((fl & (uint8_t)ATT_LINK2_F_GAP) && S->hi != S->base
-        && (uint8_t)((fl & (uint8_t)ATT_LINK2_F_EPOCH) ? FL_EPOCH : 0u) == (uint8_t)(S->flags & FL_EPOCH)) {
+        && (uint8_t)((uint8_t)((uint8_t)(fl << 2) ^ S->flags) & FL_EPOCH)
+               == 0u) { /* F_EPOCH << 2 = FL_EPOCH */
         /* a gap in what was sent since the last go-back: go back to the first record B lacks */
         S->next = S->base;
-        S->cur = (uint8_t)((uint8_t)(S->cur + 1u) >> 1); /* and shorter frames */
+        CUR_HALVE(); /* and shorter frames */
         S->flags ^= (uint8_t)FL_EPOCH;
         STAT_INC(gobacks);
         S->t0 = tick;
@@ -305,21 +315,26 @@ bad:
 
 /* -- poll: the emitter ----------------------------------------------- */
 
-/* Code m (0..3n-1) of the DATA frame being sent: sample m / 3, channel m % 3. */
-static uint16_t code_at(SELF_ uint8_t m)
+/* Nibble k of the packed codes of the DATA frame being sent (0 past the
+ * last code): sample k / 9, nibble k % 9 of its three 12-bit codes, which
+ * is the low (0) or high (0x80) nibble of byte nib_at[k % 9] & 7 of the record. */
+static const uint8_t nib_at[9] = { 0, 0x81, 1, 2, 0x83, 3, 4, 0x85, 5 };
+
+static uint8_t nibble(SELF_ uint8_t k)
 {
-    uint8_t k = (uint8_t)(m / (uint8_t)3); /* 8-bit division: DIV AB on the 8051 */
-    uint8_t c = (uint8_t)(m - (uint8_t)(k + (uint8_t)(k << 1)));
-    const uint8_t ATT_LINK_MEM *r = slot(ARG_(uint8_t)(S->f_seq + k)) + (uint8_t)(c << 1);
-    return (uint16_t)((uint16_t)((uint16_t)r[0] << 8) | r[1]);
+    uint8_t smp = (uint8_t)(k / (uint8_t)9); /* 8-bit division: DIV AB on the 8051 */
+    uint8_t w = nib_at[(uint8_t)(k - (uint8_t)(smp * (uint8_t)9))];
+    uint8_t b;
+    if (smp >= (uint8_t)(S->f_head & 0x1Fu)) {
+        return 0; /* the padding of an odd number of codes */
+    }
+    b = slot(ARG_(uint8_t)(S->f_seq + smp))[w & 7u];
+    return (uint8_t)((w & 0x80u) ? (uint8_t)(b >> 4) : (uint8_t)(b & 0x0Fu));
 }
 
 /* Decoded byte i of the frame being sent, i < f_len - 4 (the bytes the CRC covers). */
 static uint8_t frame_byte(SELF_ uint8_t i)
 {
-    uint8_t r;
-    uint8_t m;
-    uint8_t n;
     if (i == 0u) {
         return S->f_head;
     }
@@ -330,22 +345,9 @@ static uint8_t frame_byte(SELF_ uint8_t i)
     if (S->f_head & (uint8_t)ATT_LINK2_T_RAW) {
         return slot(ARG_ S->f_seq)[i];
     }
-    /* byte i of the packed codes: pair i / 3 of codes, byte i % 3 of it */
-    m = (uint8_t)(i / (uint8_t)3);
-    r = (uint8_t)(i - (uint8_t)(m + (uint8_t)(m << 1)));
-    m = (uint8_t)(m << 1);
-    if (r == 0u) {
-        return (uint8_t)(code_at(ARG_ m) >> 4);
-    }
-    if (r == 2u) {
-        return (uint8_t)code_at(ARG_(uint8_t)(m + 1u));
-    }
-    r = (uint8_t)(code_at(ARG_ m) << 4);
-    n = (uint8_t)(S->f_head & 0x1Fu);
-    if ((uint8_t)(m + 1u) < (uint8_t)(n + (uint8_t)(n << 1))) {
-        r |= (uint8_t)(code_at(ARG_(uint8_t)(m + 1u)) >> 8);
-    }
-    return r;
+    /* byte i of the packed codes: nibbles 2i and 2i + 1 */
+    i = (uint8_t)(i << 1);
+    return (uint8_t)((uint8_t)(nibble(ARG_ i) << 4) | nibble(ARG_(uint8_t)(i + 1u)));
 }
 
 /* The next encoded byte of the frame being sent (tx = TX_BODY). */
@@ -366,7 +368,11 @@ static uint8_t body_byte(SELF)
         b = frame_byte(ARG_ i);
         S->crc = att_link2_crc_byte(S->crc, b);
     } else { /* the CRC, most significant byte first */
-        b = (uint8_t)((~S->crc) >> (uint8_t)((uint8_t)(3u - (uint8_t)(i - tail)) << 3));
+        if (i == tail) {
+            S->crc = ~S->crc;
+        }
+        b = (uint8_t)(S->crc >> 24);
+        S->crc <<= 8;
     }
     S->f_pos = (uint8_t)(i + 1u);
     if (b == 0u) {
@@ -405,7 +411,7 @@ static void start_data(SELF)
         S->f_head = (uint8_t)(ATT_LINK2_T_RAW | (S->flags & FL_EPOCH));
         S->f_len = (uint8_t)(6u + (uint8_t)ATT_LINK2_RECORD);
     } else {
-        while (n < S->cur && (uint8_t)(seq + n) != S->head && window_open(ARG_(uint8_t)(seq + n))
+        while (n < CUR && (uint8_t)(seq + n) != S->head && window_open(ARG_(uint8_t)(seq + n))
                && packable(slot(ARG_(uint8_t)(seq + n)))) {
             n++;
         }
@@ -446,7 +452,7 @@ static att_link2_result poll_idle(SELF_ uint16_t tick)
         }
         if (S->hi != S->base) {
             S->next = S->base; /* no progress: go back to the first unacknowledged record */
-            S->cur = (uint8_t)((uint8_t)(S->cur + 1u) >> 1);
+            CUR_HALVE();
             S->flags ^= (uint8_t)FL_EPOCH;
         }
         if (window_open(ARG_ S->next)) {
