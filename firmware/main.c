@@ -93,31 +93,33 @@ static void timer0_init(void)
 
 #if FW_LINK_V2
 /* Link v2: the queue is the link sender's ring (ATT_LINK2_ONE_RING records,
- * kept until acknowledged). A block is written here (wp), then pushed. */
-static uint8_t rec[ATT_BLOCK_SIZE];
+ * kept until acknowledged). A block is written in place, in the ring slot
+ * the next push fills (wp), then pushed. */
 static uint16_t seq;       /* number of the next sample to take */
 static uint16_t ovr_count; /* samples lost to a full ring, not yet reported:
                               always the newest ones, seq - ovr_count .. seq - 1 */
-static uint8_t __data *wp; /* the block being written (rec) */
+static uint8_t __data *wp; /* the block being written (a ring slot) */
 static uint8_t txb;        /* byte handed out by the link sender (its out pointer is __data) */
 #define tx att_link2_one   /* link_state.c */
 static tlc2543 adc;
 
-/* Room in the ring for one block (wp = rec); 0 if it is full. */
+/* The ring slot for the next block (wp); 0 if the ring is full. */
 static uint8_t q_push(void)
 {
-    wp = rec;
-    return att_link2_sender_room(&tx) != 0u;
+    wp = att_link2_sender_tail(&tx);
+    return wp != 0;
 }
 
-/* The block at wp is complete: into the ring (room was checked). */
-#define q_commit() (void)att_link2_sender_push(&tx, rec)
+/* The block at wp is complete: push it (it is in its slot already). */
+#define q_commit() (void)att_link2_sender_push(&tx, wp)
 
-/* The self-test passed: its slot is not needed. */
-#define q_unpush()
+/* The self-test passed: its slot is not needed (never pushed). */
+#define q_unpush() ((void)0)
 
-/* Nothing queued: the ring is empty. */
-#define q_any (att_link2_sender_pending(&tx) != 0u)
+/* flush_overrun() waits for "the queue is empty": here, for two free ring
+ * slots (the report leaves one to the next sample, so a report never
+ * causes the next loss, and a busy link does not hold the report back). */
+#define q_any (att_link2_sender_room(&tx) < 2u)
 #else
 /* Everything in internal RAM (the small model's default space): __data
  * pointers are one byte and need no library call. */

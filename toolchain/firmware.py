@@ -534,7 +534,11 @@ class Session:
         self.image = image
         self.timeout = timeout
         self._tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
-        self._dev_fw = self._tmp / "uart_fw"
+        # s51's UART on two FIFOs, not on a pty: on a terminal, uCsim opens its serial
+        # control menu when the byte uart0_esc_char (^X) arrives, and link v2's ACKs carry
+        # any byte value. socat joins the FIFOs to the host's pty.
+        self._fw_in = self._tmp / "uart_fw_in"
+        self._fw_out = self._tmp / "uart_fw_out"
         self.port = self._tmp / "uart_host"
         self._socat: subprocess.Popen[bytes] | None = None
         self._s51: subprocess.Popen[bytes] | None = None
@@ -542,11 +546,13 @@ class Session:
 
     def __enter__(self) -> Session:  # noqa: PYI034 - typing.Self needs Python 3.11
         try:
+            os.mkfifo(self._fw_in)
+            os.mkfifo(self._fw_out)
             self._socat = subprocess.Popen(
-                ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],
+                ["socat", f"OPEN:{self._fw_out},rdwr!!OPEN:{self._fw_in},rdwr", f"pty,raw,echo=0,link={self.port}"],
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                 start_new_session=True)
-            while not (self._dev_fw.exists() and self.port.exists()):
+            while not self.port.exists():
                 if self._socat.poll() is not None:
                     err = self._socat.stderr.read().decode() if self._socat.stderr else ""
                     raise FirmwareError(f"socat failed: {err}")
@@ -586,7 +592,7 @@ class Session:
         # machine instead of running away from its host.
         self._s51 = s51 = subprocess.Popen(
             ["nice", "-n", str(S51_NICE), "s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
-             "-s", str(self._dev_fw), "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+             "-S", f"in={self._fw_in},out={self._fw_out}", "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
         assert s51.stdout is not None
         os.set_blocking(s51.stdout.fileno(), False)

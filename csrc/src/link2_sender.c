@@ -175,6 +175,13 @@ uint8_t API(room)(CSELF)
     return (uint8_t)(RING_SIZE - used(ARG));
 }
 
+uint8_t ATT_LINK_MEM *API(tail)(SELF)
+{
+    CHECK_NULL(return NULL);
+    CHECK_BAD(return NULL);
+    return used(ARG) >= RING_SIZE ? (uint8_t ATT_LINK_MEM *)NULL : slot(ARG_ S->head);
+}
+
 int API(push)(SELF_ const uint8_t ATT_LINK_MEM *record)
 {
     uint8_t ATT_LINK_MEM *d;

@@ -199,8 +199,10 @@ typedef struct {
     uint8_t f_pos;   /*   next decoded byte */
     uint8_t run;     /*   rCOBS: bytes since the last code */
     uint8_t rx_len;  /* ACK bytes received so far (0xFF: skipping an over-long frame) */
-    uint8_t cur;     /* samples per frame now: halved on a loss, +1 per progress */
-    uint8_t rx[8];   /* encoded ACK frame being received */
+#if !ATT_LINK2_ONE
+    uint8_t cur; /* samples per frame now: halved on a loss, +1 per progress */
+#endif
+    uint8_t rx[8]; /* encoded ACK frame being received */
 #if ATT_LINK2_ONE
     uint8_t ring[ATT_LINK2_ONE_RING * ATT_LINK2_RECORD]; /* the ring (single-instance build) */
 #endif
@@ -213,6 +215,7 @@ void att_link2_sender1_reset(void);
 uint8_t att_link2_sender1_room(void);
 uint8_t att_link2_sender1_pending(void);
 int att_link2_sender1_push(const uint8_t ATT_LINK_MEM *record);
+uint8_t ATT_LINK_MEM *att_link2_sender1_tail(void);
 att_link2_result att_link2_sender1_sink(uint8_t byte, uint16_t tick);
 att_link2_result att_link2_sender1_poll(uint16_t tick, uint8_t ATT_LINK_MEM *out_byte);
 #define att_link2_sender_init(s, cfg, ring)      att_link2_sender1_init()
@@ -220,6 +223,7 @@ att_link2_result att_link2_sender1_poll(uint16_t tick, uint8_t ATT_LINK_MEM *out
 #define att_link2_sender_room(s)                 att_link2_sender1_room()
 #define att_link2_sender_pending(s)              att_link2_sender1_pending()
 #define att_link2_sender_push(s, record)         att_link2_sender1_push(record)
+#define att_link2_sender_tail(s)                 att_link2_sender1_tail()
 #define att_link2_sender_sink(s, byte, tick)     att_link2_sender1_sink(byte, tick)
 #define att_link2_sender_poll(s, tick, out_byte) att_link2_sender1_poll(tick, out_byte)
 #else
@@ -249,6 +253,12 @@ uint8_t att_link2_sender_pending(const att_link2_sender ATT_LINK_MEM *s);
 /* Copy one 6-byte block-format record into the ring: ATT_OK,
  * ATT_LINK2_E_NULL, ATT_LINK2_E_FULL or ATT_LINK2_E_STATE. */
 int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *record);
+
+/* The ring slot the next push fills (6 bytes), or NULL if the ring is
+ * full (or s is NULL or unusable): a caller may build the record there and
+ * push that pointer (push then copies nothing new), which saves a record
+ * buffer on the 8051. The slot is the caller's until that push. */
+uint8_t ATT_LINK_MEM *att_link2_sender_tail(att_link2_sender ATT_LINK_MEM *s);
 
 /* A byte arrived from B: ATT_LINK2_NONE (stored), ATT_LINK2_FRAME (a valid
  * ACK was applied), ATT_LINK2_BAD_FRAME, ATT_LINK2_DISCARDED, or an error. */
