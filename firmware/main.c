@@ -6,7 +6,9 @@
  *
  * Built with SDCC for the 8051 small model from the library's own sources,
  * unchanged: csrc/src/tlc2543.c (ADC driver), csrc/src/link_sender.c and
- * csrc/src/block.c (the block format's encoders, attitude/block.h).
+ * csrc/src/block.c (the block format's encoders, attitude/block.h). With
+ * FW_LINK_V2 (config.h) the link is v2 instead: csrc/src/link2_sender.c in
+ * its single-instance build (ATT_LINK2_ONE), the queue is its ring.
  * See docs/firmware.md for the wiring, the block formats and the build.
  *
  *   Timer 0  mode 1, free-running: TH0 advances every 256 machine cycles
