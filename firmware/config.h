@@ -44,6 +44,18 @@
 #define FW_MAX_ATTEMPTS 5
 #endif
 
+/* Link protocol: 0 = the paper's AA/BB handshake (attitude/link.h,
+ * csrc/src/link_sender.c), 1 = link v2 (attitude/link2.h,
+ * csrc/src/link2_sender.c built as the single instance: every source is
+ * compiled with -DATT_LINK2_ONE=1 and its settings ATT_LINK2_ONE_RTO,
+ * _SAMPLES, _RING; toolchain/firmware.py passes them). */
+#ifndef FW_LINK_V2
+#define FW_LINK_V2 0
+#endif
+#if FW_LINK_V2 && !defined(ATT_LINK2_ONE)
+#error "the link v2 build needs -DATT_LINK2_ONE=1 on every source (toolchain/firmware.py passes it)"
+#endif
+
 /* Retry interval of a failed ADC self-test (ticks; 3600 = 1 s). */
 #ifndef FW_SELFTEST_RETRY_TICKS
 #define FW_SELFTEST_RETRY_TICKS 3600

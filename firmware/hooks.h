@@ -9,6 +9,8 @@
  *   FW_HOOK_LOOP_START()       top of every main-loop iteration
  *   FW_HOOK_RX(b)              byte b received, before the link sender sees it
  *   FW_HOOK_POLL(st)           the link sender's poll returned st
+ *   FW_HOOK_V2_SINK(call)      link v2: wraps the sender's sink call (its
+ *                              result is ignored in production)
  *   FW_HOOK_TX()               a byte went to the UART
  *   FW_HOOK_BLOCK_START()      the link sender took up the head block
  *   FW_HOOK_LOOP_END()         after the link work of an iteration
@@ -31,6 +33,7 @@
 #define FW_HOOK_LOOP_START()
 #define FW_HOOK_RX(b)
 #define FW_HOOK_POLL(st)
+#define FW_HOOK_V2_SINK(call) (void)(call)
 #define FW_HOOK_TX()
 #define FW_HOOK_BLOCK_START()
 #define FW_HOOK_LOOP_END()

@@ -6,7 +6,9 @@
  *
  * Built with SDCC for the 8051 small model from the library's own sources,
  * unchanged: csrc/src/tlc2543.c (ADC driver), csrc/src/link_sender.c and
- * csrc/src/block.c (the block format's encoders, attitude/block.h).
+ * csrc/src/block.c (the block format's encoders, attitude/block.h). With
+ * FW_LINK_V2 (config.h) the link is v2 instead: csrc/src/link2_sender.c in
+ * its single-instance build (ATT_LINK2_ONE), the queue is its ring.
  * See docs/firmware.md for the wiring, the block formats and the build.
  *
  *   Timer 0  mode 1, free-running: TH0 advances every 256 machine cycles
@@ -32,8 +34,13 @@
  */
 #include <8051.h>
 
+#include "config.h" /* FW_LINK_V2 */
 #include "attitude/block.h"
+#if FW_LINK_V2
+#include "attitude/link2.h"
+#else
 #include "attitude/link.h"
+#endif
 #include "attitude/tlc2543.h"
 #include "config.h"
 
@@ -86,6 +93,36 @@ static void timer0_init(void)
 
 /* ---- block queue ----------------------------------------------------- */
 
+#if FW_LINK_V2
+/* Link v2: the queue is the link sender's ring (ATT_LINK2_ONE_RING records,
+ * kept until acknowledged). A block is written in place, in the ring slot
+ * the next push fills (wp), then pushed. */
+static uint16_t seq;       /* number of the next sample to take */
+static uint16_t ovr_count; /* samples lost to a full ring, not yet reported:
+                              always the newest ones, seq - ovr_count .. seq - 1 */
+static uint8_t __data *wp; /* the block being written (a ring slot) */
+static uint8_t txb;        /* byte handed out by the link sender (its out pointer is __data) */
+#define tx att_link2_one   /* link_state.c */
+static tlc2543 adc;
+
+/* The ring slot for the next block (wp); 0 if the ring is full. */
+static uint8_t q_push(void)
+{
+    wp = att_link2_sender_tail(&tx);
+    return wp != 0;
+}
+
+/* The block at wp is complete: push it (it is in its slot already). */
+#define q_commit() (void)att_link2_sender_push(&tx, wp)
+
+/* The self-test passed: its slot is not needed (never pushed). */
+#define q_unpush() ((void)0)
+
+/* flush_overrun() waits for "the queue is empty": here, for two free ring
+ * slots (the report leaves one to the next sample, so a report never
+ * causes the next loss, and a busy link does not hold the report back). */
+#define q_any (att_link2_sender_room(&tx) < 2u)
+#else
 /* Everything in internal RAM (the small model's default space): __data
  * pointers are one byte and need no library call. */
 static uint8_t queue[2][ATT_BLOCK_SIZE];
@@ -104,6 +141,8 @@ static uint8_t txb;        /* byte handed out by the link sender (its out pointe
 extern att_link_sender fw_tx; /* link_state.c */
 #define tx fw_tx
 static tlc2543 adc;
+
+#define q_commit() /* the block is in its slot already */
 
 /* Claim the free slot at the tail (wp points to it); 0 if the queue is full. */
 static uint8_t q_push(void)
@@ -130,6 +169,8 @@ static void q_unpush(void)
     }
 }
 
+#endif /* FW_LINK_V2 */
+
 /* Samples lost to a full queue are announced in their place (after every
  * earlier block, before every later one), once the queue is empty: the
  * report then leaves the other slot to the next sample, so a report never
@@ -138,6 +179,7 @@ static void flush_overrun(void)
 {
     if (!q_any && q_push()) {
         (void)att_block_encode_loss(wp, (uint8_t)ATT_BLOCK_OVERRUN, (uint16_t)(seq - ovr_count), ovr_count);
+        q_commit();
         ovr_count = 0;
     }
 }
@@ -166,11 +208,13 @@ static uint8_t sample_slot(void)
         ovr_count++;
         return 0;
     }
+#if !FW_LINK_V2
     if (q_last) {
         slot_seq1 = seq;
     } else {
         slot_seq0 = seq;
     }
+#endif
     return 1;
 }
 
@@ -185,6 +229,7 @@ static void sample_store(int st)
     if (st != ATT_OK) {
         (void)att_block_encode_adc_error(wp, seq, (int8_t)st);
     }
+    q_commit();
 }
 
 /* Power-up self-test of the ADC (its three internal test voltages), run
@@ -203,7 +248,8 @@ static uint8_t self_test_done(int st)
             bad = ((uint16_t __data *)wp)[i];
         }
         (void)att_block_encode_selftest(wp, (int8_t)st, bad, (uint8_t)seq); /* attempt, mod 256 */
-        P3_5 = 0;                                                           /* fault LED on */
+        q_commit();
+        P3_5 = 0;                         /* fault LED on */
         return FW_HOOK_SELFTEST_FAILED(); /* 0: retried after FW_SELFTEST_RETRY_TICKS */
     }
     q_unpush(); /* passed: the slot is not needed */
@@ -212,6 +258,7 @@ static uint8_t self_test_done(int st)
 }
 
 /* ---- link events ------------------------------------------------------ */
+#if !FW_LINK_V2
 
 /* The head block was accepted by the receiver: drop it from the queue. */
 static void block_accepted(void)
@@ -239,6 +286,7 @@ static void block_given_up(void)
 
 static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER_TIMEOUT_TICKS,
                                                  ATT_BLOCK_SIZE, FW_MAX_ATTEMPTS };
+#endif /* !FW_LINK_V2 */
 
 /* main's state is static: no local lives across a call, so main pushes
  * nothing on the stack around the deep calls (the scan). */
@@ -253,10 +301,15 @@ void main(void)
     timer0_init();
     uart_init();
     FW_HOOK_INIT();
+#if FW_LINK_V2
+    att_link2_sender_init(&tx, 0, 0); /* configuration: ATT_LINK2_ONE_* (config.h) */
+#else
     (void)att_link_sender_init(&tx, &link_cfg);
+#endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push();                 /* the queue is empty: BOOT report first */
     (void)att_block_encode_boot(wp, FW_PERIOD_TICKS, (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT));
+    q_commit();
     sampling = 0;
     next_sample = tick_now();
 
@@ -264,6 +317,27 @@ void main(void)
         (void)tick_now(); /* fw_ticks = now */
         FW_HOOK_LOOP_START();
 
+#if FW_LINK_V2
+        /* 1. a byte from the receiver (an ACK frees ring slots) */
+        if (RI) {
+            RI = 0;
+            FW_HOOK_RX(SBUF);
+            FW_HOOK_V2_SINK(att_link2_sender_sink(&tx, SBUF, fw_ticks));
+        }
+
+        /* 2. the transmitter is free: the sender's next byte, if any */
+        if (TI) {
+            st = att_link2_sender_poll(&tx, fw_ticks, &txb);
+            FW_HOOK_POLL(st);
+            if (st == ATT_LINK2_SEND) {
+                TI = 0;
+                SBUF = txb;
+                FW_HOOK_TX();
+            } else if (st < 0) {
+                att_link2_sender_reset(&tx); /* corrupted state: new session */
+            }
+        }
+#else
         /* 1. a byte from the receiver */
         if (RI) {
             RI = 0;
@@ -292,6 +366,7 @@ void main(void)
                 att_link_sender_reset(&tx); /* corrupted state: resend the head block */
             }
         }
+#endif
         FW_HOOK_LOOP_END();
 
         /* 3. the sampling clock (or the self-test retry clock) */

@@ -44,7 +44,7 @@ import time
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Literal
 
 import numpy as np
 
@@ -89,6 +89,10 @@ S51_NICE = 10
 
 SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
            CSRC / "src" / "block.c"]
+#: The link v2 build: link2_sender.c (single instance) instead of link_sender.c.
+SOURCES_V2 = [CSRC / "src" / "link2_sender.c" if s.name == "link_sender.c" else s for s in SOURCES]
+#: Link protocols of the firmware (Config.link).
+LINKS = ("legacy", "v2")
 SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
 
 
@@ -116,6 +120,10 @@ class Config:
     answer_timeout: int = 180         #: 50 ms
     max_attempts: int = 5
     selftest_retry: int = 3600        #: 1 s
+    link: Literal["legacy", "v2"] = "legacy"  #: link protocol (firmware/config.h FW_LINK_V2)
+    v2_rto: int = 720                 #: v2: ticks without progress before a go-back / probe (200 ms)
+    v2_samples: int = 4               #: v2: samples per DATA frame (1..24)
+    v2_ring: int = 4                  #: v2: records the sender keeps until acknowledged (power of two)
 
     def __post_init__(self) -> None:
         if self.baud not in BAUD_RATES:
@@ -125,6 +133,14 @@ class Config:
             v = getattr(self, name)
             if not 1 <= v <= 32767:
                 raise ValueError(f"{name} must be 1..32767 ticks, got {v}")
+        if self.link not in LINKS:
+            raise ValueError(f"link must be one of {LINKS}, got {self.link!r}")
+        if not 1 <= self.v2_rto <= 32767:
+            raise ValueError(f"v2_rto must be 1..32767 ticks, got {self.v2_rto}")
+        if not 1 <= self.v2_samples <= 24:
+            raise ValueError(f"v2_samples must be 1..24, got {self.v2_samples}")
+        if self.v2_ring not in (1, 2, 4, 8, 16, 32, 64):
+            raise ValueError(f"v2_ring must be a power of two 1..64, got {self.v2_ring}")
         if not 1 <= self.max_attempts <= 255:
             raise ValueError(f"max_attempts must be 1..255, got {self.max_attempts}")
 
@@ -137,7 +153,10 @@ class Config:
                 f"FW_SYN_TIMEOUT_TICKS={self.syn_timeout}",
                 f"FW_ANSWER_TIMEOUT_TICKS={self.answer_timeout}",
                 f"FW_MAX_ATTEMPTS={self.max_attempts}",
-                f"FW_SELFTEST_RETRY_TICKS={self.selftest_retry}"]
+                f"FW_SELFTEST_RETRY_TICKS={self.selftest_retry}",
+                *([] if self.link == "legacy" else
+                  ["FW_LINK_V2=1", "ATT_LINK2_ONE=1", f"ATT_LINK2_ONE_RTO={self.v2_rto}",
+                   f"ATT_LINK2_ONE_SAMPLES={self.v2_samples}", f"ATT_LINK2_ONE_RING={self.v2_ring}"])]
 
 
 @dataclass(frozen=True)
@@ -241,7 +260,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if kind not in ("production", "sim", "bench"):
         raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
     out_dir = Path(out_dir)
-    name = name or f"fw_{kind}_{config.baud}"
+    name = name or f"fw_{kind}_{config.baud}" + ("" if config.link == "legacy" else "_v2")
     objdir = out_dir / (name + ".objs")
     shutil.rmtree(objdir, ignore_errors=True)
     objdir.mkdir(parents=True, exist_ok=True)
@@ -249,7 +268,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     incs = [f"-I{CSRC / 'include'}", f"-I{FW_DIR}"]
     defines = ["ATT_REAL_F32", *config.defines(), *extra_defines]
     extra: list[str] = []
-    sources = list(SOURCES)
+    sources = list(SOURCES if config.link == "legacy" else SOURCES_V2)
     fault_defs = {"dout_stuck_high": "FW_SIM_DOUT_STUCK=1", "dout_stuck_low": "FW_SIM_DOUT_STUCK=0",
                   "eoc_stuck": "FW_SIM_EOC_STUCK=1"}
     faults = list(faults)
@@ -515,7 +534,11 @@ class Session:
         self.image = image
         self.timeout = timeout
         self._tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
-        self._dev_fw = self._tmp / "uart_fw"
+        # s51's UART on two FIFOs, not on a pty: on a terminal, uCsim opens its serial
+        # control menu when the byte uart0_esc_char (^X) arrives, and link v2's ACKs carry
+        # any byte value. socat joins the FIFOs to the host's pty.
+        self._fw_in = self._tmp / "uart_fw_in"
+        self._fw_out = self._tmp / "uart_fw_out"
         self.port = self._tmp / "uart_host"
         self._socat: subprocess.Popen[bytes] | None = None
         self._s51: subprocess.Popen[bytes] | None = None
@@ -523,11 +546,13 @@ class Session:
 
     def __enter__(self) -> Session:  # noqa: PYI034 - typing.Self needs Python 3.11
         try:
+            os.mkfifo(self._fw_in)
+            os.mkfifo(self._fw_out)
             self._socat = subprocess.Popen(
-                ["socat", f"pty,raw,echo=0,link={self._dev_fw}", f"pty,raw,echo=0,link={self.port}"],
+                ["socat", f"OPEN:{self._fw_out},rdwr!!OPEN:{self._fw_in},rdwr", f"pty,raw,echo=0,link={self.port}"],
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                 start_new_session=True)
-            while not (self._dev_fw.exists() and self.port.exists()):
+            while not self.port.exists():
                 if self._socat.poll() is not None:
                     err = self._socat.stderr.read().decode() if self._socat.stderr else ""
                     raise FirmwareError(f"socat failed: {err}")
@@ -567,7 +592,7 @@ class Session:
         # machine instead of running away from its host.
         self._s51 = s51 = subprocess.Popen(
             ["nice", "-n", str(S51_NICE), "s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
-             "-s", str(self._dev_fw), "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+             "-S", f"in={self._fw_in},out={self._fw_out}", "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
         assert s51.stdout is not None
         os.set_blocking(s51.stdout.fileno(), False)

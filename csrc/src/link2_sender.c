@@ -13,6 +13,61 @@
 
 #include "link2_private.h"
 
+/* The two builds of one source (attitude/link2.h, ATT_LINK2_ONE): the
+ * library's (caller-owned state passed as `s`, run-time configuration,
+ * statistics) and the 8051 firmware's single instance (the state is the
+ * firmware's att_link2_one, reached by direct addressing instead of
+ * through a pointer; configuration fixed at compile time; no statistics;
+ * no NULL or configuration checks: nothing can be NULL or misconfigured). */
+#if ATT_LINK2_ONE
+#define S     (&att_link2_one)
+#define SELF  void
+#define CSELF void
+#define SELF_
+#define ARG
+#define ARG_
+#define API(name)   att_link2_sender1_##name
+#define RING_SIZE   ((uint8_t)ATT_LINK2_ONE_RING)
+#define MAX_SAMPLES ((uint8_t)ATT_LINK2_ONE_SAMPLES)
+#define RTO         ((uint16_t)ATT_LINK2_ONE_RTO)
+#define STAT_INC(name)
+#define STAT_ADD(name, n)
+#define CHECK_NULL(action)
+#define CHECK_BAD(action)
+#define CUR MAX_SAMPLES /* frames always as long as the records allow */
+#define CUR_RESET()
+#define CUR_GROW()
+#define CUR_HALVE()
+#else
+#define S                 s
+#define SELF              att_link2_sender ATT_LINK_MEM *s
+#define CSELF             const att_link2_sender ATT_LINK_MEM *s
+#define SELF_             att_link2_sender ATT_LINK_MEM *s,
+#define ARG               s
+#define ARG_              s,
+#define API(name)         att_link2_sender_##name
+#define RING_SIZE         (s->cfg.ring_size)
+#define MAX_SAMPLES       (s->cfg.max_samples)
+#define RTO               (s->cfg.rto)
+#define STAT_INC(name)    (s->stats.name++)
+#define STAT_ADD(name, n) (s->stats.name = (uint16_t)(s->stats.name + (n)))
+#define CHECK_NULL(action) \
+    if (s == NULL) {       \
+        action;            \
+    }
+#define CHECK_BAD(action)                 \
+    if (s->session >= (uint8_t)SES_BAD) { \
+        action;                           \
+    }
+#define CUR         (s->cur) /* samples per frame now: halved on a loss, +1 per progress */
+#define CUR_RESET() (s->cur = MAX_SAMPLES)
+#define CUR_GROW()              \
+    if (s->cur < MAX_SAMPLES) { \
+        s->cur++;               \
+    }
+#define CUR_HALVE() (s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1))
+#endif
+
 uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte)
 {
     uint8_t i;
@@ -29,10 +84,10 @@ uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte)
 
 /* -- ring ------------------------------------------------------------ */
 
-static uint8_t ATT_LINK_MEM *slot(const att_link2_sender ATT_LINK_MEM *s, uint8_t seq)
+static uint8_t ATT_LINK_MEM *slot(SELF_ uint8_t seq)
 {
-    uint16_t i = (uint8_t)(seq & (uint8_t)(s->cfg.ring_size - 1u));
-    return s->ring + (uint16_t)((uint16_t)(i << 2) + (uint16_t)(i << 1)); /* 6 i: no multiply on the 8051 */
+    uint16_t i = (uint8_t)(seq & (uint8_t)(RING_SIZE - 1u));
+    return S->ring + (uint16_t)((uint16_t)(i << 2) + (uint16_t)(i << 1)); /* 6 i: no multiply on the 8051 */
 }
 
 /* A sample record whose three codes fit 12 bits travels packed. */
@@ -42,444 +97,420 @@ static uint8_t packable(const uint8_t ATT_LINK_MEM *rec)
 }
 
 /* Does B's limit let A send record `seq`? (limit - seq in 1..127) */
-static uint8_t window_open(const att_link2_sender ATT_LINK_MEM *s, uint8_t seq)
+static uint8_t window_open(SELF_ uint8_t seq)
 {
-    return (uint8_t)((uint8_t)((uint8_t)(s->limit - seq) - 1u) < (uint8_t)ATT_LINK2_WINDOW_MAX);
+    return (uint8_t)((uint8_t)((uint8_t)(S->limit - seq) - 1u) < (uint8_t)ATT_LINK2_WINDOW_MAX);
 }
 
-int att_link2_sender_init(att_link2_sender ATT_LINK_MEM *s, const att_link2_sender_config *cfg,
-                          uint8_t ATT_LINK_MEM *ring)
+#if ATT_LINK2_ONE
+void API(init)(void)
+{
+    API(reset)();
+}
+#else
+int API(init)(SELF_ const att_link2_sender_config *cfg, uint8_t ATT_LINK_MEM *ring)
 {
     uint8_t ATT_LINK_MEM *p;
     uint8_t n;
     if (s == NULL || cfg == NULL || ring == NULL) {
         return ATT_LINK2_E_NULL;
     }
-    s->cfg = *cfg;
-    s->ring = ring;
-    p = (uint8_t ATT_LINK_MEM *)&s->stats;
-    n = (uint8_t)sizeof(s->stats);
+    S->cfg = *cfg;
+    S->ring = ring;
+    p = (uint8_t ATT_LINK_MEM *)&S->stats;
+    n = (uint8_t)sizeof(S->stats);
     do {
         *p++ = 0;
     } while (--n != 0);
-    att_link2_sender_reset(s);
-    n = s->cfg.ring_size;
+    API(reset)(ARG);
+    n = RING_SIZE;
     if (n == 0u || n > (uint8_t)ATT_LINK2_RING_MAX || (uint8_t)(n & (uint8_t)(n - 1u)) != 0u
-        || (uint8_t)(s->cfg.max_samples - 1u) >= (uint8_t)ATT_LINK2_SAMPLES_MAX
-        || (uint16_t)(s->cfg.rto - 1u) >= (uint16_t)ATT_LINK2_TIMEOUT_MAX) {
-        s->session = (uint8_t)SES_BAD; /* unusable: every call reports an error */
+        || (uint8_t)(MAX_SAMPLES - 1u) >= (uint8_t)ATT_LINK2_SAMPLES_MAX
+        || (uint16_t)(RTO - 1u) >= (uint16_t)ATT_LINK2_TIMEOUT_MAX) {
+        S->session = (uint8_t)SES_BAD; /* unusable: every call reports an error */
         return ATT_LINK2_E_CONFIG;
     }
     return ATT_OK;
 }
+#endif
 
-void att_link2_sender_reset(att_link2_sender ATT_LINK_MEM *s)
+void API(reset)(SELF)
 {
-    if (s == NULL) {
-        return;
-    }
-    s->head = 0;
-    s->base = 0;
-    s->next = 0;
-    s->hi = 0;
-    s->limit = 0;
-    s->t0 = 0;
-    s->crc = 0;
-    s->cur = s->cfg.max_samples;
-    s->session = (uint8_t)SES_SYN_SEND;
-    s->tx = (uint8_t)TX_IDLE;
-    s->flags = (uint8_t)FL_LINE_IDLE;
-    s->f_head = 0;
-    s->f_seq = 0;
-    s->f_len = 0;
-    s->f_pos = 0;
-    s->run = 0;
-    s->rx_len = 0;
+    CHECK_NULL(return );
+    S->head = 0;
+    S->base = 0;
+    S->next = 0;
+    S->hi = 0;
+    S->limit = 0;
+    S->t0 = 0;
+    CUR_RESET();
+    S->session = (uint8_t)SES_SYN_SEND;
+    S->tx = (uint8_t)TX_IDLE;
+    S->flags = (uint8_t)FL_LINE_IDLE;
+    S->rx_len = 0;
 }
 
 /* Records whose slots are in use: from base, or from the frame being sent
  * when B acknowledged some of its records meanwhile (its bytes are still read
  * from the ring). */
-static uint8_t used(const att_link2_sender ATT_LINK_MEM *s)
+static uint8_t used(CSELF)
 {
-    uint8_t n = (uint8_t)(s->head - s->base);
-    if (s->tx != (uint8_t)TX_IDLE && (uint8_t)(s->head - s->f_seq) > n) {
-        n = (uint8_t)(s->head - s->f_seq);
+    uint8_t n = (uint8_t)(S->head - S->base);
+    if (S->tx != (uint8_t)TX_IDLE && (uint8_t)(S->head - S->f_seq) > n) {
+        n = (uint8_t)(S->head - S->f_seq);
     }
     return n;
 }
 
-uint8_t att_link2_sender_pending(const att_link2_sender ATT_LINK_MEM *s)
+uint8_t API(pending)(CSELF)
 {
-    return s == NULL ? 0u : (uint8_t)(s->head - s->base);
+    CHECK_NULL(return 0);
+    return (uint8_t)(S->head - S->base);
 }
 
-uint8_t att_link2_sender_room(const att_link2_sender ATT_LINK_MEM *s)
+uint8_t API(room)(CSELF)
 {
-    if (s == NULL || s->session >= (uint8_t)SES_BAD) {
-        return 0;
-    }
-    return (uint8_t)(s->cfg.ring_size - used(s));
+    CHECK_NULL(return 0);
+    CHECK_BAD(return 0);
+    return (uint8_t)(RING_SIZE - used(ARG));
 }
 
-int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *record)
+uint8_t ATT_LINK_MEM *API(tail)(SELF)
+{
+    CHECK_NULL(return NULL);
+    CHECK_BAD(return NULL);
+    return used(ARG) >= RING_SIZE ? (uint8_t ATT_LINK_MEM *)NULL : slot(ARG_ S->head);
+}
+
+int API(push)(SELF_ const uint8_t ATT_LINK_MEM *record)
 {
     uint8_t ATT_LINK_MEM *d;
     uint8_t i;
-    if (s == NULL || record == NULL) {
+    CHECK_NULL(return ATT_LINK2_E_NULL);
+    if (record == NULL) {
         return ATT_LINK2_E_NULL;
     }
-    if (s->session >= (uint8_t)SES_BAD) {
-        return ATT_LINK2_E_STATE;
-    }
-    if (used(s) >= s->cfg.ring_size) {
+    CHECK_BAD(return ATT_LINK2_E_STATE);
+    if (used(ARG) >= RING_SIZE) {
         return ATT_LINK2_E_FULL;
     }
-    d = slot(s, s->head);
+    d = slot(ARG_ S->head);
     for (i = 0; i < (uint8_t)ATT_LINK2_RECORD; i++) {
         d[i] = record[i];
     }
-    s->head++;
+    S->head++;
     return ATT_OK;
 }
 
 /* -- sink: ACK frames from B ----------------------------------------- */
 
-/* Apply a valid ACK: d[0] = 0xC0 | flags, d[1] = ack, d[2] = limit. */
-static att_link2_result apply_ack(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *d,
-                                  uint16_t tick)
+/* Apply the valid ACK decoded in place in rx[1..7] (d[0] = 0xC0 | flags,
+ * d[1] = ack, d[2] = limit). */
+static att_link2_result apply_ack(SELF_ uint16_t tick)
 {
+    const uint8_t ATT_LINK_MEM *d = S->rx + 1;
     uint8_t fl = (uint8_t)(d[0] & 0x0Fu);
     uint8_t a = d[1];
-    uint8_t adv = (uint8_t)(a - s->base);
-    s->stats.acks++;
+    uint8_t adv = (uint8_t)(a - S->base);
+    STAT_INC(acks);
     if (fl & (uint8_t)ATT_LINK2_F_NOSESSION) { /* B rebooted: new session from base, ring kept */
-        s->session = (uint8_t)SES_SYN_SEND;
-        s->next = s->base;
-        s->hi = s->base;
-        s->limit = s->base;
+        S->session = (uint8_t)SES_SYN_SEND;
+        S->next = S->base;
+        S->hi = S->base;
+        S->limit = S->base;
         return ATT_LINK2_FRAME;
     }
-    if (s->session == (uint8_t)SES_SYN_WAIT) {
+    if (S->session == (uint8_t)SES_SYN_WAIT) {
         if ((fl & (uint8_t)ATT_LINK2_F_SYNACK) == 0u || adv != 0u) {
             return ATT_LINK2_FRAME; /* not the answer to our SYN */
         }
-        s->session = (uint8_t)SES_RUN;
-        s->t0 = tick;
-    } else if (s->session != (uint8_t)SES_RUN) {
+        S->session = (uint8_t)SES_RUN;
+        S->t0 = tick;
+    } else if (S->session != (uint8_t)SES_RUN) {
         return ATT_LINK2_FRAME; /* SYN not sent yet: nothing to acknowledge */
     }
-    if (adv > (uint8_t)(s->hi - s->base)) {
-        s->stats.bad_frames++; /* acknowledges records never sent */
+    if (adv > (uint8_t)(S->hi - S->base)) {
+        STAT_INC(bad_frames); /* acknowledges records never sent */
         return ATT_LINK2_BAD_FRAME;
     }
     if (adv != 0u) {
-        if ((uint8_t)(s->next - s->base) < adv) {
-            s->next = a; /* B already had what was being sent again */
+        if ((uint8_t)(S->next - S->base) < adv) {
+            S->next = a; /* B already had what was being sent again */
         }
-        s->base = a;
-        s->t0 = tick;
-        if (s->cur < s->cfg.max_samples) {
-            s->cur++; /* progress: longer frames again */
-        }
+        S->base = a;
+        S->t0 = tick;
+        CUR_GROW(); /* progress: longer frames again */
     }
     if ((uint8_t)(d[2] - a) <= (uint8_t)ATT_LINK2_WINDOW_MAX) {
-        s->limit = d[2];
+        S->limit = d[2];
     }
-    if ((fl & (uint8_t)ATT_LINK2_F_GAP) && s->hi != s->base
-        && (uint8_t)((fl & (uint8_t)ATT_LINK2_F_EPOCH) ? FL_EPOCH : 0u) == (uint8_t)(s->flags & FL_EPOCH)) {
+    if ((fl & (uint8_t)ATT_LINK2_F_GAP) && S->hi != S->base
+        && (uint8_t)((uint8_t)((uint8_t)(fl << 2) ^ S->flags) & FL_EPOCH)
+               == 0u) { /* F_EPOCH << 2 = FL_EPOCH */
         /* a gap in what was sent since the last go-back: go back to the first record B lacks */
-        s->next = s->base;
-        s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1); /* and shorter frames */
-        s->flags ^= (uint8_t)FL_EPOCH;
-        s->stats.gobacks++;
-        s->t0 = tick;
+        S->next = S->base;
+        CUR_HALVE(); /* and shorter frames */
+        S->flags ^= (uint8_t)FL_EPOCH;
+        STAT_INC(gobacks);
+        S->t0 = tick;
     }
     return ATT_LINK2_FRAME;
 }
 
-/* Decode the 8 encoded bytes in s->rx (rCOBS, backwards) into the 7 bytes
- * of an ACK and check it. */
-static att_link2_result ack_frame(att_link2_sender ATT_LINK_MEM *s, uint16_t tick)
+att_link2_result API(sink)(SELF_ uint8_t byte, uint16_t tick)
 {
-    uint8_t d[7];
-    uint8_t p = 8;
-    uint8_t q = 7;
+    uint8_t p;
+    uint8_t q;
     uint8_t code;
-    uint8_t first = 1;
+    uint8_t first;
     uint32_t crc;
+    CHECK_NULL(return ATT_LINK2_E_NULL);
+    CHECK_BAD(return ATT_LINK2_E_STATE);
+    p = S->rx_len;
+    if (byte != (uint8_t)ATT_LINK2_DELIM) {
+        if (p >= (uint8_t)sizeof(S->rx)) {
+            S->rx_len = 0xFFu; /* longer than an ACK: skip to the delimiter */
+            return ATT_LINK2_DISCARDED;
+        }
+        S->rx[p] = byte;
+        S->rx_len = (uint8_t)(p + 1u);
+        return ATT_LINK2_NONE;
+    }
+    S->rx_len = 0;
+    if (p == 0u) {
+        return ATT_LINK2_NONE; /* idle delimiter */
+    }
+    if (p != (uint8_t)sizeof(S->rx)) {
+        goto bad;
+    }
+    /* Decode the 8 encoded bytes (rCOBS, backwards) into the 7 bytes of an
+     * ACK, in place: decoded byte q lands in rx[q + 1], at or above the byte
+     * read last, so nothing is overwritten before it is read. */
+    q = 7;
+    first = 1;
     while (p != 0u) {
-        code = s->rx[p - 1u];
+        code = S->rx[p - 1u];
         if (code > p || code == 0xFFu || (uint8_t)(code - 1u + (first ^ 1u)) > q) {
             goto bad;
         }
         p--;
         if (!first) {
-            d[--q] = 0;
+            S->rx[q--] = 0;
         }
         first = 0;
         while (--code != 0u) {
-            d[--q] = s->rx[--p];
+            S->rx[q--] = S->rx[--p];
         }
     }
-    if (q != 0u || (uint8_t)(d[0] & 0xF0u) != (uint8_t)ATT_LINK2_T_ACK) {
+    if (q != 0u || (uint8_t)(S->rx[1] & 0xF0u) != (uint8_t)ATT_LINK2_T_ACK) {
         goto bad;
     }
     crc = 0xFFFFFFFFul;
-    for (q = 0; q < 3u; q++) {
-        crc = att_link2_crc_byte(crc, d[q]);
+    for (q = 1; q < 4u; q++) {
+        crc = att_link2_crc_byte(crc, S->rx[q]);
     }
     crc = ~crc;
-    if (d[3] != (uint8_t)(crc >> 24) || d[4] != (uint8_t)(crc >> 16) || d[5] != (uint8_t)(crc >> 8)
-        || d[6] != (uint8_t)crc) {
+    if (S->rx[4] != (uint8_t)(crc >> 24) || S->rx[5] != (uint8_t)(crc >> 16)
+        || S->rx[6] != (uint8_t)(crc >> 8) || S->rx[7] != (uint8_t)crc) {
         goto bad;
     }
-    return apply_ack(s, d, tick);
+    return apply_ack(ARG_ tick);
 bad:
-    s->stats.bad_frames++;
+    STAT_INC(bad_frames);
     return ATT_LINK2_BAD_FRAME;
 }
 
-att_link2_result att_link2_sender_sink(att_link2_sender ATT_LINK_MEM *s, uint8_t byte, uint16_t tick)
+/* -- poll: the emitter ----------------------------------------------- */
+
+/* Nibble k of the packed codes of the DATA frame being sent (0 past the
+ * last code): sample k / 9, nibble k % 9 of its three 12-bit codes, which
+ * is the low (0) or high (0x80) nibble of byte nib_at[k % 9] & 7 of the record. */
+static const uint8_t nib_at[9] = { 0, 0x81, 1, 2, 0x83, 3, 4, 0x85, 5 };
+
+static uint8_t nibble(SELF_ uint8_t k)
 {
-    uint8_t n;
-    if (s == NULL) {
-        return ATT_LINK2_E_NULL;
+    uint8_t smp = (uint8_t)(k / (uint8_t)9); /* 8-bit division: DIV AB on the 8051 */
+    uint8_t w = nib_at[(uint8_t)(k - (uint8_t)(smp * (uint8_t)9))];
+    uint8_t b;
+    if (smp >= (uint8_t)(S->f_head & 0x1Fu)) {
+        return 0; /* the padding of an odd number of codes */
     }
-    if (s->session >= (uint8_t)SES_BAD) {
-        return ATT_LINK2_E_STATE;
-    }
-    n = s->rx_len;
-    if (byte != (uint8_t)ATT_LINK2_DELIM) {
-        if (n >= (uint8_t)sizeof(s->rx)) {
-            s->rx_len = 0xFFu; /* longer than an ACK: skip to the delimiter */
-            return ATT_LINK2_DISCARDED;
-        }
-        s->rx[n] = byte;
-        s->rx_len = (uint8_t)(n + 1u);
-        return ATT_LINK2_NONE;
-    }
-    s->rx_len = 0;
-    if (n == 0u) {
-        return ATT_LINK2_NONE; /* idle delimiter */
-    }
-    if (n != (uint8_t)sizeof(s->rx)) {
-        s->stats.bad_frames++;
-        return ATT_LINK2_BAD_FRAME;
-    }
-    return ack_frame(s, tick);
+    b = slot(ARG_(uint8_t)(S->f_seq + smp))[w & 7u];
+    return (uint8_t)((w & 0x80u) ? (uint8_t)(b >> 4) : (uint8_t)(b & 0x0Fu));
 }
 
-/* -- poll: the emitter, one function per state ----------------------- */
-
-/* Code m (0..3n-1) of the DATA frame being sent: sample m / 3, channel m % 3. */
-static uint16_t code_at(const att_link2_sender ATT_LINK_MEM *s, uint8_t m)
+/* Decoded byte i of the frame being sent, i < f_len - 4 (the bytes the CRC covers). */
+static uint8_t frame_byte(SELF_ uint8_t i)
 {
-    uint8_t k = (uint8_t)(m / (uint8_t)3); /* 8-bit division: DIV AB on the 8051 */
-    uint8_t c = (uint8_t)(m - (uint8_t)(k + (uint8_t)(k << 1)));
-    const uint8_t ATT_LINK_MEM *r = slot(s, (uint8_t)(s->f_seq + k)) + (uint8_t)(c << 1);
-    return (uint16_t)((uint16_t)((uint16_t)r[0] << 8) | r[1]);
-}
-
-/* Byte j of the packed codes: pair j / 3 of codes, byte j % 3 of it. */
-static uint8_t packed_byte(const att_link2_sender ATT_LINK_MEM *s, uint8_t j)
-{
-    uint8_t p = (uint8_t)(j / (uint8_t)3);
-    uint8_t r = (uint8_t)(j - (uint8_t)(p + (uint8_t)(p << 1)));
-    uint8_t m = (uint8_t)(p << 1);
-    uint8_t n = (uint8_t)(s->f_head & 0x1Fu);
-    uint8_t ncodes = (uint8_t)(n + (uint8_t)(n << 1));
-    if (r == 0u) {
-        return (uint8_t)(code_at(s, m) >> 4);
-    }
-    if (r == 2u) {
-        return (uint8_t)code_at(s, (uint8_t)(m + 1u));
-    }
-    r = (uint8_t)(code_at(s, m) << 4);
-    if ((uint8_t)(m + 1u) < ncodes) {
-        r |= (uint8_t)(code_at(s, (uint8_t)(m + 1u)) >> 8);
-    }
-    return r;
-}
-
-/* Decoded byte i of the frame being sent (the CRC bytes once every byte before them went out). */
-static uint8_t frame_byte(const att_link2_sender ATT_LINK_MEM *s, uint8_t i)
-{
-    uint8_t tail = (uint8_t)(s->f_len - 4u);
-    uint32_t v;
     if (i == 0u) {
-        return s->f_head;
+        return S->f_head;
     }
     if (i == 1u) {
-        return s->f_seq;
+        return S->f_seq;
     }
-    if (i < tail) {
-        i = (uint8_t)(i - 2u);
-        if (s->f_head & (uint8_t)ATT_LINK2_T_RAW) {
-            return slot(s, s->f_seq)[i];
-        }
-        return packed_byte(s, i);
+    i = (uint8_t)(i - 2u);
+    if (S->f_head & (uint8_t)ATT_LINK2_T_RAW) {
+        return slot(ARG_ S->f_seq)[i];
     }
-    v = ~s->crc; /* the CRC, most significant byte first */
-    i = (uint8_t)(i - tail);
-    if (i == 0u) {
-        return (uint8_t)(v >> 24);
-    }
-    if (i == 1u) {
-        return (uint8_t)(v >> 16);
-    }
-    return i == 2u ? (uint8_t)(v >> 8) : (uint8_t)v;
+    /* byte i of the packed codes: nibbles 2i and 2i + 1 */
+    i = (uint8_t)(i << 1);
+    return (uint8_t)((uint8_t)(nibble(ARG_ i) << 4) | nibble(ARG_(uint8_t)(i + 1u)));
 }
 
-static att_link2_result poll_body(att_link2_sender ATT_LINK_MEM *s, uint8_t ATT_LINK_MEM *out)
+/* The next encoded byte of the frame being sent (tx = TX_BODY). */
+static uint8_t body_byte(SELF)
 {
     uint8_t b;
-    if (s->run == 254u) { /* 254 bytes without a zero: a code that stands for none */
-        s->run = 0;
-        *out = 0xFFu;
-        return ATT_LINK2_SEND;
+    uint8_t i = S->f_pos;
+    uint8_t tail = (uint8_t)(S->f_len - 4u);
+    if (S->run == 254u) { /* 254 bytes without a zero: a code that stands for none */
+        S->run = 0;
+        return 0xFFu;
     }
-    if (s->f_pos >= s->f_len) { /* final code, then the delimiter */
-        *out = (uint8_t)(s->run + 1u);
-        s->tx = (uint8_t)TX_DELIM;
-        return ATT_LINK2_SEND;
+    if (i >= S->f_len) { /* final code, then the delimiter */
+        S->tx = (uint8_t)TX_DELIM;
+        return (uint8_t)(S->run + 1u);
     }
-    b = frame_byte(s, s->f_pos);
-    if (s->f_pos < (uint8_t)(s->f_len - 4u)) {
-        s->crc = att_link2_crc_byte(s->crc, b);
+    if (i < tail) {
+        b = frame_byte(ARG_ i);
+        S->crc = att_link2_crc_byte(S->crc, b);
+    } else { /* the CRC, most significant byte first */
+        if (i == tail) {
+            S->crc = ~S->crc;
+        }
+        b = (uint8_t)(S->crc >> 24);
+        S->crc <<= 8;
     }
-    s->f_pos++;
+    S->f_pos = (uint8_t)(i + 1u);
     if (b == 0u) {
-        b = (uint8_t)(s->run + 1u);
-        s->run = 0;
+        b = (uint8_t)(S->run + 1u);
+        S->run = 0;
     } else {
-        s->run++;
+        S->run++;
     }
-    *out = b;
-    return ATT_LINK2_SEND;
+    return b;
 }
 
-static att_link2_result poll_lead(att_link2_sender ATT_LINK_MEM *s, uint8_t ATT_LINK_MEM *out)
+/* Start the frame whose f_head, f_seq and f_len are set: its first byte
+ * goes out at this poll (after a 0x00 if the line was idle). */
+static void start_frame(SELF)
 {
-    s->tx = (uint8_t)TX_BODY;
-    *out = (uint8_t)ATT_LINK2_DELIM;
-    return ATT_LINK2_SEND;
-}
-
-static att_link2_result poll_delim(att_link2_sender ATT_LINK_MEM *s, uint16_t tick, uint8_t ATT_LINK_MEM *out)
-{
-    s->tx = (uint8_t)TX_IDLE;
-    s->t0 = tick; /* the timer counts from the end of the last frame */
-    *out = (uint8_t)ATT_LINK2_DELIM;
-    return ATT_LINK2_SEND;
-}
-
-static att_link2_result start_frame(att_link2_sender ATT_LINK_MEM *s, uint8_t head, uint8_t seq, uint8_t len,
-                                    uint8_t ATT_LINK_MEM *out)
-{
-    s->f_head = head;
-    s->f_seq = seq;
-    s->f_len = len;
-    s->f_pos = 0;
-    s->run = 0;
-    s->crc = 0xFFFFFFFFul;
-    s->stats.frames++;
-    if (s->flags & (uint8_t)FL_LINE_IDLE) {
-        s->flags &= (uint8_t)~FL_LINE_IDLE;
-        return poll_lead(s, out);
+    S->f_pos = 0;
+    S->run = 0;
+    S->crc = 0xFFFFFFFFul;
+    STAT_INC(frames);
+    if (S->flags & (uint8_t)FL_LINE_IDLE) {
+        S->flags &= (uint8_t)~FL_LINE_IDLE;
+        S->tx = (uint8_t)TX_LEAD;
+    } else {
+        S->tx = (uint8_t)TX_BODY;
     }
-    s->tx = (uint8_t)TX_BODY;
-    return poll_body(s, out);
 }
 
 /* The next data frame from record `next`: one RAW record, or up to
  * max_samples packable samples below head and B's limit. */
-static att_link2_result start_data(att_link2_sender ATT_LINK_MEM *s, uint8_t ATT_LINK_MEM *out)
+static void start_data(SELF)
 {
-    uint8_t seq = s->next;
+    uint8_t seq = S->next;
     uint8_t n = 1;
     uint8_t old;
-    uint8_t head;
-    uint8_t len;
-    if (!packable(slot(s, seq))) {
-        head = (uint8_t)(ATT_LINK2_T_RAW | (s->flags & FL_EPOCH));
-        len = (uint8_t)(6u + (uint8_t)ATT_LINK2_RECORD);
+    if (!packable(slot(ARG_ seq))) {
+        S->f_head = (uint8_t)(ATT_LINK2_T_RAW | (S->flags & FL_EPOCH));
+        S->f_len = (uint8_t)(6u + (uint8_t)ATT_LINK2_RECORD);
     } else {
-        while (n < s->cur && (uint8_t)(seq + n) != s->head && window_open(s, (uint8_t)(seq + n))
-               && packable(slot(s, (uint8_t)(seq + n)))) {
+        while (n < CUR && (uint8_t)(seq + n) != S->head && window_open(ARG_(uint8_t)(seq + n))
+               && packable(slot(ARG_(uint8_t)(seq + n)))) {
             n++;
         }
-        head = (uint8_t)(n | (s->flags & FL_EPOCH));
-        len = (uint8_t)(6u + (uint8_t)((uint8_t)(9u * n + 1u) >> 1));
+        S->f_head = (uint8_t)(n | (S->flags & FL_EPOCH));
+        S->f_len = (uint8_t)(6u + (uint8_t)((uint8_t)(9u * n + 1u) >> 1));
     }
+    S->f_seq = seq;
     /* records below hi were sent before: they count as resent */
-    old = (uint8_t)(s->next - s->base) < (uint8_t)(s->hi - s->base) ? (uint8_t)(s->hi - s->next) : 0u;
+    old = (uint8_t)(seq - S->base) < (uint8_t)(S->hi - S->base) ? (uint8_t)(S->hi - seq) : 0u;
     if (old >= n) {
-        s->stats.resent += n;
+        STAT_ADD(resent, n);
     } else {
-        s->stats.resent += old;
-        s->stats.records += (uint8_t)(n - old);
-        s->hi = (uint8_t)(seq + n);
+        STAT_ADD(resent, old);
+        STAT_ADD(records, (uint8_t)(n - old));
+        S->hi = (uint8_t)(seq + n);
     }
-    s->next = (uint8_t)(seq + n);
-    return start_frame(s, head, seq, len, out);
+    S->next = (uint8_t)(seq + n);
+    start_frame(ARG);
 }
 
-static att_link2_result poll_idle(att_link2_sender ATT_LINK_MEM *s, uint16_t tick, uint8_t ATT_LINK_MEM *out)
+/* Between frames: start one (tx leaves TX_IDLE), or say why not. */
+static att_link2_result poll_idle(SELF_ uint16_t tick)
 {
-    uint8_t waiting;
-    if (s->session == (uint8_t)SES_SYN_SEND) {
-        s->session = (uint8_t)SES_SYN_WAIT;
-        s->stats.syns++;
-        return start_frame(s, (uint8_t)ATT_LINK2_T_SYN, s->base, 6u, out);
+    if (S->session == (uint8_t)SES_SYN_SEND) {
+        S->session = (uint8_t)SES_SYN_WAIT;
+        STAT_INC(syns);
+        S->f_head = (uint8_t)ATT_LINK2_T_SYN;
+        goto empty_frame; /* SYN at base */
     }
-    waiting = (uint8_t)(s->session == (uint8_t)SES_SYN_WAIT || s->hi != s->base
-                        || (s->next != s->head && !window_open(s, s->next)));
-    if (waiting && (uint16_t)(tick - s->t0) > s->cfg.rto) {
-        s->stats.timeouts++;
-        s->t0 = tick;
-        if (s->session == (uint8_t)SES_SYN_WAIT) {
-            s->session = (uint8_t)SES_SYN_SEND;
+    if ((S->session == (uint8_t)SES_SYN_WAIT || S->hi != S->base
+         || (S->next != S->head && !window_open(ARG_ S->next)))
+        && (uint16_t)(tick - S->t0) > RTO) {
+        STAT_INC(timeouts);
+        S->t0 = tick;
+        if (S->session == (uint8_t)SES_SYN_WAIT) {
+            S->session = (uint8_t)SES_SYN_SEND;
             return ATT_LINK2_TIMEOUT;
         }
-        if (s->hi != s->base) {
-            s->next = s->base; /* no progress: go back to the first unacknowledged record */
-            s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1);
-            s->flags ^= (uint8_t)FL_EPOCH;
+        if (S->hi != S->base) {
+            S->next = S->base; /* no progress: go back to the first unacknowledged record */
+            CUR_HALVE();
+            S->flags ^= (uint8_t)FL_EPOCH;
         }
-        if (window_open(s, s->next)) {
+        if (window_open(ARG_ S->next)) {
             return ATT_LINK2_TIMEOUT; /* the next poll sends again */
         }
         /* B's limit blocks A (or A missed the ACK that opened it): ask with an empty frame */
-        return start_frame(s, (uint8_t)(ATT_LINK2_T_DATA | (s->flags & FL_EPOCH)), s->next, 6u,
-                           out); /* probe */
+        S->f_head = (uint8_t)(ATT_LINK2_T_DATA | (S->flags & FL_EPOCH)); /* probe at next */
+        goto empty_frame;
     }
-    if (s->session == (uint8_t)SES_RUN && s->next != s->head && window_open(s, s->next)) {
-        return start_data(s, out);
+    if (S->session == (uint8_t)SES_RUN && S->next != S->head && window_open(ARG_ S->next)) {
+        start_data(ARG);
+        return ATT_LINK2_SEND;
     }
-    s->flags |= (uint8_t)FL_LINE_IDLE;
-    return (s->session == (uint8_t)SES_RUN && s->head == s->base) ? ATT_LINK2_IDLE : ATT_LINK2_NONE;
+    S->flags |= (uint8_t)FL_LINE_IDLE;
+    return (S->session == (uint8_t)SES_RUN && S->head == S->base) ? ATT_LINK2_IDLE : ATT_LINK2_NONE;
+empty_frame:
+    S->f_seq = S->f_head == (uint8_t)ATT_LINK2_T_SYN ? S->base : S->next;
+    S->f_len = 6u;
+    start_frame(ARG);
+    return ATT_LINK2_SEND;
 }
 
-att_link2_result att_link2_sender_poll(att_link2_sender ATT_LINK_MEM *s, uint16_t tick,
-                                       uint8_t ATT_LINK_MEM *out_byte)
+att_link2_result API(poll)(SELF_ uint16_t tick, uint8_t ATT_LINK_MEM *out_byte)
 {
-    if (s == NULL || out_byte == NULL) {
+    att_link2_result r;
+    uint8_t b = (uint8_t)ATT_LINK2_DELIM;
+    CHECK_NULL(return ATT_LINK2_E_NULL);
+    if (out_byte == NULL) {
         return ATT_LINK2_E_NULL;
     }
-    if (s->session >= (uint8_t)SES_BAD) {
-        return ATT_LINK2_E_STATE;
+    CHECK_BAD(return ATT_LINK2_E_STATE);
+    if (S->tx == (uint8_t)TX_IDLE) {
+        r = poll_idle(ARG_ tick);
+        if (r != ATT_LINK2_SEND) {
+            return r;
+        }
     }
-    switch (s->tx) {
-    case TX_IDLE:
-        return poll_idle(s, tick, out_byte);
-    case TX_LEAD:
-        return poll_lead(s, out_byte);
+    switch (S->tx) {
+    case TX_LEAD: /* the 0x00 before a frame after an idle line */
+        S->tx = (uint8_t)TX_BODY;
+        break;
     case TX_BODY:
-        return poll_body(s, out_byte);
-    case TX_DELIM:
-        return poll_delim(s, tick, out_byte);
+        b = body_byte(ARG);
+        break;
+    case TX_DELIM: /* the 0x00 that ends the frame */
+        S->tx = (uint8_t)TX_IDLE;
+        S->t0 = tick; /* the timer counts from the end of the last frame */
+        break;
     default:
         return ATT_LINK2_E_STATE;
     }
+    *out_byte = b;
+    return ATT_LINK2_SEND;
 }

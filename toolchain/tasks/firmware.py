@@ -20,13 +20,17 @@ def _tool() -> ModuleType:
     "period_ticks": "sampling period in Timer 0 ticks of 1/3600 s (72 = 20 ms)",
     "max_attempts": "link attempts per block before giving up",
     "out": "output directory (default build/firmware)",
+    "link": "link protocol: legacy (AA/BB handshake, default) or v2 (link v2, single-instance sender)",
 })
-def build(c, baud=9600, period_ticks=72, max_attempts=5, out=""):
+def build(c, baud=9600, period_ticks=72, max_attempts=5, out="", link="legacy"):
     """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM) and print flash, RAM and free stack."""
     tool = _tool()
-    cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), max_attempts=int(max_attempts))
+    if link not in tool.LINKS:
+        print(f"--link must be one of {', '.join(tool.LINKS)}, got {link!r}", file=sys.stderr)
+        raise SystemExit(2)
+    cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), max_attempts=int(max_attempts), link=link)
     try:
-        img = tool.build(Path(out) if out else tool.BUILD, cfg, kind="production", name="attitude_fw")
+        img = tool.build(Path(out) if out else tool.BUILD, cfg, kind="production", name="attitude_fw" if link == "legacy" else "attitude_fw_v2")
     except tool.FirmwareTooBig as exc:
         print(f"firmware does not fit: {exc}", file=sys.stderr)
         raise SystemExit(1) from None

@@ -145,29 +145,88 @@ typedef struct {
     uint16_t syns;       /* SYN frames sent */
 } att_link2_sender_stats;
 
+/* Single-instance build for the AT89S51 (ATT_LINK2_ONE = 1, set by the
+ * firmware's build: docs/link.md "On the AT89S51"). The same source
+ * compiles to a sender whose state is one object the firmware defines,
+ * `att_link2_sender att_link2_one` (in internal RAM, reached by direct
+ * addressing: no pointer), whose configuration is fixed at compile time
+ * (ATT_LINK2_ONE_RTO ticks, ATT_LINK2_ONE_SAMPLES per frame, a ring of
+ * ATT_LINK2_ONE_RING records inside the state), and which keeps no
+ * statistics. The functions below keep their names and arguments (macros
+ * drop s, cfg and ring); att_link2_sender_init returns nothing, and
+ * config_init, ticks_left and att_link2_crc do not exist in this build.
+ * The wire protocol is the same. */
+#ifndef ATT_LINK2_ONE
+#define ATT_LINK2_ONE 0
+#endif
+#if ATT_LINK2_ONE
+#ifndef ATT_LINK2_ONE_RTO
+#define ATT_LINK2_ONE_RTO 720 /* ticks: 200 ms of the firmware's 1/3600 s ticks */
+#endif
+#ifndef ATT_LINK2_ONE_SAMPLES
+#define ATT_LINK2_ONE_SAMPLES 4 /* samples per DATA frame */
+#endif
+#ifndef ATT_LINK2_ONE_RING
+#define ATT_LINK2_ONE_RING 4 /* records: 1, 2, 4, .., 64 */
+#endif
+#if ATT_LINK2_ONE_RTO < 1 || ATT_LINK2_ONE_RTO > 32767 || ATT_LINK2_ONE_SAMPLES < 1    \
+    || ATT_LINK2_ONE_SAMPLES > 24 || ATT_LINK2_ONE_RING < 1 || ATT_LINK2_ONE_RING > 64 \
+    || (ATT_LINK2_ONE_RING & (ATT_LINK2_ONE_RING - 1)) != 0
+#error \
+    "ATT_LINK2_ONE_RTO must be 1..32767, ATT_LINK2_ONE_SAMPLES 1..24, ATT_LINK2_ONE_RING a power of two <= 64"
+#endif
+#endif
+
 typedef struct {
+#if !ATT_LINK2_ONE
     att_link2_sender_config cfg;
     att_link2_sender_stats stats;
     uint8_t ATT_LINK_MEM *ring; /* caller's ring: cfg.ring_size records of 6 bytes */
-    uint16_t t0;                /* tick of the last progress (frame end, ack, go-back) */
-    uint32_t crc;               /* CRC of the frame being sent (running, not yet inverted) */
-    uint8_t head;               /* seq of the next record pushed */
-    uint8_t base;               /* seq of the oldest unacknowledged record */
-    uint8_t next;               /* seq of the next record to send */
-    uint8_t hi;                 /* one past the highest seq sent */
-    uint8_t limit;              /* B's limit */
-    uint8_t session;            /* private: SYN needed / SYN sent / running */
-    uint8_t tx;                 /* private: emitter state (one function per state) */
-    uint8_t flags;              /* private: line idle, epoch */
-    uint8_t f_head;             /* frame being sent: byte 0 */
-    uint8_t f_seq;              /*   its seq */
-    uint8_t f_len;              /*   decoded length including the CRC */
-    uint8_t f_pos;              /*   next decoded byte */
-    uint8_t run;                /*   rCOBS: bytes since the last code */
-    uint8_t rx_len;             /* ACK bytes received so far (0xFF: skipping an over-long frame) */
-    uint8_t cur;                /* samples per frame now: halved on a loss, +1 per progress */
-    uint8_t rx[8];              /* encoded ACK frame being received */
+#endif
+    uint16_t t0;     /* tick of the last progress (frame end, ack, go-back) */
+    uint32_t crc;    /* CRC of the frame being sent (running, not yet inverted) */
+    uint8_t head;    /* seq of the next record pushed */
+    uint8_t base;    /* seq of the oldest unacknowledged record */
+    uint8_t next;    /* seq of the next record to send */
+    uint8_t hi;      /* one past the highest seq sent */
+    uint8_t limit;   /* B's limit */
+    uint8_t session; /* private: SYN needed / SYN sent / running */
+    uint8_t tx;      /* private: emitter state (one function per state) */
+    uint8_t flags;   /* private: line idle, epoch */
+    uint8_t f_head;  /* frame being sent: byte 0 */
+    uint8_t f_seq;   /*   its seq */
+    uint8_t f_len;   /*   decoded length including the CRC */
+    uint8_t f_pos;   /*   next decoded byte */
+    uint8_t run;     /*   rCOBS: bytes since the last code */
+    uint8_t rx_len;  /* ACK bytes received so far (0xFF: skipping an over-long frame) */
+#if !ATT_LINK2_ONE
+    uint8_t cur; /* samples per frame now: halved on a loss, +1 per progress */
+#endif
+    uint8_t rx[8]; /* encoded ACK frame being received */
+#if ATT_LINK2_ONE
+    uint8_t ring[ATT_LINK2_ONE_RING * ATT_LINK2_RECORD]; /* the ring (single-instance build) */
+#endif
 } att_link2_sender;
+
+#if ATT_LINK2_ONE
+extern att_link2_sender ATT_LINK_MEM att_link2_one; /* defined by the firmware */
+void att_link2_sender1_init(void);
+void att_link2_sender1_reset(void);
+uint8_t att_link2_sender1_room(void);
+uint8_t att_link2_sender1_pending(void);
+int att_link2_sender1_push(const uint8_t ATT_LINK_MEM *record);
+uint8_t ATT_LINK_MEM *att_link2_sender1_tail(void);
+att_link2_result att_link2_sender1_sink(uint8_t byte, uint16_t tick);
+att_link2_result att_link2_sender1_poll(uint16_t tick, uint8_t ATT_LINK_MEM *out_byte);
+#define att_link2_sender_init(s, cfg, ring)      att_link2_sender1_init()
+#define att_link2_sender_reset(s)                att_link2_sender1_reset()
+#define att_link2_sender_room(s)                 att_link2_sender1_room()
+#define att_link2_sender_pending(s)              att_link2_sender1_pending()
+#define att_link2_sender_push(s, record)         att_link2_sender1_push(record)
+#define att_link2_sender_tail(s)                 att_link2_sender1_tail()
+#define att_link2_sender_sink(s, byte, tick)     att_link2_sender1_sink(byte, tick)
+#define att_link2_sender_poll(s, tick, out_byte) att_link2_sender1_poll(tick, out_byte)
+#else
 
 /* (link2_sender_aux.c) Defaults for 1 ms ticks at 9600 baud: rto 200 ms
  * (a full 16-sample frame is 82 bytes on the wire, 85 ms; its ACK 10 bytes,
@@ -195,6 +254,12 @@ uint8_t att_link2_sender_pending(const att_link2_sender ATT_LINK_MEM *s);
  * ATT_LINK2_E_NULL, ATT_LINK2_E_FULL or ATT_LINK2_E_STATE. */
 int att_link2_sender_push(att_link2_sender ATT_LINK_MEM *s, const uint8_t ATT_LINK_MEM *record);
 
+/* The ring slot the next push fills (6 bytes), or NULL if the ring is
+ * full (or s is NULL or unusable): a caller may build the record there and
+ * push that pointer (push then copies nothing new), which saves a record
+ * buffer on the 8051. The slot is the caller's until that push. */
+uint8_t ATT_LINK_MEM *att_link2_sender_tail(att_link2_sender ATT_LINK_MEM *s);
+
 /* A byte arrived from B: ATT_LINK2_NONE (stored), ATT_LINK2_FRAME (a valid
  * ACK was applied), ATT_LINK2_BAD_FRAME, ATT_LINK2_DISCARDED, or an error. */
 att_link2_result att_link2_sender_sink(att_link2_sender ATT_LINK_MEM *s, uint8_t byte, uint16_t tick);
@@ -209,6 +274,7 @@ att_link2_result att_link2_sender_poll(att_link2_sender ATT_LINK_MEM *s, uint16_
 /* Ticks after `now` at which poll acts on the timer (0: now),
  * ATT_LINK2_NO_TIMER if none runs. (link2_sender_aux.c) */
 uint16_t att_link2_sender_ticks_left(const att_link2_sender *s, uint16_t now);
+#endif /* ATT_LINK2_ONE */
 
 /* ------------------------------------------------------------------ */
 /* Receiver B                                                         */
