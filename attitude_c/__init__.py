@@ -57,3 +57,9 @@ from . import core as _core
 from .core import *
 
 __all__ += list(_core.__all__)
+
+# The aiding solvers (docs/aiding.md): loading them loads no C extension either.
+from . import magcal
+from .aiding import align, align_static, gauss_newton, triad
+
+__all__ += ["align", "align_static", "gauss_newton", "magcal", "triad"]

@@ -142,6 +142,10 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_AID_E_PARALLEL": (InvalidArgument, "specific force and field are parallel: heading undefined"),
     "ATT_AID_E_MOVING": (InvalidArgument, "static window: spread above its limit (moving start)"),
     "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
+    "ATT_AID_E_SINGULAR": (RangeError, "Gauss-Newton: Jacobian singular at an iterate"),
+    "ATT_AID_E_NOCONV": (RangeError, "Gauss-Newton: no convergence within the iteration limit"),
+    "ATT_AID_E_SPAN": (InvalidArgument, "the samples do not span enough directions for this fit"),
+    "ATT_AID_E_FIT": (InvalidArgument, "the samples do not lie on an ellipsoid"),
 }
 
 

@@ -46,7 +46,7 @@ def test_vectors_on_target(target: str, precision: str, vector_file, build_root:
 
 def test_vectors_cover_every_public_function() -> None:
     """Every array function of quat.h, the integrator methods and rk4, the link machines, the
-    denoiser and the sensor converter have vectors."""
+    denoiser, the sensor converter and the aiding solvers have vectors."""
     header = (ROOT / "csrc" / "include" / "attitude" / "quat.h").read_text()
     import re
 
@@ -55,6 +55,7 @@ def test_vectors_cover_every_public_function() -> None:
     assert public <= funcs | {"quat_mul"}, public - funcs
     assert {"quat_mul", "quat_conj", "integ", "rk4", "link_checksum", "link_rx", "link_tx"} <= funcs
     assert {"wden_dwt", "wden_idwt", "wden_stream", "sensor"} <= funcs
+    assert {"align", "triad", "gn", "align_window", "magcal", "magcal2d", "magcal_apply"} <= funcs
     methods = {c.params[0] for c in V.generate(n=4) if c.func == "integ"}
     assert set(V.INCREMENT_METHODS) <= methods
 

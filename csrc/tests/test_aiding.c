@@ -140,8 +140,112 @@ static void test_window(void)
     CHECK_EQ_INT(att_align_window_init(NULL, NULL), ATT_E_NULL);
 }
 
+static void test_gauss_newton(void)
+{
+    att_real e[3] = { -2.0, 0.6, 1.2 }, f[3], m[3], qt[4], q0[4], q[4], d[3] = { 0.1, -0.15, 0.1 }, dq[4];
+    att_real par[3];
+    att_gn_settings s;
+    att_gn_result r;
+    att_real decl = (att_real)0.25;
+    body_vectors(e, decl, (att_real)1.2, f, m);
+    att_euler_to_quat(e, qt);
+    att_rotvec_to_quat(d, dq);
+    att_quat_mul(qt, dq, q0);
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_OK);
+    CHECK(qangle(q, qt) < 100 * TOL);
+    CHECK(r.iterations <= 6u);
+    att_gn_defaults(&s);
+    s.method = ATT_GN_SIMPLIFIED;
+    s.max_iter = 200;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_OK);
+    CHECK(qangle(q, qt) < 100 * TOL);
+    s.max_iter = 1; /* one step is not enough: no convergence, q untouched */
+    q[0] = 7;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_AID_E_NOCONV);
+    CHECK(q[0] == 7);
+    CHECK_EQ_INT(r.iterations, 1);
+    s.max_iter = 0;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_E_ARG);
+    att_gn_defaults(&s);
+    s.method = 7;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, &s, q, &r), ATT_E_ARG);
+    par[0] = -2 * f[0];
+    par[1] = -2 * f[1];
+    par[2] = -2 * f[2];
+    CHECK_EQ_INT(att_gn_solve(f, par, decl, q0, NULL, q, &r), ATT_AID_E_PARALLEL);
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, NULL, NULL, q, NULL), ATT_OK); /* identity start */
+    CHECK(qangle(q, qt) < 100 * TOL);
+    CHECK_EQ_INT(att_gn_solve(NULL, m, decl, q0, NULL, q, &r), ATT_E_NULL);
+    q0[2] = (att_real)INFINITY;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_E_NONFINITE);
+    q0[0] = q0[1] = q0[2] = q0[3] = 0;
+    CHECK_EQ_INT(att_gn_solve(f, m, decl, q0, NULL, q, &r), ATT_E_ARG);
+}
+
+static void test_magcal(void)
+{
+    att_magcal c;
+    att_magcal2d c2;
+    att_magcal_result r;
+    att_magcal_settings s;
+    att_real m[3], out[3], h[3] = { 60, -30, 15 };
+    int i, model;
+    CHECK_EQ_INT(att_magcal_init(&c, NULL), ATT_OK);
+    for (i = 0; i < 200; ++i) { /* Fibonacci sphere of radius 50 around h, stretched 1.5× in x */
+        double z = 1.0 - (2.0 * i + 1.0) / 200.0, rr = sqrt(1.0 - z * z), ph = 2.399963229728653 * i;
+        m[0] = (att_real)(h[0] + 1.5 * 50.0 * rr * cos(ph));
+        m[1] = (att_real)(h[1] + 50.0 * rr * sin(ph));
+        m[2] = (att_real)(h[2] + 50.0 * z);
+        CHECK_EQ_INT(att_magcal_add(&c, m), ATT_OK);
+    }
+    for (model = ATT_MAGCAL_DIAGONAL; model <= ATT_MAGCAL_FULL; ++model) {
+        CHECK_EQ_INT(att_magcal_solve(&c, model, &r), ATT_OK);
+        CHECK_CLOSE(r.h[0], 60, 100 * TOL * 50);
+        CHECK_CLOSE(r.h[1], -30, 100 * TOL * 50);
+        CHECK_CLOSE(r.h[2], 15, 100 * TOL * 50);
+        CHECK_CLOSE(r.S[0] * 1.5, r.S[4], 100 * TOL); /* x shrunk by 1.5 relative to y, z */
+        CHECK_CLOSE(r.S[4], r.S[8], 100 * TOL);
+        CHECK_CLOSE(r.field, 50.0 * cbrt(1.5), 100 * TOL * 50);
+        CHECK_EQ_INT(att_magcal_apply(&r, m, out), ATT_OK);
+        CHECK_CLOSE(sqrt((double)out[0] * out[0] + (double)out[1] * out[1] + (double)out[2] * out[2]),
+                    r.field, 100 * TOL * 50);
+    }
+    CHECK_EQ_INT(att_magcal_solve(&c, ATT_MAGCAL_OFFSET, &r),
+                 ATT_OK); /* a sphere cannot fit: worse residual */
+    CHECK(r.residual > 0.01);
+    CHECK_EQ_INT(att_magcal_solve(&c, 9, &r), ATT_E_ARG);
+    /* a level turn: planar, refused */
+    att_magcal_defaults(&s);
+    CHECK_EQ_INT(att_magcal_init(&c, &s), ATT_OK);
+    CHECK_EQ_INT(att_magcal2d_init(&c2), ATT_OK);
+    for (i = 0; i < 100; ++i) {
+        m[0] = (att_real)(10.0 + 20.0 * cos(0.0628 * i));
+        m[1] = (att_real)(-5.0 + 25.0 * sin(0.0628 * i));
+        m[2] = -40;
+        CHECK_EQ_INT(att_magcal_add(&c, m), ATT_OK);
+        CHECK_EQ_INT(att_magcal2d_add(&c2, m), ATT_OK);
+    }
+    CHECK_EQ_INT(att_magcal_solve(&c, ATT_MAGCAL_FULL, &r), ATT_AID_E_SPAN);
+    CHECK_EQ_INT(att_magcal2d_solve(&c2, &r), ATT_OK);
+    CHECK_CLOSE(r.h[0], 10, 1e-3);
+    CHECK_CLOSE(r.h[1], -5, 1e-3);
+    CHECK_CLOSE(r.S[0], 1.25, 1e-3);
+    CHECK_CLOSE(r.S[4], 1.0, 1e-6);
+    CHECK_EQ_INT(r.model, ATT_MAGCAL_MINMAX_2D);
+    m[1] = (att_real)NAN;
+    CHECK_EQ_INT(att_magcal_add(&c, m), ATT_E_NONFINITE);
+    CHECK_EQ_INT(att_magcal2d_add(&c2, m), ATT_E_NONFINITE);
+    CHECK_EQ_INT(att_magcal_apply(&r, m, out), ATT_E_NONFINITE);
+    s.min_samples = 5;
+    CHECK_EQ_INT(att_magcal_init(&c, &s), ATT_E_ARG);
+    CHECK_EQ_INT(att_magcal_init(&c, NULL), ATT_OK);
+    CHECK_EQ_INT(att_magcal_solve(&c, ATT_MAGCAL_FULL, &r), ATT_AID_E_FEW);
+}
+
 int main(void)
 {
+    test_magcal();
+    test_gauss_newton();
     test_align_and_triad_recover_the_attitude();
     test_degenerate_inputs_give_a_status();
     test_window();

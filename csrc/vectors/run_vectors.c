@@ -25,6 +25,13 @@
  *     (att_sensor_increments; Z zero codes, K scales, A the channel of each body axis, S signs);
  *   wden_stream WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END DETREND -- N samples (1) pushed in one
  *     att_wden_push_n() call, then flushed -> N denoised samples;
+ *   align DECL SIX        -- N records f, m (6; SIX = 1: f only, 3) -> N quaternions (att_align_accmag_n);
+ *   triad DECL            -- N records f, m (6) -> N quaternions (att_triad_n);
+ *   gn DECL METHOD MAXIT  -- N records f, m, q0 (10) -> N quaternions (att_gn_solve_n, defaults but max_iter);
+ *   align_window DECL     -- N samples gyr, acc, mag (9) -> 1 quaternion (att_align_window_*, defaults);
+ *   magcal MODEL          -- N raw field samples (3) -> 1 record h, S, field (13) (att_magcal_*);
+ *   magcal2d              -- N samples (3) -> 1 record h, S, field (13) (att_magcal2d_*);
+ *   magcal_apply H0..2 S0..8 -- N samples (3) -> N corrected samples (3) (att_magcal_apply_n);
  *     WAVELET = haar|db2|db4, MODE = soft|hard;
  *     event byte: 0..255 = sink it, -1 = poll only, -2 = (sender) start the block.
  *     After each event the machine is polled until NONE or IDLE; output rows
@@ -318,6 +325,139 @@ static int run_sensor(const char *id, size_t n)
     return 0;
 }
 
+/* Aiding solvers (attitude/aiding.h); the batch forms report the first
+ * failed record as ERR_INDEX. */
+static int first_bad(const int *status, size_t n)
+{
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (status[i] != ATT_OK)
+            return (int)i;
+    return -1;
+}
+
+static void magcal_record(const att_magcal_result *r, att_real *o)
+{
+    int i;
+    for (i = 0; i < 3; i++)
+        o[i] = r->h[i];
+    for (i = 0; i < 9; i++)
+        o[3 + i] = r->S[i];
+    o[12] = r->field;
+}
+
+static int run_aiding(const char *id, const char *fn, size_t n)
+{
+    static int status[MAX_REC];
+    static att_real f[3 * MAX_REC], m[3 * MAX_REC], q0[4 * MAX_REC];
+    double p[12];
+    size_t i;
+    int bad;
+    att_status st;
+    if (strcmp(fn, "align") == 0 || strcmp(fn, "triad") == 0 || strcmp(fn, "gn") == 0) {
+        int six = 0, gn = strcmp(fn, "gn") == 0, method = 0;
+        if (number(&p[0]) != 0)
+            return -1;
+        if (strcmp(fn, "align") == 0 || gn) {
+            if (number(&p[1]) != 0)
+                return -1;
+            six = !gn && p[1] != 0.0;
+            method = gn ? (int)p[1] : 0;
+        }
+        if (gn && number(&p[2]) != 0)
+            return -1;
+        for (i = 0; i < n; i++)
+            if (read_values(f + 3 * i, 3) != 0 || (!six && read_values(m + 3 * i, 3) != 0)
+                || (gn && read_values(q0 + 4 * i, 4) != 0))
+                return -1;
+        if (gn) {
+            att_gn_settings s;
+            att_gn_defaults(&s);
+            s.method = method;
+            s.max_iter = (unsigned int)p[2];
+            st = att_gn_solve_n(f, m, (att_real)p[0], q0, &s, out_buf, n, status, NULL, NULL);
+        } else if (strcmp(fn, "triad") == 0) {
+            st = att_triad_n(f, m, (att_real)p[0], out_buf, n, status);
+        } else {
+            st = att_align_accmag_n(f, six ? NULL : m, (att_real)p[0], out_buf, n, status);
+        }
+        bad = st == ATT_OK ? -1 : first_bad(status, n);
+        result(id, st, (long)bad, st == ATT_OK ? n : 0);
+        print_records(out_buf, st == ATT_OK ? n : 0, 4);
+        return 0;
+    }
+    if (strcmp(fn, "align_window") == 0) {
+        att_align_window w;
+        att_align_window_settings s;
+        att_real g[3], a[3], mm[3];
+        if (number(&p[0]) != 0)
+            return -1;
+        att_align_window_defaults(&s);
+        s.declination_rad = (att_real)p[0];
+        st = att_align_window_init(&w, &s);
+        for (i = 0; i < n; i++) {
+            if (read_values(g, 3) != 0 || read_values(a, 3) != 0 || read_values(mm, 3) != 0)
+                return -1;
+            if (st == ATT_OK)
+                st = att_align_window_add(&w, g, a, mm);
+        }
+        if (st == ATT_OK)
+            st = att_align_window_solve(&w, out_buf);
+        result(id, st, st == ATT_OK ? -1L : 0L, st == ATT_OK ? 1 : 0);
+        print_records(out_buf, st == ATT_OK ? 1 : 0, 4);
+        return 0;
+    }
+    if (strcmp(fn, "magcal") == 0 || strcmp(fn, "magcal2d") == 0) {
+        att_magcal c;
+        att_magcal2d c2;
+        att_magcal_result r;
+        int two = strcmp(fn, "magcal2d") == 0;
+        size_t err = 0;
+        if (!two && number(&p[0]) != 0)
+            return -1;
+        if (read_values(in_buf, 3 * n) != 0)
+            return -1;
+        if (two) {
+            st = att_magcal2d_init(&c2);
+            for (i = 0; i < n && st == ATT_OK; i++)
+                st = att_magcal2d_add(&c2, in_buf + 3 * i);
+            err = i - 1;
+            if (st == ATT_OK)
+                st = att_magcal2d_solve(&c2, &r);
+        } else {
+            st = att_magcal_init(&c, NULL);
+            if (st == ATT_OK)
+                st = att_magcal_add_n(&c, in_buf, n, &err);
+            if (st == ATT_OK)
+                st = att_magcal_solve(&c, (int)p[0], &r);
+        }
+        if (st == ATT_OK)
+            magcal_record(&r, out_buf);
+        result(id, st, st == ATT_OK ? -1L : (long)err, st == ATT_OK ? 1 : 0);
+        print_records(out_buf, st == ATT_OK ? 1 : 0, 13);
+        return 0;
+    }
+    if (strcmp(fn, "magcal_apply") == 0) {
+        att_magcal_result r;
+        size_t err = 0;
+        for (i = 0; i < 12; i++)
+            if (number(&p[i]) != 0)
+                return -1;
+        for (i = 0; i < 3; i++)
+            r.h[i] = (att_real)p[i];
+        for (i = 0; i < 9; i++)
+            r.S[i] = (att_real)p[3 + i];
+        r.field = 1;
+        if (read_values(in_buf, 3 * n) != 0)
+            return -1;
+        st = att_magcal_apply_n(&r, in_buf, out_buf, n, &err);
+        result(id, st, st == ATT_OK ? -1L : (long)err, st == ATT_OK ? n : 0);
+        print_records(out_buf, st == ATT_OK ? n : 0, 3);
+        return 0;
+    }
+    return -1;
+}
+
 static int run_case(const char *id, const char *fn, size_t n)
 {
     size_t i, err = 0;
@@ -373,6 +513,9 @@ static int run_case(const char *id, const char *fn, size_t n)
         return run_wden(id, fn, n);
     if (strcmp(fn, "sensor") == 0)
         return run_sensor(id, n);
+    if (strcmp(fn, "align") == 0 || strcmp(fn, "triad") == 0 || strcmp(fn, "gn") == 0
+        || strncmp(fn, "align_", 6) == 0 || strncmp(fn, "magcal", 6) == 0)
+        return run_aiding(id, fn, n);
     if (strcmp(fn, "integ") == 0 || strcmp(fn, "rk4") == 0) {
         char mname[32];
         att_real q0[4], h = 0;
