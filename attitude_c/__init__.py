@@ -63,3 +63,8 @@ from . import magcal
 from .aiding import align, align_static, gauss_newton, triad
 
 __all__ += ["align", "align_static", "gauss_newton", "magcal", "triad"]
+
+# The UAV thesis's own EKF, for reproduction (docs/ahrs.md, "The thesis's EKF").
+from .thesis_ekf import ahrs_thesis
+
+__all__ += ["ahrs_thesis"]
