@@ -68,3 +68,8 @@ __all__ += ["align", "align_static", "gauss_newton", "magcal", "triad"]
 from .ahrs_filter import Ahrs, ahrs
 
 __all__ += ["Ahrs", "ahrs"]
+
+# The UAV thesis's own EKF, for reproduction (docs/ahrs.md, "The thesis's EKF").
+from .thesis_ekf import ahrs_thesis
+
+__all__ += ["ahrs_thesis"]

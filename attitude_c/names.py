@@ -131,6 +131,11 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "ATT_E_AHRS_SETTINGS": (InvalidArgument, "filter setting outside its domain"),
     "ATT_E_AHRS_DIVERGED": (RangeError, "filter state not finite"),
     "ATT_E_AHRS_ALIGN": (AttitudeError, "no initial attitude: the sample cannot align the filter"),
+    # ahrs_thesis.h
+    "ATT_E_TEKF_DT": (InvalidArgument, "time step not finite or not positive"),
+    "ATT_E_TEKF_SETTINGS": (InvalidArgument, "thesis EKF setting outside its domain"),
+    "ATT_E_TEKF_DIVERGED": (RangeError, "thesis EKF state not finite"),
+    "ATT_E_TEKF_ALIGN": (AttitudeError, "no initial attitude: the sample cannot align the thesis EKF"),
     # block.h
     "ATT_BLOCK_E_CODE": (BlockFormatError, "sample code above its stream's limit"),
     "ATT_BLOCK_E_KIND": (BlockFormatError, "unknown report kind"),

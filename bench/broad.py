@@ -133,6 +133,15 @@ def run_ours(tr: Any, precision: str = "f64", **settings: Any) -> np.ndarray:
     return np.asarray(ahrs(tr.gyr, tr.acc, tr.mag, rate=tr.rate, precision=precision, **settings), float)
 
 
+# --- the UAV thesis's own EKF, reproduced (attitude_c.ahrs_thesis; docs/ahrs.md "The thesis's EKF"):
+# its defaults, double build, started from its first sample like the others
+def run_thesis(tr: Any) -> np.ndarray:
+    from attitude_c import ahrs_thesis
+
+    return np.asarray(ahrs_thesis(tr.gyr, tr.acc, tr.mag, rate=tr.rate), float)
+# --- end of the thesis EKF block
+
+
 def run_vqf(tr: Any) -> np.ndarray:
     from vqf import VQF
 
@@ -389,6 +398,9 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
     runners: dict[str, Callable[[Any], np.ndarray]] = {
         "attitude_c f64": lambda t: run_ours(t, "f64"), "attitude_c f32": lambda t: run_ours(t, "f32"),
         "VQF": run_vqf, "Fusion": run_fusion, "ahrs EKF": run_ekf, "ahrs Madgwick": run_madgwick}
+    # the thesis's EKF: one more column (run_thesis above)
+    runners["attitude_c thesis EKF"] = run_thesis
+    qs["attitude_c thesis EKF"] = []
     skipped: dict[str, str] = {}
     for k, fn in runners.items():
         try:

@@ -19,5 +19,6 @@
 #include "attitude/denoise.h"
 #include "attitude/aiding.h"
 #include "attitude/ahrs.h"
+#include "attitude/ahrs_thesis.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

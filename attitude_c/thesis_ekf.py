@@ -1,0 +1,162 @@
+"""The UAV thesis's own EKF, for reproduction (``csrc/include/attitude/ahrs_thesis.h``).
+
+State: the attitude quaternion and the gyro bias (7 states); time update by
+the thesis's RK4 with the bias-corrected gyro; measurement: the Gauss–Newton
+quaternion from the accelerometer and magnetometer (``attitude_c.gauss_newton``),
+sign-aligned to the prediction (thesis sec. 3.2.3, eq. 3.45–3.57). It is the
+thesis's design with its limits (no disturbance rejection, the Gauss–Newton
+outliers); the library's filter is :mod:`attitude_c.ahrs`. docs/ahrs.md,
+"The thesis's EKF".
+
+Units: gyro rad/s, specific force any unit (+g up at rest), field any unit.
+Quaternions scalar first, body → ENU.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ._lib import ffi_lib
+from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+
+__all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "run"]
+
+FloatArray = NDArray[np.float64]
+Precision = Literal["f64", "f32"]
+
+#: Real-valued settings (fields of ``att_tekf_settings``); ``gn_max_iter`` is
+#: the Gauss–Newton iteration limit (``settings.gn.max_iter``, 1..1000).
+SETTINGS: tuple[str, ...] = ("gyr_noise", "bias_noise", "meas_noise", "init_q_sigma",
+                             "init_bias_sigma", "declination")
+
+_DTYPES = {"f64": np.float64, "f32": np.float32}
+
+
+@dataclass(frozen=True)
+class ThesisEkfResult:
+    """Output of :func:`run`."""
+
+    q: FloatArray          #: (N, 4) attitude after each sample (body → ENU)
+    bias: FloatArray       #: (3,) final gyro-bias estimate, rad/s
+    gn_skipped: int        #: samples whose measurement update was skipped (Gauss–Newton failed)
+
+
+def default_settings() -> dict[str, Any]:
+    """The library's defaults (``att_tekf_default_settings``)."""
+    ffi, lib = ffi_lib("f64")
+    s = ffi.new("att_tekf_settings *")
+    lib.att_tekf_default_settings(s)
+    out: dict[str, Any] = {k: float(getattr(s, k)) for k in SETTINGS}
+    out["gn_max_iter"] = int(s.gn.max_iter)
+    return out
+
+
+def _fill(ffi: Any, lib: Any, settings: dict[str, Any]) -> Any:
+    s = ffi.new("att_tekf_settings *")
+    lib.att_tekf_default_settings(s)
+    for k, v in settings.items():
+        if k == "gn_max_iter":
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise InvalidType(f"gn_max_iter must be an integer, got {type(v).__name__}")
+            if not 1 <= int(v) <= 1000:
+                raise InvalidArgument(f"gn_max_iter must be in 1..1000, got {v}")
+            s.gn.max_iter = int(v)
+        elif k in SETTINGS:
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise InvalidType(f"{k} must be a real number, got {type(v).__name__}")
+            fv = float(v)
+            if not np.isfinite(fv):
+                raise InvalidArgument(f"{k} must be finite, got {fv}")
+            setattr(s, k, fv)
+        else:
+            raise InvalidArgument(f"unknown thesis-EKF setting {k!r} (known: {', '.join(SETTINGS)}, gn_max_iter)")
+    if lib.att_tekf_check_settings(s) != 0:
+        raise InvalidArgument("settings: a value is outside its domain (ahrs_thesis.h: gyr_noise, meas_noise, "
+                              f"init_q_sigma > 0; bias_noise, init_bias_sigma >= 0; |declination| <= pi): {settings!r}")
+    return s
+
+
+def _vectors(x: ArrayLike, name: str) -> FloatArray:
+    a = np.asarray(x)
+    if a.dtype.kind not in "iuf":
+        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise InvalidArgument(f"{name} must have shape (N, 3), got {a.shape}")
+    a = np.asarray(a, dtype=np.float64)
+    ok = np.isfinite(a).all(axis=1)
+    if not ok.all():
+        i = int(np.argmin(ok))
+        raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
+    return a
+
+
+def run(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = None,
+        dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
+        **settings: Any) -> ThesisEkfResult:
+    """Run the thesis's EKF over N samples; see :func:`ahrs_thesis`."""
+    if precision not in _DTYPES:
+        raise InvalidArgument(f"precision must be 'f64' or 'f32', got {precision!r}")
+    g, a, m = _vectors(gyr, "gyr"), _vectors(acc, "acc"), _vectors(mag, "mag")
+    n = g.shape[0]
+    if a.shape[0] != n or m.shape[0] != n:
+        raise InvalidArgument(f"gyr, acc and mag must have the same number of samples, got "
+                              f"{n}, {a.shape[0]}, {m.shape[0]}")
+    dtype = _DTYPES[precision]
+    if dt is None:
+        if rate is None:
+            raise InvalidArgument("give rate (Hz) or dt (s)")
+        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
+            raise InvalidType(f"rate must be a number (Hz), got {type(rate).__name__}")
+        if not (np.isfinite(rate) and rate > 0):
+            raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
+        d = np.array([1.0 / float(rate)], dtype=dtype)
+    else:
+        d = np.ascontiguousarray(np.asarray(dt, dtype=np.float64).ravel(), dtype=dtype)
+        if d.size not in (1, n):
+            raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
+    ffi, lib = ffi_lib(precision)
+    s_set = _fill(ffi, lib, dict(settings))
+    state = ffi.new("att_tekf *")
+    qp = ffi.NULL
+    if q0 is not None:
+        qa = np.asarray(q0, dtype=np.float64)
+        if qa.shape != (4,):
+            raise InvalidArgument(f"q0 must have shape (4,), got {qa.shape}")
+        qp = ffi.new("att_real[4]", [float(v) for v in qa])
+    st = lib.att_tekf_init(state, s_set, qp)
+    if st != 0:
+        raise_for_status(st, "q0")
+    gc, ac, mc = (np.ascontiguousarray(x, dtype=dtype) for x in (g, a, m))
+    out = np.empty((n, 4), dtype=dtype)
+    err = ffi.new("size_t *")
+
+    def p(x: NDArray[Any]) -> Any:
+        return ffi.cast("att_real *", ffi.from_buffer(x))
+
+    st = lib.att_tekf_batch(state, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
+    if st != 0:
+        i = int(err[0])
+        if st == lib.ATT_E_TEKF_DT:
+            raise InvalidArgument(f"dt: sample {i}: the time step must be finite and > 0")
+        raise_for_status(st, "ahrs_thesis", index=i)
+    b = ffi.new("att_real[3]")
+    lib.att_tekf_bias(state, b)
+    return ThesisEkfResult(q=out.astype(np.float64), bias=np.array(list(b), dtype=np.float64),
+                           gn_skipped=int(lib.att_tekf_gn_skipped(state)))
+
+
+def ahrs_thesis(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = None,
+                dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
+                **settings: Any) -> FloatArray:
+    """The thesis's EKF over N samples: (N, 3) gyr [rad/s], acc, mag → (N, 4) quaternions.
+
+    ``rate`` (Hz) or ``dt`` (s, scalar or per sample) gives the step; ``q0``
+    the initial attitude (default: aligned from the first sample's acc and
+    mag). Settings: :data:`SETTINGS` and ``gn_max_iter`` (ahrs_thesis.h).
+    Returned as float64 whatever the precision.
+    """
+    return run(gyr, acc, mag, rate=rate, dt=dt, q0=q0, precision=precision, **settings).q

@@ -1,0 +1,49 @@
+/*
+ * Instruction-count harness for the thesis EKF (docs/ahrs.md): N samples through the
+ * UAV thesis's EKF (ahrs_thesis.h), one att_tekf_update() call each with gyro, specific
+ * force and field (the full per-sample path: time update, Gauss–Newton
+ * solve and measurement update). The motion is a steady turn about the
+ * vertical, one turn per TABLE samples at 200 Hz, tabulated at start-up
+ * (start-up cancels out in toolchain/qemu_count.py's difference of two N).
+ *
+ *   bench_ahrs_thesis N
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "attitude/attitude.h"
+
+#define TABLE 256
+
+static att_real mag[TABLE][3];
+
+int main(int argc, char **argv)
+{
+    att_tekf s;
+    att_real q[4], acc[3] = { 0.0f, 0.0f, 9.81f }, gyr[3] = { 0.0f, 0.0f, 0.0f };
+    att_real dt = (att_real)(1.0 / 200.0);
+    unsigned long n, i;
+    double w = 2.0 * 3.14159265358979 / (TABLE * (1.0 / 200.0));
+    if (argc != 2) {
+        return 2;
+    }
+    n = strtoul(argv[1], NULL, 10);
+    gyr[2] = (att_real)w;
+    for (i = 0; i < TABLE; i++) { /* m_b = R_z(−ψ) m_n, m_n = (0, 20, −40) µT */
+        double psi = w * (double)i / 200.0;
+        mag[i][0] = (att_real)(20.0 * sin(psi));
+        mag[i][1] = (att_real)(20.0 * cos(psi));
+        mag[i][2] = (att_real)-40.0;
+    }
+    if (att_tekf_init(&s, NULL, NULL) != ATT_OK) {
+        return 3;
+    }
+    for (i = 0; i < n; i++) {
+        if (att_tekf_update(&s, gyr, acc, mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
+            return 4;
+        }
+    }
+    printf("q = %g %g %g %g, flags %d\n", (double)q[0], (double)q[1], (double)q[2], (double)q[3], s.flags);
+    return 0;
+}
