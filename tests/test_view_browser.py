@@ -278,7 +278,8 @@ def test_two_tabs_pause_zoom_download_at_200_samples_per_s(browser, tmp_path: Pa
         # pause a: its readouts and chart end stay put while b's move
         a.click("#pause")
         assert a.get_attribute("#pause", "aria-pressed") == "true"
-        a.wait_for_timeout(200)  # the frozen snapshot is drawn at the next animation frame
+        # the frozen snapshot is drawn at the next animation frame (late on a loaded machine)
+        a.wait_for_selector("body[data-drawn-paused=true]", timeout=10_000)
         frozen = a.text_content("#est-t"), a.get_attribute("#chart-angles", "data-t-end")
         b_before = b.text_content("#est-t")
         a.wait_for_timeout(700)

@@ -23,6 +23,8 @@ from typing import Any
 
 import numpy as np
 
+from .options import positive
+
 #: ``attitude ahrs`` exit statuses (docs/ahrs.md, "Command").
 EXIT_OK = 0
 EXIT_IO = 1     # the input cannot be read, or an output cannot be written
@@ -38,7 +40,7 @@ def register(sub: Any) -> None:
     p.add_argument("file", metavar="FILE", help="BROAD trial (.mat) or CSV with a header")
     p.add_argument("--out", metavar="DIR", default=None,
                    help="output folder (default: results/ahrs-<file stem>)")
-    p.add_argument("--rate", type=float, default=None, help="sampling rate, Hz (CSV without a t column)")
+    p.add_argument("--rate", type=positive("--rate"), default=None, help="sampling rate, Hz (CSV without a t column)")
     p.add_argument("--precision", choices=("f64", "f32"), default="f64")
     p.add_argument("--six-axis", action="store_true", help="ignore the magnetometer")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",

@@ -13,20 +13,12 @@ import sys
 import time
 from typing import Any
 
+from .options import integer
+
 EXIT_RUNS_FAILED = 1
 EXIT_SPEC = 2
 EXIT_ENGINE = 3
 EXIT_INTERRUPTED = 130
-
-
-def _workers(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {v}")
-    return v
 
 
 class _LogProgress:
@@ -61,7 +53,7 @@ def register(subparsers: Any) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
                    help="address of a running Dask scheduler (tcp://host:8786); default: start a "
                    "local cluster of worker processes")
-    p.add_argument("--workers", type=_workers, default=None, metavar="N",
+    p.add_argument("--workers", type=integer("--workers", 1), default=None, metavar="N",
                    help="worker processes of the local cluster (default: one per CPU this process may use)")
     p.add_argument("--serial", action="store_true",
                    help="no Dask: run everything in this process, one run after another")

@@ -74,6 +74,9 @@
 
   function onHello(m) {
     stats.hellos += 1;
+    // a snapshot of the same session (a reconnect, or the server resyncing a tab that fell
+    // behind) keeps what a paused display froze; a new session freezes afresh
+    const keepFrozen = S.paused && S.frozen && S.session === m.session;
     S.session = m.session;
     S.source = m.source || "";
     S.historyS = m.history_s || 600;
@@ -87,8 +90,10 @@
     S.hub = m.hub || {};
     S.seq = m.seq || 0;
     S.state = m.state; S.text = m.text || "";
-    S.frozen = null;
-    if (S.paused) freeze();
+    if (!keepFrozen) {
+      S.frozen = null;
+      if (S.paused) freeze();
+    }
     $("source").textContent = S.source;
     $("source").title = S.source;
     $("session").textContent = "session " + S.session;
@@ -676,6 +681,7 @@
       $("chart-angles").dataset.tEnd = String(tEnd);
       $("chart-angles").dataset.window = String(S.windowS);
     }
+    document.body.dataset.drawnPaused = S.paused && S.frozen ? "true" : "false"; // what the last draw showed
     const ms = performance.now() - t0;
     stats.draws += 1;
     stats.lastDrawMs = ms;
