@@ -64,10 +64,12 @@ def _c_runner(method: str, precision: str, n: int, fresh: bool) -> Callable[[], 
     s = ffi.new("att_integ *")
     nout = ffi.new("size_t *")
     err = ffi.new("size_t *")
-    px = ffi.cast("att_real *", ffi.from_buffer(x))
-    ph = ffi.cast("att_real *", ffi.from_buffer(h))
+    bufs = (ffi.from_buffer(x), ffi.from_buffer(h))  # keep x and h (and their views) alive with run
+    px = ffi.cast("att_real *", bufs[0])
+    ph = ffi.cast("att_real *", bufs[1])
 
     def run() -> int:
+        assert bufs  # h is read only through ph: without this reference it could be freed
         out = np.empty((m, 4), dtype=x.dtype) if fresh else reused
         po = ffi.cast("att_real *", ffi.from_buffer(out))
         lib.att_integ_init(s, method_code(method, lib), ffi.NULL)
