@@ -35,7 +35,7 @@ Precision = Literal["f64", "f32"]
 
 #: The real-valued settings (field names of ``att_ahrs_settings``), besides ``method``.
 SETTINGS: tuple[str, ...] = (
-    "gravity", "gyr_noise", "bias_noise", "init_att_sigma", "init_bias_sigma", "acc_tau",
+    "gravity", "gyr_noise", "gyr_noise_rest", "bias_noise", "init_att_sigma", "init_bias_sigma", "acc_tau",
     "acc_noise", "acc_gate", "acc_reject_max", "mag_noise", "mag_norm_tol", "mag_dip_tol",
     "mag_ref_tau", "mag_reject_max", "mag_reject_factor", "mag_new_time", "mag_new_gyr",
     "mag_min_undisturbed", "declination", "rest_time", "rest_tau", "rest_gyr_th",

@@ -27,8 +27,8 @@ __all__ = ["ReferenceAhrs", "ahrs_reference"]
 F = NDArray[np.float64]
 
 _DEFAULTS: dict[str, Any] = {
-    "method": "rv3-reuse", "gravity": 9.81, "gyr_noise": 0.01, "bias_noise": 1e-4,
-    "init_att_sigma": 0.1, "init_bias_sigma": 0.03, "acc_tau": 2.0, "acc_noise": 0.025,
+    "method": "rv3-reuse", "gravity": 9.81, "gyr_noise": 0.01, "gyr_noise_rest": 0.002,
+    "bias_noise": 1e-4, "init_att_sigma": 0.1, "init_bias_sigma": 0.01, "acc_tau": 2.0, "acc_noise": 0.025,
     "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.05, "mag_norm_tol": 0.05,
     "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
@@ -101,10 +101,13 @@ class ReferenceAhrs:
         self.flags = 0
 
     # -- the Kalman pieces -------------------------------------------------
-    def _predict(self, C: F, dt: float) -> None:
+    def _predict(self, C: F, dt: float, rest: bool) -> None:
+        """Q: the attitude's process noise density is the gyro's own at rest (no motion,
+        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise."""
         Fm = np.eye(6)
         Fm[:3, 3:] = -C * dt
-        Q = np.diag([self.s["gyr_noise"] ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
+        sg = self.s["gyr_noise_rest"] if rest else self.s["gyr_noise"]
+        Q = np.diag([sg ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
         self.P = Fm @ self.P @ Fm.T + Q
 
     def _scalar(self, x: F, j: int, y: float, R: float, states: tuple[int, ...]) -> None:
@@ -158,7 +161,7 @@ class ReferenceAhrs:
             self.q = _qmul(self.q, _exp(phi))
             self.q = self.q / np.linalg.norm(self.q)
         C = _dcm(self.q)
-        self._predict(C, dt)
+        self._predict(C, dt, rest)
         if flags & 1:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)

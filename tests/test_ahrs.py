@@ -66,6 +66,19 @@ def test_c_matches_reference_six_axis_and_gate():
     assert np.abs(qc - qr).max() < 1e-12  # as above
 
 
+def test_c_matches_reference_rest_then_motion():
+    """Rest (zero-rate update, gyr_noise_rest) then turning (gyr_noise): both process noises."""
+    g0, a0, m0, _ = motion(300, 100.0, (0.0, 0.0, 0.0), bias=(0.004, -0.003, 0.002), noise=0.0005)
+    g1, a1, m1, _ = motion(300, 100.0, (0.0, 0.0, 0.6), bias=(0.004, -0.003, 0.002), noise=0.0005)
+    gyr, acc, mag = np.vstack([g0, g1]), np.vstack([a0, a1]), np.vstack([m0, m1])
+    f = Ahrs(rate=100.0)
+    flags = [f.update(gyr[i], acc[i], mag[i]) is not None and f.flags for i in range(len(gyr))]
+    assert any(fl & names.C["ATT_AHRS_F_REST"] for fl in flags[:300])  # the rest path is taken
+    qc = ahrs(gyr, acc, mag, rate=100.0)
+    qr = ahrs_reference(gyr, acc, mag, rate=100.0)
+    assert np.abs(qc - qr).max() < 1e-12  # as above
+
+
 def test_c_matches_reference_on_broad_segment():
     folder = broad.default_dir()
     if folder is None:
@@ -84,7 +97,10 @@ def test_c_matches_reference_on_broad_segment():
 def test_converges_to_truth_and_learns_bias():
     bias = np.array([0.008, -0.006, 0.004])  # rad/s (0.6°/s, a poor MEMS gyro's turn-on bias)
     gyr, acc, mag, truth = motion(6000, 100.0, (0.4, 0.3, -0.5), bias=bias)
-    f = Ahrs(rate=100.0)
+    # a poor gyro, started in motion (no rest to learn the bias at): its turn-on bias
+    # prior is declared (init_bias_sigma 0.03 rad/s ≈ 1.7°/s; the default 0.01 is a
+    # trimmed MEMS part's and learns this bias in motion more slowly)
+    f = Ahrs(rate=100.0, init_bias_sigma=0.03)
     q = f.update(gyr, acc, mag)
     err = angle_deg(q, truth)
     # exact sensors, 60 s of constant turning: unaided, the bias would
@@ -97,14 +113,42 @@ def test_converges_to_truth_and_learns_bias():
 
 def test_rest_bias_and_six_axis():
     bias = np.array([0.01, -0.01, 0.02])
-    gyr, acc, _, truth = motion(3000, 100.0, (0.0, 0.0, 0.0), q0=ref.euler_to_quat([0.0, 0.1, 0.2]),
+    # 60 s: at rest the tilt averages the accelerometer over acc_noise/gyr_noise_rest =
+    # 12.5 s, so the start-up error (the bias integrated before rest is declared) takes
+    # 5 of those time constants to fall below 0.01°
+    gyr, acc, _, truth = motion(6000, 100.0, (0.0, 0.0, 0.0), q0=ref.euler_to_quat([0.0, 0.1, 0.2]),
                                 bias=bias)
     f = Ahrs(rate=100.0)
     q = f.update(gyr, acc)
     assert f.flags & names.C["ATT_AHRS_F_REST"]
-    assert np.abs(f.bias - bias).max() < 1e-3  # zero-rate update at rest: 1e-3 rad/s in 30 s
+    assert np.abs(f.bias - bias).max() < 1e-3  # zero-rate update at rest: 1e-3 rad/s
     inc = broad.error_angles(q[-1:], truth[-1:])[2]
     assert np.degrees(inc[0]) < 0.01  # exact gravity: inclination to 0.01°
+
+
+def test_rest_process_noise_closed_form():
+    """At rest the attitude's process noise density is gyr_noise_rest. With the bias
+    states switched off (init_bias_sigma = bias_noise = 0: P_θb stays 0), each tilt
+    axis is a scalar random walk measured directly, whose covariance converges to the
+    discrete Riccati fixed point: P⁻ = P⁺ + q, P⁺ = P⁻R/(P⁻ + R), q = σ_g² dt,
+    R = σ_acc²/dt, so P⁻ = (q + √(q² + 4qR))/2."""
+    rate, sr, sa = 50.0, 0.002, 0.025
+    gyr, acc, _, _ = motion(int(300 * rate), rate, (0.0, 0.0, 0.0), q0=ref.euler_to_quat([0.0, 0.1, 0.2]))
+    kw = {"init_bias_sigma": 0.0, "bias_noise": 0.0, "gyr_noise_rest": sr, "acc_noise": sa}
+    f = Ahrs(rate=rate, **kw)
+    f.update(gyr, acc)
+    assert f.flags & names.C["ATT_AHRS_F_REST"]
+    dt = 1.0 / rate
+    q, R = sr**2 * dt, sa**2 / dt
+    pm = (q + math.sqrt(q * q + 4 * q * R)) / 2
+    pp = pm * R / (pm + R)
+    # 300 s at rest is 24 of the loop's time constants σ_acc/σ_rest = 12.5 s: the
+    # start-up transient has decayed by e^-24 ≈ 4e-11, below the 1e-9 asked
+    assert f.sigma[0][:2] == pytest.approx([math.sqrt(pp)] * 2, rel=1e-9)
+    # in motion (gyr_noise = 0.01) the same loop settles to √(σ_g σ_acc)-size: larger
+    g = Ahrs(rate=rate, **{**kw, "gyr_noise_rest": 0.01})
+    g.update(gyr, acc)
+    assert g.sigma[0][0] > 2 * f.sigma[0][0]
 
 
 def test_streaming_equals_batch():
@@ -140,6 +184,8 @@ def test_errors():
         ahrs(gyr, acc, rate=100.0, acc_tauu=1.0)
     with pytest.raises(InvalidArgument, match="domain"):
         ahrs(gyr, acc, rate=100.0, acc_noise=-1.0)
+    with pytest.raises(InvalidArgument, match="domain"):
+        ahrs(gyr, acc, rate=100.0, gyr_noise_rest=0.0)
     with pytest.raises(InvalidArgument, match="rk4"):
         Ahrs(rate=100.0, method="rk4")
     with pytest.raises(InvalidType):

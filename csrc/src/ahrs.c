@@ -18,9 +18,10 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->method = ATT_METHOD_RV3_REUSE;
     set->gravity = ATT_R(9.81);
     set->gyr_noise = ATT_R(0.01);
+    set->gyr_noise_rest = ATT_R(0.002);
     set->bias_noise = ATT_R(1e-4);
     set->init_att_sigma = ATT_R(0.1);
-    set->init_bias_sigma = ATT_R(0.03);
+    set->init_bias_sigma = ATT_R(0.01);
     set->acc_tau = ATT_R(2.0);
     set->acc_noise = ATT_R(0.025);
     set->acc_gate = ATT_R(0.2);
@@ -71,6 +72,9 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set)
           && t->acc_reject_max > 0 && fin(t->rest_tau) && t->rest_tau > 0 && fin(t->rest_gyr_th)
           && t->rest_gyr_th > 0 && fin(t->rest_acc_th) && t->rest_acc_th > 0 && fin(t->rest_noise)
           && t->rest_noise > 0 && fin(t->overrange_sigma) && t->overrange_sigma >= 0)) {
+        return ATT_E_AHRS_SETTINGS;
+    }
+    if (!(fin(t->gyr_noise_rest) && t->gyr_noise_rest > 0)) {
         return ATT_E_AHRS_SETTINGS;
     }
     /* zero = off */
@@ -401,7 +405,11 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         return ATT_E_AHRS_DIVERGED;
     }
     q2C(s->integ.q, C);
-    propagate_cov(s->P, C, dt, set->gyr_noise * set->gyr_noise * dt, set->bias_noise * set->bias_noise * dt);
+    {
+        /* process noise: at rest the gyro's own (no motion, no model error) */
+        att_real sg = rest ? set->gyr_noise_rest : set->gyr_noise;
+        propagate_cov(s->P, C, dt, sg * sg * dt, set->bias_noise * set->bias_noise * dt);
+    }
     if (flags & ATT_AHRS_F_OVERRANGE) {
         att_real o = set->overrange_sigma * set->overrange_sigma;
         s->P[0][0] += o;

@@ -75,10 +75,15 @@ typedef struct {
                                  must be within [0.25, 4]·gravity at alignment and its slow
                                  (10 s) average within [0.5, 8]·gravity, else ATT_E_AHRS_UNITS */
     att_real gyr_noise;           /* [rad/√s] attitude process noise density σ_g (gyro noise plus
-                                 model error), 0.01 */
+                                 model error) in motion, 0.01 */
+    att_real gyr_noise_rest;      /* [rad/√s] σ_g while rest is detected: the gyro's own noise
+                                 (no motion, hence no model error), so the tilt averages the
+                                 accelerometer over acc_noise/gyr_noise_rest (12.5 s) at rest,
+                                 0.002 */
     att_real bias_noise;          /* [rad/s/√s] gyro-bias random walk σ_b, 1e-4 */
     att_real init_att_sigma;      /* [rad] 1σ of the initial attitude error (each axis), 0.1 */
-    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis), 0.03 */
+    att_real init_bias_sigma;     /* [rad/s] 1σ of the initial bias (each axis): the gyro's
+                                 turn-on bias, 0.01 (0.57°/s) */
     att_real acc_tau;             /* [s] low-pass time constant of the specific force in the
                                  navigation frame, 2.0 (0 = off: raw specific force) */
     att_real acc_noise;           /* [rad·√s] inclination measurement noise density (R = σ²/dt;
