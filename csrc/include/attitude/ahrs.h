@@ -9,7 +9,8 @@
  * increments Δθ = (ω − b_est)·dt, so the integrator's coning correction
  * carries into the aided attitude. The error covariance P (6×6) is
  * propagated with F = [[I, −C dt], [0, I]] (C = C_b^n of the current
- * estimate), Q = diag(σ_g² dt I, σ_b² dt I).
+ * estimate), Q = diag(σ_g² dt I, σ_b² dt I) (σ_g = gyr_noise, or
+ * gyr_noise_rest at rest).
  *
  * Aiding (sequential scalar updates, each with a selector H, so the cost
  * is O(36) per scalar):
@@ -36,7 +37,9 @@
  *   - rest: when the gyro and accelerometer stay within rest_gyr_th /
  *     rest_acc_th of their low-pass values for rest_time seconds, the
  *     low-passed rate measures the bias directly (zero-rate update; bias
- *     states only).
+ *     states only), and the attitude's process noise density is
+ *     gyr_noise_rest (the gyro's own noise: no motion, no model error)
+ *     instead of gyr_noise, so the tilt averages the accelerometer longer.
  * Corrections: q ← exp(δθ) ⊗ q, b ← b + δb, the error state reset to 0.
  *
  * The state is caller-owned; no malloc, no global state, no I/O. A batch
