@@ -308,7 +308,9 @@ void main(void)
 #endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push();                 /* the queue is empty: BOOT report first */
-    (void)att_block_encode_boot(wp, FW_PERIOD_TICKS, (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT));
+    (void)att_block_encode_boot(
+        wp, (uint16_t)(FW_PERIOD_TICKS | (FW_LINK_V2 ? ATT_BLOCK_BOOT_LINK2 : 0)),
+        (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT)); /* the protocol in the period word */
     q_commit();
     sampling = 0;
     next_sample = tick_now();
@@ -327,6 +329,7 @@ void main(void)
 
         /* 2. the transmitter is free: the sender's next byte, if any */
         if (TI) {
+            FW_HOOK_POLL_BEGIN();
             st = att_link2_sender_poll(&tx, fw_ticks, &txb);
             FW_HOOK_POLL(st);
             if (st == ATT_LINK2_SEND) {
