@@ -222,6 +222,9 @@ static void put_stat(const char *name)
     } while (0)
 
 /* Final report of a simulation run (hex values), then stop. */
+#if FW_LINK_V2
+__sfr __at(0xA7) sim_bad_acks; /* ACK frames the sender dropped (CRC, length: a byte lost or changed) */
+#endif
 static void sim_finish(void)
 {
     fw_sim_puts("STATS");
@@ -231,6 +234,7 @@ static void sim_finish(void)
     STAT("queued", att_link2_sender_pending(&tx));
     STAT("overrun_pending", ovr_count);
     STAT("ticks", fw_ticks);
+    STAT("bad_acks", sim_bad_acks);
 #else
     STAT("accepted", tx.stats.blocks_accepted);
     STAT("sent", tx.stats.blocks_sent);
@@ -273,6 +277,9 @@ static void sim_init(void)
 {
     sim_accepted = 0;
     sim_samples = 0;
+#if FW_LINK_V2
+    sim_bad_acks = 0;
+#endif
 #if defined(FW_BENCH)
     bench_init();
 #endif
@@ -384,11 +391,13 @@ static void sim_acked(void)
         sim_base0++;
     }
 }
-#define FW_HOOK_V2_SINK(call)           \
-    do {                                \
-        sim_base0 = att_link2_one.base; \
-        (void)(call);                   \
-        sim_acked();                    \
+#define FW_HOOK_V2_SINK(call)                      \
+    do {                                           \
+        sim_base0 = att_link2_one.base;            \
+        if ((call) == ATT_LINK2_BAD_FRAME) {       \
+            sim_bad_acks++; /* e.g. a byte lost */ \
+        }                                          \
+        sim_acked();                               \
     } while (0)
 #endif
 
