@@ -650,6 +650,7 @@ def test_rx_command_line_getopt(rx_builds, tmp_path: Path) -> None:
     for h in ("-h", "--help"):
         rc, out, err = run(h)
         assert rc == 0 and out.startswith("usage:") and "--period" in out and err == ""
+        assert "--link P                 auto (default:" in out  # link v2 or legacy, as the board speaks
     rc, out, _ = run("--version")
     import attitude_c
 
