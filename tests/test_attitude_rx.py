@@ -942,10 +942,10 @@ def test_rx_link_auto_v2_board_mid_stream_loses_nothing(rx_builds) -> None:
     while a.base < 5:
         t += 1
         assert t < 10_000, "the first receiver took nothing"
-        res, byte = a.poll(t)
+        _, byte = a.poll(t)
         if byte is not None:
             old.sink(byte)
-        res, byte = old.poll()
+        _, byte = old.poll()
         if byte is not None:
             a.sink(byte, t)
     base = a.base  # A's first record not acknowledged: a frame after it may be on its way
