@@ -179,8 +179,9 @@ def _stats(err: str) -> dict[str, int]:
     for line in err.splitlines():
         if line.startswith(("attitude-rx: link:", "attitude-rx: samples:", "attitude-rx: reports:")):
             for kv in line.split(":", 2)[2].split():
-                k, v = kv.split("=")
-                out[k] = int(v)
+                if "=" in kv:  # not "link: the board speaks the legacy protocol" (--link auto)
+                    k, v = kv.split("=")
+                    out[k] = int(v)
     return out
 
 
