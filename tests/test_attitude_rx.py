@@ -179,7 +179,7 @@ def _stats(err: str) -> dict[str, int]:
     for line in err.splitlines():
         if line.startswith(("attitude-rx: link:", "attitude-rx: samples:", "attitude-rx: reports:")):
             for kv in line.split(":", 2)[2].split():
-                if "=" in kv:  # not "link: the board speaks the legacy protocol" (--link auto)
+                if "=" in kv:  # key=value pairs only
                     k, v = kv.split("=")
                     out[k] = int(v)
     return out

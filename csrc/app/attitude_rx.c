@@ -447,7 +447,7 @@ static void *receiver_thread(void *arg)
                     st2 = att_link2_receiver_sink(&r2, buf[i]);
                     if (mode == RX_LINK_AUTO && (st2 == ATT_LINK2_FRAME || st2 == ATT_LINK2_DELIVERED)) {
                         mode = RX_LINK_V2; /* this frame is answered below: nothing it carried is lost */
-                        rx_log(&app->stop, "link: the board speaks link v2");
+                        rx_log(&app->stop, "protocol: the board speaks link v2");
                         publish_live(app, &r.stats, &r2.stats, mode); /* before its BOOT is checked */
                     }
                     if (mode == RX_LINK_V2) {
@@ -466,7 +466,7 @@ static void *receiver_thread(void *arg)
                 if (att_link_receiver_sink(&r, buf[i], now_tick()) == ATT_LINK_ACCEPTED) {
                     if (mode == RX_LINK_AUTO && legacy_block_decodes(block, app->cfg.block_size)) {
                         mode = RX_LINK_LEGACY; /* this block is delivered below */
-                        rx_log(&app->stop, "link: the board speaks the legacy protocol");
+                        rx_log(&app->stop, "protocol: the board speaks the legacy protocol");
                         publish_live(app, &r.stats, &r2.stats, mode);
                     }
                     ack = deliver(app, &x, block);
