@@ -5,7 +5,7 @@ read-out, and the chunked batch conversion through a C driver."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Callable, NoReturn
+from typing import Any, Callable, Generic, NoReturn, TypeVar
 
 import numpy as np
 
@@ -87,6 +87,49 @@ def twin_trace(m: Any, signals: Sequence[str]) -> list[tuple[int, str, int]]:
     """A C twin's pin trace as (t_ns, signal name, value) tuples."""
     return [(int(m.trace[i].t), signals[m.trace[i].signal], int(m.trace[i].value))
             for i in range(m.trace_len)]
+
+
+V = TypeVar("V", bound=Exception)
+
+
+class CTwinBase(Generic[V]):
+    """What the device models' C twins share: their analog inputs, pin trace,
+    conversion count, model time and latched violation (an exception of type
+    ``V``). A subclass sets ``_ffi``, ``_lib`` and ``_m`` (the C model) in its
+    constructor and the class attributes below."""
+
+    #: the twin's ``<model>_set_inputs(m, const double *v, n)``, the number of inputs and their pin name
+    _SET_INPUTS: tuple[str, int, str]
+    _SIGNALS: Sequence[str]     #: the trace's signal names
+    _RULES: Sequence[str]       #: the protocol rules (``m.violation`` is 1-based into them)
+    _VIOLATION: type[V]         #: the exception a latched violation becomes
+    _ffi: Any
+    _lib: Any
+    _m: Any
+
+    def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
+        from .errors import raise_for_status
+
+        fn, count, pin = self._SET_INPUTS
+        v = check_inputs(inputs, count, pin)
+        st = getattr(self._lib, fn)(self._m, self._ffi.cast("double *", v.ctypes.data), v.size)
+        raise_for_status(st, "CTwin.set_inputs(inputs)")
+
+    @property
+    def trace(self) -> list[tuple[int, str, int]]:
+        return twin_trace(self._m, self._SIGNALS)
+
+    @property
+    def conversions(self) -> int:
+        return int(self._m.conversions)
+
+    @property
+    def t(self) -> int:
+        return int(self._m.t)
+
+    def violation(self) -> V | None:
+        """The latched violation (or None)."""
+        return twin_violation(self._ffi, self._m, self._RULES, self._VIOLATION)  # type: ignore[return-value]
 
 
 def convert_in_chunks(n: int, k: int, chunk: int, step: Callable[[int, int, bool, np.ndarray], tuple[int, int]],

@@ -3,7 +3,8 @@
 Every result file of attitude_c (``attitude simulate``'s CSV, JSON, PNG and
 Markdown files; the budget's) goes through this module:
 
-* :func:`atomic_path` / :func:`atomic_open` / :func:`write_text`: the file
+* :func:`atomic_path` / :func:`atomic_open` / :func:`write_text` /
+  :func:`write_with`: the file
   is written under a temporary name in the same directory
   (``.NAME.tmp-XXXXXX.EXT``: same filesystem, same extension for writers
   that go by it), flushed to the disk (``fsync``) and renamed into place
@@ -31,7 +32,8 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import IO, Any, Callable
 
-__all__ = ["ResultsIncomplete", "atomic_open", "atomic_path", "check_output_dir", "write_results", "write_text"]
+__all__ = ["ResultsIncomplete", "atomic_open", "atomic_path", "check_output_dir", "write_results", "write_text",
+           "write_with"]
 
 
 def _fsync_dir(directory: Path) -> None:
@@ -95,6 +97,13 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", **kw: Any) -> Ite
         yield fh
 
 
+def write_with(path: str | os.PathLike[str], writer: Callable[[Path], object]) -> None:
+    """``writer(tmp)`` fills a temporary path, renamed to ``path`` once complete
+    (:func:`atomic_path`): for writers that take a file name (savefig, to_csv, savetxt)."""
+    with atomic_path(path) as tmp:
+        writer(tmp)
+
+
 def write_text(path: str | os.PathLike[str], text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` complete or not at all."""
     with atomic_open(path, "w") as fh:
@@ -131,8 +140,7 @@ def write_results(files: Sequence[tuple[Path, Callable[[Path], object]]]) -> lis
     done: list[Path] = []
     for k, (path, writer) in enumerate(files):
         try:
-            with atomic_path(path) as tmp:
-                writer(tmp)
+            write_with(path, writer)
         except OSError as exc:
             raise ResultsIncomplete(exc, path, done, [p for p, _ in files[k:]]) from exc
         done.append(path)

@@ -19,12 +19,13 @@ Settings are keyword arguments named as the C struct's fields
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import names
+from . import _settings, names
 from ._lib import ffi_lib
 from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 
@@ -33,14 +34,23 @@ __all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings"]
 FloatArray = NDArray[np.float64]
 Precision = Literal["f64", "f32"]
 
-#: The real-valued settings (field names of ``att_ahrs_settings``), besides ``method``.
-SETTINGS: tuple[str, ...] = (
-    "gravity", "gyr_noise", "gyr_noise_rest", "bias_noise", "init_att_sigma", "init_bias_sigma", "acc_tau",
-    "acc_noise", "acc_gate", "acc_reject_max", "mag_noise", "mag_norm_tol", "mag_dip_tol",
-    "mag_ref_tau", "mag_reject_max", "mag_reject_factor", "mag_new_time", "mag_new_gyr",
-    "mag_min_undisturbed", "declination", "rest_time", "rest_tau", "rest_gyr_th",
-    "rest_acc_th", "rest_noise", "gyro_range", "overrange_sigma", "sensor_delay",
-)
+def _method(name: str, v: Any) -> int:
+    if not isinstance(v, str):
+        raise InvalidType(f"{name} must be a method name (str), got {type(v).__name__}")
+    code = names.method_code(v)
+    if code == names.C["ATT_METHOD_RK4"]:
+        raise InvalidArgument(f"{name}: the filter needs an increment method, not 'rk4'")
+    return code
+
+
+_SPEC = _settings.SettingsSpec(
+    "att_ahrs_settings", "att_ahrs_default_settings", "att_ahrs_check_settings", label="filter",
+    domain="ahrs.h: noises and times > 0, '0 = off' fields ≥ 0",
+    choices={"method": _settings.Choice(_method, lambda code: names.method_names()[code])})
+
+#: The real-valued settings (field names of ``att_ahrs_settings``, read from the
+#: library on first use), besides ``method``.
+SETTINGS: Sequence[str] = _settings.SettingNames(_SPEC, "real")
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
@@ -53,39 +63,7 @@ def _check_precision(precision: Any) -> str:
 
 def default_settings() -> dict[str, Any]:
     """The library's defaults (``att_ahrs_default_settings``), ``method`` by name."""
-    ffi, lib = ffi_lib("f64")
-    s = ffi.new("att_ahrs_settings *")
-    lib.att_ahrs_default_settings(s)
-    out: dict[str, Any] = {"method": names.method_names()[s.method]}
-    out.update({k: float(getattr(s, k)) for k in SETTINGS})
-    return out
-
-
-def _fill_settings(ffi: Any, lib: Any, settings: dict[str, Any]) -> Any:
-    s = ffi.new("att_ahrs_settings *")
-    lib.att_ahrs_default_settings(s)
-    for k, v in settings.items():
-        if k == "method":
-            if not isinstance(v, str):
-                raise InvalidType(f"method must be a method name (str), got {type(v).__name__}")
-            code = names.method_code(v)
-            if code == names.C["ATT_METHOD_RK4"]:
-                raise InvalidArgument("method: the filter needs an increment method, not 'rk4'")
-            s.method = code
-        elif k in SETTINGS:
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise InvalidType(f"{k} must be a real number, got {type(v).__name__}")
-            fv = float(v)
-            if not np.isfinite(fv):
-                raise InvalidArgument(f"{k} must be finite, got {fv}")
-            setattr(s, k, fv)
-        else:
-            raise InvalidArgument(f"unknown filter setting {k!r} (known: method, {', '.join(SETTINGS)})")
-    st = lib.att_ahrs_check_settings(s)
-    if st != 0:
-        raise InvalidArgument("settings: a value is outside its domain (ahrs.h: noises and times > 0, "
-                              f"'0 = off' fields ≥ 0): {settings!r}")
-    return s
+    return _settings.defaults(_SPEC)
 
 
 def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[np.float64] | None:
@@ -99,9 +77,8 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
     if a.ndim not in (1, 2) or a.shape[-1] != 3:
         raise InvalidArgument(f"{name} must have shape (3,) or (N, 3), got {a.shape}")
     a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
-    ok = np.isfinite(a).all(axis=1)
-    if not ok.all():
-        i = int(np.argmin(ok))
+    if not np.isfinite(a).all():  # the per-row search only on failure (it costs ~10x the check)
+        i = int(np.argmin(np.isfinite(a).all(axis=1)))
         raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
     return a
 
@@ -125,7 +102,7 @@ class Ahrs:
                 raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
         self.rate = None if rate is None else float(rate)
         self._ffi, self._lib = ffi_lib(self.precision)
-        self._set = _fill_settings(self._ffi, self._lib, dict(settings))
+        self._set = _settings.fill(self._ffi, self._lib, _SPEC, settings)
         self._s = self._ffi.new("att_ahrs *")
         q = self._ffi.NULL
         if q0 is not None:
@@ -139,9 +116,7 @@ class Ahrs:
 
     @property
     def settings(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"method": names.method_names()[self._set.method]}
-        out.update({k: float(getattr(self._set, k)) for k in SETTINGS})
-        return out
+        return _settings.read(_SPEC, self._set)
 
     @property
     def q(self) -> FloatArray:
@@ -212,8 +187,7 @@ class Ahrs:
             if st == self._lib.ATT_E_AHRS_DT:
                 raise InvalidArgument(f"dt: sample {i}: the time step must be finite and > 0")
             raise_for_status(st, "ahrs", index=i)
-        res = out.astype(np.float64) if self.precision == "f64" else out
-        return res[0] if single else res
+        return out[0] if single else out  # float64 for f64 (no copy), float32 for f32
 
     def __repr__(self) -> str:
         return f"Ahrs(rate={self.rate}, precision={self.precision!r})"

@@ -8,7 +8,8 @@ library, never typed again in Python::
     C["ATT_FX_DTHETA_MAX"], C["ATT_BLOCK_E_CODE"], C["ATT_METHOD_RV3"]
 
 :data:`STATUS` says, for each status code of the library (keyed by its C
-name), which exception a Python caller gets and what the code means;
+name), which exception a Python caller gets and what the code means (the
+library's own text, ``att_status_str``: :func:`status_text`);
 :func:`raise_for_status` (re-exported by :mod:`attitude_c.errors`) turns a
 returned code into that exception. The method names come from the library
 too (:func:`method_names`, ``att_integ_method_name``), and so does the
@@ -44,16 +45,21 @@ __all__ = [
     "raise_for_status",
     "samples_per_update",
     "status_name",
+    "status_text",
 ]
 
 #: Prefixes of the library's constants (the modules' prefixes, upper case).
 PREFIXES = ("ATT_", "TLC2543", "AD7927")
 
 
-def _lib() -> Any:
+def _ffi_lib() -> tuple[Any, Any]:
     from ._lib import ffi_lib
 
-    return ffi_lib("f64")[1]
+    return ffi_lib("f64")
+
+
+def _lib() -> Any:
+    return _ffi_lib()[1]
 
 
 class _Constants(Mapping[str, int]):
@@ -93,65 +99,93 @@ class _Constants(Mapping[str, int]):
 #: The library's constants, keyed by C name (``C["ATT_E_ARG"] == -2``).
 C: Mapping[str, int] = _Constants()
 
-# What each status code means to a Python caller: C name -> (exception class, text).
-# The device drivers and their models (attitude_c.tlc2543, attitude_c.ad7927:
-# their own exception classes) and the denoiser (texts naming its choices)
-# give the meanings of their codes in their own modules, keyed by C name too,
-# through raise_for_status's ``extra``.
-STATUS: dict[str, tuple[type[Exception], str]] = {
+# The exception a Python caller gets for each status code, by C name. The text
+# of a code is the library's own (att_status_str, csrc/src/common.c: one table
+# for every module). The device drivers and their models (attitude_c.tlc2543,
+# attitude_c.ad7927: their own exception classes) and the denoiser (texts
+# naming its choices) give the meanings of their codes in their own modules,
+# keyed by C name too, through raise_for_status's ``extra``.
+_CLASSES: dict[str, type[Exception]] = {
     # generic (common.h)
-    "ATT_E_NULL": (InvalidArgument, "NULL pointer argument"),
-    "ATT_E_ARG": (InvalidArgument, "argument out of range"),
-    "ATT_E_NONFINITE": (NonFiniteError, "non-finite input (NaN or Inf)"),
-    "ATT_E_RANGE": (RangeError, "value outside representable range"),
-    "ATT_E_STATE": (AttitudeError, "call not valid in current state"),
-    "ATT_E_TIMEOUT": (DeviceTimeout, "timeout"),
-    "ATT_E_BUFFER": (InvalidArgument, "buffer too small"),
+    "ATT_E_NULL": InvalidArgument,
+    "ATT_E_ARG": InvalidArgument,
+    "ATT_E_NONFINITE": NonFiniteError,
+    "ATT_E_RANGE": RangeError,
+    "ATT_E_STATE": AttitudeError,
+    "ATT_E_TIMEOUT": DeviceTimeout,
+    "ATT_E_BUFFER": InvalidArgument,
     # integrator.h
-    "ATT_E_INTEG_METHOD": (InvalidArgument, "unknown method, or a call not valid for this method"),
-    "ATT_E_INTEG_DIVERGED": (RangeError, "increment too large: the attitude update is not finite"),
-    "ATT_E_INTEG_RANGE": (RangeError, ("increment too large: more than pi rad per sample "
-                                      "(|dtheta| <= pi; rk4: |omega|*h/2 <= pi)")),
-    # link.h
-    "ATT_LINK_E_NULL": (InvalidArgument, "NULL pointer"),
-    "ATT_LINK_E_CONFIG": (InvalidArgument, "link configuration out of range"),
-    "ATT_LINK_E_BUSY": (LinkBusy, "sender busy with the previous block"),
-    "ATT_LINK_E_STATE": (LinkError, "link state corrupted"),
-    "ATT_LINK2_E_NULL": (InvalidArgument, "NULL pointer"),
-    "ATT_LINK2_E_CONFIG": (InvalidArgument, "link v2 configuration out of range"),
-    "ATT_LINK2_E_FULL": (LinkBusy, "link v2 sender ring full"),
-    "ATT_LINK2_E_STATE": (LinkError, "link v2 state corrupted"),
+    "ATT_E_INTEG_METHOD": InvalidArgument,
+    "ATT_E_INTEG_DIVERGED": RangeError,
+    "ATT_E_INTEG_RANGE": RangeError,
+    # link.h, link2.h
+    "ATT_LINK_E_NULL": InvalidArgument,
+    "ATT_LINK_E_CONFIG": InvalidArgument,
+    "ATT_LINK_E_BUSY": LinkBusy,
+    "ATT_LINK_E_STATE": LinkError,
+    "ATT_LINK2_E_NULL": InvalidArgument,
+    "ATT_LINK2_E_CONFIG": InvalidArgument,
+    "ATT_LINK2_E_FULL": LinkBusy,
+    "ATT_LINK2_E_STATE": LinkError,
     # fixed.h
-    "ATT_FX_E_RANGE": (RangeError, "value outside its fixed-point format's range"),
-    "ATT_FX_E_METHOD": (InvalidArgument, "unknown fixed-point method"),
-    "ATT_FX_E_ZERO": (InvalidArgument, "zero quaternion"),
+    "ATT_FX_E_RANGE": RangeError,
+    "ATT_FX_E_METHOD": InvalidArgument,
+    "ATT_FX_E_ZERO": InvalidArgument,
     # ahrs.h
-    "ATT_E_AHRS_DT": (InvalidArgument, "time step not finite or not positive"),
-    "ATT_E_AHRS_UNITS": (InvalidArgument, "specific force far from gravity: accelerometer not in m/s²?"),
-    "ATT_E_AHRS_SETTINGS": (InvalidArgument, "filter setting outside its domain"),
-    "ATT_E_AHRS_DIVERGED": (RangeError, "filter state not finite"),
-    "ATT_E_AHRS_ALIGN": (AttitudeError, "no initial attitude: the sample cannot align the filter"),
+    "ATT_E_AHRS_DT": InvalidArgument,
+    "ATT_E_AHRS_UNITS": InvalidArgument,
+    "ATT_E_AHRS_SETTINGS": InvalidArgument,
+    "ATT_E_AHRS_DIVERGED": RangeError,
+    "ATT_E_AHRS_ALIGN": AttitudeError,
     # ahrs_thesis.h
-    "ATT_E_TEKF_DT": (InvalidArgument, "time step not finite or not positive"),
-    "ATT_E_TEKF_SETTINGS": (InvalidArgument, "thesis EKF setting outside its domain"),
-    "ATT_E_TEKF_DIVERGED": (RangeError, "thesis EKF state not finite"),
-    "ATT_E_TEKF_ALIGN": (AttitudeError, "no initial attitude: the sample cannot align the thesis EKF"),
+    "ATT_E_TEKF_DT": InvalidArgument,
+    "ATT_E_TEKF_SETTINGS": InvalidArgument,
+    "ATT_E_TEKF_DIVERGED": RangeError,
+    "ATT_E_TEKF_ALIGN": AttitudeError,
     # block.h
-    "ATT_BLOCK_E_CODE": (BlockFormatError, "sample code above its stream's limit"),
-    "ATT_BLOCK_E_KIND": (BlockFormatError, "unknown report kind"),
-    "ATT_BLOCK_E_FIELD": (BlockFormatError, "report field out of range"),
-    "ATT_BLOCK_E_SEQ": (BlockFormatError, "loss report disagrees with the sample count"),
+    "ATT_BLOCK_E_CODE": BlockFormatError,
+    "ATT_BLOCK_E_KIND": BlockFormatError,
+    "ATT_BLOCK_E_FIELD": BlockFormatError,
+    "ATT_BLOCK_E_SEQ": BlockFormatError,
     # aiding.h
-    "ATT_AID_E_ZERO_F": (InvalidArgument, "specific force is zero: no up direction"),
-    "ATT_AID_E_ZERO_M": (InvalidArgument, "magnetic field is zero: no north direction"),
-    "ATT_AID_E_PARALLEL": (InvalidArgument, "specific force and field are parallel: heading undefined"),
-    "ATT_AID_E_MOVING": (InvalidArgument, "static window: spread above its limit (moving start)"),
-    "ATT_AID_E_FEW": (InvalidArgument, "too few samples"),
-    "ATT_AID_E_SINGULAR": (RangeError, "Gauss-Newton: Jacobian singular at an iterate"),
-    "ATT_AID_E_NOCONV": (RangeError, "Gauss-Newton: no convergence within the iteration limit"),
-    "ATT_AID_E_SPAN": (InvalidArgument, "the samples do not span enough directions for this fit"),
-    "ATT_AID_E_FIT": (InvalidArgument, "the samples do not lie on an ellipsoid"),
+    "ATT_AID_E_ZERO_F": InvalidArgument,
+    "ATT_AID_E_ZERO_M": InvalidArgument,
+    "ATT_AID_E_PARALLEL": InvalidArgument,
+    "ATT_AID_E_MOVING": InvalidArgument,
+    "ATT_AID_E_FEW": InvalidArgument,
+    "ATT_AID_E_SINGULAR": RangeError,
+    "ATT_AID_E_NOCONV": RangeError,
+    "ATT_AID_E_SPAN": InvalidArgument,
+    "ATT_AID_E_FIT": InvalidArgument,
 }
+
+
+def status_text(status: int) -> str:
+    """The library's description of status code ``status`` (``att_status_str``;
+    "unknown status" for a value no header defines)."""
+    ffi, lib = _ffi_lib()
+    return str(ffi.string(lib.att_status_str(int(status))).decode())
+
+
+class _Status(Mapping[str, tuple[type[Exception], str]]):
+    """C name -> (exception class, the library's text), read on first use."""
+
+    def __getitem__(self, name: str) -> tuple[type[Exception], str]:
+        return _CLASSES[name], status_text(C[name])
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(_CLASSES)
+
+    def __len__(self) -> int:
+        return len(_CLASSES)
+
+    def __repr__(self) -> str:
+        return f"<libattitude status meanings: {len(self)} codes>"
+
+
+#: What each status code of the library means to a Python caller, keyed by its C
+#: name: (exception class, ``att_status_str`` text).
+STATUS: Mapping[str, tuple[type[Exception], str]] = _Status()
 
 
 @cache
@@ -183,7 +217,7 @@ def raise_for_status(status: int, what: str,
     meaning = None
     if name is not None:
         meaning = (extra or {}).get(name) or STATUS.get(name)
-    cls, text = meaning or (AttitudeError, "unknown status")
+    cls, text = meaning or (AttitudeError, status_text(status))  # the library's text, whatever the module
     where = f" at sample {index}" if index is not None else ""
     msg = f"{what}: {text}{where} (status {status}{', ' + name if name else ''})"
     if issubclass(cls, (NonFiniteError, RangeError)):

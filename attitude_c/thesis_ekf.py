@@ -14,12 +14,14 @@ Quaternions scalar first, body → ENU.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _settings
 from ._lib import ffi_lib
 from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 
@@ -28,10 +30,16 @@ __all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "ru
 FloatArray = NDArray[np.float64]
 Precision = Literal["f64", "f32"]
 
-#: Real-valued settings (fields of ``att_tekf_settings``); ``gn_max_iter`` is
-#: the Gauss–Newton iteration limit (``settings.gn.max_iter``, 1..1000).
-SETTINGS: tuple[str, ...] = ("gyr_noise", "bias_noise", "meas_noise", "init_q_sigma",
-                             "init_bias_sigma", "declination")
+_SPEC = _settings.SettingsSpec(
+    "att_tekf_settings", "att_tekf_default_settings", "att_tekf_check_settings", label="thesis-EKF",
+    domain=("ahrs_thesis.h: gyr_noise, meas_noise, init_q_sigma > 0; bias_noise, init_bias_sigma >= 0; "
+            "|declination| <= pi; gn_max_iter 1..1000"),
+    nested={"gn": ("max_iter",)})
+
+#: Real-valued settings (fields of ``att_tekf_settings``, read from the library on
+#: first use); besides them ``gn_max_iter``, the Gauss–Newton iteration limit
+#: (``settings.gn.max_iter``, 1..1000).
+SETTINGS: Sequence[str] = _settings.SettingNames(_SPEC, "real")
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
@@ -47,37 +55,7 @@ class ThesisEkfResult:
 
 def default_settings() -> dict[str, Any]:
     """The library's defaults (``att_tekf_default_settings``)."""
-    ffi, lib = ffi_lib("f64")
-    s = ffi.new("att_tekf_settings *")
-    lib.att_tekf_default_settings(s)
-    out: dict[str, Any] = {k: float(getattr(s, k)) for k in SETTINGS}
-    out["gn_max_iter"] = int(s.gn.max_iter)
-    return out
-
-
-def _fill(ffi: Any, lib: Any, settings: dict[str, Any]) -> Any:
-    s = ffi.new("att_tekf_settings *")
-    lib.att_tekf_default_settings(s)
-    for k, v in settings.items():
-        if k == "gn_max_iter":
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-                raise InvalidType(f"gn_max_iter must be an integer, got {type(v).__name__}")
-            if not 1 <= int(v) <= 1000:
-                raise InvalidArgument(f"gn_max_iter must be in 1..1000, got {v}")
-            s.gn.max_iter = int(v)
-        elif k in SETTINGS:
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise InvalidType(f"{k} must be a real number, got {type(v).__name__}")
-            fv = float(v)
-            if not np.isfinite(fv):
-                raise InvalidArgument(f"{k} must be finite, got {fv}")
-            setattr(s, k, fv)
-        else:
-            raise InvalidArgument(f"unknown thesis-EKF setting {k!r} (known: {', '.join(SETTINGS)}, gn_max_iter)")
-    if lib.att_tekf_check_settings(s) != 0:
-        raise InvalidArgument("settings: a value is outside its domain (ahrs_thesis.h: gyr_noise, meas_noise, "
-                              f"init_q_sigma > 0; bias_noise, init_bias_sigma >= 0; |declination| <= pi): {settings!r}")
-    return s
+    return _settings.defaults(_SPEC)
 
 
 def _vectors(x: ArrayLike, name: str) -> FloatArray:
@@ -119,7 +97,7 @@ def run(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = Non
         if d.size not in (1, n):
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
     ffi, lib = ffi_lib(precision)
-    s_set = _fill(ffi, lib, dict(settings))
+    s_set = _settings.fill(ffi, lib, _SPEC, settings)
     state = ffi.new("att_tekf *")
     qp = ffi.NULL
     if q0 is not None:

@@ -55,6 +55,7 @@ other half, and the other way round; the held-out scores of all trials
 are averaged.
 
     python -m bench.broad [--quick] [--no-timing] [--no-cv] [--data DIR]
+    python -m bench.broad --throughput-only [--quick] [--data DIR]   # host throughput table only
 
 The peers' attitudes are cached in ``results/bench-cache/broad`` (the ahrs
 package's EKF runs at about 1 ms per sample here: a first full run takes
@@ -326,25 +327,52 @@ def armv4t_counts() -> list[tuple[str, float]]:
     return rows
 
 
-def throughput(trials: list[Any], reps: int) -> list[tuple[str, float]]:
+def throughput(trials: list[Any], rounds: int) -> list[tuple[str, float, float, float]]:
+    """Samples/s of one batch call over all trials concatenated: ours (f64, f32) and VQF's
+    ``updateBatch`` on the same float64 arrays, same rate, 9-axis, each constructing its filter
+    inside the timed call. The three alternate within each round (so load changes hit all of
+    them alike); a warm-up call of each precedes. Returns (label, best, median, median of the
+    per-round ratio to VQF)."""
+    import statistics
+
     from vqf import VQF
 
     from attitude_c.ahrs_filter import Ahrs
-
-    from .host import _best
 
     g = np.ascontiguousarray(np.vstack([t.gyr for t in trials]))
     a = np.ascontiguousarray(np.vstack([t.acc for t in trials]))
     m = np.ascontiguousarray(np.vstack([t.mag for t in trials]))
     rate = trials[0].rate
     n = len(g)
-    rows = []
-    for prec in ("f64", "f32"):
-        def ours(prec: str = prec) -> None:
-            Ahrs(rate=rate, precision=prec).update(g, a, m)  # type: ignore[arg-type]
-        rows.append((f"attitude_c.Ahrs.update, {prec}, one block", n / _best(ours, reps)))
-    rows.append(("VQF.updateBatch (C++)", n / _best(lambda: VQF(1.0 / rate).updateBatch(g, a, m), reps)))
-    return rows
+    calls: dict[str, Callable[[], Any]] = {
+        f"attitude_c.Ahrs.update, {p}, one block": (lambda p=p: Ahrs(rate=rate, precision=p).update(g, a, m))
+        for p in ("f64", "f32")}
+    calls["VQF.updateBatch (C++)"] = lambda: VQF(1.0 / rate).updateBatch(g, a, m)
+    for fn in calls.values():  # warm-up: imports, first-touch of the buffers
+        fn()
+    sps: dict[str, list[float]] = {k: [] for k in calls}
+    for _ in range(rounds):
+        for k, fn in calls.items():
+            t0 = time.perf_counter()
+            fn()
+            sps[k].append(n / (time.perf_counter() - t0))
+    vqf = sps["VQF.updateBatch (C++)"]
+    return [(k, max(v), statistics.median(v), statistics.median(x / y for x, y in zip(v, vqf)))
+            for k, v in sps.items()]
+
+
+def throughput_table(trials: list[Any], rounds: int) -> list[str]:
+    import os
+
+    load = os.getloadavg()
+    out = [(f"**Host throughput** (all {sum(t.n for t in trials):,} samples of the trials concatenated, one "
+            f"call each, {rounds} rounds alternating the three calls, `time.perf_counter`; a shared "
+            f"2-core machine, load average {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} at the start):\n"),
+           "| what | samples/s, best round | median round | ratio to VQF (median of rounds) |",
+           "|---|---|---|---|"]
+    for label, best, med, ratio in throughput(trials, rounds):
+        out.append(f"| {label} | {best:,.0f} | {med:,.0f} | {ratio:.2f} |")
+    return out
 
 
 # -- plot -------------------------------------------------------------------------------------
@@ -468,12 +496,8 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
     except Exception as exc:  # noqa: BLE001 - a missing cross toolchain must not lose the rest
         out.append(f"\nARMv4T counts: not measured ({type(exc).__name__}: {exc}).")
     if timing:
-        out.append("\n**Host throughput** (all trials concatenated, one call, best of "
-                   f"{2 if quick else 5} runs, `time.perf_counter`, on a shared machine):\n")
-        out.append("| what | samples/s |")
-        out.append("|---|---|")
-        for label, sps in throughput(trials, 2 if quick else 5):
-            out.append(f"| {label} | {sps:,.0f} |")
+        out.append("")
+        out.extend(throughput_table(trials, 2 if quick else 9))
     return "\n".join(out)
 
 
@@ -482,6 +506,12 @@ if __name__ == "__main__":  # pragma: no cover
     if "--data" in sys.argv:
         data = sys.argv[sys.argv.index("--data") + 1]
     t0 = time.time()
+    if "--throughput-only" in sys.argv:  # just the host throughput table (ours vs VQF, same run)
+        from attitude_c import broad as _broad
+
+        _trials = [_broad.load_trial(p) for p in _broad.find_trials(data)]
+        print("\n".join(throughput_table(_trials, 2 if "--quick" in sys.argv else 9)))
+        sys.exit(0)
     print(run(quick="--quick" in sys.argv, timing="--no-timing" not in sys.argv, cv="--no-cv" not in sys.argv,
               data=data))
     print(f"\n({time.time() - t0:.0f} s)", file=sys.stderr)

@@ -21,7 +21,6 @@ machine would be wrong); everything else is exact or seeded.
 from __future__ import annotations
 
 import math
-import os
 import sys
 import tempfile
 from pathlib import Path
@@ -220,6 +219,8 @@ def plot_static(res: dict[str, Any], path: Path = PLOT) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from attitude_c._io import write_with
+
     t, x, y = res["t"], res["x_dps"][:, 1], res["y_dps"][:, 1]
     b = res["mean_raw"][1]
     fig, axes = plt.subplots(2, 1, figsize=(8, 5), sharex=True, sharey=True)
@@ -233,16 +234,10 @@ def plot_static(res: dict[str, Any], path: Path = PLOT) -> Path:
     axes[1].set_xlabel("time (s)")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(suffix=".png", dir=path.parent)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=110)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private
-        os.replace(tmp, path)
+        write_with(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path
 
 

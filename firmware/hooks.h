@@ -8,6 +8,7 @@
  *   FW_HOOK_INIT()             after the timers and the UART are set up
  *   FW_HOOK_LOOP_START()       top of every main-loop iteration
  *   FW_HOOK_RX(b)              byte b received, before the link sender sees it
+ *   FW_HOOK_POLL_BEGIN()       link v2: right before the sender's poll
  *   FW_HOOK_POLL(st)           the link sender's poll returned st
  *   FW_HOOK_V2_SINK(call)      link v2: wraps the sender's sink call (its
  *                              result is ignored in production)
@@ -32,6 +33,7 @@
 #define FW_HOOK_INIT()
 #define FW_HOOK_LOOP_START()
 #define FW_HOOK_RX(b)
+#define FW_HOOK_POLL_BEGIN()
 #define FW_HOOK_POLL(st)
 #define FW_HOOK_V2_SINK(call) (void)(call)
 #define FW_HOOK_TX()

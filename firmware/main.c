@@ -118,10 +118,14 @@ static uint8_t q_push(void)
 /* The self-test passed: its slot is not needed (never pushed). */
 #define q_unpush() ((void)0)
 
-/* flush_overrun() waits for "the queue is empty": here, for two free ring
- * slots (the report leaves one to the next sample, so a report never
- * causes the next loss, and a busy link does not hold the report back). */
-#define q_any (att_link2_sender_room(&tx) < 2u)
+/* flush_overrun() waits for "the queue is empty": here, for an empty ring
+ * (every record acknowledged). While samples are being lost nothing is
+ * pushed, so the ring drains within one round trip; the report then goes
+ * out at once and leaves the next samples 3 free slots. (Waiting for only
+ * two free slots made each report the cause of the next loss when the
+ * window was tight: at period 41 in s51 the stream settled into a sample
+ * and a report in turn, 24 samples/s instead of 38; docs/link.md.) */
+#define q_any (att_link2_sender_room(&tx) < (uint8_t)ATT_LINK2_ONE_RING)
 #else
 /* Everything in internal RAM (the small model's default space): __data
  * pointers are one byte and need no library call. */
@@ -288,6 +292,28 @@ static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER
                                                  ATT_BLOCK_SIZE, FW_MAX_ATTEMPTS };
 #endif /* !FW_LINK_V2 */
 
+#if FW_LINK_V2
+/* A byte from the receiver, if one came. The UART holds one received byte
+ * (SBUF, RI): one that completes while RI is still set is lost, and so is
+ * the ACK it belongs to (its records are then freed only by the next ACK).
+ * Bytes arrive every 960 machine cycles at 9600 baud; a poll (up to ~860)
+ * and a scan (852) in one loop iteration would exceed that, so the loop
+ * looks at RI before each of them and after the scan. (A function: two
+ * more bytes of stack on the sink's path, which stays shallower than the
+ * scan's; inlined three times it cost 33 bytes of flash.) */
+static void link_rx(void)
+{
+    if (RI) {
+        RI = 0;
+        FW_HOOK_RX(SBUF);
+        FW_HOOK_V2_SINK(att_link2_sender_sink(&tx, SBUF, fw_ticks));
+    }
+}
+#define LINK_RX() link_rx()
+#else
+#define LINK_RX() ((void)0)
+#endif
+
 /* main's state is static: no local lives across a call, so main pushes
  * nothing on the stack around the deep calls (the scan). */
 static uint16_t next_sample; /* tick of the next sample (or self-test retry) */
@@ -308,7 +334,9 @@ void main(void)
 #endif
     (void)tlc2543_init(&adc, 0, 0); /* 12-bit, MSB first, unipolar */
     (void)q_push();                 /* the queue is empty: BOOT report first */
-    (void)att_block_encode_boot(wp, FW_PERIOD_TICKS, (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT));
+    (void)att_block_encode_boot(
+        wp, (uint16_t)(FW_PERIOD_TICKS | (FW_LINK_V2 ? ATT_BLOCK_BOOT_LINK2 : 0)),
+        (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT)); /* the protocol in the period word */
     q_commit();
     sampling = 0;
     next_sample = tick_now();
@@ -319,14 +347,11 @@ void main(void)
 
 #if FW_LINK_V2
         /* 1. a byte from the receiver (an ACK frees ring slots) */
-        if (RI) {
-            RI = 0;
-            FW_HOOK_RX(SBUF);
-            FW_HOOK_V2_SINK(att_link2_sender_sink(&tx, SBUF, fw_ticks));
-        }
+        LINK_RX();
 
         /* 2. the transmitter is free: the sender's next byte, if any */
         if (TI) {
+            FW_HOOK_POLL_BEGIN();
             st = att_link2_sender_poll(&tx, fw_ticks, &txb);
             FW_HOOK_POLL(st);
             if (st == ATT_LINK2_SEND) {
@@ -377,9 +402,11 @@ void main(void)
             if (sampling) {
                 next_sample += (uint16_t)FW_PERIOD_TICKS;
                 if (sample_slot()) {
+                    LINK_RX(); /* v2: the byte that came during the poll, before the scan's 0.9 ms */
                     FW_HOOK_SCAN_BEGIN();
                     st = tlc2543_scan(&adc, xyz, 3, (uint16_t __data *)wp, TLC2543_POWER_DOWN);
                     FW_HOOK_SCAN_END();
+                    LINK_RX(); /* v2: the byte that came during the scan */
                     sample_store(st);
                 }
                 seq++;

@@ -73,3 +73,43 @@ def clean_copy(dst: Path, *paths: str) -> Path:
             (dst / f).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(ROOT / f, dst / f)
     return dst
+
+
+# ---- truth for the attitude filters' tests (test_ahrs.py, test_ahrs_thesis.py) ----
+
+G = 9.81  # m/s², the filters' default gravity
+M_N = (0.0, 20.0, -40.0)  # µT, ENU: north and down (dip 63°)
+
+
+def motion(n: int, rate: float, w: tuple[float, float, float], q0=None, bias=(0, 0, 0), noise=0.0, seed=1):
+    """Constant body rate w: truth q_k = q0 ⊗ exp(w t_k) exactly (closed form); ideal
+    sensors (gyro w + bias; specific force and field rotated into the body), plus white
+    noise of σ ``noise`` rad/s (20× that in m/s², 50× in µT) when ``noise`` > 0.
+    Returns gyr, acc, mag (n, 3) and the truth (n, 4)."""
+    import numpy as np
+
+    from attitude_c import reference as ref
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / rate
+    wv = np.asarray(w, float)
+    q0 = np.array([1.0, 0, 0, 0]) if q0 is None else np.asarray(q0, float)
+    truth = ref.quat_multiply(q0, ref.rotvec_to_quat(np.outer(t, wv)))
+    C = ref.quat_to_dcm(truth)
+    acc = np.einsum("nji,j->ni", C, [0.0, 0.0, G])  # C^T up·g
+    mag = np.einsum("nji,j->ni", C, np.asarray(M_N))
+    gyr = np.tile(wv, (n, 1)) + np.asarray(bias, float)
+    if noise:
+        gyr = gyr + noise * rng.standard_normal(gyr.shape)
+        acc = acc + 20 * noise * rng.standard_normal(acc.shape)
+        mag = mag + 50 * noise * rng.standard_normal(mag.shape)
+    return gyr, acc, mag, truth
+
+
+def angle_deg(qa, qb):
+    """Rotation angle between attitudes, degrees."""
+    import numpy as np
+
+    from attitude_c import reference as ref
+
+    return np.degrees(ref.quat_angle(qa, qb))

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import angle_deg, motion
 
 import attitude_c
 from attitude_c import broad
@@ -19,31 +20,6 @@ from attitude_c import reference as ref
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
 from attitude_c.thesis_ekf import default_settings, run
 from attitude_c.thesis_ekf_reference import thesis_ekf_reference
-
-G = 9.81
-M_N = np.array([0.0, 20.0, -40.0])  # µT, ENU: north and down (dip 63°)
-
-
-def motion(n, rate, w, q0=None, bias=(0, 0, 0), noise=0.0, seed=1):
-    """Constant body rate w: truth q_k = q0 ⊗ exp(w t_k) exactly; ideal sensors (+ bias, noise)."""
-    rng = np.random.default_rng(seed)
-    t = np.arange(n) / rate
-    wv = np.asarray(w, float)
-    q0 = np.array([1.0, 0, 0, 0]) if q0 is None else np.asarray(q0, float)
-    truth = ref.quat_multiply(q0, ref.rotvec_to_quat(np.outer(t, wv)))
-    C = ref.quat_to_dcm(truth)
-    acc = np.einsum("nji,j->ni", C, [0.0, 0.0, G])
-    mag = np.einsum("nji,j->ni", C, M_N)
-    gyr = np.tile(wv, (n, 1)) + np.asarray(bias, float)
-    if noise:
-        gyr = gyr + noise * rng.standard_normal(gyr.shape)
-        acc = acc + 20 * noise * rng.standard_normal(acc.shape)
-        mag = mag + 50 * noise * rng.standard_normal(mag.shape)
-    return gyr, acc, mag, truth
-
-
-def angle_deg(qa, qb):
-    return np.degrees(ref.quat_angle(qa, qb))
 
 
 @pytest.mark.parametrize("kw,given_q0", [({}, False),

@@ -179,8 +179,9 @@ def _stats(err: str) -> dict[str, int]:
     for line in err.splitlines():
         if line.startswith(("attitude-rx: link:", "attitude-rx: samples:", "attitude-rx: reports:")):
             for kv in line.split(":", 2)[2].split():
-                k, v = kv.split("=")
-                out[k] = int(v)
+                if "=" in kv:  # key=value pairs only
+                    k, v = kv.split("=")
+                    out[k] = int(v)
     return out
 
 
@@ -650,6 +651,7 @@ def test_rx_command_line_getopt(rx_builds, tmp_path: Path) -> None:
     for h in ("-h", "--help"):
         rc, out, err = run(h)
         assert rc == 0 and out.startswith("usage:") and "--period" in out and err == ""
+        assert "--link P                 auto (default:" in out  # link v2 or legacy, as the board speaks
     rc, out, _ = run("--version")
     import attitude_c
 
@@ -818,6 +820,8 @@ def test_rx_warns_when_the_rate_cannot_fit_the_line(rx_builds) -> None:
                 if need > cap:
                     assert m, (baud, n, period, err)
                     assert (m.group(1), m.group(2)) == (f"{need:.1f}", f"{cap:.1f}"), err
+                    # --link auto (the default) has heard nothing yet: the figures are the legacy link's
+                    assert "(if it speaks the legacy protocol; link v2 carries about twice as much)" in err
                     warned += 1
                 else:
                     assert "warning" not in err, (baud, n, period, err)
@@ -837,6 +841,7 @@ def test_rx_warns_when_the_boot_period_cannot_fit_the_line(rx_builds) -> None:
         rc, _, err = rx.finish(signal.SIGINT)
         assert rc == 0, err
         assert ("needs 100.0 blocks/s" in err and "carries at most 96.0" in err) == warns, err
+        assert "if it speaks" not in err  # the BOOT came over the legacy link: auto knows it
 
 
 class _PtyMaster:
@@ -879,14 +884,101 @@ def test_rx_link_v2(rx_builds, link: str) -> None:
     stats = dict(kv.split("=") for kv in line.split(":", 2)[2].split())
     assert int(stats["records"]) == rep.acknowledged and int(stats["syns"]) == 1
     assert ("the board speaks link v2" in err) == (link == "auto")
+    assert "warning" not in err  # 100 samples/s (BOOT) is beyond the legacy link's 96.0, not v2's
 
 
-def test_rx_link_auto_hears_legacy(rx_builds) -> None:
-    rx = Rx(rx_builds["host"], "--link", "auto", "--method", "rv1", "--count", "20", "--no-header",
-            "--gap-ms", "2000")
-    feeder = Feeder(rx.master, impl="c", timeout_ms=300)
-    acked = _send_while_alive(feeder, rx, [list(c) for c in _gyro_codes(40)])
+@pytest.mark.parametrize("link", [None, "auto"])
+def test_rx_link_auto_hears_legacy(rx_builds, link: str | None) -> None:
+    """auto (the default) and a legacy board: the block that names the protocol is the
+    first one printed (delivered, not just detected); every acknowledged sample printed."""
+    args = () if link is None else ("--link", link)
+    rx = Rx(rx_builds["host"], *args, "--method", "rv1", "--count", "20", "--no-header", "--gap-ms", "2000")
+    # 1 s answer timeout: a stall of the loaded machine must not make A resend a block B took
+    # (the legacy protocol would deliver it twice), and A gives up within 5 s once rx is gone
+    feeder = Feeder(rx.master, impl="c", timeout_ms=1000)
+    codes = [tuple(int(v) for v in c) for c in _gyro_codes(40)]
+    acked = _send_while_alive(feeder, rx, codes)
     rc, out, err = rx.finish(sig=None)
-    assert len(acked) == 20
     assert rc == 0, err
-    assert len(out.splitlines()) == 20 and "the board speaks the legacy protocol" in err
+    assert acked == codes[:20] and _rows(out) == acked, f"{err}\nA: {feeder.sender.stats} B sent {feeder.b_bytes}"
+    assert "the board speaks the legacy protocol" in err and "link2:" not in err
+
+
+def _pump2(a, rx: Rx, seconds: float) -> None:
+    """Sender A (attitude_c.link.v2.Sender2) on the pty's master side in real time (1 ms
+    ticks) until attitude-rx ends or `seconds` pass."""
+    from attitude_c.link.v2 import Result2
+
+    end = time.monotonic() + seconds
+    while time.monotonic() < end and rx.proc.poll() is None:
+        out = bytearray()
+        while len(out) < 64:
+            res, byte = a.poll(_tick())
+            if res == Result2.SEND:
+                out.append(byte)
+            elif res != Result2.TIMEOUT:
+                break
+        if out:
+            os.write(rx.master, bytes(out))
+        r, _, _ = select.select([rx.master], [], [], 0.005)
+        if r:
+            for b in os.read(rx.master, 4096):
+                a.sink(b, _tick())
+
+
+def test_rx_link_auto_v2_board_mid_stream_loses_nothing(rx_builds) -> None:
+    """The default (auto) started while a v2 board streams to a receiver that went away: the
+    first frame it hears is a DATA frame of a session it never saw. That frame is answered
+    F_NOSESSION (not just used for detection), the board starts a session at its first
+    unacknowledged record, and from that record on every sample is printed, in order."""
+    from attitude_c.link import block, v2
+
+    codes = [tuple(int(v) for v in c) for c in _gyro_codes(60)]
+    recs = [block.encode_boot(72, 9600)] + [_block(c) for c in codes]
+    a = v2.Sender2(ring_size=64, max_samples=4, rto=300)
+    old = v2.Receiver2(room=100)  # the receiver before: BOOT and a few samples acknowledged
+    for r in recs:
+        a.push(r)
+    t = 0
+    while a.base < 5:
+        t += 1
+        assert t < 10_000, "the first receiver took nothing"
+        _, byte = a.poll(t)
+        if byte is not None:
+            old.sink(byte)
+        _, byte = old.poll()
+        if byte is not None:
+            a.sink(byte, t)
+    base = a.base  # A's first record not acknowledged: a frame after it may be on its way
+    assert a.session == "run" and a.next > base
+    rx = Rx(rx_builds["host"], "--method", "rv1", "--count", "40", "--no-header")
+    _pump2(a, rx, 20)
+    rc, out, err = rx.finish(sig=None)
+    assert rc == 0, err
+    assert _rows(out) == codes[base - 1:base - 1 + 40], err  # record k is sample k - 1 (BOOT first)
+    line = next(x for x in err.splitlines() if x.startswith("attitude-rx: link2:"))
+    stats = {k: int(v) for k, v in (kv.split("=") for kv in line.split(":", 2)[2].split())}
+    # each DATA frame already on its way is answered F_NOSESSION too, and makes A SYN again (at
+    # its base: the rows above show nothing lost or repeated)
+    assert stats["no_session"] >= 1 and stats["syns"] >= 1, err
+    assert "the board speaks link v2" in err and "attitude-rx: link: syns=" not in err
+
+
+def test_rx_link_auto_undecodable_legacy_block_decides_nothing(rx_builds) -> None:
+    """auto: a block the legacy checksum accepts but whose record does not decode (as a v2
+    frame's bytes may by chance) is delivered as on the legacy link but does not name the
+    protocol: a v2 board heard afterwards is still detected and every sample printed."""
+    from attitude_c.link import block
+    from attitude_c.link.transport2 import run_sender2
+
+    rx = Rx(rx_builds["host"], "--method", "rv1", "--no-header", "--gap-ms", "2000")
+    assert Feeder(rx.master, impl="c", timeout_ms=300).send(_block((0xF123, 0x4567, 0x89AB)))
+    codes = [tuple(int(v) for v in c) for c in _gyro_codes(30)]
+    rep = run_sender2(_PtyMaster(rx.master), [block.encode_boot(72, 9600)] + [_block(c) for c in codes],
+                      impl="python", timeout=15)
+    assert rep.acknowledged == 31
+    time.sleep(0.3)
+    rc, out, err = rx.finish(signal.SIGINT)
+    assert rc == 0, err
+    assert "the board speaks link v2" in err and "legacy protocol" not in err
+    assert [r for r in _rows(out) if max(r) < 4096][-30:] == codes, err

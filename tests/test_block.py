@@ -33,7 +33,7 @@ def _spec(raw: bytes) -> tuple[str, bool]:
         return "unknown", False
     kind = KINDS[raw[1]]
     w34, w45 = raw[3] << 8 | raw[4], raw[4] << 8 | raw[5]
-    ok = {"boot": raw[2] == 1 and 1 <= w34 <= 32767 and raw[5] != 0,
+    ok = {"boot": raw[2] == 1 and 1 <= w34 & 0x7FFF and raw[5] != 0,  # top bit: the link v2 flag
           "selftest": raw[2] >= 0x80 and w34 <= 4095,
           "gave_up": w45 != 0, "overrun": w45 != 0,
           "adc_error": raw[4] >= 0x80 and raw[5] == 0,
@@ -54,6 +54,13 @@ def test_constants_come_from_the_library() -> None:
 def test_encoders_give_the_bytes_of_the_table() -> None:
     assert block.encode_sample([0x123, 4095, 0]) == bytes.fromhex("01230fff0000")
     assert block.encode_boot(72, 9600) == bytes.fromhex("fe0001004808")  # docs/firmware.md's first block
+    # a link v2 board: the top bit of the period word (docs/block.md)
+    assert block.encode_boot(72, 9600, "v2") == bytes.fromhex("fe0001804808")
+    r = block.decode(bytes.fromhex("fe0001804808"))
+    assert (r.link, r.period_ticks, r.as_dict()["link"]) == ("v2", 72, "v2")
+    assert block.decode(bytes.fromhex("fe0001004808")).link == "legacy"
+    with pytest.raises(InvalidArgument, match="link"):
+        block.encode_boot(72, 9600, "v3")  # type: ignore[arg-type]
     assert block.encode_selftest(-41, 0xFFF, 3) == bytes.fromhex("fe01d70fff03")
     assert block.encode_loss("gave_up", 0x1234, 1) == bytes.fromhex("fe0212340001")
     assert block.encode_loss("overrun", 2, 3) == bytes.fromhex("fe0300020003")
@@ -114,7 +121,7 @@ def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
     if ok:  # a valid record encodes back to the same bytes
         assert rec is not None
         again = {"sample": lambda: block.encode_sample(rec.codes),
-                 "boot": lambda: block.encode_boot(rec.period_ticks, rec.baud),
+                 "boot": lambda: block.encode_boot(rec.period_ticks, rec.baud, rec.link),
                  "selftest": lambda: block.encode_selftest(rec.status, rec.bad_code, rec.attempt),
                  "gave_up": lambda: block.encode_loss("gave_up", rec.first, rec.count),
                  "overrun": lambda: block.encode_loss("overrun", rec.first, rec.count),

@@ -136,6 +136,7 @@ def test_200_samples_match_the_analog_inputs(out: Path, impl: str, n: int) -> No
           f"max SP 0x{res.max_sp:02X}; host {res.host.stats()}")
     stream = res.stream  # raises if a loss report does not match the numbering
     assert isinstance(stream[0], tool.Report) and stream[0].kind == "boot"
+    assert stream[0].link == "legacy" and stream[0].raw[3] & 0x80 == 0  # the legacy build announces legacy
     samples = _samples(stream)
     assert [s.seq for s in samples] == sorted({s.seq for s in samples})  # in order, no duplicate
     _assert_match_model(samples)

@@ -96,8 +96,11 @@ def test_v2_firmware_delivers_every_record_once_in_order(out: Path) -> None:
     n = 120
     img = tool.build(out, tool.Config(link="v2", period_ticks=18), kind="sim", sim_samples=n, name="fw_v2_rate")
     fw, recs, rx = _run_v2(img, timeout=120)
+    # the 8051's CRC-32C (assembly in link2_sender.c) of "123456789" = the check value (docs/link.md)
+    assert "CRC E3069283" in fw.output.upper()
     stream = tool.decode_stream(recs)  # raises if a loss report disagrees with the numbering
     assert isinstance(stream[0], tool.Report) and stream[0].kind == "boot"
+    assert stream[0].link == "v2" and stream[0].period_ticks == 18  # the v2 build announces v2 in BOOT
     samples = [x for x in stream if isinstance(x, tool.Sample)]
     assert [s.seq for s in samples] == sorted({s.seq for s in samples})
     # (no check against the gyro model here: at 5 ms the loop's link work delays scans,

@@ -9,6 +9,7 @@ import json
 import subprocess
 import sys
 import threading
+from typing import Any
 
 import pytest
 
@@ -127,3 +128,85 @@ def test_cli_tx_rx_v2_over_pty() -> None:
     assert rx.returncode == 0, err
     lines = [json.loads(x) for x in out.splitlines()]
     assert len(lines) == 50 and all("codes" in x and "error" not in x for x in lines)
+
+
+@pytest.mark.parametrize("protocol", ["v2", "legacy"])
+def test_cli_rx_auto_hears_either_protocol(protocol: str) -> None:
+    """`link-rx --protocol auto` and a sender of either protocol (hex lines on stdin): every
+    record printed once, in order, from the first one (the frame or block that names the
+    protocol is answered, not just recognised)."""
+    import select
+
+    recs = [record(i) for i in range(40)]
+    lines = [r.hex(" ") for r in recs]
+    with PtyPair() as (pa, pb):
+        rx = subprocess.Popen([sys.executable, "-m", "attitude_c", "link-rx", "--protocol", "auto", "--port", pb,
+                               "--count", "40", "--impl", "python", "--gap-timeout-ms", "1000", "--duration", "60"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            assert select.select([rx.stderr], [], [], 30)[0] and "legacy or link v2" in rx.stderr.readline()
+            extra = ["--wait", "60"] if protocol == "v2" else ["--syn-timeout-ms", "1000", "--answer-timeout-ms", "1000"]
+            tx = _cli("link-tx", "--protocol", protocol, "--port", pa, "--impl", "python", *extra,
+                      input="\n".join(lines) + "\n")
+            out, err = rx.communicate(timeout=60)
+        finally:
+            if rx.poll() is None:
+                rx.kill()
+                rx.communicate()
+    assert tx.returncode == 0, tx.stderr
+    assert rx.returncode == 0, err
+    assert out.splitlines() == lines, err
+    assert f"the sender speaks {'link v2' if protocol == 'v2' else 'the legacy protocol'}" in err
+
+
+def test_listen_auto_undecodable_legacy_block_decides_nothing() -> None:
+    """listen_auto: a legacy block whose record does not decode (as a v2 frame's bytes may pass
+    the 8-bit sum) is handed on as the legacy link would, but names no protocol: the v2 SYN
+    after it does, and run_receiver2 goes on with the same receiver: all records, in order."""
+    import time
+
+    from attitude_c.link import make_sender
+    from attitude_c.link.protocol import Result
+    from attitude_c.link.transport2 import listen_auto, run_receiver2, run_sender2
+
+    recs = [record(i) for i in range(5)]
+    bad = bytes([0xF1, 0x23, 0x45, 0x67, 0x89, 0xAB])  # codes above 4095: not a record
+    box: dict[str, Any] = {}
+    blocks: list[bytes] = []
+
+    def receive(port: Any) -> None:
+        heard = listen_auto(port, impl="python", on_block=blocks.append, duration=30)
+        box["protocol"] = heard.protocol
+        box["rep"] = run_receiver2(heard.port, impl="python", receiver=heard.v2, count=5, duration=30)
+
+    with PtyPair() as (pa, pb):
+        port_a, port_b = open_port(pa, 9600), open_port(pb, 9600)
+        t = threading.Thread(target=receive, args=(port_b,))
+        t.start()
+        try:
+            tx = make_sender("python", block_size=6, syn_timeout=1000, answer_timeout=1000)
+            t0 = time.monotonic()
+
+            def tick() -> int:
+                return int((time.monotonic() - t0) * 1000) & 0xFFFF
+
+            tx.start(bad, tick())
+            port_a.timeout = 0.01
+            while time.monotonic() - t0 < 20:
+                res, byte = tx.poll(tick())
+                if res == Result.SEND:
+                    port_a.write(bytes([byte]))
+                elif res == Result.IDLE:
+                    break
+                else:
+                    for b in port_a.read(16):
+                        tx.sink(b, tick())
+            assert tx.stats.blocks_accepted == 1 and blocks == [bad]
+            sent = run_sender2(port_a, recs, impl="python", timeout=20)
+            t.join(30)
+        finally:
+            port_a.close()
+            port_b.close()
+    assert sent.acknowledged == 5
+    assert box["protocol"] == "v2"
+    assert box["rep"].records == recs

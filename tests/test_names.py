@@ -112,3 +112,48 @@ def test_no_status_code_is_typed_again_in_python() -> None:
                     if isinstance(k, ast.UnaryOp) and isinstance(k.op, ast.USub) and isinstance(k.operand, ast.Constant):
                         hits.append(f"{f.relative_to(ROOT)}:{k.lineno}")
     assert not hits, hits
+
+
+def _library_status_codes() -> dict[str, int]:
+    """The status codes the library's own headers define (csrc/include/attitude; not the
+    host twins' codes), by their text."""
+    lib_headers = [h for h in HEADERS if h.parent.name == "attitude"]
+    out: dict[str, int] = {}
+    for h in lib_headers:
+        text = re.sub(r"/\*.*?\*/", " ", h.read_text(), flags=re.DOTALL)
+        out.update({m[0]: int(m[1]) for m in re.findall(r"\b(\w+_E_\w+)\s*=\s*(-\d+)", text)})
+    return out
+
+
+def test_att_status_str_names_every_code_of_the_headers() -> None:
+    """att_status_str (csrc/src/common.c, one table): every code of every module's header
+    has its own text; csrc/tests/test_status.c (run by test_c_programs.py under the
+    sanitizers) lists exactly these codes and checks the same in C."""
+    from attitude_c._lib import ffi_lib
+
+    codes = _library_status_codes()
+    assert len(codes) > 50 and all(v < 0 for v in codes.values())
+    assert codes == {k: v for k, v in _header_enums().items() if k in codes}
+    listed = re.findall(r"CODE\(([A-Z][A-Z0-9_]+)\)", (ROOT / "csrc" / "tests" / "test_status.c").read_text())
+    assert sorted(listed) == sorted(codes) and len(set(listed)) == len(listed)
+    for precision in ("f64", "f32"):
+        ffi, lib = ffi_lib(precision)
+        texts = {k: ffi.string(lib.att_status_str(v)).decode() for k, v in codes.items()}
+        assert not [k for k, t in texts.items() if t in ("unknown status", "ok", "")], texts
+        assert len(set(texts.values())) == len(texts), texts  # a text names its code
+        assert {names.status_text(v) for v in codes.values()} == set(texts.values())
+
+
+def test_python_error_texts_are_the_librarys() -> None:
+    import pytest
+
+    from attitude_c.errors import AttitudeError, raise_for_status
+
+    for name, (_, text) in names.STATUS.items():
+        assert text == names.status_text(names.C[name]) != "unknown status", name
+    assert set(names.STATUS) <= set(_library_status_codes())
+    # a code without a Python meaning of its own: still the library's text
+    with pytest.raises(AttitudeError, match=r"adc: TLC2543: EOC did not rise .*TLC2543_E_EOC_TIMEOUT"):
+        raise_for_status(names.C["TLC2543_E_EOC_TIMEOUT"], "adc")
+    with pytest.raises(AttitudeError, match=r"x: unknown status \(status -999\)"):
+        raise_for_status(-999, "x")

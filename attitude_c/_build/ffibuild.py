@@ -33,7 +33,7 @@ CFFI_DIR = CSRC / "cffi"
 # Library sources (portable C99) and host-only sources (device models...).
 SOURCE_DIRS = (CSRC / "src", CSRC / "host")
 
-COMPILE_ARGS = ["-std=c99", "-O2", "-fno-strict-aliasing"]
+COMPILE_ARGS = ["-std=c99", "-O3", "-fno-strict-aliasing"]
 
 
 def _rel(p: Path) -> str:

@@ -27,7 +27,7 @@ from typing import Any, Callable, Literal
 
 import numpy as np
 
-from .._devmodel import check_inputs, check_level, convert_in_chunks
+from .._devmodel import CTwinBase, check_level, convert_in_chunks
 from ..errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 from . import _capi
 from ._errors import AddressMismatch, FrameError
@@ -106,13 +106,18 @@ def _channel(name: str, v: Any) -> int:
     return int(v)
 
 
-class CTwin:
+class CTwin(CTwinBase[ProtocolViolation]):
     """The C twin of :class:`Ad7927Model` (csrc/host/ad7927_model.c).
 
     Same arguments and behaviour; violations are latched (:meth:`violation`)
     and raised by :class:`Ad7927` after the driver call. ``trace_capacity``
     pin events and ``frames_capacity`` frames are recorded (0 = none).
     """
+
+    _SET_INPUTS = ("ad7927m_set_inputs", 8, "VIN")
+    _SIGNALS = SIGNALS
+    _RULES = RULES
+    _VIOLATION = ProtocolViolation
 
     def __init__(self, inputs: Sequence[float] | np.ndarray = (), *, refin: float = 2.5,
                  powerup_control: int = POWERUP_CONTROL, powerup_shadow: bool = True,
@@ -140,33 +145,13 @@ class CTwin:
         self._m.frames, self._m.frames_cap = self._frames, int(frames_capacity)
         self.set_inputs(inputs)
 
-    def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        v = check_inputs(inputs, 8, "VIN")
-        st = self._lib.ad7927m_set_inputs(self._m, self._ffi.cast("double *", v.ctypes.data), v.size)
-        raise_for_status(st, "CTwin.set_inputs(inputs)")
-
     def hal(self, kind: Hal) -> Any:
         """The model's ad7927_hal of that kind (the C driver points at it)."""
         return self._ffi.addressof(self._m, "frame_hal" if _check_hal(kind) else "pin_hal")
 
     @property
-    def trace(self) -> list[tuple[int, str, int]]:
-        return _capi.twin_trace(self._m)
-
-    @property
     def frames(self) -> list[Frame]:
         return _capi.frame_log(self._m)
-
-    @property
-    def conversions(self) -> int:
-        return int(self._m.conversions)
-
-    @property
-    def t(self) -> int:
-        return int(self._m.t)
-
-    def violation(self) -> ProtocolViolation | None:
-        return _capi.twin_violation(self._ffi, self._m)
 
 
 class Ad7927:

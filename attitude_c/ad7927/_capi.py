@@ -6,12 +6,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from .. import _devmodel
 from .._bridge import Bridge
 from .._lib import ffi_lib
 from ..errors import DeviceError
 from ._errors import AddressMismatch, FrameError
-from .model import RULES, SIGNALS, Frame, ProtocolViolation
+from .model import Frame, ProtocolViolation
 
 __all__ = [
     "STATUS",
@@ -19,8 +18,6 @@ __all__ = [
     "frame_log",
     "python_hal",
     "register",
-    "twin_trace",
-    "twin_violation",
 ]
 
 _registered: set[str] = set()
@@ -98,15 +95,6 @@ STATUS: dict[str, tuple[type[Exception], str]] = {
     "AD7927_E_TRANSFER": (DeviceError, "the frame-transfer HAL failed"),
     "AD7927M_E_VIOLATION": (ProtocolViolation, "protocol violation"),
 }
-
-
-def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
-    """The C twin's latched violation as a ProtocolViolation (or None)."""
-    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
-
-
-def twin_trace(m: Any) -> list[tuple[int, str, int]]:
-    return _devmodel.twin_trace(m, SIGNALS)
 
 
 def frame_log(m: Any) -> list[Frame]:

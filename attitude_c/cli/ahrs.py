@@ -15,14 +15,13 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from .._io import write_with
 from .options import positive
 
 #: ``attitude ahrs`` exit statuses (docs/ahrs.md, "Command").
@@ -112,17 +111,6 @@ def _read(path: Path, rate: float | None) -> dict[str, Any]:
     return _read_csv(path, rate)
 
 
-def _write_atomic(path: Path, writer: Any) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        writer(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def _plot(path: Path, t: np.ndarray, angles: tuple[np.ndarray, ...], title: str) -> None:
     import matplotlib
 
@@ -138,7 +126,7 @@ def _plot(path: Path, t: np.ndarray, angles: tuple[np.ndarray, ...], title: str)
     ax.grid(alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    _write_atomic(path, lambda tmp: fig.savefig(tmp, format="png", dpi=100))
+    write_with(path, lambda tmp: fig.savefig(tmp, format="png", dpi=100))
     plt.close(fig)
 
 
@@ -178,7 +166,7 @@ def _main(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else Path("results") / f"ahrs-{path.stem}"
     out.mkdir(parents=True, exist_ok=True)
     table = np.column_stack([rec["t"], q, e])
-    _write_atomic(out / "attitude.csv", lambda tmp: np.savetxt(
+    write_with(out / "attitude.csv", lambda tmp: np.savetxt(
         tmp, table, delimiter=",", fmt="%.9g", header="t,qw,qx,qy,qz,yaw_deg,pitch_deg,roll_deg", comments=""))
     summary: dict[str, Any] = {"file": str(path), "samples": len(q), "rate_hz": float(rec["rate"]),
                                "six_axis": mag is None, "precision": args.precision, "settings": settings,
@@ -188,7 +176,7 @@ def _main(args: argparse.Namespace) -> int:
         figs = broad.errors(q, rec["ref"], rec["movement"])
         summary["errors_deg"] = figs.as_dict()
         summary["errors_over"] = "movement phases" if rec["movement"] is not None else "all samples"
-        _write_atomic(out / "errors.json", lambda tmp: Path(tmp).write_text(json.dumps(summary, indent=2) + "\n"))
+        write_with(out / "errors.json", lambda tmp: Path(tmp).write_text(json.dumps(summary, indent=2) + "\n"))
         written.append("errors.json")
         if not args.no_plots:
             _plot(out / "errors.png", rec["t"], broad.error_angles(q, rec["ref"]),

@@ -10,7 +10,8 @@ import signal
 import sys
 import threading
 from collections.abc import Iterator
-from typing import Any
+from types import SimpleNamespace
+from typing import Any, Callable
 
 from ..errors import AttitudeError
 from . import options
@@ -61,23 +62,25 @@ BLOCK_SIZE = integer("--block-size", 1, 64)
 TICKS_MS = (1, 32767)  # link timeouts: 1..32767 ticks of 1 ms
 
 
-def _add_common(p: argparse.ArgumentParser) -> None:
+def _add_common(p: argparse.ArgumentParser, auto: bool = False) -> None:
     p.add_argument("--port", required=True, help="device or pyserial URL (/dev/ttyS1, socket://host:port, ...)")
     p.add_argument("--baud", type=BAUD, default=9600, help="line rate (default 9600, 8N1)")
     p.add_argument("--block-size", type=BLOCK_SIZE, default=6, help="data bytes per block N (1..64, default 6)")
     p.add_argument("--impl", choices=("c", "python"), default="c", help="protocol end: the C machine or the Python one")
-    _add_protocol(p)
+    _add_protocol(p, auto)
 
 
-def _add_protocol(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--protocol", choices=("legacy", "v2"), default="legacy",
+def _add_protocol(p: argparse.ArgumentParser, auto: bool = False) -> None:
+    p.add_argument("--protocol", choices=("legacy", "v2", "auto") if auto else ("legacy", "v2"), default="legacy",
                    help="legacy: the paper's AA/BB handshake (default); v2: the streaming protocol "
-                        "(CRC-32C, windowed acknowledgements; 6-byte records, --block-size ignored)")
+                        "(CRC-32C, windowed acknowledgements; 6-byte records, --block-size ignored)"
+                        + ("; auto: whichever the sender speaks (the first valid v2 frame or legacy block "
+                           "whose records decode names it, and is answered: nothing lost)" if auto else ""))
 
 
 def register(sub: Any) -> None:
     p = sub.add_parser("link-rx", help="receiver B on a serial port: print accepted blocks as hex")
-    _add_common(p)
+    _add_common(p, auto=True)
     p.add_argument("--count", type=integer("--count", 1), default=None, help="stop after N accepted blocks")
     p.add_argument("--gap-timeout-ms", type=integer("--gap-timeout-ms", *TICKS_MS), default=20,
                    help="max gap inside a block (ms, 1..32767)")
@@ -180,11 +183,12 @@ def cmd_rx(args: argparse.Namespace) -> int:
     if args.protocol == "v2":
         return _rx2(args)
 
-    if args.decode:
+    if args.decode or args.protocol == "auto":
         from ..link import block
 
         if args.block_size % block.fmt().size:
-            print(f"link-rx: --decode needs a block size that is a multiple of {block.fmt().size} (records "
+            what = "--decode" if args.decode else "--protocol auto"
+            print(f"link-rx: {what} needs a block size that is a multiple of {block.fmt().size} (records "
                   f"of the block format), got {args.block_size}", file=sys.stderr)
             return 2
     stop = _stop_on_signals()
@@ -200,8 +204,10 @@ def cmd_rx(args: argparse.Namespace) -> int:
     if args.decode:
         show = _block_printer()
 
-    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl})",
-          file=sys.stderr, flush=True)
+    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl}"
+          + (", legacy or link v2" if args.protocol == "auto" else "") + ")", file=sys.stderr, flush=True)
+    if args.protocol == "auto":
+        return _rx_auto(args, port, show, stop)
 
     try:
         rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
@@ -401,6 +407,49 @@ def _rx2(args: argparse.Namespace) -> int:
     try:
         rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
                             stop=stop, eof_after=args.idle_eof, keep_records=False)
+    finally:
+        port.close()
+    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
+    if rep.error:
+        print(f"link-rx: {rep.error}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None], stop: threading.Event) -> int:
+    """link-rx --protocol auto: listen_auto, then the receiver of the protocol heard."""
+    import time
+
+    from ..link.transport import run_receiver
+    from ..link.transport2 import listen_auto, run_receiver2
+
+    t0 = time.monotonic()
+
+    def left() -> float | None:
+        return None if args.duration is None else max(1e-3, args.duration - (time.monotonic() - t0))
+
+    try:
+        heard = listen_auto(port, impl=args.impl, block_size=args.block_size, gap_timeout_ms=args.gap_timeout_ms,
+                            on_block=show, on_record=show, stop=stop, duration=args.duration,
+                            eof_after=args.idle_eof)
+        if heard.protocol == "legacy":
+            print("link-rx: the sender speaks the legacy protocol", file=sys.stderr, flush=True)
+            rep: Any = run_receiver(heard.port, receiver=heard.legacy, count=args.count, duration=left(),
+                                    on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+        elif heard.protocol == "v2":
+            print("link-rx: the sender speaks link v2", file=sys.stderr, flush=True)
+            count = None if args.count is None else args.count - heard.records
+            if count is not None and count <= 0:
+                rep = SimpleNamespace(stats=heard.v2.stats.as_dict(), ended_by="count", error="")
+            else:
+                rep = run_receiver2(heard.port, impl=args.impl, receiver=heard.v2, count=count, duration=left(),
+                                    on_record=show, stop=stop, eof_after=args.idle_eof, keep_records=False)
+        else:
+            rep = SimpleNamespace(stats={"legacy": heard.legacy.stats.as_dict(), "v2": heard.v2.stats.as_dict()},
+                                  ended_by=heard.ended_by + ", no protocol heard", error=heard.error)
+    except AttitudeError as exc:
+        print(f"link-rx: {exc}", file=sys.stderr)
+        return 2
     finally:
         port.close()
     print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)

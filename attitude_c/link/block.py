@@ -62,6 +62,7 @@ class Format:
     baud_unit: int     #: BOOT baud_div unit
     oversample_max: int  #: largest OVERSAMPLE n
     sum_max: int       #: largest word of an oversampled sample
+    boot_link2: int    #: BOOT period word: the flag of a link v2 board
     kinds: dict[int, Kind] = field(repr=False)  #: C kind value -> name
     errors: dict[int, str] = field(repr=False)  #: C status -> what it means
 
@@ -88,7 +89,7 @@ def fmt() -> Format:
                       version=lib.ATT_BLOCK_VERSION, tick_hz=lib.ATT_BLOCK_TICK_HZ,
                       period_max=lib.ATT_BLOCK_PERIOD_MAX, baud_unit=lib.ATT_BLOCK_BAUD_UNIT,
                       oversample_max=lib.ATT_BLOCK_OVERSAMPLE_MAX, sum_max=lib.ATT_BLOCK_SUM_MAX,
-                      kinds=kinds, errors=errors)
+                      boot_link2=lib.ATT_BLOCK_BOOT_LINK2, kinds=kinds, errors=errors)
     return _fmt
 
 
@@ -115,6 +116,7 @@ class Record:
     bad_code: int = 0      #: selftest: code read from the failed test input
     attempt: int = 0       #: selftest: attempt number
     oversample: int = 0    #: oversample: conversions summed per word of the samples that follow
+    link: Literal["legacy", "v2"] = "legacy"  #: boot: the board's link protocol (top bit of the period word)
 
     @property
     def is_report(self) -> bool:
@@ -137,6 +139,8 @@ class Record:
         if self.kind == "boot":
             out.update(version=self.version, period_ticks=self.period_ticks, period_s=self.period_s,
                        baud=self.baud)
+            if self.link != "legacy":  # (a legacy BOOT keeps the fields attitude-rx prints)
+                out["link"] = self.link
         elif self.kind == "selftest":
             out.update(status=self.status, bad_code=self.bad_code, attempt=self.attempt)
         elif self.kind == "oversample":
@@ -186,7 +190,7 @@ def _record(b: bytes, out: Any) -> Record | None:
     return Record(kind=kind, raw=b, codes=(out.code[0], out.code[1], out.code[2]), first=out.first,
                   count=out.count, period_ticks=out.period_ticks, baud=out.baud_div * fmt().baud_unit,
                   version=out.version, status=out.status, bad_code=out.bad_code, attempt=out.attempt,
-                  oversample=out.oversample)
+                  oversample=out.oversample, link="v2" if out.link == 2 else "legacy")
 
 
 def decode(raw: Bytes, index: int | None = None) -> Record:
@@ -232,14 +236,18 @@ def encode_sample(codes: Sequence[int]) -> bytes:
     return _encode("att_block_encode_sample", ffi.new("uint16_t[3]", c))
 
 
-def encode_boot(period_ticks: int, baud: int) -> bytes:
-    """BOOT: the sampling period in ticks of 1/3600 s and the line rate (a multiple of 1200)."""
+def encode_boot(period_ticks: int, baud: int, link: Literal["legacy", "v2"] = "legacy") -> bytes:
+    """BOOT: the sampling period in ticks of 1/3600 s, the line rate (a multiple of 1200) and
+    the board's link protocol (``"v2"`` sets the top bit of the period word)."""
     _check("period_ticks", period_ticks, 1, fmt().period_max)
     u = fmt().baud_unit
     _check("baud", baud, u, 255 * u)
     if baud % u:
         raise InvalidArgument(f"baud must be a multiple of {u}, got {baud}")
-    return _encode("att_block_encode_boot", period_ticks, baud // u)
+    if link not in ("legacy", "v2"):
+        raise InvalidArgument(f"link must be 'legacy' or 'v2', got {link!r}")
+    flag = fmt().boot_link2 if link == "v2" else 0
+    return _encode("att_block_encode_boot", period_ticks | flag, baud // u)
 
 
 def encode_selftest(status: int, bad_code: int, attempt: int) -> bytes:

@@ -56,12 +56,13 @@ def _impl(impl: str) -> None:
 def run_receiver2(port: Any, *, impl: Impl = "c", count: int | None = None, duration: float | None = None,
                   on_record: Callable[[bytes], None] | None = None, room: Callable[[], int] | None = None,
                   stop: threading.Event | None = None, eof_after: float | None = None,
-                  keep_records: bool = True) -> Receiver2Report:
+                  keep_records: bool = True, receiver: Any = None) -> Receiver2Report:
     """Run receiver B until ``count`` records, ``duration`` s, ``stop`` or ``eof_after`` s of
     silence. ``room()`` says how many records the caller can take now (default: always
-    room); every record handed to ``on_record`` is acknowledged, none other."""
+    room); every record handed to ``on_record`` is acknowledged, none other. ``receiver``:
+    a receiver to go on with (:func:`listen_auto`'s), default a new one of ``impl``."""
     _impl(impl)
-    rx: Any = CReceiver2() if impl == "c" else Receiver2()
+    rx: Any = receiver if receiver is not None else (CReceiver2() if impl == "c" else Receiver2())
     rep = Receiver2Report()
     t_end = None if duration is None else time.monotonic() + duration
     last = time.monotonic()
@@ -178,3 +179,137 @@ def run_sender2(port: Any, records: Iterable[bytes], *, impl: Impl = "c", rto_ms
     rep.acknowledged = rep.pushed - tx.pending
     rep.stats = tx.stats.as_dict()
     return rep
+
+
+# ---- --protocol auto: which protocol does the board speak? ----
+
+@dataclass
+class Heard:
+    """What :func:`listen_auto` heard. ``protocol`` "legacy" or "v2" (``""``: the listening
+    ended first, ``ended_by`` says why); ``legacy`` / ``v2``: the two receivers, to go on with
+    (``run_receiver(..., receiver=heard.legacy)`` / ``run_receiver2(..., receiver=heard.v2)``)
+    on ``heard.port``, which hands out first the bytes read after the deciding one."""
+
+    protocol: str
+    legacy: Any
+    v2: Any
+    port: Any
+    records: int = 0  # v2 records handed to on_record while listening (0 unless a SYN came first)
+    ended_by: str = ""
+    error: str = ""
+
+
+class _Prefixed:
+    """``port`` whose reads return ``data`` first (what was read past the deciding byte)."""
+
+    def __init__(self, port: Any, data: bytes) -> None:
+        self.port = port
+        self.data = bytearray(data)
+        self.name = getattr(port, "name", port)
+
+    @property
+    def timeout(self) -> Any:
+        return self.port.timeout
+
+    @timeout.setter
+    def timeout(self, value: Any) -> None:
+        self.port.timeout = value
+
+    @property
+    def in_waiting(self) -> int:
+        return len(self.data) if self.data else int(getattr(self.port, "in_waiting", 0))
+
+    def read(self, n: int = 1) -> bytes:
+        if self.data:
+            out = bytes(self.data[:n])
+            del self.data[:n]
+            return out
+        return bytes(self.port.read(n))
+
+    def write(self, data: bytes) -> Any:
+        return self.port.write(data)
+
+    def flush(self) -> None:
+        self.port.flush()
+
+
+def _decodes(block: bytes) -> bool:
+    """Every 6-byte record of a legacy block decodes alone (attitude/block.h)."""
+    from .block import try_decode
+
+    return all(try_decode(block[k:k + RECORD])[1] == 0 for k in range(0, len(block) - RECORD + 1, RECORD))
+
+
+def listen_auto(port: Any, *, impl: Impl = "c", block_size: int = 6, gap_timeout_ms: int = 20,
+                on_block: Callable[[bytes], None] | None = None,
+                on_record: Callable[[bytes], None] | None = None, stop: threading.Event | None = None,
+                duration: float | None = None, eof_after: float | None = None) -> Heard:
+    """Feed every byte to a legacy receiver (answering it) and a link v2 receiver until one hears
+    its protocol: a valid v2 frame (answered here: a SYN's SYNACK, a DATA frame's F_NOSESSION,
+    so the sender sends its records again), or a legacy block whose records all decode
+    (handed to ``on_block`` and acknowledged here). A legacy block that does not decode (a v2
+    frame's bytes pass the 8-bit sum 1 time in 256) is handed to ``on_block`` as the legacy
+    link would, and decides nothing. As attitude-rx ``--link auto`` (docs/link.md)."""
+    from .cends import make_receiver
+    from .protocol import Result
+    from .transport import _drain
+
+    _impl(impl)
+    old = make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout_ms)
+    new: Any = CReceiver2() if impl == "c" else Receiver2()
+    new.set_room(0xFFFF)
+    clock = _Clock()
+    t_end = None if duration is None else time.monotonic() + duration
+    last = time.monotonic()
+    heard = Heard("", old, new, port)
+    try:
+        while True:
+            if stop is not None and stop.is_set():
+                heard.ended_by = "stop"
+                return heard
+            if t_end is not None and time.monotonic() >= t_end:
+                heard.ended_by = "duration"
+                return heard
+            data = _read(port, 0.01)
+            now = time.monotonic()
+            if data:
+                last = now
+            elif eof_after is not None and now - last > eof_after:
+                heard.ended_by = "eof"
+                return heard
+            tick = clock()
+            out = bytearray()
+            for i, b in enumerate(data):
+                st = new.sink(b)
+                if st in (Result2.FRAME, Result2.DELIVERED):
+                    heard.protocol = "v2"
+                    for rec in (new.delivered if st == Result2.DELIVERED else []):
+                        heard.records += 1
+                        if on_record is not None:
+                            on_record(rec)
+                    while True:
+                        r, o = new.poll()
+                        if r != Result2.SEND or o is None:
+                            break
+                        out.append(o)
+                elif old.sink(b, tick) is Result.ACCEPTED:
+                    blk = bytes(old.block)
+                    if on_block is not None:
+                        on_block(blk)
+                    if _decodes(blk):
+                        heard.protocol = "legacy"
+                    _drain(old, tick, out)
+                else:
+                    _drain(old, tick, out)
+                if heard.protocol:
+                    heard.port = _Prefixed(port, bytes(data[i + 1:]))
+                    break
+            if not heard.protocol:
+                _drain(old, tick, out)  # a timeout's answer
+            if out:
+                _write(port, bytes(out))
+            if heard.protocol:
+                return heard
+    except LinkError as exc:
+        heard.ended_by, heard.error = "error", str(exc)
+        return heard

@@ -10,9 +10,8 @@ import contextlib
 import csv
 import json
 import math
-from collections.abc import Iterator
 from pathlib import Path
-from typing import IO, Any, Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -22,18 +21,12 @@ __all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "sens
            "write_run"]
 
 
-def _replacing(path: Path) -> contextlib.AbstractContextManager[Path]:
+def _atomic(path: Path) -> contextlib.AbstractContextManager[Path]:
     """A temporary path beside ``path``, fsynced and renamed onto it when the
     block succeeds, removed when it fails (attitude_c._io.atomic_path)."""
     from .._io import atomic_path
 
     return atomic_path(path)
-
-
-@contextlib.contextmanager
-def _open_replacing(path: Path) -> Iterator[IO[str]]:
-    with _replacing(path) as tmp, open(tmp, "w", newline="") as fh:
-        yield fh
 
 
 def to_jsonable(x: Any) -> Any:
@@ -60,6 +53,14 @@ def _plt():
     return plt
 
 
+def _save(plt: Any, fig: Any, path: Path, dpi: int) -> None:
+    """Save ``fig`` as PNG to ``path`` as it is (the caller makes the write atomic) and close it."""
+    try:
+        fig.savefig(path, dpi=dpi, format="png")
+    finally:
+        plt.close(fig)
+
+
 def _title(res: SimResult) -> str:
     c = res.config
     est = c.method if c.estimator == "integrator" else c.estimator
@@ -68,7 +69,13 @@ def _title(res: SimResult) -> str:
 
 
 def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
-    """Heading, pitch and roll error curves, one panel each (paper Fig. 8 style)."""
+    """Heading, pitch and roll error curves, one panel each (paper Fig. 8 style), to ``path``
+    complete or not at all."""
+    with _atomic(path) as tmp:
+        _draw_errors(res, tmp, dpi)
+
+
+def _draw_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 7.0), sharex=True)
     series = [("a. heading error", res.err_heading, "heading"),
@@ -88,13 +95,17 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Attitude error curves — " + _title(res), fontsize=9.5)
     fig.tight_layout()
-    with _replacing(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png")
-    plt.close(fig)
+    _save(plt, fig, path, dpi)
 
 
 def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
-    """The attitude itself: truth and computed yaw, pitch, roll (degrees)."""
+    """The attitude itself: truth and computed yaw, pitch, roll (degrees), to ``path``
+    complete or not at all."""
+    with _atomic(path) as tmp:
+        _draw_attitude(res, tmp, dpi)
+
+
+def _draw_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
     c = res.config
@@ -111,16 +122,21 @@ def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Attitude — " + _title(res), fontsize=9.5)
     fig.tight_layout()
-    with _replacing(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png")
-    plt.close(fig)
+    _save(plt, fig, path, dpi)
 
 
 def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
     """The filter's gyro-bias estimate per body axis (°/s) beside the bias the
-    estimator's rates actually carry (their mean minus the true rates' over the run)."""
+    estimator's rates actually carry (their mean minus the true rates' over the run),
+    to ``path`` complete or not at all."""
     if res.bias is None or res.bias_t is None:
         raise ValueError("plot_bias: the run has no filter bias estimate (estimator 'integrator')")
+    with _atomic(path) as tmp:
+        _draw_bias(res, tmp, dpi)
+
+
+def _draw_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
+    assert res.bias is not None and res.bias_t is not None
     plt = _plt()
     fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
     resid = res.summary.get("estimator", {}).get("bias_residual_rad_s")
@@ -134,13 +150,17 @@ def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
     axes[-1].set_xlabel("t / s")
     fig.suptitle("Gyro bias estimate — " + _title(res), fontsize=9.5)
     fig.tight_layout()
-    with _replacing(path) as tmp:
-        fig.savefig(tmp, dpi=dpi, format="png")
-    plt.close(fig)
+    _save(plt, fig, path, dpi)
 
 
 def write_csv(res: SimResult, path: Path) -> None:
-    with _open_replacing(path) as fh:
+    """timeseries.csv (one row per update) to ``path`` complete or not at all."""
+    with _atomic(path) as tmp:
+        _write_csv(res, tmp)
+
+
+def _write_csv(res: SimResult, path: Path) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(["t_s", "yaw_true", "pitch_true", "roll_true", "yaw_est", "pitch_est", "roll_est",
                     "err_yaw", "err_pitch", "err_roll", "err_heading", "err_angle",
@@ -189,8 +209,14 @@ def sensor_rows(res: SimResult) -> tuple[list[str], np.ndarray]:
 
 
 def write_sensors_csv(res: SimResult, path: Path) -> None:
+    """sensors.csv (:func:`sensor_rows`) to ``path`` complete or not at all."""
+    with _atomic(path) as tmp:
+        _write_sensors_csv(res, tmp)
+
+
+def _write_sensors_csv(res: SimResult, path: Path) -> None:
     head, rows = sensor_rows(res)
-    with _open_replacing(path) as fh:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(head)
         for r in rows:
@@ -286,14 +312,17 @@ def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
             files["bias_png"] = out / "bias.png"
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
-    steps: list[tuple[Path, Callable[[Path], object]]] = [(files["csv"], lambda p: write_csv(res, p))]
+    # write_results gives each writer the temporary path it renames into place: the writers
+    # write to it as it is (one temporary file and one rename per result file)
+    steps: list[tuple[Path, Callable[[Path], object]]] = [(files["csv"], lambda p: _write_csv(res, p))]
     if res.aux:
-        steps.append((files["sensors_csv"], lambda p: write_sensors_csv(res, p)))
+        steps.append((files["sensors_csv"], lambda p: _write_sensors_csv(res, p)))
     if plots:
-        steps += [(files["errors_png"], lambda p: plot_errors(res, p)),
-                  (files["attitude_png"], lambda p: plot_attitude(res, p))]
+        steps += [(files["errors_png"], lambda p: _draw_errors(res, p)),
+                  (files["attitude_png"], lambda p: _draw_attitude(res, p))]
         if res.bias is not None:
-            steps.append((files["bias_png"], lambda p: plot_bias(res, p)))
-    steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n")))
+            steps.append((files["bias_png"], lambda p: _draw_bias(res, p)))
+    steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n",
+                                                            encoding="utf-8")))
     write_results(steps)
     return files

@@ -49,6 +49,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .._io import write_with
 from ..core import Method, Precision
 from ..errors import InvalidArgument
 
@@ -779,16 +780,6 @@ class _Lock:
         self.f.close()
 
 
-def _atomic(path: Path, write: Callable[[Path], None]) -> None:
-    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-
-
 # ---------------------------------------------------------------------------
 # execution
 # ---------------------------------------------------------------------------
@@ -1025,7 +1016,7 @@ def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
 
         def save(p: Path, fig: Any = fig) -> None:
             fig.savefig(p, dpi=100)
-        _atomic(path, save)
+        write_with(path, save)
         plt.close(fig)
         files.append(path)
     return files
@@ -1066,7 +1057,7 @@ def sweep(spec: Spec | str | os.PathLike[str] | Mapping[str, Any], client: Any =
 
             def put(p: Path) -> None:
                 p.write_text(text)
-            _atomic(folder / "spec.toml", put)
+            write_with(folder / "spec.toml", put)
         return _sweep_locked(sp, folder, client, workers, progress, retry_failed, plots)
     finally:
         lock.release()
@@ -1116,9 +1107,9 @@ def _sweep_locked(sp: Spec, folder: Path, client: Any, workers: int | None,
         bar.close()
 
     df = results_table(sp, records)
-    _atomic(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
+    write_with(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
     summ = summarize(df, sp)
-    _atomic(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
+    write_with(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
     files = plot_results(df, sp, folder) if plots else []
     df.attrs.update(plots=[str(f) for f in files])
     df.attrs.update(executed=executed, reused=reused, failed=int((df["error"] != "").sum()), out=str(folder),

@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._devmodel import check_inputs, check_level, convert_in_chunks
+from .._devmodel import CTwinBase, check_level, convert_in_chunks
 from ..errors import (
     DeviceError,
     DeviceTimeout,
@@ -88,13 +88,18 @@ def _check_length(length: int) -> int:
     return int(length)
 
 
-class CTwin:
+class CTwin(CTwinBase[ProtocolViolation]):
     """The C twin of :class:`Tlc2543Model` (csrc/host/tlc2543_model.c).
 
     Same arguments and behaviour; violations are latched (``violation``)
     and raised by :class:`Tlc2543` after the driver call. ``trace_capacity``
     events are recorded (0 = none).
     """
+
+    _SET_INPUTS = ("tlc2543m_set_inputs", 11, "AIN")
+    _SIGNALS = SIGNALS
+    _RULES = RULES
+    _VIOLATION = ProtocolViolation
 
     def __init__(self, inputs: Sequence[float] | np.ndarray = (), *, vref_plus: float = 5.0,
                  vref_minus: float = 0.0, stuck_eoc: int | None = None,
@@ -114,29 +119,10 @@ class CTwin:
         self._m.trace_cap = int(trace_capacity)
         self.set_inputs(inputs)
 
-    def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        v = check_inputs(inputs, 11, "AIN")
-        st = self._lib.tlc2543m_set_inputs(self._m, self._ffi.cast("double *", v.ctypes.data), v.size)
-        raise_for_status(st, "CTwin.set_inputs(inputs)")
-
     @property
     def hal(self) -> Any:
         return self._ffi.addressof(self._m, "hal")
 
-    @property
-    def trace(self) -> list[tuple[int, str, int]]:
-        return _capi.twin_trace(self._m)
-
-    @property
-    def conversions(self) -> int:
-        return int(self._m.conversions)
-
-    @property
-    def t(self) -> int:
-        return int(self._m.t)
-
-    def violation(self) -> ProtocolViolation | None:
-        return _capi.twin_violation(self._ffi, self._m)
 
 
 class Tlc2543:

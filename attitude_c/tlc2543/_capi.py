@@ -5,12 +5,10 @@ from __future__ import annotations
 
 from typing import Any
 
-from .. import _devmodel
 from .._bridge import Bridge
 from .._lib import ffi_lib
-from .model import RULES, SIGNALS, ProtocolViolation
 
-__all__ = ["Bridge", "python_hal", "register", "twin_trace", "twin_violation"]
+__all__ = ["Bridge", "python_hal", "register"]
 
 _registered: set[str] = set()
 
@@ -62,12 +60,3 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge) -> tuple[Any, Any]:
     hal.get_eoc = lib.tlc2543py_get_eoc
     hal.delay_ns = lib.tlc2543py_delay_ns
     return hal, handle
-
-
-def twin_violation(ffi: Any, m: Any) -> ProtocolViolation | None:
-    """The C twin's latched violation as a ProtocolViolation (or None)."""
-    return _devmodel.twin_violation(ffi, m, RULES, ProtocolViolation)  # type: ignore[return-value]
-
-
-def twin_trace(m: Any) -> list[tuple[int, str, int]]:
-    return _devmodel.twin_trace(m, SIGNALS)

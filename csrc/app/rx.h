@@ -75,11 +75,12 @@ typedef struct {
     double consumer_delay; /* s the attitude thread sleeps per sample (diagnostics/tests) */
     double reopen_delay;   /* s between attempts to reopen a port that went away */
     int header;            /* print the CSV header line */
-    int link;              /* RX_LINK_LEGACY (default), RX_LINK_V2, RX_LINK_AUTO */
+    int link;              /* RX_LINK_AUTO (default), RX_LINK_V2, RX_LINK_LEGACY */
 } rx_config;
 
 /* Link protocols (--link): the paper's handshake, link v2 (attitude/link2.h), or
- * whichever is heard first (legacy: an accepted block; v2: a valid frame). */
+ * whichever is heard first (legacy: an accepted block whose records decode;
+ * v2: a valid frame), the default. */
 enum {
     RX_LINK_LEGACY = 0,
     RX_LINK_V2 = 1,
@@ -88,7 +89,7 @@ enum {
 
 /* Defaults: 9600 baud, period 0.02 s (RX_PERIOD_DEFAULT), zero 2048,
  * scale = 90 deg/s per 2048 codes, axes x,y,z, rv3, CSV, N = 6, queue 256,
- * gap 20 ms, hold 20 ms. */
+ * gap 20 ms, hold 20 ms, link auto. */
 void rx_config_defaults(rx_config *c);
 
 /* Parse argv with getopt_long (and the --config files it names, whose

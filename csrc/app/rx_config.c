@@ -69,6 +69,7 @@ void rx_config_defaults(rx_config *c)
     c->hold_ms = RX_HOLD_MS_DEFAULT;
     c->reopen_delay = 1.0;
     c->header = 1;
+    c->link = RX_LINK_AUTO;
 }
 
 int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t len)
@@ -480,9 +481,10 @@ void rx_usage(const char *prog, void *stream)
 {
     fprintf((FILE *)stream,
             "usage: %s --port PATH [options]\n"
-            "Receive gyro samples and reports over the serial link (AA/BB handshake, checksum, 00/FF\n"
-            "answer; block format of attitude/block.h), integrate the attitude in a second thread, print\n"
-            "one line per attitude update (and, with --format jsonl, one record per report).\n\n"
+            "Receive gyro samples and reports over the serial link (link v2, or the legacy AA/BB\n"
+            "handshake with checksum and 00/FF answer: whichever the board speaks; block format of\n"
+            "attitude/block.h), integrate the attitude in a second thread, print one line per attitude\n"
+            "update (and, with --format jsonl, one record per report).\n\n"
             "  --port PATH              serial device (required)\n"
             "  --baud N                 line rate, default 9600 (8N1 raw)\n"
             "  --period SECONDS         gyro sample period; default: the one the BOOT report announces\n"
@@ -492,18 +494,20 @@ void rx_usage(const char *prog, void *stream)
             "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
             "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4, default rv3\n"
             "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
-            "  --block-size N           link block bytes (multiple of 6), default 6\n"
+            "  --block-size N           legacy link block bytes (multiple of 6), default 6\n"
             "  --queue N                records the inter-thread queue holds, default 256\n"
-            "  --gap-ms MS              link gap timeout inside a block, default 20\n"
-            "  --link P                 legacy (AA/BB handshake, default), v2 (link v2) or auto\n"
-            "  --hold-ms MS             a block that finds the queue full waits this long for room\n"
-            "                           before it is answered 0xFF (send again), default 20\n"
+            "  --gap-ms MS              legacy link gap timeout inside a block, default 20\n"
+            "  --link P                 auto (default: the protocol the board speaks, detected from\n"
+            "                           its first valid v2 frame or legacy block, which is not lost),\n"
+            "                           v2 (link v2) or legacy (AA/BB handshake)\n"
+            "  --hold-ms MS             a legacy block that finds the queue full waits this long for\n"
+            "                           room before it is answered 0xFF (send again), default 20\n"
             "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
             "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
             "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
             "  --config FILE            'name = value' lines with the names above; the command line wins\n"
             "  -h, --help               this text;  --version: the version\n"
-            "A block is acknowledged (0x00) only once its records are queued; every acknowledged\n"
+            "A block (v2: a record) is acknowledged only once its records are queued; every acknowledged\n"
             "sample is integrated and printed, also on --count and SIGINT/SIGTERM. Missing samples\n"
             "(loss reports, bad codes) are filled by holding the last rate and counted\n"
             "(docs/attitude-rx.md).\n"

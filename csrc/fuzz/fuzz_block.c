@@ -82,16 +82,18 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
     zero.kind = b->kind;
     switch (raw[1]) {
     case ATT_BLOCK_BOOT:
-        check(b->version == raw[2] && b->period_ticks == be16(raw + 3) && b->baud_div == raw[5]);
+        check(b->version == raw[2] && b->period_ticks == (be16(raw + 3) & 0x7FFFu) && b->baud_div == raw[5]
+              && b->link == ((raw[3] & 0x80u) ? 2 : 0));
         check(st
-              == ((raw[2] == ATT_BLOCK_VERSION && be16(raw + 3) >= 1 && be16(raw + 3) <= ATT_BLOCK_PERIOD_MAX
-                   && raw[5] != 0)
+              == ((raw[2] == ATT_BLOCK_VERSION && (be16(raw + 3) & 0x7FFFu) >= 1 && raw[5] != 0)
                       ? ATT_OK
                       : ATT_BLOCK_E_FIELD));
         zero.version = b->version;
         zero.period_ticks = b->period_ticks;
         zero.baud_div = b->baud_div;
-        e = att_block_encode_boot(enc, b->period_ticks, b->baud_div);
+        zero.link = b->link;
+        e = att_block_encode_boot(enc, (uint16_t)(b->period_ticks | (b->link ? ATT_BLOCK_BOOT_LINK2 : 0)),
+                                  b->baud_div);
         if (b->version == ATT_BLOCK_VERSION) { /* the encoder writes no other version */
             check(e == st);
         }
@@ -237,10 +239,10 @@ static void check_encode(uint8_t which, const uint8_t *p)
     }
     case 1:
         e = att_block_encode_boot(enc, be16(p), p[2]);
-        check(e
-              == (be16(p) >= 1 && be16(p) <= ATT_BLOCK_PERIOD_MAX && p[2] != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        check(e == ((be16(p) & 0x7FFFu) >= 1 && p[2] != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_BOOT && b.period_ticks == be16(p)
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_BOOT
+                  && b.period_ticks == (be16(p) & 0x7FFFu) && b.link == ((p[0] & 0x80u) ? 2 : 0)
                   && b.baud_div == p[2] && b.version == ATT_BLOCK_VERSION);
         }
         return;

@@ -17,7 +17,7 @@
  * ticks_left is checked by polling copies of A one tick before and at the
  * reported time.
  *
- * Mode 1: arbitrary bytes into B, then into A (ACKs the fuzzer may forge):
+ * Mode 1 (first byte & 3 == 1): arbitrary bytes into B, then into A (ACKs the fuzzer may forge):
  * no out-of-bounds access (ASan), B delivers at most its room and at most
  * one frame's records, A's window bookkeeping stays consistent, and after
  * it all a fresh exchange still works (B takes a SYN and a DATA frame).
@@ -174,13 +174,27 @@ static void hand_out(rig *r)
     }
 }
 
+/* Every other record is built in the ring slot tail() hands out (the 8051's way). */
 static void push_all(rig *r, int n)
 {
     uint8_t rec[6];
+    uint8_t *slot;
     while (n-- > 0 && att_link2_sender_room(&r->a) > 0) {
-        record(r->pushed, rec);
-        CHECK(att_link2_sender_push(&r->a, rec) == ATT_OK);
+        slot = att_link2_sender_tail(&r->a);
+        CHECK(slot != NULL);
+        if (r->pushed & 1u) {
+            record(r->pushed, slot);
+            CHECK(att_link2_sender_push(&r->a, slot) == ATT_OK);
+        } else {
+            record(r->pushed, rec);
+            CHECK(att_link2_sender_push(&r->a, rec) == ATT_OK);
+        }
         r->pushed++;
+    }
+    if (att_link2_sender_room(&r->a) == 0) {
+        CHECK(att_link2_sender_tail(&r->a) == NULL);
+        record(r->pushed, rec);
+        CHECK(att_link2_sender_push(&r->a, rec) == ATT_LINK2_E_FULL);
     }
 }
 
@@ -381,6 +395,341 @@ static void mode_raw(const uint8_t *data, size_t size)
     CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
 }
 
+/* -- mode 3: well-formed frames and ACKs (valid CRC, fuzzer-chosen fields) -- */
+
+/* rCOBS, from docs/link.md: every 0 becomes the count of bytes since the
+ * previous 0 (or the start) plus one, and that count for the tail follows
+ * the last byte. n + 1 bytes out, none 0. */
+static size_t rcobs(const uint8_t *in, size_t n, uint8_t *out)
+{
+    size_t i;
+    uint8_t run = 0;
+    for (i = 0; i < n; i++) {
+        out[i] = in[i] != 0 ? in[i] : (uint8_t)(run + 1u);
+        run = in[i] != 0 ? (uint8_t)(run + 1u) : 0u;
+    }
+    out[n] = (uint8_t)(run + 1u);
+    return n + 1;
+}
+
+/* f[0..n) followed by its CRC-32C, most significant byte first: returns n + 4. */
+static size_t with_crc(uint8_t *f, size_t n)
+{
+    uint32_t crc = att_link2_crc(f, (uint16_t)n);
+    f[n] = (uint8_t)(crc >> 24);
+    f[n + 1] = (uint8_t)(crc >> 16);
+    f[n + 2] = (uint8_t)(crc >> 8);
+    f[n + 3] = (uint8_t)crc;
+    return n + 4;
+}
+
+/* Code m of a DATA payload: nibbles 3m, 3m + 1, 3m + 2 of the nibble stream
+ * (high nibble of each byte first), as the spec packs them. */
+static uint16_t code_at(const uint8_t *payload, unsigned m)
+{
+    uint16_t v = 0;
+    unsigned j;
+    for (j = 3 * m; j < 3 * m + 3; j++) {
+        v = (uint16_t)((v << 4) | ((j & 1u) ? (payload[j / 2] & 0x0Fu) : (payload[j / 2] >> 4)));
+    }
+    return v;
+}
+
+/* The receiver as the spec describes it (docs/link.md), for mode 3's oracle. */
+typedef struct {
+    int synced;
+    uint8_t expected, last_limit;
+    uint16_t room;
+} rx_model;
+
+/* B polled: the ACK the model expects (flags given), or IDLE (flags < 0). */
+static void expect_ack(att_link2_receiver *b, rx_model *m, int flags)
+{
+    uint8_t d[8], want[10], byte;
+    size_t n, i;
+    if (flags < 0) {
+        CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
+        return;
+    }
+    d[0] = (uint8_t)(ATT_LINK2_T_ACK | flags);
+    d[1] = m->synced ? m->expected : 0u;
+    d[2] = m->synced ? (uint8_t)(m->expected + (m->room > 127u ? 127u : m->room)) : 0u;
+    want[0] = 0;
+    n = rcobs(d, with_crc(d, 3), want + 1);
+    CHECK(n == 8);
+    want[9] = 0;
+    for (i = 0; i < 10; i++) {
+        CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_SEND && byte == want[i]);
+    }
+    CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
+    m->last_limit = d[2];
+}
+
+/* Frame f[0..len) (CRC appended here) into B: result, delivery and ACK as the model says. */
+static void frame_to_b(att_link2_receiver *b, rx_model *m, const uint8_t *out, uint8_t *f, size_t len)
+{
+    uint8_t wire[ATT_LINK2_WIRE_MAX + 8];
+    uint8_t h = f[0], seq = f[1], off;
+    size_t n, i;
+    unsigned cnt = 0, k, c;
+    int valid, st, flags;
+    n = rcobs(f, with_crc(f, len), wire);
+    CHECK(att_link2_receiver_sink(b, 0) == ATT_LINK2_NONE);
+    for (i = 0; i < n; i++) {
+        st = att_link2_receiver_sink(b, wire[i]);
+        CHECK(st == (i < ATT_LINK2_WIRE_MAX ? ATT_LINK2_NONE : ATT_LINK2_DISCARDED));
+    }
+    st = att_link2_receiver_sink(b, 0);
+    switch (h & 0xC0u) {
+    case ATT_LINK2_T_DATA:
+        cnt = h & 0x1Fu;
+        valid = len >= 2 && cnt <= ATT_LINK2_SAMPLES_MAX && len == 2 + (9 * cnt + 1) / 2
+                && !((cnt & 1u) && (f[len - 1] & 0x0Fu) != 0);
+        break;
+    case ATT_LINK2_T_RAW:
+        cnt = 1;
+        valid = (h & ~ATT_LINK2_E_BIT) == ATT_LINK2_T_RAW && len == 2 + ATT_LINK2_RECORD;
+        break;
+    case ATT_LINK2_T_SYN:
+        valid = h == ATT_LINK2_T_SYN && len == 2;
+        break;
+    default:
+        valid = 0;
+        break;
+    }
+    if (!valid || len < 2) {
+        CHECK(st == ATT_LINK2_BAD_FRAME);
+        expect_ack(b, m, -1);
+        return;
+    }
+    if (h == ATT_LINK2_T_SYN) {
+        CHECK(st == ATT_LINK2_FRAME);
+        m->synced = 1;
+        m->expected = seq;
+        expect_ack(b, m, ATT_LINK2_F_SYNACK);
+        return;
+    }
+    flags = (h & ATT_LINK2_E_BIT) ? ATT_LINK2_F_EPOCH : 0;
+    off = (uint8_t)(m->expected - seq);
+    if (!m->synced || off > 127u) {
+        CHECK(st == ATT_LINK2_FRAME);
+        expect_ack(b, m, m->synced ? (ATT_LINK2_F_GAP | flags) : ATT_LINK2_F_NOSESSION);
+        return;
+    }
+    k = off >= cnt ? 0u : cnt - off;
+    if (k > m->room) {
+        k = m->room;
+    }
+    if (k == 0) {
+        CHECK(st == ATT_LINK2_FRAME);
+    } else {
+        CHECK(st == ATT_LINK2_DELIVERED && b->n_out == k);
+        for (i = 0; i < k; i++) {
+            for (c = 0; c < 3; c++) {
+                uint16_t v = (h & ATT_LINK2_T_RAW) ? (uint16_t)((f[2 + 2 * c] << 8) | f[3 + 2 * c])
+                                                   : code_at(f + 2, 3 * (off + (unsigned)i) + c);
+                CHECK(out[6 * i + 2 * c] == (uint8_t)(v >> 8) && out[6 * i + 2 * c + 1] == (uint8_t)v);
+            }
+        }
+        m->expected = (uint8_t)(m->expected + k);
+        m->room = (uint16_t)(m->room - k);
+    }
+    expect_ack(b, m, flags);
+}
+
+/* A valid ACK (flags, ack, limit) into A: it never acknowledges what was never sent. */
+static void ack_to_a(att_link2_sender *a, uint8_t flags, uint8_t ack, uint8_t limit, uint16_t t)
+{
+    uint8_t d[8], wire[8];
+    uint8_t base = a->base, hi = a->hi, head = a->head, next = a->next;
+    size_t i;
+    int st;
+    d[0] = (uint8_t)(ATT_LINK2_T_ACK | (flags & 0x0Fu));
+    d[1] = ack;
+    d[2] = limit;
+    CHECK(rcobs(d, with_crc(d, 3), wire) == 8);
+    CHECK(att_link2_sender_sink(a, 0, t) == ATT_LINK2_NONE);
+    for (i = 0; i < 8; i++) {
+        CHECK(att_link2_sender_sink(a, wire[i], t) == ATT_LINK2_NONE);
+    }
+    st = att_link2_sender_sink(a, 0, t);
+    CHECK(st == ATT_LINK2_FRAME || st == ATT_LINK2_BAD_FRAME);
+    CHECK(a->head == head);
+    if (st == ATT_LINK2_BAD_FRAME) { /* acknowledges records never sent: ignored */
+        CHECK((uint8_t)(ack - base) > (uint8_t)(hi - base) && a->base == base && a->hi == hi
+              && a->next == next);
+        return;
+    }
+    if (flags & ATT_LINK2_F_NOSESSION) { /* B lost the session: SYN again at base, ring kept */
+        CHECK(a->base == base && att_link2_sender_ticks_left(a, t) == 0);
+        return;
+    }
+    CHECK(a->base == base || (a->base == ack && (uint8_t)(ack - base) <= (uint8_t)(hi - base)));
+}
+
+/* The calls every unusable or absent sender / receiver must refuse. */
+static void refusals(void)
+{
+    att_link2_sender a;
+    att_link2_sender_config cfg;
+    att_link2_receiver b;
+    uint8_t ring[6], out[ATT_LINK2_OUT_MAX], byte = 0;
+    att_link2_sender_config_init(NULL, 4);
+    att_link2_sender_reset(NULL);
+    att_link2_receiver_reset(NULL);
+    att_link2_receiver_set_room(NULL, 3);
+    CHECK(att_link2_crc(NULL, 3) == 0);
+    CHECK(att_link2_sender_ticks_left(NULL, 0) == ATT_LINK2_NO_TIMER);
+    CHECK(att_link2_sender_room(NULL) == 0 && att_link2_sender_pending(NULL) == 0);
+    CHECK(att_link2_sender_tail(NULL) == NULL);
+    CHECK(att_link2_sender_push(NULL, ring) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_sink(NULL, 1, 0) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_poll(NULL, 0, &byte) == ATT_LINK2_E_NULL);
+    att_link2_sender_config_init(&cfg, 1);
+    CHECK(att_link2_sender_init(NULL, &cfg, ring) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_init(&a, NULL, ring) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_init(&a, &cfg, NULL) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_init(&a, &cfg, ring) == ATT_OK);
+    CHECK(att_link2_sender_push(&a, NULL) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_sender_poll(&a, 0, NULL) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_receiver_init(NULL, out) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_receiver_init(&b, NULL) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_receiver_poll(NULL, &byte) == ATT_LINK2_E_NULL);
+    CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
+    CHECK(att_link2_receiver_poll(&b, NULL) == ATT_LINK2_E_NULL);
+    b.tx_pos = 3; /* past tx_len: corrupted */
+    CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
+    b.tx_pos = 0;
+    b.tx_len = 11; /* longer than tx */
+    CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
+}
+
+/* Mode 3: d[0..3] configure A (any values: out of range ones must be refused
+ * and leave A refusing every call); then ops drive B with well-formed frames
+ * (valid CRC; fields, types and lengths the fuzzer's) checked against a model
+ * of the spec (result, records delivered, the exact ACK), and A with valid
+ * ACKs carrying any flags, ack and limit. */
+static void mode_frames(const uint8_t *data, size_t size)
+{
+    static uint8_t ring[ATT_LINK2_RING_MAX * 6];
+    att_link2_sender a;
+    att_link2_sender_config cfg;
+    att_link2_receiver b;
+    rx_model m;
+    uint8_t out[ATT_LINK2_OUT_MAX], f[ATT_LINK2_FRAME_MAX + 8], rec[6], byte;
+    size_t i = 4, j, len;
+    uint16_t t = 0, room;
+    int a_ok, st;
+    memset(f, 0, sizeof(f));
+    refusals();
+    if (size < 4) {
+        return;
+    }
+    att_link2_sender_config_init(&cfg, data[3]);
+    CHECK(cfg.ring_size == data[3] && cfg.rto == 200 && cfg.max_samples == ATT_LINK2_SAMPLES_DEFAULT);
+    if (data[2] & 0x80u) { /* otherwise the defaults */
+        cfg.rto = (uint16_t)((data[0] << 8) | data[1]);
+        cfg.max_samples = (uint8_t)(data[2] & 0x7Fu);
+    }
+    a_ok = cfg.ring_size >= 1 && cfg.ring_size <= ATT_LINK2_RING_MAX
+           && (cfg.ring_size & (cfg.ring_size - 1)) == 0 && cfg.max_samples >= 1
+           && cfg.max_samples <= ATT_LINK2_SAMPLES_MAX && cfg.rto >= 1 && cfg.rto <= ATT_LINK2_TIMEOUT_MAX;
+    st = att_link2_sender_init(&a, &cfg, ring);
+    CHECK(st == (a_ok ? ATT_OK : ATT_LINK2_E_CONFIG));
+    if (!a_ok) {
+        memset(rec, 0, sizeof(rec));
+        CHECK(att_link2_sender_room(&a) == 0 && att_link2_sender_pending(&a) == 0);
+        CHECK(att_link2_sender_tail(&a) == NULL);
+        CHECK(att_link2_sender_push(&a, rec) == ATT_LINK2_E_STATE);
+        CHECK(att_link2_sender_sink(&a, 0, 0) == ATT_LINK2_E_STATE);
+        CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
+        CHECK(att_link2_sender_ticks_left(&a, 0) == ATT_LINK2_NO_TIMER);
+    }
+    CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
+    memset(&m, 0, sizeof(m));
+    while (i < size) {
+        uint8_t op = data[i++];
+        uint8_t x = i < size ? data[i] : 0u, y = i + 1 < size ? data[i + 1] : 0u;
+        switch (op & 7u) {
+        case 0: /* a frame of x % 111 bytes (before its CRC): those that follow */
+            len = x % (ATT_LINK2_FRAME_MAX - 3u);
+            i++;
+            for (j = 0; j < len; j++) {
+                f[j] = i < size ? data[i++] : 0u;
+            }
+            if (len >= 2 && (op & 0x08u) && (f[0] & 0xC0u) == ATT_LINK2_T_DATA
+                && (f[0] & 0x1Fu) <= ATT_LINK2_SAMPLES_MAX) {
+                f[0] = (uint8_t)(f[0] & 0x3Fu); /* a well-sized DATA frame, more often than by chance */
+                len = 2 + (9u * (f[0] & 0x1Fu) + 1u) / 2u;
+                for (; j < len; j++) {
+                    f[j] = i < size ? data[i++] : 0u;
+                }
+                if (f[0] & 1u) {
+                    f[len - 1] &= 0xF0u;
+                }
+            }
+            frame_to_b(&b, &m, out, f, len);
+            break;
+        case 1: /* room: a window update when it opens a window narrower than a frame */
+            room = (uint16_t)((op >> 3) * x);
+            i++;
+            {
+                uint8_t old = (uint8_t)(m.last_limit - m.expected);
+                uint8_t w = room > 127u ? 127u : (uint8_t)room;
+                att_link2_receiver_set_room(&b, room);
+                m.room = room;
+                expect_ack(&b, &m, (m.synced && old < ATT_LINK2_SAMPLES_MAX && w > old) ? 0 : -1);
+            }
+            break;
+        case 2: /* B reboots */
+            att_link2_receiver_reset(&b);
+            m.synced = 0;
+            m.expected = 0;
+            m.last_limit = 0;
+            expect_ack(&b, &m, -1);
+            break;
+        case 3: /* a stray byte and a delimiter: a bad frame, nothing answered */
+            CHECK(att_link2_receiver_sink(&b, (uint8_t)(op | 1u)) == ATT_LINK2_NONE);
+            CHECK(att_link2_receiver_sink(&b, 0) == ATT_LINK2_BAD_FRAME);
+            expect_ack(&b, &m, -1);
+            break;
+        default:
+            if (!a_ok) {
+                break;
+            }
+            switch (op & 7u) {
+            case 4: /* push (ring full: refused) */
+                memset(rec, x, sizeof(rec));
+                rec[0] = (uint8_t)(op >> 4);
+                i++;
+                room = att_link2_sender_room(&a);
+                CHECK((att_link2_sender_tail(&a) == NULL) == (room == 0));
+                CHECK(att_link2_sender_push(&a, rec) == (room != 0 ? ATT_OK : ATT_LINK2_E_FULL));
+                break;
+            case 5: /* A sends (to nowhere) */
+                for (j = 0; j < 2000
+                            && ((st = att_link2_sender_poll(&a, t, &byte)) == ATT_LINK2_SEND
+                                || st == ATT_LINK2_TIMEOUT);
+                     j++) {
+                }
+                CHECK(st >= 0);
+                break;
+            case 6: /* a valid ACK */
+                ack_to_a(&a, (uint8_t)(op >> 4), x, y, t);
+                i += 2;
+                break;
+            default: /* time passes */
+                t = (uint16_t)(t + (uint16_t)((op >> 3) + 1u) * x);
+                i++;
+                break;
+            }
+            check_ticks_left(&a, t);
+            sender_invariants(&a);
+            break;
+        }
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -388,7 +737,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (size < 2) {
         return 0;
     }
-    if (data[0] & 1u) {
+    if ((data[0] & 3u) == 3u) {
+        mode_frames(data + 1, size - 1);
+    } else if (data[0] & 1u) {
         mode_raw(data + 1, size - 1);
     } else {
         mode_link(data + 1, size - 1);

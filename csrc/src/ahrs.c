@@ -3,6 +3,9 @@
  * filter on top of the rotation-vector integrator. docs/ahrs.md derives
  * every step; attitude_c/ahrs_reference.py is the independent NumPy model.
  */
+#include <stddef.h>
+#include <string.h>
+
 #include "attitude/ahrs.h"
 #include "attitude/aiding.h"
 
@@ -139,6 +142,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
         s->rest_acc[i] = 0;
     }
     set_initial_cov(s);
+    s->step.dt = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -210,35 +214,133 @@ static att_status align(const att_ahrs_settings *set, const att_real acc[3], con
     return st;
 }
 
-/* Scalar update of the error state x with measurement y of x[j]
- * (H = e_j), variance R; the gain is kept only on the states in `mask`
- * (bit i = state i) and P follows the Joseph form for that gain:
- * P ← P − K Pj' − Pj K' + K K' S, S = P[j][j] + R, Pj = column j. */
-static void scalar_update(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R, unsigned mask)
+/* Scalar updates of the error state x with a measurement y of x[j]
+ * (H = e_j), variance R. The gain K = P e_j / S, S = P[j][j] + R, is kept
+ * only on the states the measurement may move (its mask) and P follows
+ * the Joseph form for that gain,
+ *     P ← P − K Pjᵀ − Pj Kᵀ + K Kᵀ S,   Pj = column j,
+ * which is valid for any gain. P is symmetric: the upper triangle is
+ * computed and mirrored. The three masks are written out (no runtime mask,
+ * no work on zero gains): an entry with both states in the mask takes the
+ * full expression; one with state i in the mask and o outside (K_o = 0)
+ * reduces exactly to P_io − K_i Pj_o; one with neither is unchanged. */
+#define GAIN(i)               \
+    do {                      \
+        K[i] = pj[i] / S;     \
+        x[i] += K[i] * innov; \
+    } while (0)
+#define JOSEPH2(r, c)                                                          \
+    do {                                                                       \
+        att_real v_ = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S; \
+        P[r][c] = v_;                                                          \
+        P[c][r] = v_;                                                          \
+    } while (0)
+#define JOSEPH1(i, o)                         \
+    do {                                      \
+        att_real v_ = P[i][o] - K[i] * pj[o]; \
+        P[i][o] = v_;                         \
+        P[o][i] = v_;                         \
+    } while (0)
+#define COLUMN_J()                    \
+    do {                              \
+        int r_;                       \
+        S = P[j][j] + R;              \
+        innov = y - x[j];             \
+        for (r_ = 0; r_ < NX; r_++) { \
+            pj[r_] = P[r_][j];        \
+        }                             \
+    } while (0)
+
+/* Accelerometer (j = 0 or 1): mask δθx, δθy, δb (not δθz = state 2). */
+static void update_acc(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
     att_real pj[NX], K[NX], S, innov;
-    int r, c;
-    S = P[j][j] + R;
-    innov = y - x[j];
-    for (r = 0; r < NX; r++) {
-        pj[r] = P[r][j];
-        K[r] = ((mask >> r) & 1u) ? pj[r] / S : 0;
-        x[r] += K[r] * innov;
-    }
-    for (r = 0; r < NX; r++) {
-        for (c = r; c < NX; c++) {
-            att_real v = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S;
-            P[r][c] = v;
-            P[c][r] = v;
-        }
-    }
+    COLUMN_J();
+    GAIN(0);
+    GAIN(1);
+    GAIN(3);
+    GAIN(4);
+    GAIN(5);
+    JOSEPH2(0, 0);
+    JOSEPH2(0, 1);
+    JOSEPH2(0, 3);
+    JOSEPH2(0, 4);
+    JOSEPH2(0, 5);
+    JOSEPH2(1, 1);
+    JOSEPH2(1, 3);
+    JOSEPH2(1, 4);
+    JOSEPH2(1, 5);
+    JOSEPH2(3, 3);
+    JOSEPH2(3, 4);
+    JOSEPH2(3, 5);
+    JOSEPH2(4, 4);
+    JOSEPH2(4, 5);
+    JOSEPH2(5, 5);
+    JOSEPH1(0, 2);
+    JOSEPH1(1, 2);
+    JOSEPH1(3, 2);
+    JOSEPH1(4, 2);
+    JOSEPH1(5, 2);
 }
 
-enum {
-    MASK_ACC = 0x3Bu, /* δθx, δθy, δb */
-    MASK_MAG = 0x3Cu, /* δθz, δb */
-    MASK_BIAS = 0x38u /* δb */
-};
+/* Magnetometer (j = 2): mask δθz, δb (not δθx, δθy). */
+static void update_mag(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
+{
+    att_real pj[NX], K[NX], S, innov;
+    COLUMN_J();
+    GAIN(2);
+    GAIN(3);
+    GAIN(4);
+    GAIN(5);
+    JOSEPH2(2, 2);
+    JOSEPH2(2, 3);
+    JOSEPH2(2, 4);
+    JOSEPH2(2, 5);
+    JOSEPH2(3, 3);
+    JOSEPH2(3, 4);
+    JOSEPH2(3, 5);
+    JOSEPH2(4, 4);
+    JOSEPH2(4, 5);
+    JOSEPH2(5, 5);
+    JOSEPH1(2, 0);
+    JOSEPH1(2, 1);
+    JOSEPH1(3, 0);
+    JOSEPH1(3, 1);
+    JOSEPH1(4, 0);
+    JOSEPH1(4, 1);
+    JOSEPH1(5, 0);
+    JOSEPH1(5, 1);
+}
+
+/* Zero-rate update (j = 3, 4 or 5): mask δb only. */
+static void update_bias(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
+{
+    att_real pj[NX], K[NX], S, innov;
+    COLUMN_J();
+    GAIN(3);
+    GAIN(4);
+    GAIN(5);
+    JOSEPH2(3, 3);
+    JOSEPH2(3, 4);
+    JOSEPH2(3, 5);
+    JOSEPH2(4, 4);
+    JOSEPH2(4, 5);
+    JOSEPH2(5, 5);
+    JOSEPH1(3, 0);
+    JOSEPH1(3, 1);
+    JOSEPH1(3, 2);
+    JOSEPH1(4, 0);
+    JOSEPH1(4, 1);
+    JOSEPH1(4, 2);
+    JOSEPH1(5, 0);
+    JOSEPH1(5, 1);
+    JOSEPH1(5, 2);
+}
+
+#undef GAIN
+#undef JOSEPH2
+#undef JOSEPH1
+#undef COLUMN_J
 
 /* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
  * D = Pbb): A ← A − dt (C B' + B C') + dt² C D C' + qa I,
@@ -307,12 +409,44 @@ static att_status write_q(const att_ahrs *s, att_real q_out[4])
     return ATT_OK;
 }
 
+/* What an update may change: the members from integ on (set and the cached
+ * step constants come first and need no saving; ahrs.h keeps that order). */
+#define MUTABLE_FROM offsetof(att_ahrs, integ)
+
+static void copy_mutable(att_ahrs *dst, const att_ahrs *src)
+{
+    memcpy((unsigned char *)dst + MUTABLE_FROM, (const unsigned char *)src + MUTABLE_FROM,
+           sizeof(att_ahrs) - MUTABLE_FROM);
+}
+
+/* The constants of a step dt (> 0), recomputed only when dt changes. */
+static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    att_ahrs_step *c = &s->step;
+    if (c->dt != dt) {
+        c->dt = dt;
+        c->k_norm = dt / (ATT_R(10.0) + dt);
+        c->k_rest = dt / (set->rest_tau + dt);
+        c->k_acc = (set->acc_tau > 0) ? dt / (set->acc_tau + dt) : ATT_R(1.0);
+        c->k_mag = dt / (set->mag_ref_tau + dt);
+        c->q_att = set->gyr_noise * set->gyr_noise * dt;
+        c->q_att_rest = set->gyr_noise_rest * set->gyr_noise_rest * dt;
+        c->q_bias = set->bias_noise * set->bias_noise * dt;
+        c->r_acc = set->acc_noise * set->acc_noise / dt;
+        c->r_mag = set->mag_noise * set->mag_noise / dt;
+        c->r_rest = set->rest_noise * set->rest_noise / dt;
+    }
+    return c;
+}
+
 att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
                            att_real dt, att_real q_out[4])
 {
     const att_ahrs_settings *set;
+    const att_ahrs_step *k;
     att_ahrs save;
-    att_real C[9], dth[3], x[NX], an, a_alpha, v[3];
+    att_real C[9], dth[3], x[NX], an, an_lp, v[3];
     int i, rest, flags = 0, r;
     if (s == NULL || gyr == NULL) {
         return ATT_E_NULL;
@@ -325,15 +459,17 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         return ATT_E_NONFINITE;
     }
     an = 0;
-    a_alpha = 0;
+    an_lp = 0;
     if (acc != NULL) {
         an = norm3(acc);
         if (!s->acc_init && !(an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity)) {
             return ATT_E_AHRS_UNITS;
         }
         if (s->acc_init) {
-            att_real lp = s->acc_norm_lp + dt / (ATT_R(10.0) + dt) * (an - s->acc_norm_lp);
-            if (!(lp >= ATT_R(0.5) * set->gravity && lp <= ATT_R(8.0) * set->gravity)) {
+            /* the cached constant when dt is unchanged (the state is not touched before the checks) */
+            att_real kn = (s->step.dt == dt) ? s->step.k_norm : dt / (ATT_R(10.0) + dt);
+            an_lp = s->acc_norm_lp + kn * (an - s->acc_norm_lp);
+            if (!(an_lp >= ATT_R(0.5) * set->gravity && an_lp <= ATT_R(8.0) * set->gravity)) {
                 return ATT_E_AHRS_UNITS;
             }
         }
@@ -354,7 +490,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         }
         s->aligned = 1;
     }
-    save = *s;
+    copy_mutable(&save, s);
+    k = step_constants(s, dt);
 
     /* gyro over-range */
     if (set->gyro_range > 0
@@ -374,10 +511,10 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
             s->rest_init = 1;
             s->rest_t = 0;
         } else {
-            att_real k = dt / (set->rest_tau + dt), dg = 0, da = 0, dw = 0, e;
+            att_real dg = 0, da = 0, dw = 0, e;
             for (i = 0; i < 3; i++) {
-                s->rest_gyr[i] += k * (gyr[i] - s->rest_gyr[i]);
-                s->rest_acc[i] += k * (acc[i] - s->rest_acc[i]);
+                s->rest_gyr[i] += k->k_rest * (gyr[i] - s->rest_gyr[i]);
+                s->rest_acc[i] += k->k_rest * (acc[i] - s->rest_acc[i]);
                 e = gyr[i] - s->rest_gyr[i];
                 dg += e * e;
                 e = acc[i] - s->rest_acc[i];
@@ -401,15 +538,12 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     }
     r = att_integ_update(&s->integ, dth, NULL);
     if (r < 0) {
-        *s = save;
+        copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
     q2C(s->integ.q, C);
-    {
-        /* process noise: at rest the gyro's own (no motion, no model error) */
-        att_real sg = rest ? set->gyr_noise_rest : set->gyr_noise;
-        propagate_cov(s->P, C, dt, sg * sg * dt, set->bias_noise * set->bias_noise * dt);
-    }
+    /* process noise: at rest the gyro's own (no motion, no model error) */
+    propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
     if (flags & ATT_AHRS_F_OVERRANGE) {
         att_real o = set->overrange_sigma * set->overrange_sigma;
         s->P[0][0] += o;
@@ -431,11 +565,10 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
             s->acc_norm_lp = an;
             s->acc_init = 1;
         } else {
-            a_alpha = (set->acc_tau > 0) ? dt / (set->acc_tau + dt) : ATT_R(1.0);
             for (i = 0; i < 3; i++) {
-                s->acc_lp[i] += a_alpha * (an_n[i] - s->acc_lp[i]);
+                s->acc_lp[i] += k->k_acc * (an_n[i] - s->acc_lp[i]);
             }
-            s->acc_norm_lp += dt / (ATT_R(10.0) + dt) * (an - s->acc_norm_lp);
+            s->acc_norm_lp = an_lp;
         }
         nv = norm3(s->acc_lp);
         if (nv > 0) {
@@ -463,9 +596,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
                 s->acc_rej_time = 0;
             }
             if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
-                att_real R = set->acc_noise * set->acc_noise / dt;
-                scalar_update(s->P, x, 0, y0, R, MASK_ACC);
-                scalar_update(s->P, x, 1, y1, R, MASK_ACC);
+                update_acc(s->P, x, 0, y0, k->r_acc);
+                update_acc(s->P, x, 1, y1, k->r_acc);
             }
         }
     }
@@ -496,9 +628,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
              * body would change with the attitude and fail the test) */
             if (att_fabs(nm - s->mag_cand[0]) <= set->mag_norm_tol * s->mag_cand[0]
                 && att_fabs(dip - s->mag_cand[1]) <= set->mag_dip_tol) {
-                att_real k = dt / (set->mag_ref_tau + dt);
-                s->mag_cand[0] += k * (nm - s->mag_cand[0]);
-                s->mag_cand[1] += k * (dip - s->mag_cand[1]);
+                s->mag_cand[0] += k->k_mag * (nm - s->mag_cand[0]);
+                s->mag_cand[1] += k->k_mag * (dip - s->mag_cand[1]);
                 if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2]
                     >= set->mag_new_gyr * set->mag_new_gyr) {
                     s->mag_cand_t += dt;
@@ -508,12 +639,11 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
                 s->mag_cand[1] = dip;
                 s->mag_cand_t = 0;
             }
-            rm = set->mag_noise * set->mag_noise / dt;
+            rm = k->r_mag;
             if (att_fabs(nm - s->mag_ref[0]) <= set->mag_norm_tol * s->mag_ref[0]
                 && att_fabs(dip - s->mag_ref[1]) <= set->mag_dip_tol) {
-                att_real k = dt / (set->mag_ref_tau + dt);
-                s->mag_ref[0] += k * (nm - s->mag_ref[0]);
-                s->mag_ref[1] += k * (dip - s->mag_ref[1]);
+                s->mag_ref[0] += k->k_mag * (nm - s->mag_ref[0]);
+                s->mag_ref[1] += k->k_mag * (dip - s->mag_ref[1]);
                 s->mag_undist_t += dt;
                 if (s->mag_undist_t >= set->mag_min_undisturbed) {
                     s->mag_rej_time = 0;
@@ -542,17 +672,16 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
             }
             if (use) {
                 att_real y = wrap_pi(att_atan2(m[0], m[1]) - set->declination);
-                scalar_update(s->P, x, 2, y, rm, MASK_MAG);
+                update_mag(s->P, x, 2, y, rm);
             }
         }
     }
 
     /* rest: zero-rate update of the bias */
     if (rest) {
-        att_real R = set->rest_noise * set->rest_noise / dt;
         flags |= ATT_AHRS_F_REST;
         for (i = 0; i < 3; i++) {
-            scalar_update(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], R, MASK_BIAS);
+            update_bias(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], k->r_rest);
         }
     }
 
@@ -574,7 +703,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     s->bias[2] += x[5];
     s->flags = flags;
     if (!finite_state(s)) {
-        *s = save;
+        copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
     if (q_out != NULL && set->sensor_delay != 0) {

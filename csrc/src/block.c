@@ -33,8 +33,9 @@ int att_block_encode_boot(uint8_t ATT_LINK_MEM *blk, uint16_t period_ticks, uint
     if (blk == NULL) {
         return ATT_E_NULL;
     }
-    /* 1..ATT_BLOCK_PERIOD_MAX in one unsigned comparison (0 wraps to 0xFFFF) */
-    if ((uint16_t)(period_ticks - 1u) >= (uint16_t)ATT_BLOCK_PERIOD_MAX || baud_div == 0u) {
+    /* 1..ATT_BLOCK_PERIOD_MAX in one unsigned comparison (0 wraps to 0x7FFF),
+     * the link flag aside */
+    if ((uint16_t)((period_ticks - 1u) & 0x7FFFu) >= (uint16_t)ATT_BLOCK_PERIOD_MAX || baud_div == 0u) {
         return ATT_BLOCK_E_FIELD;
     }
     *blk++ = (uint8_t)ATT_BLOCK_MARK;

@@ -41,7 +41,8 @@ int att_block_decode(const uint8_t *raw, att_block *out)
     switch (raw[1]) {
     case ATT_BLOCK_BOOT:
         out->version = raw[2];
-        out->period_ticks = be16(raw + 3);
+        out->period_ticks = (uint16_t)(be16(raw + 3) & 0x7FFFu);
+        out->link = (uint8_t)((raw[3] & 0x80u) ? 2u : 0u); /* ATT_BLOCK_BOOT_LINK2 */
         out->baud_div = raw[5];
         if (out->version != (uint8_t)ATT_BLOCK_VERSION || out->period_ticks == 0u
             || out->period_ticks > (uint16_t)ATT_BLOCK_PERIOD_MAX || out->baud_div == 0u) {

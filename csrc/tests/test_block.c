@@ -63,7 +63,7 @@ static void test_encoders_reject_out_of_range(void)
     CHECK_EQ_INT(att_block_encode_sample(NULL, codes), ATT_E_NULL);
     CHECK_EQ_INT(att_block_encode_sample(b, NULL), ATT_E_NULL);
     CHECK_EQ_INT(att_block_encode_boot(b, 0, 8), ATT_BLOCK_E_FIELD);
-    CHECK_EQ_INT(att_block_encode_boot(b, 32768, 8), ATT_BLOCK_E_FIELD);
+    CHECK_EQ_INT(att_block_encode_boot(b, 32768, 8), ATT_BLOCK_E_FIELD); /* the link v2 flag, period 0 */
     CHECK_EQ_INT(att_block_encode_boot(b, 32767, 8), ATT_OK);
     CHECK_EQ_INT(att_block_encode_boot(b, 1, 0), ATT_BLOCK_E_FIELD);
     CHECK_EQ_INT(att_block_encode_boot(NULL, 72, 8), ATT_E_NULL);
@@ -146,7 +146,7 @@ static void test_decoder_rejects(void)
         static const uint8_t bad[][6] = {
             { 0xFE, 0x00, 0x02, 0x00, 0x48, 0x08 }, /* BOOT of another format version */
             { 0xFE, 0x00, 0x01, 0x00, 0x00, 0x08 }, /* period 0 */
-            { 0xFE, 0x00, 0x01, 0x80, 0x00, 0x08 }, /* period 32768 */
+            { 0xFE, 0x00, 0x01, 0x80, 0x00, 0x08 }, /* period 0 of a link v2 board */
             { 0xFE, 0x00, 0x01, 0x00, 0x48, 0x00 }, /* baud 0 */
             { 0xFE, 0x01, 0x00, 0x00, 0x00, 0x01 }, /* self-test status 0 */
             { 0xFE, 0x01, 0xD7, 0x10, 0x00, 0x01 }, /* bad code 4096 */
@@ -194,6 +194,16 @@ static void test_round_trips(void)
     CHECK_EQ_INT(att_block_encode_boot(b, 32767, 255), ATT_OK);
     CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
     CHECK(d.kind == ATT_BLOCK_BOOT && d.period_ticks == 32767 && d.baud_div == 255 && d.version == 1);
+    CHECK_EQ_INT(d.link, 0);
+    { /* a link v2 board: the top bit of the period word (docs/block.md), by hand */
+        static const uint8_t boot2[6] = { 0xFE, 0x00, 0x01, 0x80, 0x48, 0x08 };
+        CHECK_EQ_INT(att_block_encode_boot(b, (uint16_t)(72u | ATT_BLOCK_BOOT_LINK2), 8), ATT_OK);
+        CHECK(memcmp(b, boot2, 6) == 0);
+        CHECK_EQ_INT(att_block_decode(boot2, &d), ATT_OK);
+        CHECK(d.kind == ATT_BLOCK_BOOT && d.period_ticks == 72 && d.link == 2 && d.baud_div == 8);
+        CHECK_EQ_INT(att_block_encode_boot(b, (uint16_t)ATT_BLOCK_BOOT_LINK2, 8),
+                     ATT_BLOCK_E_FIELD); /* period 0 */
+    }
     CHECK_EQ_INT(att_block_encode_loss(b, ATT_BLOCK_GAVE_UP, 65535, 65535), ATT_OK);
     CHECK_EQ_INT(att_block_decode(b, &d), ATT_OK);
     CHECK(d.kind == ATT_BLOCK_GAVE_UP && d.first == 65535 && d.count == 65535);

@@ -1,10 +1,18 @@
 /*
- * Instruction-count harness for bench/broad.py: N samples through the
- * attitude filter, one att_ahrs_update() call each with gyro, specific
- * force and field (the full per-sample path: propagation, accelerometer
- * and magnetometer updates). The motion is a steady turn about the
- * vertical, one turn per TABLE samples at 200 Hz, tabulated at start-up
- * (start-up cancels out in toolchain/qemu_count.py's difference of two N).
+ * Instruction-count harness of the attitude filters (bench/broad.py,
+ * docs/ahrs.md): N samples through one filter, one update call each with
+ * gyro, specific force and field (the full per-sample path). The motion is
+ * a steady turn about the vertical, one turn per TABLE samples at 200 Hz,
+ * tabulated at start-up (start-up cancels out in toolchain/qemu_count.py's
+ * difference of two N).
+ *
+ * The filter is chosen at compile time, so that each build calls its
+ * filter directly (the counts are those of the filter alone):
+ *   (default)          att_ahrs_update (ahrs.h): propagation, accelerometer
+ *                      and magnetometer updates;
+ *   -DBENCH_AHRS_TEKF  att_tekf_update (ahrs_thesis.h), the UAV thesis's
+ *                      EKF: time update, Gauss–Newton solve, measurement
+ *                      update.
  *
  *   bench_ahrs N
  */
@@ -14,13 +22,23 @@
 
 #include "attitude/attitude.h"
 
+#ifdef BENCH_AHRS_TEKF
+typedef att_tekf bench_filter;
+#define BENCH_INIT   att_tekf_init
+#define BENCH_UPDATE att_tekf_update
+#else
+typedef att_ahrs bench_filter;
+#define BENCH_INIT   att_ahrs_init
+#define BENCH_UPDATE att_ahrs_update
+#endif
+
 #define TABLE 256
 
 static att_real mag[TABLE][3];
 
 int main(int argc, char **argv)
 {
-    att_ahrs s;
+    bench_filter s;
     att_real q[4], acc[3] = { 0.0f, 0.0f, 9.81f }, gyr[3] = { 0.0f, 0.0f, 0.0f };
     att_real dt = (att_real)(1.0 / 200.0);
     unsigned long n, i;
@@ -36,11 +54,11 @@ int main(int argc, char **argv)
         mag[i][1] = (att_real)(20.0 * cos(psi));
         mag[i][2] = (att_real)-40.0;
     }
-    if (att_ahrs_init(&s, NULL, NULL) != ATT_OK) {
+    if (BENCH_INIT(&s, NULL, NULL) != ATT_OK) {
         return 3;
     }
     for (i = 0; i < n; i++) {
-        if (att_ahrs_update(&s, gyr, acc, mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
+        if (BENCH_UPDATE(&s, gyr, acc, mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
             return 4;
         }
     }

@@ -70,6 +70,11 @@ __sfr32 __at(0xF4F3F2F1) bench_busy_sum;
 __sfr32 __at(0xF9F8F7F6) bench_exch_sum;     /* block start -> accepted */
 __sfr32 __at(0xBCBBBAB9) bench_syn_wait_sum; /* 0xAA handed out -> 0xBB received */
 __sfr32 __at(0xFDFCFBFA) bench_ans_wait_sum; /* checksum handed out -> answer received */
+/* link v2: cycles of the polls that handed out a byte */
+__sfr16 __at(0xA2A1) bench_poll_max;
+__sfr16 __at(0xA4A3) bench_polls;
+__sfr16 __at(0xA6A5) bench_poll_sum16; /* sum of cycles / 16 (wraps after ~3000 polls) */
+__sfr16 __at(0xB3B2) bench_t_poll;
 
 static void bench_init(void)
 {
@@ -85,6 +90,11 @@ static void bench_init(void)
     bench_exch_sum = 0;
     bench_syn_wait_sum = 0;
     bench_ans_wait_sum = 0;
+#if FW_LINK_V2
+    bench_poll_max = 0;
+    bench_polls = 0;
+    bench_poll_sum16 = 0;
+#endif
 }
 
 static void bench_loop_start(void)
@@ -101,6 +111,20 @@ static void bench_loop_end(void)
 }
 
 #if FW_LINK_V2
+/* Link v2: machine cycles of each poll that handed out a byte (the CPU
+ * the sender spends per byte sent: compare with a byte time, 960 cycles at
+ * 9600 baud), in more unimplemented SFR cells. */
+static void bench_poll_end(int st)
+{
+    uint16_t d = (uint16_t)(cycles_now() - bench_t_poll);
+    if (st == ATT_LINK2_SEND) {
+        if (d > bench_poll_max) {
+            bench_poll_max = d;
+        }
+        bench_polls++;
+        bench_poll_sum16 += (uint16_t)(d >> 4);
+    }
+}
 /* Link v2: the link work is counted (busy), the exchange per record runs
  * from its block start to its acknowledgement (not traced per byte). */
 static void bench_rx(uint8_t b)
@@ -198,6 +222,9 @@ static void put_stat(const char *name)
     } while (0)
 
 /* Final report of a simulation run (hex values), then stop. */
+#if FW_LINK_V2
+__sfr __at(0xA7) sim_bad_acks; /* ACK frames the sender dropped (CRC, length: a byte lost or changed) */
+#endif
 static void sim_finish(void)
 {
     fw_sim_puts("STATS");
@@ -207,6 +234,7 @@ static void sim_finish(void)
     STAT("queued", att_link2_sender_pending(&tx));
     STAT("overrun_pending", ovr_count);
     STAT("ticks", fw_ticks);
+    STAT("bad_acks", sim_bad_acks);
 #else
     STAT("accepted", tx.stats.blocks_accepted);
     STAT("sent", tx.stats.blocks_sent);
@@ -235,6 +263,11 @@ static void sim_finish(void)
     STAT32("exch_sum", bench_exch_sum);
     STAT32("syn_wait_sum", bench_syn_wait_sum);
     STAT32("ans_wait_sum", bench_ans_wait_sum);
+#if FW_LINK_V2
+    STAT("poll_max", bench_poll_max);
+    STAT("polls", bench_polls);
+    STAT("poll_sum16", bench_poll_sum16);
+#endif
     fw_sim_putc('\n');
 #endif
     fw_sim_stop(0);
@@ -244,11 +277,39 @@ static void sim_init(void)
 {
     sim_accepted = 0;
     sim_samples = 0;
+#if FW_LINK_V2
+    sim_bad_acks = 0;
+#endif
 #if defined(FW_BENCH)
     bench_init();
 #endif
 #if defined(FW_SIM_MODEL)
     fw_sim_model_init();
+#endif
+#if FW_LINK_V2
+    /* "CRC <hex>": the 8051's CRC-32C (link2_sender.c, in assembly there) of
+     * the check string "123456789", nested calls (no RAM); the tests compare
+     * it with 0xE3069283 (docs/link.md) */
+#define SIM_CRC9                                                                                      \
+    att_link2_crc_byte(                                                                               \
+        att_link2_crc_byte(                                                                           \
+            att_link2_crc_byte(                                                                       \
+                att_link2_crc_byte(                                                                   \
+                    att_link2_crc_byte(                                                               \
+                        att_link2_crc_byte(                                                           \
+                            att_link2_crc_byte(                                                       \
+                                att_link2_crc_byte(att_link2_crc_byte(0xFFFFFFFFul, '1'), '2'), '3'), \
+                            '4'),                                                                     \
+                        '5'),                                                                         \
+                    '6'),                                                                             \
+                '7'),                                                                                 \
+            '8'),                                                                                     \
+        '9')
+    fw_sim_puts("CRC ");
+    fw_sim_puthex((uint16_t)(~SIM_CRC9 >> 16));
+    fw_sim_puthex((uint16_t)~SIM_CRC9);
+    fw_sim_putc('\n');
+#undef SIM_CRC9
 #endif
 }
 
@@ -330,11 +391,13 @@ static void sim_acked(void)
         sim_base0++;
     }
 }
-#define FW_HOOK_V2_SINK(call)           \
-    do {                                \
-        sim_base0 = att_link2_one.base; \
-        (void)(call);                   \
-        sim_acked();                    \
+#define FW_HOOK_V2_SINK(call)                      \
+    do {                                           \
+        sim_base0 = att_link2_one.base;            \
+        if ((call) == ATT_LINK2_BAD_FRAME) {       \
+            sim_bad_acks++; /* e.g. a byte lost */ \
+        }                                          \
+        sim_acked();                               \
     } while (0)
 #endif
 
@@ -346,7 +409,17 @@ static void sim_acked(void)
         SIM_COUNT_BLOCK();  \
         SIM_COUNT_SAMPLE(); \
     } while (0)
+#if defined(FW_BENCH) && FW_LINK_V2
+#define FW_HOOK_POLL_BEGIN() (bench_t_poll = cycles_now())
+#define FW_HOOK_POLL(st)    \
+    do {                    \
+        bench_poll_end(st); \
+        SIM_TRACE_POLL(st); \
+    } while (0)
+#else
+#define FW_HOOK_POLL_BEGIN()
 #define FW_HOOK_POLL(st) SIM_TRACE_POLL(st)
+#endif
 #if defined(FW_BENCH)
 #define FW_HOOK_LOOP_START() bench_loop_start()
 #define FW_HOOK_LOOP_END()   bench_loop_end()

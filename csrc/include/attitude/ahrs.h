@@ -125,9 +125,29 @@ typedef struct {
                                  recording set-up, not of the filter (docs/ahrs.md) */
 } att_ahrs_settings;
 
-/* Caller-owned state. Treat as opaque; read it with the accessors. */
+/* Constants of one time step, derived from the settings and dt; kept in
+ * the state and recomputed only when dt changes (part of the state: treat
+ * as opaque). */
+typedef struct {
+    att_real dt;         /* [s] the step they are for; 0 = none yet */
+    att_real k_norm;     /* dt/(10 s + dt): low-pass of |a| (unit check) */
+    att_real k_rest;     /* dt/(rest_tau + dt) */
+    att_real k_acc;      /* dt/(acc_tau + dt), 1 when acc_tau = 0 */
+    att_real k_mag;      /* dt/(mag_ref_tau + dt) */
+    att_real q_att;      /* gyr_noise²·dt */
+    att_real q_att_rest; /* gyr_noise_rest²·dt */
+    att_real q_bias;     /* bias_noise²·dt */
+    att_real r_acc;      /* acc_noise²/dt */
+    att_real r_mag;      /* mag_noise²/dt */
+    att_real r_rest;     /* rest_noise²/dt */
+} att_ahrs_step;
+
+/* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
+ * set and step first; an update saves and restores the members from integ
+ * on.) */
 typedef struct {
     att_ahrs_settings set;
+    att_ahrs_step step;    /* per-step constants for the last dt */
     att_integ integ;       /* attitude q (body → ENU) and the integrator's buffers */
     att_real bias[3];      /* gyro bias estimate b_est [rad/s], body frame */
     att_real P[6][6];      /* error covariance [δθ (rad); δb (rad/s)] */

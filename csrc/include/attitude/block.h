@@ -21,7 +21,8 @@
  * byte 1 = kind, bytes 2-5 by kind (widths in bits):
  *
  *     kind         byte 2        bytes 3-4        byte 5        sent
- *     0 BOOT       version (8)   period (16)      baud_div (8)  once at power-up, first
+ *     0 BOOT       version (8)   link + period    baud_div (8)  once at power-up, first
+ *                                (1 + 15)
  *     1 SELFTEST   status (8)    bad_code (16)    attempt (8)   each failed ADC self-test
  *
  *     kind         bytes 2-3     bytes 4-5                      sent
@@ -40,7 +41,11 @@
  *             receiver decodes only version 1.
  *   period    sampling period in ticks of 1/ATT_BLOCK_TICK_HZ s (1/3600 s:
  *             Timer 0 of the AT89S51 at 11.0592 MHz), 1..ATT_BLOCK_PERIOD_MAX.
- *             72 = 20 ms.
+ *             72 = 20 ms. The low 15 bits of bytes 3-4.
+ *   link      the top bit of bytes 3-4 (ATT_BLOCK_BOOT_LINK2): the board's
+ *             link protocol, 0 = the paper's AA/BB handshake (attitude/link.h;
+ *             every BOOT before this bit existed), 1 = link v2
+ *             (attitude/link2.h). Decoded as att_block.link 0 or 2.
  *   baud_div  line rate / ATT_BLOCK_BAUD_UNIT (1200), 1..255: 8 = 9600 baud.
  *   status    the att_status of the failure, -128..-1: a TLC2543_E_* code
  *             (attitude/tlc2543.h: -40 EOC timeout, -41/-42/-43 a self-test
@@ -110,7 +115,8 @@ enum {
     ATT_BLOCK_PERIOD_MAX = 32767,  /* largest BOOT period (ticks) */
     ATT_BLOCK_BAUD_UNIT = 1200,    /* BOOT baud_div unit (baud per count) */
     ATT_BLOCK_OVERSAMPLE_MAX = 16, /* largest OVERSAMPLE n (conversions per word) */
-    ATT_BLOCK_SUM_MAX = 0xFDFF     /* largest word of an oversampled sample (byte 0 below the mark) */
+    ATT_BLOCK_SUM_MAX = 0xFDFF,    /* largest word of an oversampled sample (byte 0 below the mark) */
+    ATT_BLOCK_BOOT_LINK2 = 0x8000  /* BOOT period word: the board speaks link v2 (or-ed into period_ticks) */
 };
 
 /* Record kinds: byte 1 of a report record, or ATT_BLOCK_SAMPLE. */
@@ -144,7 +150,8 @@ enum {
  * scans the ADC's words into the block and converts them in place. */
 int att_block_encode_sample(uint8_t ATT_LINK_MEM *blk, const uint16_t ATT_LINK_MEM *codes);
 
-/* BOOT: version ATT_BLOCK_VERSION, period_ticks 1..32767, baud_div 1..255
+/* BOOT: version ATT_BLOCK_VERSION, period_ticks 1..32767, or-ed with
+ * ATT_BLOCK_BOOT_LINK2 by a board that speaks link v2, baud_div 1..255
  * (else ATT_BLOCK_E_FIELD). */
 int att_block_encode_boot(uint8_t ATT_LINK_MEM *blk, uint16_t period_ticks, uint8_t baud_div);
 
@@ -185,6 +192,7 @@ typedef struct {
     uint16_t kind;         /* att_block_kind, or an unknown report kind byte (ATT_BLOCK_E_KIND) */
     uint8_t version;       /* BOOT: format version */
     uint8_t baud_div;      /* BOOT: line rate / ATT_BLOCK_BAUD_UNIT */
+    uint8_t link;          /* BOOT: the board's link protocol: 0 legacy (AA/BB), 2 link v2 */
     uint8_t attempt;       /* SELFTEST: attempt number (from 1, mod 256) */
     uint8_t oversample;    /* OVERSAMPLE: conversions per word of the samples that follow */
     int8_t status;         /* SELFTEST, ADC_ERROR: the failure's att_status */

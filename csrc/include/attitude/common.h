@@ -51,7 +51,9 @@ enum {
 };
 typedef int att_status;
 
-/* Short English description of a status code (static storage). */
+/* Short English description of a status code (static storage): every code
+ * of every module's header has its own, distinct text (csrc/src/common.c,
+ * one table); "unknown status" for any other value. Never NULL. */
 const char *att_status_str(int status);
 
 /* Size of att_real in bytes in this build (4 = float, 8 = double). */
