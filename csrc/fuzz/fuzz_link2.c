@@ -174,6 +174,22 @@ static void hand_out(rig *r)
     }
 }
 
+/* A byte time on the channel: each direction delivers what is on its line, the clock
+   ticks, and both ends hand out their next byte. */
+static void byte_time(rig *r)
+{
+    if (r->a_full) {
+        deliver_to_b(r, r->a_line[0]);
+        r->a_full = 0;
+    }
+    if (r->b_full) {
+        CHECK(att_link2_sender_sink(&r->a, r->b_line[0], r->t) >= 0);
+        r->b_full = 0;
+    }
+    r->t++;
+    hand_out(r);
+}
+
 /* Every other record is built in the ring slot tail() hands out (the 8051's way). */
 static void push_all(rig *r, int n)
 {
@@ -221,17 +237,8 @@ static void mode_link(const uint8_t *data, size_t size)
         case 0:
         case 1:
         case 2:
-        case 3: /* a byte time: each direction delivers what is on its line */
-            if (r.a_full) {
-                deliver_to_b(&r, r.a_line[0]);
-                r.a_full = 0;
-            }
-            if (r.b_full) {
-                CHECK(att_link2_sender_sink(&r.a, r.b_line[0], r.t) >= 0);
-                r.b_full = 0;
-            }
-            r.t++;
-            hand_out(&r);
+        case 3: /* a byte time */
+            byte_time(&r);
             break;
         case 4: /* drop the byte on a line */
             if (op & 0x10u)
@@ -287,19 +294,8 @@ static void mode_link(const uint8_t *data, size_t size)
     }
     /* the line recovers: everything A holds reaches B, once, in order */
     att_link2_receiver_set_room(&r.b, 0xFFFFu);
-    for (steps = 0; steps < 200000 && (att_link2_sender_pending(&r.a) != 0 || r.a_full || r.b_full);
-         steps++) {
-        if (r.a_full) {
-            deliver_to_b(&r, r.a_line[0]);
-            r.a_full = 0;
-        }
-        if (r.b_full) {
-            CHECK(att_link2_sender_sink(&r.a, r.b_line[0], r.t) >= 0);
-            r.b_full = 0;
-        }
-        r.t++;
-        hand_out(&r);
-    }
+    for (steps = 0; steps < 200000 && (att_link2_sender_pending(&r.a) != 0 || r.a_full || r.b_full); steps++)
+        byte_time(&r);
     CHECK(att_link2_sender_pending(&r.a) == 0);
     CHECK(r.delivered == r.pushed || (r.pushed == r.pushed_at_reboot && r.delivered <= r.pushed));
 }
