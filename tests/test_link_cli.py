@@ -51,7 +51,11 @@ def test_tx_bad_stdin_line_is_a_usage_error(protocol: str, size: int, monkeypatc
 @pytest.mark.parametrize("transport", ["pty", "socket"])
 @pytest.mark.parametrize("protocol", ["legacy", "v2"])
 def test_link_test_over_a_real_bridge(protocol: str, transport: str, capsys) -> None:
-    """link-test --transport pty|socket: every block through a clean bridge, real time."""
+    """link-test --transport pty|socket: the blocks through a clean bridge, in real time. Link v2
+    delivers every record once, in order, whatever the timing; the legacy link's outcome hangs
+    on it (a 50 ms answer timeout missed on a loaded machine: a block given up, or accepted twice,
+    or, once the ends are out of step, a block nobody sent accepted -- seen in a few of 40 runs
+    with the code before the cleanup and after): there only what holds for every timing is checked."""
     n = 5
     rc = main(["link-test", "--protocol", protocol, "--transport", transport, "--blocks", str(n), "--json"])
     assert rc == 0, capsys.readouterr().err
@@ -63,9 +67,9 @@ def test_link_test_over_a_real_bridge(protocol: str, transport: str, capsys) -> 
         assert out["in_order_exactly_once"] is True
         assert out["receiver"]["records"] == n
     else:
-        assert (out["blocks"], out["accepted_by_B"], out["acked"], out["gave_up"]) == (n, n, n, 0)
-        assert out["not_sent_blocks_accepted"] == 0
-        assert out["receiver"]["blocks_accepted"] == n and out["sender"]["blocks_accepted"] == n
+        assert out["blocks"] == n and out["acked"] + out["gave_up"] == n  # each block ends one way
+        assert out["sender"]["blocks_accepted"] == out["acked"]
+        assert out["receiver"]["blocks_accepted"] == out["accepted_by_B"]
 
 
 @pytest.mark.parametrize("protocol", ["legacy", "v2"])
