@@ -10,18 +10,8 @@
 
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
-
-if(NOT DEFINED CROSS_COMPILE)
-  if(DEFINED ENV{CROSS_COMPILE})
-    set(CROSS_COMPILE "$ENV{CROSS_COMPILE}")
-  else()
-    set(CROSS_COMPILE "arm-none-eabi-")
-  endif()
-endif()
-set(CROSS_COMPILE "${CROSS_COMPILE}" CACHE STRING "cross compiler prefix")
-set(CMAKE_C_COMPILER ${CROSS_COMPILE}gcc)
-set(CMAKE_AR ${CROSS_COMPILE}ar CACHE FILEPATH "archiver")
-set(CMAKE_RANLIB ${CROSS_COMPILE}ranlib CACHE FILEPATH "ranlib")
+set(ATT_CROSS_COMPILE_DEFAULT "arm-none-eabi-")
+include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes
 
 # The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.
 set(CMAKE_C_FLAGS_INIT "-O2 -marm -mcpu=arm920t -mfloat-abi=soft")
@@ -34,11 +24,6 @@ set(ATT_BUILD_APP OFF CACHE BOOL "build the attitude-rx receiver app")
 
 # No OS: the compiler checks build a static library, not a program.
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
-
-set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
-set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
 # Run cross-built programs (try_run, ctest) under the target's emulator.
 set(CMAKE_CROSSCOMPILING_EMULATOR qemu-arm;-cpu;ti925t)

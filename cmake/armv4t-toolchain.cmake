@@ -10,18 +10,8 @@
 
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR arm)
-
-if(NOT DEFINED CROSS_COMPILE)
-  if(DEFINED ENV{CROSS_COMPILE})
-    set(CROSS_COMPILE "$ENV{CROSS_COMPILE}")
-  else()
-    set(CROSS_COMPILE "arm-linux-gnueabi-")
-  endif()
-endif()
-set(CROSS_COMPILE "${CROSS_COMPILE}" CACHE STRING "cross compiler prefix")
-set(CMAKE_C_COMPILER ${CROSS_COMPILE}gcc)
-set(CMAKE_AR ${CROSS_COMPILE}ar CACHE FILEPATH "archiver")
-set(CMAKE_RANLIB ${CROSS_COMPILE}ranlib CACHE FILEPATH "ranlib")
+set(ATT_CROSS_COMPILE_DEFAULT "arm-linux-gnueabi-")
+include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes
 
 # The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.
 set(CMAKE_C_FLAGS_INIT "-O2 -march=armv4t -mtune=arm920t -marm -mfloat-abi=soft")
@@ -33,11 +23,6 @@ set(CMAKE_SHARED_LINKER_FLAGS_INIT "")
 set(ATT_SHARED_LINK_OPTIONS "-nostdlib;-Wl,--no-undefined;-Wl,-z,noexecstack")
 set(ATT_SHARED_LIBGCC_CMD "arm-none-eabi-gcc;-marm;-mcpu=arm920t;-mfloat-abi=soft;-print-libgcc-file-name")
 set(ATT_SHARED_LIBS "-lm;-lc")
-
-set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
-set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
 # Run cross-built programs (try_run, ctest) under the target's emulator.
 set(CMAKE_CROSSCOMPILING_EMULATOR qemu-arm)

@@ -9,28 +9,13 @@
 
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR arm)
-
-if(NOT DEFINED CROSS_COMPILE)
-  if(DEFINED ENV{CROSS_COMPILE})
-    set(CROSS_COMPILE "$ENV{CROSS_COMPILE}")
-  else()
-    set(CROSS_COMPILE "arm-linux-gnueabihf-")
-  endif()
-endif()
-set(CROSS_COMPILE "${CROSS_COMPILE}" CACHE STRING "cross compiler prefix")
-set(CMAKE_C_COMPILER ${CROSS_COMPILE}gcc)
-set(CMAKE_AR ${CROSS_COMPILE}ar CACHE FILEPATH "archiver")
-set(CMAKE_RANLIB ${CROSS_COMPILE}ranlib CACHE FILEPATH "ranlib")
+set(ATT_CROSS_COMPILE_DEFAULT "arm-linux-gnueabihf-")
+include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes
 
 # The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.
 set(CMAKE_C_FLAGS_INIT "-O2 -march=armv7-a -mfpu=vfpv3-d16 -mfloat-abi=hard")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-static")
 set(CMAKE_SHARED_LINKER_FLAGS_INIT "")
-
-set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
-set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
-set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 
 # Run cross-built programs (try_run, ctest) under the target's emulator.
 set(CMAKE_CROSSCOMPILING_EMULATOR qemu-arm)

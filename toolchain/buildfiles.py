@@ -9,7 +9,8 @@ Generated (and committed, so that make and CMake need no Python):
 * ``toolchain/targets.mk``: one block of ``ATT_TARGET_*_<name>`` variables per
   target, read by ``make TARGET=<name>``;
 * ``cmake/<name>-toolchain.cmake`` for every gcc-kind target (CMake has no
-  SDCC preset).
+  SDCC preset); the cross ones include ``cmake/cross-common.cmake``, what
+  they share (the ``CROSS_COMPILE`` prefix, the tools under it, the find modes).
 
 What goes where: the TOML ``cflags`` (the target: architecture, ABI,
 optimization, instrumentation) go unchanged into every path; the TOML
@@ -34,6 +35,7 @@ from toolchain import targets as T
 ROOT = T.ROOT
 MAKE_FRAGMENT = ROOT / "toolchain" / "targets.mk"
 CMAKE_DIR = ROOT / "cmake"
+CROSS_COMMON = CMAKE_DIR / "cross-common.cmake"
 
 #: Link flags only a program takes (not a shared library).
 PROGRAM_ONLY_LDFLAGS = ("-static", "--specs=")
@@ -122,6 +124,34 @@ def _processor(t: T.Target) -> str | None:
     return None
 
 
+def cross_common() -> str:
+    """cmake/cross-common.cmake: the part every cross toolchain file shares."""
+    return "\n".join([
+        _generated_note("toolchain/buildfiles.py").rstrip("\n"),
+        "# Included by every cross toolchain file (cmake/<name>-toolchain.cmake), which sets",
+        "# ATT_CROSS_COMPILE_DEFAULT first: the compiler prefix CROSS_COMPILE (-DCROSS_COMPILE=<prefix>,",
+        "# else the environment's CROSS_COMPILE, else that default), the tools under it, and",
+        "# find_* looking in the sysroot only (programs: on the build machine).",
+        "",
+        "if(NOT DEFINED CROSS_COMPILE)",
+        "  if(DEFINED ENV{CROSS_COMPILE})",
+        '    set(CROSS_COMPILE "$ENV{CROSS_COMPILE}")',
+        "  else()",
+        '    set(CROSS_COMPILE "${ATT_CROSS_COMPILE_DEFAULT}")',
+        "  endif()",
+        "endif()",
+        'set(CROSS_COMPILE "${CROSS_COMPILE}" CACHE STRING "cross compiler prefix")',
+        "set(CMAKE_C_COMPILER ${CROSS_COMPILE}gcc)",
+        'set(CMAKE_AR ${CROSS_COMPILE}ar CACHE FILEPATH "archiver")',
+        'set(CMAKE_RANLIB ${CROSS_COMPILE}ranlib CACHE FILEPATH "ranlib")',
+        "",
+        "set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)",
+        "set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)",
+        "set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)",
+        "set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)",
+    ]) + "\n"
+
+
 def cmake_toolchain(t: T.Target) -> str:
     prefix, cc, ar = split_tool(t)
     cross = bool(prefix) or t.os == "none"
@@ -135,23 +165,15 @@ def cmake_toolchain(t: T.Target) -> str:
                 "# the environment) and, if it has its own sysroot, -DCMAKE_SYSROOT=/path/to/sysroot."]
     out.append("")
     if cross:
+        if (cc, ar) != ("gcc", "ar"):
+            raise ValueError(f"toolchain/{t.name}.toml: {t.cc} / {t.ar}: cmake/cross-common.cmake "
+                             "knows only <prefix>gcc and <prefix>ar")
         out.append(f"set(CMAKE_SYSTEM_NAME {'Linux' if t.os == 'linux' else 'Generic'})")
         proc = _processor(t)
         if proc:
             out.append(f"set(CMAKE_SYSTEM_PROCESSOR {proc})")
-        out.append("")
-    if prefix:
-        out += ["if(NOT DEFINED CROSS_COMPILE)",
-                "  if(DEFINED ENV{CROSS_COMPILE})",
-                '    set(CROSS_COMPILE "$ENV{CROSS_COMPILE}")',
-                "  else()",
-                f'    set(CROSS_COMPILE "{prefix}")',
-                "  endif()",
-                "endif()",
-                'set(CROSS_COMPILE "${CROSS_COMPILE}" CACHE STRING "cross compiler prefix")',
-                f"set(CMAKE_C_COMPILER ${{CROSS_COMPILE}}{cc})",
-                f'set(CMAKE_AR ${{CROSS_COMPILE}}{ar} CACHE FILEPATH "archiver")',
-                f'set(CMAKE_RANLIB ${{CROSS_COMPILE}}{"ranlib" if ar == "ar" else ar} CACHE FILEPATH "ranlib")']
+        out += [f'set(ATT_CROSS_COMPILE_DEFAULT "{prefix}")',
+                'include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes']
     else:
         out.append(f"set(CMAKE_C_COMPILER {cc})")
     out += ["",
@@ -176,20 +198,14 @@ def cmake_toolchain(t: T.Target) -> str:
     if t.os == "none":
         out += ["", "# No OS: the compiler checks build a static library, not a program.",
                 "set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)"]
-    if cross:
-        out += ["",
-                "set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)",
-                "set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)",
-                "set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)",
-                "set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)"]
-        if t.run_cmd:
-            out += ["", "# Run cross-built programs (try_run, ctest) under the target's emulator.",
-                    f'set(CMAKE_CROSSCOMPILING_EMULATOR {";".join(t.run_cmd)})']
+    if cross and t.run_cmd:
+        out += ["", "# Run cross-built programs (try_run, ctest) under the target's emulator.",
+                f'set(CMAKE_CROSSCOMPILING_EMULATOR {";".join(t.run_cmd)})']
     return "\n".join(out) + "\n"
 
 
 def outputs() -> dict[Path, str]:
-    files = {MAKE_FRAGMENT: make_fragment()}
+    files = {MAKE_FRAGMENT: make_fragment(), CROSS_COMMON: cross_common()}
     for name in T.names():
         t = _load_plain(name)
         if t.kind == "gcc":

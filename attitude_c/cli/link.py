@@ -177,13 +177,21 @@ def _block_printer() -> Any:
     return show
 
 
+def _open(cmd: str, args: argparse.Namespace) -> Any:
+    """The port of ``--port`` at ``--baud``; None when it does not open (said in one line)."""
+    from ..link.transport import open_port
+
+    try:
+        return open_port(args.port, args.baud)
+    except AttitudeError as exc:
+        print(f"{cmd}: {exc}", file=sys.stderr)
+        return None
+
+
 def cmd_rx(args: argparse.Namespace) -> int:
-    from ..link.transport import open_port, run_receiver
+    from ..link.transport import run_receiver
 
-    if args.protocol == "v2":
-        return _rx2(args)
-
-    if args.decode or args.protocol == "auto":
+    if args.protocol != "v2" and (args.decode or args.protocol == "auto"):
         from ..link import block
 
         if args.block_size % block.fmt().size:
@@ -192,27 +200,25 @@ def cmd_rx(args: argparse.Namespace) -> int:
                   f"of the block format), got {args.block_size}", file=sys.stderr)
             return 2
     stop = _stop_on_signals()
-    try:
-        port = open_port(args.port, args.baud)
-    except AttitudeError as exc:
-        print(f"link-rx: {exc}", file=sys.stderr)
+    port = _open("link-rx", args)
+    if port is None:
         return 1
-
-    def show(b: bytes) -> None:
-        print(_hex_block(b), flush=True)
-
-    if args.decode:
-        show = _block_printer()
-
-    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, N={args.block_size}, {args.impl}"
-          + (", legacy or link v2" if args.protocol == "auto" else "") + ")", file=sys.stderr, flush=True)
-    if args.protocol == "auto":
-        return _rx_auto(args, port, show, stop)
-
+    show: Callable[[bytes], None] = _block_printer() if args.decode else (lambda b: print(_hex_block(b), flush=True))
+    what = (f"link v2, {args.impl}" if args.protocol == "v2" else f"N={args.block_size}, {args.impl}"
+            + (", legacy or link v2" if args.protocol == "auto" else ""))
+    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, {what})", file=sys.stderr, flush=True)
     try:
-        rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
-                           gap_timeout_ms=args.gap_timeout_ms, count=args.count, duration=args.duration,
-                           on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+        if args.protocol == "auto":
+            rep = _rx_auto(args, port, show, stop)
+        elif args.protocol == "v2":
+            from ..link.transport2 import run_receiver2
+
+            rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
+                                stop=stop, eof_after=args.idle_eof, keep_records=False)
+        else:
+            rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
+                               gap_timeout_ms=args.gap_timeout_ms, count=args.count, duration=args.duration,
+                               on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
     except AttitudeError as exc:
         print(f"link-rx: {exc}", file=sys.stderr)
         return 2
@@ -225,37 +231,31 @@ def cmd_rx(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_tx(args: argparse.Namespace) -> int:
-    from ..link.transport import (
-        OUTCOME_GAVE_UP,
-        OUTCOME_INTERRUPTED,
-        OUTCOME_NO_RECEIVER,
-        BlockReport,
-        open_port,
-        run_sender,
-    )
-
-    if args.protocol == "v2":
-        return _tx2(args)
-    stop = _stop_on_signals()
+def _tx_input(args: argparse.Namespace, size: int) -> Iterator[bytes]:
+    """What link-tx sends: ``--generate``d test samples, or hex lines from stdin (blank and
+    ``#`` lines skipped), at most ``--count``, each ``size`` bytes."""
     if args.generate:
-        blocks: Any = test_samples(args.count if args.count is not None else 100, args.block_size)
-    else:
-        def from_stdin() -> Iterator[bytes]:
-            k = 0
-            for lineno, line in enumerate(sys.stdin, 1):
-                if not line.strip() or line.lstrip().startswith("#"):
-                    continue
-                if args.count is not None and k >= args.count:
-                    return
-                yield _parse_hex_line(line, args.block_size, lineno)
-                k += 1
-        blocks = from_stdin()
-    try:
-        port = open_port(args.port, args.baud)
-    except AttitudeError as exc:
-        print(f"link-tx: {exc}", file=sys.stderr)
-        return 1
+        yield from test_samples(args.count if args.count is not None else 100, size)
+        return
+    k = 0
+    for lineno, line in enumerate(sys.stdin, 1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        if args.count is not None and k >= args.count:
+            return
+        yield _parse_hex_line(line, size, lineno)
+        k += 1
+
+
+def cmd_tx(args: argparse.Namespace) -> int:
+    from ..link.transport import OUTCOME_INTERRUPTED, OUTCOME_NO_RECEIVER, BlockReport, run_sender
+
+    v2 = args.protocol == "v2"
+    stop = _stop_on_signals()
+    blocks = _tx_input(args, 6 if v2 else args.block_size)  # link v2: 6-byte records
+    port = _open("link-tx", args)
+    if port is None:
+        return EXIT_PORT
 
     def show(r: BlockReport) -> None:
         if r.outcome in (OUTCOME_NO_RECEIVER, OUTCOME_INTERRUPTED):
@@ -268,12 +268,17 @@ def cmd_tx(args: argparse.Namespace) -> int:
               file=sys.stderr, flush=True)
 
     try:
-        reports, stats = run_sender(port, blocks, impl=args.impl, block_size=args.block_size,
-                                    syn_timeout_ms=args.syn_timeout_ms,
-                                    answer_timeout_ms=args.answer_timeout_ms,
-                                    max_attempts=args.max_attempts, on_result=show, stop=stop,
-                                    wait_first=args.wait, on_waiting=waiting, waiting_every=WAIT_NOTE_S,
-                                    on_give_up=args.on_give_up)
+        if v2:
+            from ..link.transport2 import run_sender2
+
+            rep2 = run_sender2(port, blocks, impl=args.impl, timeout=args.wait, stop=stop)
+        else:
+            reports, stats = run_sender(port, blocks, impl=args.impl, block_size=args.block_size,
+                                        syn_timeout_ms=args.syn_timeout_ms,
+                                        answer_timeout_ms=args.answer_timeout_ms,
+                                        max_attempts=args.max_attempts, on_result=show, stop=stop,
+                                        wait_first=args.wait, on_waiting=waiting, waiting_every=WAIT_NOTE_S,
+                                        on_give_up=args.on_give_up)
     except ValueError as exc:
         print(f"link-tx: {exc}", file=sys.stderr)
         return EXIT_USAGE
@@ -282,6 +287,13 @@ def cmd_tx(args: argparse.Namespace) -> int:
         return EXIT_PORT
     finally:
         port.close()
+    return _tx2_end(args, rep2) if v2 else _tx_end(args, reports, stats)
+
+
+def _tx_end(args: argparse.Namespace, reports: list[Any], stats: dict[str, int]) -> int:
+    """link-tx (legacy): the statistics, the last block's fate, the exit status."""
+    from ..link.transport import OUTCOME_GAVE_UP, OUTCOME_INTERRUPTED, OUTCOME_NO_RECEIVER
+
     print("link-tx stats: " + json.dumps(stats), file=sys.stderr)
     last = reports[-1] if reports else None
     if last is not None and last.outcome == OUTCOME_NO_RECEIVER:
@@ -321,6 +333,8 @@ def cmd_test(args: argparse.Namespace) -> int:
                              dead=dead, seed=args.seed)  # type: ignore[arg-type]
         blocks = np.frombuffer(b"".join(test_samples(args.blocks, args.block_size)),
                                dtype=np.uint8).reshape(args.blocks, args.block_size)
+        if reboots and args.transport != "sim":
+            raise ValueError("--reboot is only available with --transport sim")
         if args.protocol == "v2":
             out = _test2(args, chan, reboots, [bytes(r) for r in blocks])
         elif args.transport == "sim":
@@ -330,8 +344,6 @@ def cmd_test(args: argparse.Namespace) -> int:
             out["channel"] = run.channel_stats
             out["engine"] = run.engine
         else:
-            if reboots:
-                raise ValueError("--reboot is only available with --transport sim")
             out = _real_time_test(args, chan, [bytes(r) for r in blocks])
     except (ValueError, TypeError, argparse.ArgumentTypeError) as exc:
         print(f"link-test: {exc}", file=sys.stderr)
@@ -347,10 +359,14 @@ def cmd_test(args: argparse.Namespace) -> int:
     return 0
 
 
-def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) -> dict[str, Any]:
+def _over_bridge(args: argparse.Namespace, chan: Any, receive: Callable[[Any, threading.Event], Any],
+                 send: Callable[[Any], Any]) -> tuple[Any, Any, float, Any]:
+    """link-test --transport pty|socket: ``receive(port, stop)`` in a thread on one end of a real
+    bridge through ``chan``, ``send(port)`` on the other. Returns the receiver's report (None if it
+    did not end), the sender's, the seconds ``send`` took and the channel's statistics."""
     import time
 
-    from ..link.transport import PtyPair, SocketRelay, open_port, run_receiver, run_sender
+    from ..link.transport import PtyPair, SocketRelay, open_port
 
     bridge: Any = PtyPair(baud=args.baud, channel=chan) if args.transport == "pty" \
         else SocketRelay(baud=args.baud, channel=chan)
@@ -359,12 +375,11 @@ def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) ->
     box: dict[str, Any] = {}
     try:
         pb = open_port(urls[1], args.baud)
-        th = threading.Thread(target=lambda: box.setdefault(
-            "rx", run_receiver(pb, impl=args.receiver, block_size=args.block_size, stop=stop)), daemon=True)
+        th = threading.Thread(target=lambda: box.setdefault("rx", receive(pb, stop)), daemon=True)
         th.start()
         pa = open_port(urls[0], args.baud)
         t0 = time.monotonic()
-        reports, sstats = run_sender(pa, blocks, impl=args.sender, block_size=args.block_size)
+        sent = send(pa)
         dt = time.monotonic() - t0
         time.sleep(0.1)
         stop.set()
@@ -373,51 +388,36 @@ def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) ->
         pb.close()
     finally:
         bridge.close()
-    rx = box.get("rx")
-    got = rx.blocks if rx else []
-    sent = {b for b in blocks}
+    return box.get("rx"), sent, dt, bridge.channel_stats()
+
+
+def _real_time_test(args: argparse.Namespace, chan: Any, blocks: list[bytes]) -> dict[str, Any]:
+    from ..link.transport import run_receiver, run_sender
+
+    rx, (reports, sstats), dt, channel = _over_bridge(
+        args, chan, lambda port, stop: run_receiver(port, impl=args.receiver, block_size=args.block_size, stop=stop),
+        lambda port: run_sender(port, blocks, impl=args.sender, block_size=args.block_size))
+    got = rx.blocks if rx is not None else []
+    sent = set(blocks)
+    acked = sum(r.outcome == "accepted" for r in reports)
     return {
         "blocks": len(blocks),
         "accepted_by_B": len(got),
-        "acked": sum(r.outcome == "accepted" for r in reports),
+        "acked": acked,
         "gave_up": sum(r.outcome == "gave up" for r in reports),
         "not_sent_blocks_accepted": sum(b not in sent for b in got),
         "duration_s": dt,
-        "blocks_per_s": sum(r.outcome == "accepted" for r in reports) / dt if dt > 0 else 0.0,
+        "blocks_per_s": acked / dt if dt > 0 else 0.0,
         "sender": sstats,
-        "receiver": rx.stats if rx else {},
-        "channel": bridge.channel_stats(),
+        "receiver": rx.stats if rx is not None else {},
+        "channel": channel,
     }
 
 
 # ---------------------------------------------------------------- link v2 (docs/link.md, "Link v2")
 
-def _rx2(args: argparse.Namespace) -> int:
-    from ..link.transport import open_port
-    from ..link.transport2 import run_receiver2
-
-    stop = _stop_on_signals()
-    try:
-        port = open_port(args.port, args.baud)
-    except AttitudeError as exc:
-        print(f"link-rx: {exc}", file=sys.stderr)
-        return 1
-    show: Any = _block_printer() if args.decode else (lambda r: print(_hex_block(r), flush=True))
-    print(f"link-rx: listening on {args.port} ({args.baud} 8N1, link v2, {args.impl})", file=sys.stderr, flush=True)
-    try:
-        rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
-                            stop=stop, eof_after=args.idle_eof, keep_records=False)
-    finally:
-        port.close()
-    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
-    if rep.error:
-        print(f"link-rx: {rep.error}", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None], stop: threading.Event) -> int:
-    """link-rx --protocol auto: listen_auto, then the receiver of the protocol heard."""
+def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None], stop: threading.Event) -> Any:
+    """link-rx --protocol auto: listen_auto, then the receiver of the protocol heard; its report."""
     import time
 
     from ..link.transport import run_receiver
@@ -428,67 +428,29 @@ def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None],
     def left() -> float | None:
         return None if args.duration is None else max(1e-3, args.duration - (time.monotonic() - t0))
 
-    try:
-        heard = listen_auto(port, impl=args.impl, block_size=args.block_size, gap_timeout_ms=args.gap_timeout_ms,
-                            on_block=show, on_record=show, stop=stop, duration=args.duration,
-                            eof_after=args.idle_eof)
-        if heard.protocol == "legacy":
-            print("link-rx: the sender speaks the legacy protocol", file=sys.stderr, flush=True)
-            rep: Any = run_receiver(heard.port, receiver=heard.legacy, count=args.count, duration=left(),
-                                    on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
-        elif heard.protocol == "v2":
-            print("link-rx: the sender speaks link v2", file=sys.stderr, flush=True)
-            count = None if args.count is None else args.count - heard.records
-            if count is not None and count <= 0:
-                rep = SimpleNamespace(stats=heard.v2.stats.as_dict(), ended_by="count", error="")
-            else:
-                rep = run_receiver2(heard.port, impl=args.impl, receiver=heard.v2, count=count, duration=left(),
-                                    on_record=show, stop=stop, eof_after=args.idle_eof, keep_records=False)
+    heard = listen_auto(port, impl=args.impl, block_size=args.block_size, gap_timeout_ms=args.gap_timeout_ms,
+                        on_block=show, on_record=show, stop=stop, duration=args.duration,
+                        eof_after=args.idle_eof)
+    if heard.protocol == "legacy":
+        print("link-rx: the sender speaks the legacy protocol", file=sys.stderr, flush=True)
+        rep: Any = run_receiver(heard.port, receiver=heard.legacy, count=args.count, duration=left(),
+                                on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+    elif heard.protocol == "v2":
+        print("link-rx: the sender speaks link v2", file=sys.stderr, flush=True)
+        count = None if args.count is None else args.count - heard.records
+        if count is not None and count <= 0:
+            rep = SimpleNamespace(stats=heard.v2.stats.as_dict(), ended_by="count", error="")
         else:
-            rep = SimpleNamespace(stats={"legacy": heard.legacy.stats.as_dict(), "v2": heard.v2.stats.as_dict()},
-                                  ended_by=heard.ended_by + ", no protocol heard", error=heard.error)
-    except AttitudeError as exc:
-        print(f"link-rx: {exc}", file=sys.stderr)
-        return 2
-    finally:
-        port.close()
-    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
-    if rep.error:
-        print(f"link-rx: {rep.error}", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _tx2(args: argparse.Namespace) -> int:
-    from ..link.transport import open_port
-    from ..link.transport2 import run_sender2
-
-    stop = _stop_on_signals()
-    if args.generate:
-        records: Any = test_samples(args.count if args.count is not None else 100, 6)
+            rep = run_receiver2(heard.port, impl=args.impl, receiver=heard.v2, count=count, duration=left(),
+                                on_record=show, stop=stop, eof_after=args.idle_eof, keep_records=False)
     else:
-        def from_stdin() -> Iterator[bytes]:
-            k = 0
-            for lineno, line in enumerate(sys.stdin, 1):
-                if not line.strip() or line.lstrip().startswith("#"):
-                    continue
-                if args.count is not None and k >= args.count:
-                    return
-                yield _parse_hex_line(line, 6, lineno)
-                k += 1
-        records = from_stdin()
-    try:
-        port = open_port(args.port, args.baud)
-    except AttitudeError as exc:
-        print(f"link-tx: {exc}", file=sys.stderr)
-        return EXIT_PORT
-    try:
-        rep = run_sender2(port, records, impl=args.impl, timeout=args.wait, stop=stop)
-    except ValueError as exc:
-        print(f"link-tx: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    finally:
-        port.close()
+        rep = SimpleNamespace(stats={"legacy": heard.legacy.stats.as_dict(), "v2": heard.v2.stats.as_dict()},
+                              ended_by=heard.ended_by + ", no protocol heard", error=heard.error)
+    return rep
+
+
+def _tx2_end(args: argparse.Namespace, rep: Any) -> int:
+    """link-tx --protocol v2: the statistics, what was acknowledged, the exit status."""
     print("link-tx stats: " + json.dumps(rep.stats), file=sys.stderr)
     print(f"link-tx: {rep.acknowledged} of {rep.pushed} record(s) acknowledged (ended by {rep.ended_by})",
           flush=True)
@@ -505,10 +467,7 @@ def _tx2(args: argparse.Namespace) -> int:
 
 
 def _test2(args: argparse.Namespace, chan: Any, reboots: list[Any], records: list[bytes]) -> dict[str, Any]:
-    import time
-
     from ..link.sim2 import simulate_link2
-    from ..link.transport import PtyPair, SocketRelay, open_port
     from ..link.transport2 import run_receiver2, run_sender2
 
     if args.transport == "sim":
@@ -522,32 +481,11 @@ def _test2(args: argparse.Namespace, chan: Any, reboots: list[Any], records: lis
                              sender=args.sender, receiver=args.receiver, reboot_sender_s=when["sender"],
                              reboot_receiver_s=when["receiver"])
         return {"protocol": "v2", **run.summary(), "channel": run.channel}
-    if reboots:
-        raise ValueError("--reboot is only available with --transport sim")
-    bridge: Any = PtyPair(baud=args.baud, channel=chan) if args.transport == "pty" \
-        else SocketRelay(baud=args.baud, channel=chan)
-    urls = bridge.paths if args.transport == "pty" else [bridge.url, bridge.url]
-    stop = threading.Event()
-    box: dict[str, Any] = {}
-    try:
-        pb = open_port(urls[1], args.baud)
-        th = threading.Thread(target=lambda: box.setdefault("rx", run_receiver2(pb, impl=args.receiver, stop=stop)),
-                              daemon=True)
-        th.start()
-        pa = open_port(urls[0], args.baud)
-        t0 = time.monotonic()
-        rep = run_sender2(pa, records, impl=args.sender, timeout=600)
-        dt = time.monotonic() - t0
-        time.sleep(0.1)
-        stop.set()
-        th.join(timeout=5)
-        pa.close()
-        pb.close()
-    finally:
-        bridge.close()
-    got = box["rx"].records if "rx" in box else []
+    rx, rep, dt, channel = _over_bridge(
+        args, chan, lambda port, stop: run_receiver2(port, impl=args.receiver, stop=stop),
+        lambda port: run_sender2(port, records, impl=args.sender, timeout=600))
+    got = rx.records if rx is not None else []
     return {"protocol": "v2", "records": len(records), "acknowledged": rep.acknowledged,
             "delivered": len(got), "in_order_exactly_once": got == records[:len(got)],
             "duration_s": dt, "records_per_s": rep.acknowledged / dt if dt > 0 else 0.0,
-            "sender": rep.stats, "receiver": box["rx"].stats if "rx" in box else {},
-            "channel": bridge.channel_stats()}
+            "sender": rep.stats, "receiver": rx.stats if rx is not None else {}, "channel": channel}

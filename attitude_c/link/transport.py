@@ -308,6 +308,41 @@ def _write(port: Any, data: bytes) -> None:
         raise LinkError(f"port {getattr(port, 'name', port)!r} failed on write: {exc}") from exc
 
 
+class _Limits:
+    """The ends of a real-time loop that are not the protocol's: ``stop`` set, ``duration``
+    seconds past (reported as ``late``), ``eof_after`` seconds without a byte."""
+
+    def __init__(self, stop: threading.Event | None, duration: float | None, eof_after: float | None = None,
+                 late: str = "duration") -> None:
+        self.stop, self.eof_after, self.late = stop, eof_after, late
+        self.t_end = None if duration is None else time.monotonic() + duration
+        self.last_byte = time.monotonic()
+
+    def ended(self) -> str:
+        """``"stop"``, ``late`` when the time is up, else ``""``."""
+        if self.stop is not None and self.stop.is_set():
+            return "stop"
+        if self.t_end is not None and time.monotonic() >= self.t_end:
+            return self.late
+        return ""
+
+    def read(self, port: Any, wait_s: float) -> bytes | None:
+        """The bytes read within ``wait_s``; None after ``eof_after`` s without one."""
+        data = _read(port, wait_s)
+        now = time.monotonic()
+        if data:
+            self.last_byte = now
+        elif self.eof_after is not None and now - self.last_byte > self.eof_after:
+            return None
+        return data
+
+
+def _wait_s(ticks_left: int | None) -> float:
+    """How long a legacy end may wait for a byte (s): until its timer is due (ms ticks),
+    0.5 .. 20 ms."""
+    return 0.02 if ticks_left is None else min(0.02, max(0.0005, ticks_left / 1000.0))
+
+
 def _drain(rx: Any, tick: int, out: bytearray) -> None:
     """Collect every byte receiver ``rx`` wants to send now (its answers) into ``out``."""
     while True:
@@ -361,23 +396,14 @@ def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT
                                                              gap_timeout=gap_timeout_ms)
     clock = _Clock()
     rep = ReceiverReport()
-    t_end = None if duration is None else time.monotonic() + duration
-    last_byte = time.monotonic()
+    limits = _Limits(stop, duration, eof_after)
     try:
         while True:
-            if stop is not None and stop.is_set():
-                rep.ended_by = "stop"
+            rep.ended_by = limits.ended()
+            if rep.ended_by:
                 break
-            if t_end is not None and time.monotonic() >= t_end:
-                rep.ended_by = "duration"
-                break
-            left = rx.ticks_left(clock())
-            wait = 0.02 if left is None else min(0.02, max(0.0005, left / 1000.0))
-            data = _read(port, wait)
-            now = time.monotonic()
-            if data:
-                last_byte = now
-            elif eof_after is not None and now - last_byte > eof_after:
+            data = limits.read(port, _wait_s(rx.ticks_left(clock())))
+            if data is None:
                 rep.ended_by = "eof"
                 break
             tick = clock()
@@ -514,9 +540,7 @@ def run_sender(port: Any, blocks: Iterable[bytes], *, impl: Impl = "c", block_si
             _write(port, bytes(out))
         if ended:
             break
-        left = tx.ticks_left(clock())
-        wait = 0.02 if left is None else min(0.02, max(0.0005, left / 1000.0))
-        data = _read(port, wait)
+        data = _read(port, _wait_s(tx.ticks_left(clock())))
         tick = clock()
         for b in data:
             r = tx.sink(b, tick)

@@ -13,7 +13,7 @@ from typing import Any, Callable, Literal
 import serial
 
 from ..errors import InvalidArgument, LinkError
-from .transport import _Clock, _read, _write
+from .transport import _Clock, _Limits, _read, _write
 from .v2 import RECORD, Receiver2, Result2, Sender2
 from .v2c import CReceiver2, CSender2
 
@@ -48,6 +48,15 @@ def _out_waiting(port: Any) -> int:
         return 0
 
 
+def _drain2(end: Any, out: bytearray) -> None:
+    """Collect every byte a link v2 receiver wants to send now (its answers) into ``out``."""
+    while True:
+        r, o = end.poll()
+        if r != Result2.SEND or o is None:
+            return
+        out.append(o)
+
+
 def _impl(impl: str) -> None:
     if impl not in ("c", "python"):
         raise InvalidArgument(f'impl must be "c" or "python", got {impl!r}')
@@ -64,23 +73,16 @@ def run_receiver2(port: Any, *, impl: Impl = "c", count: int | None = None, dura
     _impl(impl)
     rx: Any = receiver if receiver is not None else (CReceiver2() if impl == "c" else Receiver2())
     rep = Receiver2Report()
-    t_end = None if duration is None else time.monotonic() + duration
-    last = time.monotonic()
+    limits = _Limits(stop, duration, eof_after)
     n = 0
     try:
         while True:
-            if stop is not None and stop.is_set():
-                rep.ended_by = "stop"
-                break
-            if t_end is not None and time.monotonic() >= t_end:
-                rep.ended_by = "duration"
+            rep.ended_by = limits.ended()
+            if rep.ended_by:
                 break
             rx.set_room(min(0xFFFF, max(0, room())) if room is not None else 0xFFFF)
-            data = _read(port, 0.01)
-            now = time.monotonic()
-            if data:
-                last = now
-            elif eof_after is not None and now - last > eof_after:
+            data = limits.read(port, 0.01)
+            if data is None:
                 rep.ended_by = "eof"
                 break
             out = bytearray()
@@ -92,16 +94,8 @@ def run_receiver2(port: Any, *, impl: Impl = "c", count: int | None = None, dura
                             rep.records.append(rec)
                         if on_record is not None:
                             on_record(rec)
-                while True:  # answer at once
-                    r, o = rx.poll()
-                    if r != Result2.SEND or o is None:
-                        break
-                    out.append(o)
-            while True:
-                r, o = rx.poll()
-                if r != Result2.SEND or o is None:
-                    break
-                out.append(o)
+                _drain2(rx, out)  # answer at once
+            _drain2(rx, out)
             if out:
                 _write(port, bytes(out))
             if count is not None and n >= count:
@@ -125,7 +119,7 @@ def run_sender2(port: Any, records: Iterable[bytes], *, impl: Impl = "c", rto_ms
     exhausted = False
     clock = _Clock()
     rep = Sender2Report()
-    t_end = None if timeout is None else time.monotonic() + timeout
+    limits = _Limits(stop, timeout, late="timeout")
     baud = getattr(port, "baudrate", None)
     byte_s = 10.0 / baud if isinstance(baud, int) and baud > 0 else 0.0  # 8N1
     busy_until = 0.0
@@ -143,14 +137,8 @@ def run_sender2(port: Any, records: Iterable[bytes], *, impl: Impl = "c", rto_ms
                 tx.push(pending)
                 pending = None
                 rep.pushed += 1
-            if exhausted and tx.pending == 0:
-                rep.ended_by = "done"
-                break
-            if stop is not None and stop.is_set():
-                rep.ended_by = "stop"
-                break
-            if t_end is not None and time.monotonic() >= t_end:
-                rep.ended_by = "timeout"
+            rep.ended_by = "done" if exhausted and tx.pending == 0 else limits.ended()
+            if rep.ended_by:
                 break
             out = bytearray()
             # one frame at a time, once the line has carried the last one (a UART's "transmitter
@@ -259,22 +247,15 @@ def listen_auto(port: Any, *, impl: Impl = "c", block_size: int = 6, gap_timeout
     new: Any = CReceiver2() if impl == "c" else Receiver2()
     new.set_room(0xFFFF)
     clock = _Clock()
-    t_end = None if duration is None else time.monotonic() + duration
-    last = time.monotonic()
+    limits = _Limits(stop, duration, eof_after)
     heard = Heard("", old, new, port)
     try:
         while True:
-            if stop is not None and stop.is_set():
-                heard.ended_by = "stop"
+            heard.ended_by = limits.ended()
+            if heard.ended_by:
                 return heard
-            if t_end is not None and time.monotonic() >= t_end:
-                heard.ended_by = "duration"
-                return heard
-            data = _read(port, 0.01)
-            now = time.monotonic()
-            if data:
-                last = now
-            elif eof_after is not None and now - last > eof_after:
+            data = limits.read(port, 0.01)
+            if data is None:
                 heard.ended_by = "eof"
                 return heard
             tick = clock()
@@ -287,11 +268,7 @@ def listen_auto(port: Any, *, impl: Impl = "c", block_size: int = 6, gap_timeout
                         heard.records += 1
                         if on_record is not None:
                             on_record(rec)
-                    while True:
-                        r, o = new.poll()
-                        if r != Result2.SEND or o is None:
-                            break
-                        out.append(o)
+                    _drain2(new, out)
                 elif old.sink(b, tick) is Result.ACCEPTED:
                     blk = bytes(old.block)
                     if on_block is not None:
