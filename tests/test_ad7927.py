@@ -12,6 +12,7 @@ the C driver.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from typing import Any
 
@@ -408,11 +409,9 @@ class TwinPins:
     def __init__(self, **kw: Any) -> None:
         self.twin = A.CTwin(**kw)
         lib, m = self.twin._lib, self.twin._m
-        self.set_cs = lambda v: lib.ad7927m_set_cs(m, v)
-        self.set_sclk = lambda v: lib.ad7927m_set_sclk(m, v)
-        self.set_din = lambda v: lib.ad7927m_set_din(m, v)
-        self.get_dout = lambda: lib.ad7927m_get_dout(m)
-        self.delay_ns = lambda ns: lib.ad7927m_delay_ns(m, ns)
+        # the C model's ad7927m_<pin>(m, ...) as self.<pin>(...)
+        for pin in ("set_cs", "set_sclk", "set_din", "get_dout", "delay_ns"):
+            setattr(self, pin, functools.partial(getattr(lib, "ad7927m_" + pin), m))
         tx = self.twin._ffi.new("uint16_t[]", 8)
         rx = self.twin._ffi.new("uint16_t[]", 8)
 
