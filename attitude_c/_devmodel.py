@@ -1,6 +1,7 @@
 """Pieces shared by the ADC packages (attitude_c.tlc2543, attitude_c.ad7927):
 their device models' argument checks, the C twins' violation and trace
-read-out, and the chunked batch conversion through a C driver."""
+read-out, the model's error raised after a driver call, and the chunked
+batch conversion through a C driver."""
 
 from __future__ import annotations
 
@@ -130,6 +131,18 @@ class CTwinBase(Generic[V]):
     def violation(self) -> V | None:
         """The latched violation (or None)."""
         return twin_violation(self._ffi, self._m, self._RULES, self._VIOLATION)  # type: ignore[return-value]
+
+
+def raise_model_error(bridge: Any, model: Any) -> None:
+    """After a C driver call: re-raise the exception a Python model's callback
+    met (``bridge``, an attitude_c._bridge.Bridge), or else raise the violation
+    the C twin ``model`` latched; nothing when there is none."""
+    if bridge is not None:
+        bridge.raise_pending()
+    elif isinstance(model, CTwinBase):
+        v = model.violation()
+        if v is not None:
+            raise v
 
 
 def convert_in_chunks(n: int, k: int, chunk: int, step: Callable[[int, int, bool, np.ndarray], tuple[int, int]],

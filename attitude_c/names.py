@@ -162,9 +162,10 @@ _CLASSES: dict[str, type[Exception]] = {
 
 def status_text(status: int) -> str:
     """The library's description of status code ``status`` (``att_status_str``;
+    the host device twins' own codes: ``devm_status_str``, csrc/host/devmodel.h;
     "unknown status" for a value no header defines)."""
     ffi, lib = _ffi_lib()
-    return str(ffi.string(lib.att_status_str(int(status))).decode())
+    return str(ffi.string(lib.devm_status_str(int(status))).decode())
 
 
 class _Status(Mapping[str, tuple[type[Exception], str]]):

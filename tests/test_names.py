@@ -144,6 +144,39 @@ def test_att_status_str_names_every_code_of_the_headers() -> None:
         assert {names.status_text(v) for v in codes.values()} == set(texts.values())
 
 
+def _host_status_codes() -> dict[str, int]:
+    """The status codes the host twins' headers define (csrc/host: outside the library)."""
+    out: dict[str, int] = {}
+    for h in (h for h in HEADERS if h.parent.name == "host"):
+        text = re.sub(r"/\*.*?\*/", " ", h.read_text(), flags=re.DOTALL)
+        out.update({m[0]: int(m[1]) for m in re.findall(r"\b(\w+_E_\w+)\s*=\s*(-\d+)", text)})
+    return out
+
+
+def test_every_code_python_can_see_has_a_text_of_its_own() -> None:
+    """Every status code the package knows (names.C: the library's and the host
+    twins', which the C twins' batch calls return) has its own text: the library's
+    from att_status_str, the twins' from devm_status_str (csrc/host/devmodel.c; the
+    twins live outside the library); csrc/tests/test_devmodel.c (run by
+    test_c_programs.py) lists exactly the twins' codes and checks the same in C."""
+    import pytest
+
+    from attitude_c.errors import AttitudeError, raise_for_status
+
+    host, library = _host_status_codes(), _library_status_codes()
+    assert host and set(host).isdisjoint(library)
+    listed = re.findall(r"HOST_CODE\(([A-Z][A-Z0-9_]+)\)", (ROOT / "csrc" / "tests" / "test_devmodel.c").read_text())
+    assert sorted(listed) == sorted(host) and len(set(listed)) == len(listed)
+    codes = {k: v for k, v in names.C.items() if v < 0 and "_E_" in k}
+    assert set(codes) == set(host) | set(library)
+    texts = {k: names.status_text(v) for k, v in codes.items()}
+    assert not [k for k, t in texts.items() if t in ("unknown status", "ok", "")], texts
+    assert len(set(texts.values())) == len(texts), texts  # a text names its code
+    for name, v in host.items():  # without a module's own meaning: the twin's text and its name
+        with pytest.raises(AttitudeError, match=rf"^x: {re.escape(texts[name])} \(status {v}, {name}\)$"):
+            raise_for_status(v, "x")
+
+
 def test_python_error_texts_are_the_librarys() -> None:
     import pytest
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -228,6 +229,32 @@ def test_chain_ideal_sensors_hand_over_the_truth_and_the_default_has_none() -> N
         SimConfig(mag=mag_preset("ideal"), soft_iron=np.zeros((3, 3))).validate()
     with pytest.raises(InvalidArgument, match="accelerometer model"):
         SimConfig(accel=mag_preset("ideal")).validate()
+
+
+# each switch of ``without`` and the one field it turns off (None: no filter); the
+# field names are the models' documented attributes
+_VECTOR_SWITCHES = {"noise": ("noise_density", 0.0), "bias": ("bias_sigma", 0.0),
+                    "bandwidth": ("bandwidth_hz", None), "scale": ("scale_sigma", 0.0),
+                    "misalignment": ("misalignment_sigma", 0.0), "markov": ("markov_sigma", 0.0)}
+_GYRO_SWITCHES = {"noise": ("noise_density", 0.0), "bias": ("bias_dps", 0.0),
+                  "bandwidth": ("bandwidth_hz", None), "scale": ("scale_error", 0.0)}
+
+
+@pytest.mark.parametrize("kind", ["accel", "mag", "gyro"])
+def test_without_switches_off_exactly_the_named_sources(kind: str) -> None:
+    """``without(x=True)`` turns off the one field of x and leaves every other
+    field as it was; ``perfect()`` (vector parts) turns them all off."""
+    part, switches = {"accel": (accel_preset("adis16405"), _VECTOR_SWITCHES),
+                      "mag": (replace(mag_preset("adis16405"), markov_sigma=0.1), _VECTOR_SWITCHES),
+                      "gyro": (replace(gyro_preset("adxrs150"), scale_error=0.01), _GYRO_SWITCHES)}[kind]
+    before = vars(part)
+    assert all(before[f] not in (0.0, None) for f, _ in switches.values())  # every switch has work to do
+    assert part.without() == part
+    for flag, (name, off) in switches.items():
+        assert vars(part.without(**{flag: True})) == {**before, name: off}, flag
+    assert vars(part.without(**dict.fromkeys(switches, True))) == {**before, **dict(switches.values())}
+    if kind != "gyro":
+        assert part.perfect() == part.without(**dict.fromkeys(switches, True))
 
 
 @pytest.mark.parametrize("part", [*ACCEL_PRESETS.values(), *MAG_PRESETS.values()],

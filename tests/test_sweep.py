@@ -223,6 +223,49 @@ def test_spec_errors_are_one_line_and_exit_2(tmp_path, capsys, text, words):
     assert "cannot read" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize("argv, code, line", [
+    ([], 2, "give a SPEC file (or --list-options)"),
+    (["SPEC", "--serial", "--workers", "2"], 2, "--serial runs in this process: drop --scheduler/--workers"),
+    (["SPEC", "--scheduler", "tcp://x:1", "--workers", "2"], 2,
+     "--workers sizes the local cluster: an existing scheduler has its own workers"),
+])
+def test_argument_errors_are_one_line(tmp_path, capsys, argv, code, line):
+    spec = str(_write(tmp_path, "[grid]\nperiod = [0.1]\n"))
+    assert main(["sweep", *(spec if a == "SPEC" else a for a in argv)]) == code
+    assert capsys.readouterr().err == f"attitude sweep: error: {line}\n"
+
+
+@pytest.mark.parametrize("exc, code, line", [
+    (ImportError("needs dask: pip install dask"), 3, "error: needs dask: pip install dask"),
+    (ValueError("another sweep holds the folder"), 2, "error: another sweep holds the folder"),
+    (ConnectionError("no scheduler at tcp://x:1"), 3, "error: no scheduler at tcp://x:1"),
+    (PermissionError(13, "Permission denied", "/x/runs.csv"), 2, "error: /x/runs.csv: Permission denied"),
+    (PermissionError(13, "Permission denied"), 2, "error: OUT: Permission denied"),
+    (KeyboardInterrupt(), 130,
+     "interrupted: 0 of 1 runs are recorded in OUT/; rerun the same command to resume"),
+])
+def test_engine_errors_are_one_line_with_their_exit_code(tmp_path, capsys, monkeypatch, exc, code, line):
+    # what sweeps.sweep may raise, and the one line and exit code each becomes (docs/sweep.md)
+    def raise_it(*_a, **_k):
+        raise exc
+
+    monkeypatch.setattr(sweeps, "sweep", raise_it)
+    out = tmp_path / "out"
+    rc = main(["sweep", str(_write(tmp_path, "[grid]\nperiod = [0.1]\n")), "--serial", "--out", str(out)])
+    err = capsys.readouterr().err.splitlines()
+    assert rc == code
+    assert err[1:] == [f"attitude sweep: {line.replace('OUT', str(out))}"], err
+
+
+def test_a_spec_that_needs_a_missing_package_exits_3(tmp_path, capsys, monkeypatch):
+    def raise_it(*_a, **_k):
+        raise ImportError("needs pandas: pip install pandas")
+
+    monkeypatch.setattr(sweeps, "load_spec", raise_it)
+    assert main(["sweep", str(_write(tmp_path, "[grid]\nperiod = [0.1]\n"))]) == 3
+    assert capsys.readouterr().err == "attitude sweep: error: needs pandas: pip install pandas\n"
+
+
 # ---------------------------------------------------------------------------
 # engines: the same table everywhere
 # ---------------------------------------------------------------------------

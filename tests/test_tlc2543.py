@@ -8,6 +8,7 @@ reference driver, and the C driver against the C twin of the model.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from typing import Any
 
@@ -239,12 +240,9 @@ class TwinPins:
     def __init__(self, **kw: Any) -> None:
         self.twin = T.CTwin(**kw)
         lib, m = self.twin._lib, self.twin._m
-        self.set_cs = lambda v: lib.tlc2543m_set_cs(m, v)
-        self.set_clock = lambda v: lib.tlc2543m_set_clock(m, v)
-        self.set_din = lambda v: lib.tlc2543m_set_din(m, v)
-        self.get_dout = lambda: lib.tlc2543m_get_dout(m)
-        self.get_eoc = lambda: lib.tlc2543m_get_eoc(m)
-        self.delay_ns = lambda ns: lib.tlc2543m_delay_ns(m, ns)
+        # the C model's tlc2543m_<pin>(m, ...) as self.<pin>(...)
+        for pin in ("set_cs", "set_clock", "set_din", "get_dout", "get_eoc", "delay_ns"):
+            setattr(self, pin, functools.partial(getattr(lib, "tlc2543m_" + pin), m))
 
     def rule(self) -> str | None:
         v = self.twin.violation()

@@ -27,7 +27,7 @@ from typing import Any, Callable, Literal
 
 import numpy as np
 
-from .._devmodel import CTwinBase, check_level, convert_in_chunks
+from .._devmodel import CTwinBase, check_level, convert_in_chunks, raise_model_error
 from ..errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 from . import _capi
 from ._errors import AddressMismatch, FrameError
@@ -192,12 +192,7 @@ class Ad7927:
 
     # -- plumbing -------------------------------------------------------------
     def _after(self, status: int, what: str) -> None:
-        if self._bridge is not None:
-            self._bridge.raise_pending()
-        elif isinstance(self.model, CTwin):
-            v = self.model.violation()
-            if v is not None:
-                raise v
+        raise_model_error(self._bridge, self.model)
         if status in (self._lib.AD7927_E_CHANNEL, self._lib.AD7927_E_FRAME):
             word, exp = int(self._dev.last_word), int(self._dev.last_expect)
             cls = AddressMismatch if status == self._lib.AD7927_E_CHANNEL else FrameError

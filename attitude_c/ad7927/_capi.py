@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from .._bridge import Bridge
+from .._bridge import Bridge, connect_pins, def_pin_callbacks
 from .._lib import ffi_lib
 from ..errors import DeviceError
 from ._errors import AddressMismatch, FrameError
@@ -21,6 +21,9 @@ __all__ = [
 ]
 
 _registered: set[str] = set()
+#: the pin callbacks ad7927py_<name> (csrc/cffi/ad7927.cdef), each calling the model's method <name>
+_SETTERS = ("set_cs", "set_sclk", "set_din", "delay_ns")
+_GETTERS = ("get_dout",)
 
 
 def register(precision: str) -> tuple[Any, Any]:
@@ -28,26 +31,7 @@ def register(precision: str) -> tuple[Any, Any]:
     ffi, lib = ffi_lib(precision)
     if precision in _registered:
         return ffi, lib
-
-    @ffi.def_extern(name="ad7927py_set_cs")
-    def _set_cs(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_cs", level)
-
-    @ffi.def_extern(name="ad7927py_set_sclk")
-    def _set_sclk(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_sclk", level)
-
-    @ffi.def_extern(name="ad7927py_set_din")
-    def _set_din(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_din", level)
-
-    @ffi.def_extern(name="ad7927py_get_dout")
-    def _get_dout(ctx: Any) -> int:
-        return 1 if ffi.from_handle(ctx).call("get_dout") == 1 else 0
-
-    @ffi.def_extern(name="ad7927py_delay_ns")
-    def _delay_ns(ctx: Any, ns: int) -> None:
-        ffi.from_handle(ctx).call("delay_ns", ns)
+    def_pin_callbacks(ffi, "ad7927py_", _SETTERS, _GETTERS)
 
     @ffi.def_extern(name="ad7927py_transfer")
     def _transfer(ctx: Any, tx: Any, rx: Any, n: int, hold_ns: int) -> int:
@@ -75,11 +59,7 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge, frames: bool) -> tuple[Any, A
         return hal, None, handle
     pins = ffi.new("ad7927_pins *")
     pins.ctx = handle
-    pins.set_cs = lib.ad7927py_set_cs
-    pins.set_sclk = lib.ad7927py_set_sclk
-    pins.set_din = lib.ad7927py_set_din
-    pins.get_dout = lib.ad7927py_get_dout
-    pins.delay_ns = lib.ad7927py_delay_ns
+    connect_pins(pins, lib, "ad7927py_", _SETTERS + _GETTERS)
     hal.ctx = pins
     hal.transfer = ffi.addressof(lib, "ad7927_pins_transfer")
     return hal, pins, handle

@@ -58,6 +58,13 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def fail(prog: str, message: str, code: int) -> int:
+    """Report a failure as its one line "PROG: error: MESSAGE" on stderr; return
+    ``code``, the exit status (``return fail(prog, ..., EXIT_USAGE)``)."""
+    print(f"{prog}: error: {message}", file=sys.stderr)
+    return code
+
+
 def os_error_line(exc: OSError) -> str:
     """One line for an OS error: what failed (the file when known) and why."""
     why = exc.strerror or str(exc) or type(exc).__name__

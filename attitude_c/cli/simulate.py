@@ -400,16 +400,14 @@ def build_config(args: argparse.Namespace) -> Any:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import AttitudeError
-    from . import EXIT_OS, EXIT_USAGE, os_error_line
+    from . import EXIT_OS, EXIT_USAGE, fail, os_error_line
 
     try:
         return _run(args)
     except OSError as exc:  # the output location, a full disk (ResultsIncomplete says which files)
-        print(f"attitude simulate: error: {os_error_line(exc)}", file=sys.stderr)
-        return EXIT_OS
+        return fail("attitude simulate", os_error_line(exc), EXIT_OS)
     except (AttitudeError, ValueError, TypeError) as exc:
-        print(f"attitude simulate: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+        return fail("attitude simulate", str(exc), EXIT_USAGE)
 
 
 def _run(args: argparse.Namespace) -> int:

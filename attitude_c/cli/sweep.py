@@ -87,30 +87,25 @@ def _list_options() -> int:
 
 def run(args: argparse.Namespace) -> int:
     from ..errors import AttitudeError
+    from . import fail
 
     prog = "attitude sweep"
     if args.list_options:
         return _list_options()
     if not args.spec:
-        print(f"{prog}: error: give a SPEC file (or --list-options)", file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, "give a SPEC file (or --list-options)", EXIT_SPEC)
     if args.serial and (args.scheduler or args.workers):
-        print(f"{prog}: error: --serial runs in this process: drop --scheduler/--workers", file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, "--serial runs in this process: drop --scheduler/--workers", EXIT_SPEC)
     if args.scheduler and args.workers:
-        print(f"{prog}: error: --workers sizes the local cluster: an existing scheduler has its own workers",
-              file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, "--workers sizes the local cluster: an existing scheduler has its own workers", EXIT_SPEC)
     from ..sim import sweeps
 
     try:
         spec = sweeps.load_spec(args.spec)
     except (AttitudeError, ValueError, TypeError) as exc:
-        print(f"{prog}: error: {args.spec}: {exc}", file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, f"{args.spec}: {exc}", EXIT_SPEC)
     except ImportError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return EXIT_ENGINE
+        return fail(prog, str(exc), EXIT_ENGINE)
     from pathlib import Path
 
     out = Path(args.out) if args.out else Path("results") / f"sweep-{spec.name}"
@@ -135,17 +130,13 @@ def run(args: argparse.Namespace) -> int:
               "rerun the same command to resume", file=sys.stderr)
         return EXIT_INTERRUPTED
     except ImportError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return EXIT_ENGINE
+        return fail(prog, str(exc), EXIT_ENGINE)
     except (AttitudeError, ValueError) as exc:  # e.g. another sweep holds the folder
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, str(exc), EXIT_SPEC)
     except ConnectionError as exc:
-        print(f"{prog}: error: {exc}", file=sys.stderr)
-        return EXIT_ENGINE
+        return fail(prog, str(exc), EXIT_ENGINE)
     except OSError as exc:
-        print(f"{prog}: error: {exc.filename or out}: {exc.strerror or exc}", file=sys.stderr)
-        return EXIT_SPEC
+        return fail(prog, f"{exc.filename or out}: {exc.strerror or exc}", EXIT_SPEC)
     a = df.attrs
     print(f"ran {a['executed']} run(s), reused {a['reused']}, on {a['engine']} in "
           f"{time.perf_counter() - t0:.1f} s; {a['failed']} failed; wrote {out}/ (runs.csv, summary.csv"

@@ -10,6 +10,7 @@ import contextlib
 import csv
 import json
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
 
@@ -53,9 +54,23 @@ def _plt():
     return plt
 
 
-def _save(plt: Any, fig: Any, path: Path, dpi: int) -> None:
-    """Save ``fig`` as PNG to ``path`` as it is (the caller makes the write atomic) and close it."""
+@contextlib.contextmanager
+def _panels(path: Path, dpi: int, height: float, title: str, legend: bool = True) -> Iterator[Any]:
+    """Three stacked panels over t (the block draws into the axes it gets), then
+    the frame every figure shares: dotted grid, legend in the first panel, t
+    axis, ``title``; saved as PNG to ``path`` as it is (the caller makes the
+    write atomic) and closed."""
+    plt = _plt()
+    fig, axes = plt.subplots(3, 1, figsize=(7.0, height), sharex=True)
     try:
+        yield axes
+        for ax in axes:
+            ax.grid(True, linestyle=":", linewidth=0.6)
+        if legend:
+            axes[0].legend(loc="upper right", fontsize=8)
+        axes[-1].set_xlabel("t / s")
+        fig.suptitle(title, fontsize=9.5)
+        fig.tight_layout()
         fig.savefig(path, dpi=dpi, format="png")
     finally:
         plt.close(fig)
@@ -76,26 +91,20 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
 
 
 def _draw_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
-    plt = _plt()
-    fig, axes = plt.subplots(3, 1, figsize=(7.0, 7.0), sharex=True)
     series = [("a. heading error", res.err_heading, "heading"),
               ("b. pitch error", res.err[:, 1], "pitch"),
               ("c. roll error", res.err[:, 2], None)]
-    for ax, (label, e, key) in zip(axes, series):
-        ax.plot(res.t, e, color="black", linewidth=0.9)
-        ax.axhline(0.0, color="0.6", linewidth=0.6)
-        ax.set_ylabel("error / rad")
-        ax.grid(True, linestyle=":", linewidth=0.6)
-        txt = f"{label}: max {np.max(e, initial=0):.2e}, min {np.min(e, initial=0):.2e} rad"
-        if key is not None:
-            lo, hi = PAPER_MAXIMA[key]
-            txt += f"  (paper: {lo:+.2f} … {hi:+.2f} rad)"
-        ax.set_title(txt, fontsize=8.5, loc="right")
-        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
-    axes[-1].set_xlabel("t / s")
-    fig.suptitle("Attitude error curves — " + _title(res), fontsize=9.5)
-    fig.tight_layout()
-    _save(plt, fig, path, dpi)
+    with _panels(path, dpi, 7.0, "Attitude error curves — " + _title(res), legend=False) as axes:
+        for ax, (label, e, key) in zip(axes, series):
+            ax.plot(res.t, e, color="black", linewidth=0.9)
+            ax.axhline(0.0, color="0.6", linewidth=0.6)
+            ax.set_ylabel("error / rad")
+            txt = f"{label}: max {np.max(e, initial=0):.2e}, min {np.min(e, initial=0):.2e} rad"
+            if key is not None:
+                lo, hi = PAPER_MAXIMA[key]
+                txt += f"  (paper: {lo:+.2f} … {hi:+.2f} rad)"
+            ax.set_title(txt, fontsize=8.5, loc="right")
+            ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
 
 
 def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
@@ -106,23 +115,16 @@ def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
 
 
 def _draw_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
-    plt = _plt()
-    fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
     c = res.config
     t_a = c.trajectory.t_start
     tt = np.linspace(t_a, res.t[-1] if len(res.t) else t_a + c.duration, 2000)
     truth = c.trajectory.euler(tt)
-    for i, (ax, name) in enumerate(zip(axes, ("yaw ψ", "pitch θ", "roll γ"))):
-        ax.plot(tt, np.degrees(truth[:, i]), color="0.55", linewidth=2.2, label="truth")
-        ax.plot(res.t, np.degrees(res.euler_est[:, i]), color="black", linewidth=0.8,
-                linestyle="--", label="computed")
-        ax.set_ylabel(f"{name} / °")
-        ax.grid(True, linestyle=":", linewidth=0.6)
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("t / s")
-    fig.suptitle("Attitude — " + _title(res), fontsize=9.5)
-    fig.tight_layout()
-    _save(plt, fig, path, dpi)
+    with _panels(path, dpi, 6.0, "Attitude — " + _title(res)) as axes:
+        for i, (ax, name) in enumerate(zip(axes, ("yaw ψ", "pitch θ", "roll γ"))):
+            ax.plot(tt, np.degrees(truth[:, i]), color="0.55", linewidth=2.2, label="truth")
+            ax.plot(res.t, np.degrees(res.euler_est[:, i]), color="black", linewidth=0.8,
+                    linestyle="--", label="computed")
+            ax.set_ylabel(f"{name} / °")
 
 
 def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
@@ -137,20 +139,13 @@ def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
 
 def _draw_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
     assert res.bias is not None and res.bias_t is not None
-    plt = _plt()
-    fig, axes = plt.subplots(3, 1, figsize=(7.0, 6.0), sharex=True)
     resid = res.summary.get("estimator", {}).get("bias_residual_rad_s")
-    for i, (ax, axis) in enumerate(zip(axes, "xyz")):
-        ax.plot(res.bias_t, np.degrees(res.bias[:, i]), color="black", linewidth=0.9, label="estimate")
-        if resid is not None:
-            ax.axhline(math.degrees(resid[i]), color="0.55", linewidth=2.0, label="rates − truth, run mean")
-        ax.set_ylabel(f"b_{axis} / (°/s)")
-        ax.grid(True, linestyle=":", linewidth=0.6)
-    axes[0].legend(loc="upper right", fontsize=8)
-    axes[-1].set_xlabel("t / s")
-    fig.suptitle("Gyro bias estimate — " + _title(res), fontsize=9.5)
-    fig.tight_layout()
-    _save(plt, fig, path, dpi)
+    with _panels(path, dpi, 6.0, "Gyro bias estimate — " + _title(res)) as axes:
+        for i, (ax, axis) in enumerate(zip(axes, "xyz")):
+            ax.plot(res.bias_t, np.degrees(res.bias[:, i]), color="black", linewidth=0.9, label="estimate")
+            if resid is not None:
+                ax.axhline(math.degrees(resid[i]), color="0.55", linewidth=2.0, label="rates − truth, run mean")
+            ax.set_ylabel(f"b_{axis} / (°/s)")
 
 
 def write_csv(res: SimResult, path: Path) -> None:

@@ -17,12 +17,13 @@ marked as assumptions in docs/simulation.md.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
 
 from ..errors import InvalidArgument
+from .accelmag import ar1, filtered, switched_off
 from .trajectory import Trajectory
 
 __all__ = [
@@ -64,16 +65,7 @@ class GyroModel:
     def without(self, *, noise: bool = False, bias: bool = False, bandwidth: bool = False,
                 scale: bool = False) -> GyroModel:
         """A copy with the named error sources switched off."""
-        kw: dict[str, Any] = {}
-        if noise:
-            kw["noise_density"] = 0.0
-        if bias:
-            kw["bias_dps"] = 0.0
-        if bandwidth:
-            kw["bandwidth_hz"] = None
-        if scale:
-            kw["scale_error"] = 0.0
-        return replace(self, **kw)
+        return switched_off(self, noise_density=noise, bias_dps=bias, bandwidth_hz=bandwidth, scale_error=scale)
 
     @property
     def tau(self) -> float:
@@ -120,18 +112,9 @@ def gyro_preset(name: str) -> GyroModel:
         raise InvalidArgument(f"gyro must be one of {sorted(GYRO_PRESETS)}, got {name!r}") from None
 
 
-# Gauss–Laguerre nodes for the first-order filter y(t) = ∫ ω(t−s) e^{−s/τ}/τ ds:
-# 16 nodes integrate e^{−x}·(polynomial of degree 31) exactly; for rates of
-# ≤ 1 Hz and τ ≤ 5 ms the remainder is far below 1e-12 rad/s.
-_GLA_X, _GLA_W = np.polynomial.laguerre.laggauss(16)
-
-
 def filtered_rate(traj: Trajectory, t: np.ndarray, tau: float) -> np.ndarray:
     """True body rate seen through a first-order low-pass of time constant tau."""
-    if tau <= 0:
-        return traj.omega(t)
-    tt = np.asarray(t, dtype=float)[..., None] - tau * _GLA_X
-    return np.einsum("j,...jk->...k", _GLA_W, traj.omega(tt))
+    return filtered(traj.omega, t, tau)
 
 
 def rate_noise(n: int, dt: float, gyro: GyroModel, rng: np.random.Generator) -> np.ndarray:
@@ -147,14 +130,7 @@ def rate_noise(n: int, dt: float, gyro: GyroModel, rng: np.random.Generator) -> 
     # one-sided density nd²: variance through a first-order filter = nd²·π/2·f_c
     sigma = nd * math.sqrt(math.pi / 2 * gyro.bandwidth_hz)
     a = math.exp(-dt / gyro.tau)
-    out = np.empty((n, 3))
-    x = e[0] * sigma
-    out[0] = x
-    b = sigma * math.sqrt(1 - a * a)
-    for i in range(1, n):  # n is at most a few 10^4: a plain loop is fine
-        x = a * x + b * e[i]
-        out[i] = x
-    return out
+    return ar1(e, a, sigma * math.sqrt(1 - a * a), e[0] * sigma)
 
 
 def gyro_volts(rate: np.ndarray, gyro: GyroModel, bias: np.ndarray) -> np.ndarray:

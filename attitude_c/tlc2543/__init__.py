@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._devmodel import CTwinBase, check_level, convert_in_chunks
+from .._devmodel import CTwinBase, check_level, convert_in_chunks, raise_model_error
 from ..errors import (
     DeviceError,
     DeviceTimeout,
@@ -163,12 +163,7 @@ class Tlc2543:
 
     # -- plumbing -------------------------------------------------------------
     def _after(self, status: int, what: str) -> None:
-        if self._bridge is not None:
-            self._bridge.raise_pending()
-        elif isinstance(self.model, CTwin):
-            v = self.model.violation()
-            if v is not None:
-                raise v
+        raise_model_error(self._bridge, self.model)
         raise_for_status(status, what, _STATUS)
 
     def _signed(self, word: int) -> int:

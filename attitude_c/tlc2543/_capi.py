@@ -5,45 +5,23 @@ from __future__ import annotations
 
 from typing import Any
 
-from .._bridge import Bridge
+from .._bridge import Bridge, connect_pins, def_pin_callbacks
 from .._lib import ffi_lib
 
 __all__ = ["Bridge", "python_hal", "register"]
 
 _registered: set[str] = set()
+#: the pin callbacks tlc2543py_<name> (csrc/cffi/tlc2543.cdef), each calling the model's method <name>
+_SETTERS = ("set_cs", "set_clock", "set_din", "delay_ns")
+_GETTERS = ("get_dout", "get_eoc")
 
 
 def register(precision: str) -> tuple[Any, Any]:
     """(ffi, lib) with the Python pin callbacks registered."""
     ffi, lib = ffi_lib(precision)
-    if precision in _registered:
-        return ffi, lib
-
-    @ffi.def_extern(name="tlc2543py_set_cs")
-    def _set_cs(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_cs", level)
-
-    @ffi.def_extern(name="tlc2543py_set_clock")
-    def _set_clock(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_clock", level)
-
-    @ffi.def_extern(name="tlc2543py_set_din")
-    def _set_din(ctx: Any, level: int) -> None:
-        ffi.from_handle(ctx).call("set_din", level)
-
-    @ffi.def_extern(name="tlc2543py_get_dout")
-    def _get_dout(ctx: Any) -> int:
-        return 1 if ffi.from_handle(ctx).call("get_dout") == 1 else 0
-
-    @ffi.def_extern(name="tlc2543py_get_eoc")
-    def _get_eoc(ctx: Any) -> int:
-        return 1 if ffi.from_handle(ctx).call("get_eoc") == 1 else 0
-
-    @ffi.def_extern(name="tlc2543py_delay_ns")
-    def _delay_ns(ctx: Any, ns: int) -> None:
-        ffi.from_handle(ctx).call("delay_ns", ns)
-
-    _registered.add(precision)
+    if precision not in _registered:
+        def_pin_callbacks(ffi, "tlc2543py_", _SETTERS, _GETTERS)
+        _registered.add(precision)
     return ffi, lib
 
 
@@ -53,10 +31,5 @@ def python_hal(ffi: Any, lib: Any, bridge: Bridge) -> tuple[Any, Any]:
     handle = ffi.new_handle(bridge)
     hal = ffi.new("tlc2543_hal *")
     hal.ctx = handle
-    hal.set_cs = lib.tlc2543py_set_cs
-    hal.set_clock = lib.tlc2543py_set_clock
-    hal.set_din = lib.tlc2543py_set_din
-    hal.get_dout = lib.tlc2543py_get_dout
-    hal.get_eoc = lib.tlc2543py_get_eoc
-    hal.delay_ns = lib.tlc2543py_delay_ns
+    connect_pins(hal, lib, "tlc2543py_", _SETTERS + _GETTERS)
     return hal, handle

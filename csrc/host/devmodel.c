@@ -4,6 +4,9 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "ad7927_model.h"
+#include "tlc2543_model.h"
+
 void devm_log(devm_event *trace, size_t cap, size_t *len, size_t *dropped, int64_t t, uint8_t signal,
               uint8_t value)
 {
@@ -47,5 +50,17 @@ void devm_vfail(int *violation, int64_t *violation_t, char *message, size_t size
         *violation = code;
         *violation_t = t;
         vsnprintf(message, size, fmt, ap);
+    }
+}
+
+const char *devm_status_str(int status)
+{
+    switch (status) {
+    case TLC2543M_E_VIOLATION:
+        return "TLC2543 model: the driver broke a protocol rule (the model's violation says which)";
+    case AD7927M_E_VIOLATION:
+        return "AD7927 model: the driver broke a protocol rule (the model's violation says which)";
+    default:
+        return att_status_str(status);
     }
 }

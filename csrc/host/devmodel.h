@@ -1,8 +1,9 @@
 /*
  * devmodel.h — pieces shared by the host-only C twins of the device models
  * (tlc2543_model.c, ad7927_model.c): the pin-trace event, its logging into a
- * caller-owned buffer, the latch of the first protocol violation, and the
- * checked copy of input voltages.
+ * caller-owned buffer, the latch of the first protocol violation, the
+ * checked copy of input voltages, and the description of a twin's status
+ * code.
  */
 #ifndef ATTITUDE_DEVMODEL_H
 #define ATTITUDE_DEVMODEL_H
@@ -28,6 +29,14 @@ void devm_log(devm_event *trace, size_t cap, size_t *len, size_t *dropped, int64
 /* Copy n (<= cap) finite voltages into inputs. ATT_E_NULL, ATT_E_ARG (n >
  * cap) or ATT_E_NONFINITE, with nothing copied. */
 int devm_set_inputs(double *inputs, size_t cap, const double *volts, size_t n);
+
+/* Short description of a status code a host twin's function returns (static
+ * storage, never NULL): the twins' own codes (TLC2543M_E_VIOLATION,
+ * AD7927M_E_VIOLATION) have their own, distinct text; any other code gets
+ * att_status_str's ("unknown status" for a value no header defines). The
+ * library's table (csrc/src/common.c) does not hold the twins' codes: the
+ * twins live outside the library. attitude_c.names.status_text reads this. */
+const char *devm_status_str(int status);
 
 #ifndef ATT_CDEF
 /* Latch the first violation: if *violation is 0, store code, t and the
