@@ -130,7 +130,7 @@ def aiding_delay(gyr: ArrayLike, vec: ArrayLike, q: ArrayLike, rate: float, *, w
         raise InvalidArgument(f"gyr, vec and q must have the same number of samples, got {n}, {len(x)}, {len(qq)}")
     r = _number(rate, "rate", "Hz")
     w = _number(window, "window", "s")
-    half = int(round(w * r / 2))
+    half = round(w * r / 2)
     if half < 1:
         raise InvalidArgument(f"window must span at least 3 samples at {r:g} Hz, got {w:g} s")
     if np.any(np.linalg.norm(qq, axis=1) == 0):

@@ -182,7 +182,7 @@ def _main(args: argparse.Namespace) -> int:
         from ..timing import aiding_delay
 
         sel = None if rec["movement"] is None else np.asarray(rec["movement"], dtype=bool)
-        d = aiding_delay(rec["gyr"], mag, q, float(rec["rate"]), mask=sel)
+        d = aiding_delay(rec["gyr"], np.asarray(mag), q, float(rec["rate"]), mask=sel)
         summary["mag_delay_estimate_s"] = d
     if rec["ref"] is not None:
         figs = broad.errors(q, rec["ref"], rec["movement"])
