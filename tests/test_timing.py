@@ -157,3 +157,14 @@ def test_errors():
         aiding_delay(np.tile(w, (400, 1)), _body(qu, M_N), qu, RATE)
     with pytest.raises(InvalidArgument, match="not observable"):
         aiding_delay(gyr, mag, q, RATE, mask=np.zeros(400, bool))
+
+
+def test_bench_smoke():
+    """bench/broad_timing.py on a third of the BROAD trials (the full run: invoke bench --only broad_timing)."""
+    from attitude_c import broad
+    from bench import broad_timing as B
+
+    if broad.default_dir() is None:
+        pytest.skip("BROAD data not found beside the checkout (../shared/data/broad)")
+    body = B.run(quick=True)
+    assert "mag_delay = " in body and "acc_delay = 5 ms" in body and "| defaults" in body
