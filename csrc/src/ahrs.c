@@ -457,6 +457,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_acc = set->acc_noise * set->acc_noise / dt;
         c->r_mag = set->mag_noise * set->mag_noise / dt;
         c->r_rest = set->rest_noise * set->rest_noise / dt;
+        c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
     }
     return c;
 }
@@ -467,7 +468,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     const att_ahrs_settings *set;
     const att_ahrs_step *k;
     att_ahrs save;
-    att_real C[9], dth[3], x[NX], an, an_lp, v[3];
+    att_real C[9], dth[3], x[NX], an, an_lp, v[3], acc_c[3], mag_c[3];
+    const att_real *fa, *fm; /* the aiding samples used: raw, or turned by acc/mag_delay */
     int i, rest, flags = 0, r;
     if (s == NULL || gyr == NULL) {
         return ATT_E_NULL;
@@ -575,16 +577,25 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         x[i] = 0;
     }
 
+    /* aiding samples that lag the gyro: turned to the gyro's time (one integer test
+     * when both delays are 0) */
+    fa = acc;
+    fm = mag;
+    if (k->delays) {
+        if (acc != NULL && (k->delays & 1)) {
+            delay_comp(gyr, s->bias, set->acc_delay, acc, acc_c);
+            fa = acc_c;
+        }
+        if (mag != NULL && (k->delays & 2)) {
+            delay_comp(gyr, s->bias, set->mag_delay, mag, mag_c);
+            fm = mag_c;
+        }
+    }
+
     /* accelerometer: low-pass in the navigation frame, inclination update */
     if (acc != NULL) {
         att_real an_n[3], nv, hs, ang, y0, y1;
-        if (set->acc_delay != 0) {
-            att_real ac[3];
-            delay_comp(gyr, s->bias, set->acc_delay, acc, ac);
-            mat_vec(C, ac, an_n);
-        } else {
-            mat_vec(C, acc, an_n);
-        }
+        mat_vec(C, fa, an_n);
         if (!s->acc_init) {
             for (i = 0; i < 3; i++) {
                 s->acc_lp[i] = an_n[i];
@@ -633,13 +644,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     if (mag != NULL) {
         att_real m[3], h, nm, dip, rm;
         int use = 0;
-        if (set->mag_delay != 0) {
-            att_real mc[3];
-            delay_comp(gyr, s->bias, set->mag_delay, mag, mc);
-            mat_vec(C, mc, m);
-        } else {
-            mat_vec(C, mag, m);
-        }
+        mat_vec(C, fm, m);
         h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
         nm = norm3(m);
         if (h > 0) {

@@ -159,6 +159,8 @@ typedef struct {
     att_real r_acc;      /* acc_noise²/dt */
     att_real r_mag;      /* mag_noise²/dt */
     att_real r_rest;     /* rest_noise²/dt */
+    int delays;          /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
+                            sample: a float compare is a library call on soft-float targets) */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
