@@ -177,6 +177,10 @@ def test_errors():
         ahrs(gyr, acc, rate=100.0, acc_noise=-1.0)
     with pytest.raises(InvalidArgument, match="domain"):
         ahrs(gyr, acc, rate=100.0, gyr_noise_rest=0.0)
+    with pytest.raises(InvalidArgument, match=r"mag_delay=0.06 outside its domain .*0.05 s"):
+        ahrs(gyr, acc, mag, rate=100.0, mag_delay=0.06)  # a lag is ≤ 50 ms (ahrs.h)
+    with pytest.raises(InvalidArgument, match="acc_delay"):
+        ahrs(gyr, acc, mag, rate=100.0, acc_delay=-0.06)
     with pytest.raises(InvalidArgument, match="rk4"):
         Ahrs(rate=100.0, method="rk4")
     with pytest.raises(InvalidType):
