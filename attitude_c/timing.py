@@ -102,13 +102,14 @@ def aiding_delay(gyr: ArrayLike, vec: ArrayLike, q: ArrayLike, rate: float, *, w
 
     Reliability. The model is a vector *fixed in the navigation frame*. It holds for
     a magnetometer in a homogeneous field: on the 15 BROAD trials the estimate from
-    the filter's own attitude is 12.5–13.4 ms on every undisturbed trial
-    (docs/ahrs.md, ``invoke bench --only broad_timing``). It fails where the field is
+    the filter's own attitude is 11.1–13.4 ms on the 9 undisturbed trials (8 of them
+    within 12.5–13.4 ms; docs/ahrs.md, ``invoke bench --only broad_timing``). It fails where the field is
     not fixed: near a magnet moved with the sensor (BROAD trials 33/35: −6 and
     +18 ms). It is **not** usable for an accelerometer: the specific force holds the
     linear acceleration, and that correlates with the rotation (a hand-held or swung
     sensor accelerates as it turns), which biases the slope — on BROAD the same
-    estimate for the accelerometer spreads over −37…+54 ms between trials. Declare an
+    estimate for the accelerometer spreads over −31…+40 ms between trials, where a
+    scan scored with the reference puts the lag near 5 ms. Declare an
     accelerometer's lag from its data sheet or its filter's group delay instead.
 
     Iterating. The attitude used here comes from a filter fed the lagged vector; its
