@@ -69,6 +69,11 @@ from .ahrs_filter import Ahrs, ahrs
 
 __all__ += ["Ahrs", "ahrs"]
 
+# Aiding-sensor time alignment (docs/ahrs.md, "Sensor timing"): the magnetometer's lag behind the gyro.
+from .timing import aiding_delay
+
+__all__ += ["aiding_delay"]
+
 # The UAV thesis's own EKF, for reproduction (docs/ahrs.md, "The thesis's EKF").
 from .thesis_ekf import ahrs_thesis
 

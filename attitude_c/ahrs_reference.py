@@ -34,6 +34,7 @@ _DEFAULTS: dict[str, Any] = {
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
+    "acc_delay": 0.0, "mag_delay": 0.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
@@ -49,6 +50,24 @@ def _exp(phi: F) -> F:
     if a == 0.0:
         return np.array([1.0, 0.0, 0.0, 0.0])
     return np.concatenate([[math.cos(a / 2)], math.sin(a / 2) / a * phi])
+
+
+def _skew(v: F) -> F:
+    """[v×], the matrix of the cross product v × ·."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def _undelay(x: F, rate: F, d: float) -> F:
+    """A body-frame sample x taken d seconds before the gyro's, seen at the gyro's time.
+
+    A navigation-fixed vector seen from the body obeys ẋ = −[ω×] x, so over d at constant
+    rate x(t) = exp(−[θ×]) x(t − d), θ = ω d; kept to second order, (I − W + W²/2) x with
+    W = [θ×] (the remainder is the series' cubic term and beyond: ≤ |θ|³/6·|x| to leading order).
+    """
+    if d == 0.0:
+        return x
+    W = _skew(rate * d)
+    return (np.eye(3) - W + 0.5 * (W @ W)) @ x
 
 
 def _dcm(q: F) -> F:
@@ -166,7 +185,8 @@ class ReferenceAhrs:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)
         # accelerometer
-        fnav = C @ f
+        wc = w - self.b  # the rate the propagation used (the bias before this sample's update)
+        fnav = C @ _undelay(f, wc, s["acc_delay"])
         if self.acc_lp is None:
             self.acc_lp, self.acc_norm_lp = fnav, fn
         else:
@@ -193,7 +213,7 @@ class ReferenceAhrs:
                 self._scalar(x, j, float(y[j]), R, (0, 1, 3, 4, 5))
         # magnetometer
         if m is not None:
-            mn = C @ m
+            mn = C @ _undelay(m, wc, s["mag_delay"])
             h = math.hypot(mn[0], mn[1])
             if h > 0:
                 cur = np.array([float(np.linalg.norm(mn)), math.atan2(-mn[2], h)])

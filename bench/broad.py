@@ -312,17 +312,19 @@ def cross_validate(trials: list[Any], rounds: int) -> tuple[list[tuple[str, dict
 
 # -- cost -----------------------------------------------------------------------------------
 
-def armv4t_counts() -> list[tuple[str, float]]:
-    """Instructions per sample (acc + mag every sample) on the emulated ARM920T."""
+def armv4t_counts(delays: bool = False, precisions: tuple[str, ...] = ("f32", "f64")) -> list[tuple[str, float]]:
+    """Instructions per sample (acc + mag every sample) on the emulated ARM920T; ``delays``:
+    with acc_delay 5 ms and mag_delay 13 ms (``-DBENCH_AHRS_DELAYS``, bench/broad_timing.py)."""
     from toolchain import targets as T
     from toolchain.qemu_count import per_iteration
 
     t = T.load("armv4t-bare")
     rows = []
     with tempfile.TemporaryDirectory() as d:
-        for prec in ("f32", "f64"):
+        for prec in precisions:
+            defines = (["ATT_REAL_F32"] if prec == "f32" else []) + (["BENCH_AHRS_DELAYS"] if delays else [])
             exe = t.build_program([ROOT / "csrc" / "vectors" / "bench_ahrs.c"], Path(d) / f"bench_ahrs_{prec}",
-                                  defines=["ATT_REAL_F32"] if prec == "f32" else [])
+                                  defines=defines)
             rows.append((prec, per_iteration(exe, lambda m: [str(m)], 300, 556)))
     return rows
 

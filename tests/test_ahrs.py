@@ -42,6 +42,21 @@ def test_c_matches_reference_six_axis_and_gate():
     assert np.abs(qc - qr).max() < 1e-12  # as above
 
 
+@pytest.mark.parametrize("delays", [(0.005, 0.013), (-0.02, 0.05), (0.0, -0.01)])
+def test_c_matches_reference_with_sensor_delays(delays):
+    """acc_delay / mag_delay: the C's cross products against the model's matrix series."""
+    gyr, acc, mag, _ = motion(900, 100.0, (2.0, -1.5, 3.0), q0=ref.euler_to_quat([0.4, 0.2, -0.3]),
+                              bias=(0.01, -0.02, 0.005), noise=0.002)
+    kw = {"acc_delay": delays[0], "mag_delay": delays[1]}
+    qc = ahrs(gyr, acc, mag, rate=100.0, **kw)
+    qr = ahrs_reference(gyr, acc, mag, rate=100.0, **kw)
+    assert np.abs(qc - qr).max() < 1e-12  # as above
+    q0 = ahrs(gyr, acc, mag, rate=100.0)
+    assert np.abs(qc - q0).max() > 1e-4  # the compensation is taken (|θ| up to 0.2 rad here)
+    qf = ahrs(gyr, acc, mag, rate=100.0, precision="f32", **kw)
+    assert angle_deg(qf.astype(float), qc).max() < np.degrees(1e-4)  # float: as on the BROAD segment
+
+
 def test_c_matches_reference_rest_then_motion():
     """Rest (zero-rate update, gyr_noise_rest) then turning (gyr_noise): both process noises."""
     g0, a0, m0, _ = motion(300, 100.0, (0.0, 0.0, 0.0), bias=(0.004, -0.003, 0.002), noise=0.0005)
@@ -162,6 +177,10 @@ def test_errors():
         ahrs(gyr, acc, rate=100.0, acc_noise=-1.0)
     with pytest.raises(InvalidArgument, match="domain"):
         ahrs(gyr, acc, rate=100.0, gyr_noise_rest=0.0)
+    with pytest.raises(InvalidArgument, match=r"mag_delay=0.06 outside its domain .*0.05 s"):
+        ahrs(gyr, acc, mag, rate=100.0, mag_delay=0.06)  # a lag is ≤ 50 ms (ahrs.h)
+    with pytest.raises(InvalidArgument, match="acc_delay"):
+        ahrs(gyr, acc, mag, rate=100.0, acc_delay=-0.06)
     with pytest.raises(InvalidArgument, match="rk4"):
         Ahrs(rate=100.0, method="rk4")
     with pytest.raises(InvalidType):

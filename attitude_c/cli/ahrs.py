@@ -44,6 +44,10 @@ def register(sub: Any) -> None:
     p.add_argument("--six-axis", action="store_true", help="ignore the magnetometer")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a filter setting (docs/ahrs.md), e.g. --set acc_tau=3 --set method=rv1")
+    p.add_argument("--estimate-mag-delay", action="store_true",
+                   help="also print the magnetometer's lag behind the gyro estimated from this run's attitude "
+                   "(attitude_c.aiding_delay; over the movement phases of a BROAD trial), to pass back as "
+                   "--set mag_delay=D (docs/ahrs.md, \"Sensor timing\")")
     p.add_argument("--no-plots", action="store_true", help="do not write errors.png")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=main)
@@ -160,6 +164,8 @@ def _main(args: argparse.Namespace) -> int:
     settings = _settings(args.set)
     rec = _read(path, args.rate)
     mag = None if args.six_axis else rec["mag"]
+    if args.estimate_mag_delay and mag is None:
+        raise _Usage("--estimate-mag-delay needs a magnetometer (mx my mz columns, not --six-axis)")
     q = np.asarray(ahrs(rec["gyr"], rec["acc"], mag, rate=rec["rate"], precision=args.precision, **settings),
                    dtype=np.float64)
     e = np.degrees(quat_to_euler(q))
@@ -172,6 +178,12 @@ def _main(args: argparse.Namespace) -> int:
                                "six_axis": mag is None, "precision": args.precision, "settings": settings,
                                "out": str(out)}
     written = ["attitude.csv"]
+    if args.estimate_mag_delay:
+        from ..timing import aiding_delay
+
+        sel = None if rec["movement"] is None else np.asarray(rec["movement"], dtype=bool)
+        d = aiding_delay(rec["gyr"], np.asarray(mag), q, float(rec["rate"]), mask=sel)
+        summary["mag_delay_estimate_s"] = d
     if rec["ref"] is not None:
         figs = broad.errors(q, rec["ref"], rec["movement"])
         summary["errors_deg"] = figs.as_dict()
@@ -191,5 +203,11 @@ def _main(args: argparse.Namespace) -> int:
             f = summary["errors_deg"]
             print(f"error vs reference ({summary['errors_over']}): total {f['total']:.3f}°, heading "
                   f"{f['heading']:.3f}°, inclination {f['inclination']:.3f}° (RMS, BROAD metric)")
+        if "mag_delay_estimate_s" in summary:
+            d = summary["mag_delay_estimate_s"]
+            used = settings.get("mag_delay", 0.0)
+            print(f"magnetometer lag behind the gyro (relative to this run's attitude, mag_delay {used:g} s): "
+                  f"{d * 1e3:.2f} ms" + (f"; use it with --set mag_delay={d:.4f}" if abs(d) <= 0.05
+                                         else " (outside the filter's |mag_delay| <= 0.05 s: not a lag)"))
         print(f"wrote {out}/ ({', '.join(written)})")
     return EXIT_OK

@@ -47,6 +47,8 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->gyro_range = ATT_R(0.0);
     set->overrange_sigma = ATT_R(0.05);
     set->sensor_delay = ATT_R(0.0);
+    set->acc_delay = ATT_R(0.0);
+    set->mag_delay = ATT_R(0.0);
 }
 
 static int fin(att_real x)
@@ -85,6 +87,11 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set)
           && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
           && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0)
           && att_fabs(t->declination) <= ATT_PI)) {
+        return ATT_E_AHRS_SETTINGS;
+    }
+    /* aiding-sensor time skew */
+    if (!(fin(t->acc_delay) && att_fabs(t->acc_delay) <= ATT_R(0.05) && fin(t->mag_delay)
+          && att_fabs(t->mag_delay) <= ATT_R(0.05))) {
         return ATT_E_AHRS_SETTINGS;
     }
     return ATT_OK;
@@ -181,6 +188,20 @@ static void mat_vec(const att_real C[9], const att_real v[3], att_real out[3])
     out[0] = C[0] * v[0] + C[1] * v[1] + C[2] * v[2];
     out[1] = C[3] * v[0] + C[4] * v[1] + C[5] * v[2];
     out[2] = C[6] * v[0] + C[7] * v[1] + C[8] * v[2];
+}
+
+/* An aiding vector x that lags the gyro by d, turned to the gyro's time
+ * (ahrs.h, acc_delay): θ = (ω − b)·d with the bias before this sample's
+ * update (the one the propagation used), out = x − θ×x + ½ θ×(θ×x).
+ * Called only when d != 0 (no cost with the defaults). */
+static void delay_comp(const att_real gyr[3], const att_real b[3], att_real d, const att_real x[3],
+                       att_real out[3])
+{
+    att_real t0 = (gyr[0] - b[0]) * d, t1 = (gyr[1] - b[1]) * d, t2 = (gyr[2] - b[2]) * d;
+    att_real c0 = t1 * x[2] - t2 * x[1], c1 = t2 * x[0] - t0 * x[2], c2 = t0 * x[1] - t1 * x[0];
+    out[0] = x[0] - c0 + ATT_R(0.5) * (t1 * c2 - t2 * c1);
+    out[1] = x[1] - c1 + ATT_R(0.5) * (t2 * c0 - t0 * c2);
+    out[2] = x[2] - c2 + ATT_R(0.5) * (t0 * c1 - t1 * c0);
 }
 
 static att_real norm3(const att_real v[3])
@@ -436,6 +457,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_acc = set->acc_noise * set->acc_noise / dt;
         c->r_mag = set->mag_noise * set->mag_noise / dt;
         c->r_rest = set->rest_noise * set->rest_noise / dt;
+        c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
     }
     return c;
 }
@@ -446,7 +468,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     const att_ahrs_settings *set;
     const att_ahrs_step *k;
     att_ahrs save;
-    att_real C[9], dth[3], x[NX], an, an_lp, v[3];
+    att_real C[9], dth[3], x[NX], an, an_lp, v[3], acc_c[3], mag_c[3];
+    const att_real *fa, *fm; /* the aiding samples used: raw, or turned by acc/mag_delay */
     int i, rest, flags = 0, r;
     if (s == NULL || gyr == NULL) {
         return ATT_E_NULL;
@@ -554,10 +577,25 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         x[i] = 0;
     }
 
+    /* aiding samples that lag the gyro: turned to the gyro's time (one integer test
+     * when both delays are 0) */
+    fa = acc;
+    fm = mag;
+    if (k->delays) {
+        if (acc != NULL && (k->delays & 1)) {
+            delay_comp(gyr, s->bias, set->acc_delay, acc, acc_c);
+            fa = acc_c;
+        }
+        if (mag != NULL && (k->delays & 2)) {
+            delay_comp(gyr, s->bias, set->mag_delay, mag, mag_c);
+            fm = mag_c;
+        }
+    }
+
     /* accelerometer: low-pass in the navigation frame, inclination update */
     if (acc != NULL) {
         att_real an_n[3], nv, hs, ang, y0, y1;
-        mat_vec(C, acc, an_n);
+        mat_vec(C, fa, an_n);
         if (!s->acc_init) {
             for (i = 0; i < 3; i++) {
                 s->acc_lp[i] = an_n[i];
@@ -606,7 +644,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     if (mag != NULL) {
         att_real m[3], h, nm, dip, rm;
         int use = 0;
-        mat_vec(C, mag, m);
+        mat_vec(C, fm, m);
         h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
         nm = norm3(m);
         if (h > 0) {

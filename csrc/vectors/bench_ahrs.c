@@ -12,7 +12,10 @@
  *                      and magnetometer updates;
  *   -DBENCH_AHRS_TEKF  att_tekf_update (ahrs_thesis.h), the UAV thesis's
  *                      EKF: time update, Gauss–Newton solve, measurement
- *                      update.
+ *                      update;
+ *   -DBENCH_AHRS_DELAYS att_ahrs_update with acc_delay = 5 ms and
+ *                      mag_delay = 13 ms (the time-skew compensation of
+ *                      both aiding vectors, ahrs.h).
  *
  *   bench_ahrs N
  */
@@ -54,9 +57,21 @@ int main(int argc, char **argv)
         mag[i][1] = (att_real)(20.0 * cos(psi));
         mag[i][2] = (att_real)-40.0;
     }
+#ifdef BENCH_AHRS_DELAYS
+    {
+        att_ahrs_settings set;
+        att_ahrs_default_settings(&set);
+        set.acc_delay = (att_real)0.005;
+        set.mag_delay = (att_real)0.013;
+        if (att_ahrs_init(&s, &set, NULL) != ATT_OK) {
+            return 3;
+        }
+    }
+#else
     if (BENCH_INIT(&s, NULL, NULL) != ATT_OK) {
         return 3;
     }
+#endif
     for (i = 0; i < n; i++) {
         if (BENCH_UPDATE(&s, gyr, acc, mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
             return 4;

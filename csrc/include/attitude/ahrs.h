@@ -123,6 +123,25 @@ typedef struct {
                                  by it, q ⊗ exp((ω − b)·d) (the state is not: see
                                  att_ahrs_attitude). 0 (off) by default: a property of a
                                  recording set-up, not of the filter (docs/ahrs.md) */
+    att_real acc_delay;           /* [s] |d| ≤ 0.05: how long the accelerometer's samples lag the
+                                 gyro's (a time-skewed IMU; positive = the accelerometer is
+                                 older). Before it is rotated into the navigation frame, a
+                                 sample x is turned forward to the gyro's time by the
+                                 bias-corrected rate, θ = (ω − b)·d,
+                                     x_c = x − θ×x + ½ θ×(θ×x),
+                                 the second-order series of exp(−[θ×]) x (the body-frame
+                                 view of a navigation-fixed vector at t, from its view at
+                                 t − d, at constant rate). Truncation bound
+                                 |x_c − exp(−[θ×]) x| ≤ |θ|³/6·√(1 + |θ|²/16)·|x|, e.g.
+                                 700°/s × 13 ms: |θ| = 0.16 rad, 7e-4·|x|. x_c feeds the
+                                 low-pass and the gate; the unit check on |a| and the rest
+                                 detector use the raw sample. 0 (off, no work) by default: a
+                                 property of the sensor, declared by the user (docs/ahrs.md,
+                                 "Sensor timing") */
+    att_real mag_delay;           /* [s] |d| ≤ 0.05: the same for the magnetometer's samples;
+                                 the compensated field feeds the norm/dip checks, the
+                                 reference and the heading. 0 (off, no work) by default;
+                                 attitude_c.aiding_delay estimates it from a recording */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
@@ -140,6 +159,8 @@ typedef struct {
     att_real r_acc;      /* acc_noise²/dt */
     att_real r_mag;      /* mag_noise²/dt */
     att_real r_rest;     /* rest_noise²/dt */
+    int delays;          /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
+                            sample: a float compare is a library call on soft-float targets) */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
