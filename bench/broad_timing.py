@@ -14,6 +14,13 @@ reuses).
 3. A scan of ``acc_delay`` (0, 2.5, 5, 7.5 ms) on top of it, scored WITH the
    reference: a diagnostic of how much BROAD's accelerometer lags, not a tuned
    default (the estimator does not work for an accelerometer: docs/ahrs.md).
+4. The output's lag behind the optical reference (no filter can observe it: it is
+   between the IMU and the cameras), per trial for this filter (defaults) and VQF:
+   the lag d that best explains the horizontal part of the error rotation
+   e = q_est ⊗ q_ref⁻¹ as −d·ω_n (ω_n the rate in the navigation frame, from the
+   reference attitude; least squares over the movement phases), and the BROAD
+   inclination before and after the estimate is turned by exp(d·ω_n). What is left
+   after is the part of the inclination error that is not timing.
 
 The defaults of the filter stay 0: these lags are properties of BROAD's IMU.
 
@@ -48,6 +55,51 @@ def estimates(trials: list[Any], **settings: Any) -> list[float]:
 
     return [aiding_delay(t.gyr, t.mag, run_ours(t, **settings), t.rate, mask=np.asarray(t.movement, bool))
             for t in trials]
+
+
+def output_lag(q: np.ndarray, t: Any) -> tuple[float, float, float]:
+    """(d [s], inclination RMS [°] of q, the same with the fitted lag term removed)
+    for one trial: see item 4 of the module docstring."""
+    from attitude_c import broad
+    from attitude_c import reference as ref
+
+    q_ref = np.asarray(t.quat, float)
+    ok = np.asarray(t.movement, bool) & np.all(np.isfinite(q_ref), axis=1)
+    e = ref.quat_to_rotvec(ref.quat_multiply(q[ok], ref.quat_conj(q_ref[ok])))
+    w_n = np.einsum("nij,nj->ni", ref.quat_to_dcm(q_ref[ok]), t.gyr[ok])
+    d = -float(np.sum(e[:, :2] * w_n[:, :2]) / np.sum(w_n[:, :2] ** 2))
+    q_fix = q.copy()
+    q_fix[ok] = ref.quat_multiply(ref.rotvec_to_quat(d * w_n), q[ok])
+    before = broad.errors(q, q_ref, t.movement).inclination
+    after = broad.errors(q_fix, q_ref, t.movement).inclination
+    return d, before, after
+
+
+def lag_table(trials: list[Any]) -> list[str]:
+    """Item 4: the output's lag behind the reference, this filter and VQF."""
+    from bench.broad import run_vqf
+
+    try:
+        import vqf  # noqa: F401  (bench extra: pip install -e ".[bench]")
+        have_vqf = True
+    except ImportError:
+        have_vqf = False
+    out = [("**The output's lag behind the optical reference** (item 4 of the module docstring; ms, and BROAD "
+            "inclination RMS in °, before → after the fitted lag term is removed; VQF 2 with its defaults as in "
+            "the *broad* section). Not a filter property: it lies between the IMU's clock and the cameras'.\n"),
+           "| trial | lag, this filter | inclination | lag, VQF | inclination, VQF |", "|---|---|---|---|---|"]
+    rows = []
+    for t in trials:
+        a = output_lag(run_ours(t), t)
+        b = output_lag(np.asarray(run_vqf(t), float), t) if have_vqf else (float("nan"),) * 3
+        rows.append((a, b))
+        out.append(f"| {t.name} | {a[0] * 1e3:.2f} | {a[1]:.3f} → {a[2]:.3f} | {b[0] * 1e3:.2f} | "
+                   f"{b[1]:.3f} → {b[2]:.3f} |")
+    mean = [float(np.mean([r[k][i] for r in rows])) for k in (0, 1) for i in (1, 2)]
+    out.append(f"| **mean** | | **{mean[0]:.3f} → {mean[1]:.3f}** | | **{mean[2]:.3f} → {mean[3]:.3f}** |")
+    if not have_vqf:
+        out.append("\n(VQF not installed: its columns are empty; `pip install -e \".[bench]\"`.)")
+    return out
 
 
 def run(quick: bool = False, data: str | None = None) -> str:
@@ -99,7 +151,8 @@ def run(quick: bool = False, data: str | None = None) -> str:
     f32 = score(trials, [run_ours(t, "f32", **kw) for t in trials])
     dmax = max(abs(a.total - b.total) for a, b in zip(f64, f32))
     out.append(f"\nFloat build with mag_delay = {dm:g}, acc_delay = 5 ms: largest per-trial difference of the "
-               f"total RMS to double {dmax:.4f}°.")
+               f"total RMS to double {dmax:.4f}°.\n")
+    out += lag_table(trials)
     return "\n".join(out)
 
 

@@ -168,3 +168,4 @@ def test_bench_smoke():
         pytest.skip("BROAD data not found beside the checkout (../shared/data/broad)")
     body = B.run(quick=True)
     assert "mag_delay = " in body and "acc_delay = 5 ms" in body and "| defaults" in body
+    assert "output's lag behind the optical reference" in body
