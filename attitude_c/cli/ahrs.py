@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +25,7 @@ from .options import positive
 
 #: ``attitude ahrs`` exit statuses (docs/ahrs.md, "Command").
 EXIT_OK = 0
+PROG = "attitude ahrs"
 EXIT_IO = 1     # the input cannot be read, or an output cannot be written
 EXIT_USAGE = 2  # bad option, or the file's content is not a usable recording
 
@@ -136,18 +136,14 @@ def _plot(path: Path, t: np.ndarray, angles: tuple[np.ndarray, ...], title: str)
 
 def main(args: argparse.Namespace) -> int:
     from ..errors import AttitudeError
+    from . import fail, os_error_line
 
     try:
         return _main(args)
-    except _Usage as exc:
-        print(f"attitude ahrs: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
-    except (AttitudeError, ValueError, TypeError) as exc:
-        print(f"attitude ahrs: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
+    except (_Usage, AttitudeError, ValueError, TypeError) as exc:
+        return fail(PROG, str(exc), EXIT_USAGE)
     except OSError as exc:
-        print(f"attitude ahrs: error: {exc.filename or ''}: {exc.strerror or exc}", file=sys.stderr)
-        return EXIT_IO
+        return fail(PROG, os_error_line(exc), EXIT_IO)
 
 
 def _main(args: argparse.Namespace) -> int:
@@ -157,8 +153,9 @@ def _main(args: argparse.Namespace) -> int:
 
     path = Path(args.file)
     if not path.is_file():
-        print(f"attitude ahrs: error: {path}: no such file", file=sys.stderr)
-        return EXIT_IO
+        from . import fail
+
+        return fail(PROG, f"{path}: no such file", EXIT_IO)
     if args.rate is not None and not (math.isfinite(args.rate) and args.rate > 0):
         raise _Usage(f"--rate must be > 0, got {args.rate}")
     settings = _settings(args.set)
