@@ -161,6 +161,15 @@ def _records(x: ArrayLike, name: str, tail: tuple[int, ...], what: str,
     return a
 
 
+def _rows(x: ArrayLike, name: str, width: int, what: str) -> NDArray[np.float64]:
+    """Strictly (N, width) real and finite; return float64 (N, width). Errors name
+    ``name`` (and the first non-finite sample)."""
+    shape = np.shape(x)
+    if len(shape) != 2 or shape[1] != width:
+        raise InvalidArgument(f"{name} must have shape (N, {width}), got {shape}")
+    return _records(x, name, (width,), what)
+
+
 def _to_c(a: NDArray[np.float64], precision: str, name: str) -> NDArray[Any]:
     dt = _DTYPES[precision]
     if dt is np.float32:

@@ -23,7 +23,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings
 from ._lib import ffi_lib
-from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+from .core import _rows
+from .errors import InvalidArgument, InvalidType, raise_for_status
 
 __all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "run"]
 
@@ -58,27 +59,13 @@ def default_settings() -> dict[str, Any]:
     return _settings.defaults(_SPEC)
 
 
-def _vectors(x: ArrayLike, name: str) -> FloatArray:
-    a = np.asarray(x)
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
-    if a.ndim != 2 or a.shape[1] != 3:
-        raise InvalidArgument(f"{name} must have shape (N, 3), got {a.shape}")
-    a = np.asarray(a, dtype=np.float64)
-    ok = np.isfinite(a).all(axis=1)
-    if not ok.all():
-        i = int(np.argmin(ok))
-        raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
-    return a
-
-
 def run(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = None,
         dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
         **settings: Any) -> ThesisEkfResult:
     """Run the thesis's EKF over N samples; see :func:`ahrs_thesis`."""
     if precision not in _DTYPES:
         raise InvalidArgument(f"precision must be 'f64' or 'f32', got {precision!r}")
-    g, a, m = _vectors(gyr, "gyr"), _vectors(acc, "acc"), _vectors(mag, "mag")
+    g, a, m = _rows(gyr, "gyr", 3, "angular rate"), _rows(acc, "acc", 3, "specific force"), _rows(mag, "mag", 3, "field")
     n = g.shape[0]
     if a.shape[0] != n or m.shape[0] != n:
         raise InvalidArgument(f"gyr, acc and mag must have the same number of samples, got "

@@ -25,25 +25,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import InvalidArgument, InvalidType, NonFiniteError
+from .core import _rows, quat_to_dcm
+from .errors import InvalidArgument, InvalidType
 
 __all__ = ["aiding_delay"]
 
 F = NDArray[np.float64]
-
-
-def _rows(x: Any, name: str, width: int) -> F:
-    a = np.asarray(x)
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
-    if a.ndim != 2 or a.shape[1] != width:
-        raise InvalidArgument(f"{name} must have shape (N, {width}), got {a.shape}")
-    a = np.asarray(a, dtype=np.float64)
-    ok = np.isfinite(a).all(axis=1)
-    if not ok.all():
-        i = int(np.argmin(ok))
-        raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
-    return a
 
 
 def _number(x: Any, name: str, unit: str) -> float:
@@ -53,15 +40,6 @@ def _number(x: Any, name: str, unit: str) -> float:
     if not (np.isfinite(v) and v > 0):
         raise InvalidArgument(f"{name} must be finite and > 0 ({unit}), got {x}")
     return v
-
-
-def _dcm(q: F) -> F:
-    """C_b^n of each row of q (scalar first, body → ENU; docs/conventions.md eq. 1)."""
-    w, x, y, z = (q / np.linalg.norm(q, axis=1, keepdims=True)).T
-    return np.stack([
-        np.stack([w * w + x * x - y * y - z * z, 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), w * w - x * x + y * y - z * z, 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), w * w - x * x - y * y + z * z], -1)], -2)
 
 
 def _highpass(v: F, half: int) -> F:
@@ -123,9 +101,9 @@ def aiding_delay(gyr: ArrayLike, vec: ArrayLike, q: ArrayLike, rate: float, *, w
     values; NonFiniteError for NaN/Inf samples; InvalidArgument when the selected
     samples hold no rotation that would make the lag observable.
     """
-    g = _rows(gyr, "gyr", 3)
-    x = _rows(vec, "vec", 3)
-    qq = _rows(q, "q", 4)
+    g = _rows(gyr, "gyr", 3, "angular rate")
+    x = _rows(vec, "vec", 3, "aiding vector")
+    qq = _rows(q, "q", 4, "quaternion")
     n = len(g)
     if len(x) != n or len(qq) != n:
         raise InvalidArgument(f"gyr, vec and q must have the same number of samples, got {n}, {len(x)}, {len(qq)}")
@@ -145,7 +123,7 @@ def aiding_delay(gyr: ArrayLike, vec: ArrayLike, q: ArrayLike, rate: float, *, w
         if m.shape != (n,):
             raise InvalidArgument(f"mask must have shape ({n},), got {m.shape}")
         sel = m
-    C = _dcm(qq)
+    C = quat_to_dcm(qq)  # C_b^n of q/|q| (docs/conventions.md eq. 1)
     xn = np.einsum("nij,nj->ni", C, x)
     yn = np.einsum("nij,nj->ni", C, np.cross(g, x))
     a = _highpass(xn, half)[sel]
