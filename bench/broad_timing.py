@@ -21,6 +21,11 @@ reuses).
    reference attitude; least squares over the movement phases), and the BROAD
    inclination before and after the estimate is turned by exp(d·ω_n). What is left
    after is the part of the inclination error that is not timing.
+5. The same output prediction given to both filters: d = the median of this
+   filter's per-trial lags of item 4 (fitted WITH the reference), as this filter's
+   ``sensor_delay`` and, for VQF, its 9-D output turned by exp((ω − b̂)·d) in the body
+   frame with VQF's own bias estimate b̂ (the same formula as ``sensor_delay``). It
+   shows which filter is ahead once neither pays for the IMU-to-camera timing.
 
 The defaults of the filter stay 0: these lags are properties of BROAD's IMU.
 
@@ -75,15 +80,33 @@ def output_lag(q: np.ndarray, t: Any) -> tuple[float, float, float]:
     return d, before, after
 
 
-def lag_table(trials: list[Any]) -> list[str]:
-    """Item 4: the output's lag behind the reference, this filter and VQF."""
-    from bench.broad import run_vqf
-
+def _have_vqf() -> bool:
     try:
         import vqf  # noqa: F401  (bench extra: pip install -e ".[bench]")
-        have_vqf = True
     except ImportError:
-        have_vqf = False
+        return False
+    return True
+
+
+def vqf_predicted(t: Any, d: float) -> np.ndarray:
+    """VQF's 9-D output (defaults, as in bench/broad.py) turned forward by d seconds:
+    q ⊗ exp((ω − b̂)·d), b̂ VQF's own bias estimate (``sensor_delay``'s formula)."""
+    from vqf import VQF
+
+    from attitude_c import reference as ref
+
+    out = VQF(1.0 / t.rate).updateBatch(np.ascontiguousarray(t.gyr), np.ascontiguousarray(t.acc),
+                                        np.ascontiguousarray(t.mag))
+    w = np.asarray(t.gyr, float) - np.asarray(out["bias"], float)
+    return np.asarray(ref.quat_multiply(np.asarray(out["quat9D"], float), ref.rotvec_to_quat(w * d)))
+
+
+def lag_table(trials: list[Any]) -> tuple[list[str], list[float]]:
+    """Item 4: the output's lag behind the reference, this filter and VQF; and this
+    filter's per-trial lags (s)."""
+    from bench.broad import run_vqf
+
+    have_vqf = _have_vqf()
     out = [("**The output's lag behind the optical reference** (item 4 of the module docstring; ms, and BROAD "
             "inclination RMS in °, before → after the fitted lag term is removed; VQF 2 with its defaults as in "
             "the *broad* section). Not a filter property: it lies between the IMU's clock and the cameras'.\n"),
@@ -99,6 +122,30 @@ def lag_table(trials: list[Any]) -> list[str]:
     out.append(f"| **mean** | | **{mean[0]:.3f} → {mean[1]:.3f}** | | **{mean[2]:.3f} → {mean[3]:.3f}** |")
     if not have_vqf:
         out.append("\n(VQF not installed: its columns are empty; `pip install -e \".[bench]\"`.)")
+    return out, [r[0][0] for r in rows]
+
+
+def prediction_table(trials: list[Any], lags: list[float], dm: float) -> list[str]:
+    """Item 5: both filters given the same output prediction d (the median lag)."""
+    d = round(statistics.median(lags), 4)
+    rows: list[tuple[str, list[np.ndarray]]] = [
+        ("this filter, defaults", [run_ours(t) for t in trials]),
+        (f"this filter, `sensor_delay` = {d * 1e3:g} ms", [run_ours(t, sensor_delay=d) for t in trials]),
+        (f"this filter, `sensor_delay` = {d * 1e3:g} ms, `mag_delay` = {dm * 1e3:g} ms, `acc_delay` = 5 ms",
+         [run_ours(t, sensor_delay=d, mag_delay=dm, acc_delay=0.005) for t in trials])]
+    if _have_vqf():
+        rows += [("VQF, defaults", [vqf_predicted(t, 0.0) for t in trials]),
+                 (f"VQF, output turned forward by {d * 1e3:g} ms", [vqf_predicted(t, d) for t in trials])]
+    out = [(f"\n**The same output prediction for both filters** (item 5: d = {d * 1e3:g} ms, the median of this "
+            "filter's per-trial lags above, fitted WITH the reference; mean of per-trial RMS, °):\n"),
+           "| filter, settings | total | heading | inclination | disturbed (total) | undisturbed (total) |",
+           "|---|---|---|---|---|---|"]
+    for label, qs in rows:
+        gm = group_means(trials, score(trials, qs))
+        m = gm["all"]
+        out.append(f"| {label} | {m['total']:.3f} | {m['heading']:.3f} | {m['inclination']:.3f} | "
+                   f"{gm.get('disturbed', {}).get('total', float('nan')):.3f} | "
+                   f"{gm.get('undisturbed', {}).get('total', float('nan')):.3f} |")
     return out
 
 
@@ -152,7 +199,9 @@ def run(quick: bool = False, data: str | None = None) -> str:
     dmax = max(abs(a.total - b.total) for a, b in zip(f64, f32))
     out.append(f"\nFloat build with mag_delay = {dm:g}, acc_delay = 5 ms: largest per-trial difference of the "
                f"total RMS to double {dmax:.4f}°.\n")
-    out += lag_table(trials)
+    lag_lines, lags = lag_table(trials)
+    out += lag_lines
+    out += prediction_table(trials, lags, dm)
     return "\n".join(out)
 
 

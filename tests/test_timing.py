@@ -159,6 +159,25 @@ def test_errors():
         aiding_delay(gyr, mag, q, RATE, mask=np.zeros(400, bool))
 
 
+@pytest.mark.parametrize("d", [0.004, -0.003])
+def test_bench_output_lag_recovers_a_known_lag(d):
+    """bench/broad_timing.output_lag (item 4): an estimate that is the closed-form attitude
+    d seconds late is fitted as lag d, and with the term removed its inclination error
+    is gone. Tolerances: the fit is first order in d·|ω| (|ω| ≤ 1.6 rad/s here, so
+    d·|ω| ≤ 0.007 rad): the second-order rest is ~(d·|ω|)²/2 ≈ 2e-5 rad, 1 % of the
+    0.4° inclination error being removed."""
+    from types import SimpleNamespace
+
+    from bench.broad_timing import output_lag
+
+    t = np.arange(3000) / RATE
+    tr = SimpleNamespace(gyr=_rate(t), quat=_attitude(t), movement=np.ones(len(t), bool))
+    lag, before, after = output_lag(_attitude(t - d), tr)
+    assert lag == pytest.approx(d, rel=0.02)
+    assert before > 0.1  # degrees: the lag makes a visible inclination error
+    assert after < 0.01 * before
+
+
 def test_bench_smoke():
     """bench/broad_timing.py on a third of the BROAD trials (the full run: invoke bench --only broad_timing)."""
     from attitude_c import broad
@@ -169,3 +188,4 @@ def test_bench_smoke():
     body = B.run(quick=True)
     assert "mag_delay = " in body and "acc_delay = 5 ms" in body and "| defaults" in body
     assert "output's lag behind the optical reference" in body
+    assert "same output prediction for both filters" in body and "VQF, output turned forward by" in body
