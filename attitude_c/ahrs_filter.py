@@ -121,7 +121,8 @@ class Ahrs:
 
     @property
     def q(self) -> FloatArray:
-        """Current attitude (4,), float64 (raises before alignment)."""
+        """Current reported attitude (4,), float64: the state's, levelled by ``tilt_tau``'s
+        low-pass, without the ``sensor_delay`` prediction (raises before alignment)."""
         out = self._ffi.new("att_real[4]")
         st = self._lib.att_ahrs_attitude(self._s, out)
         if st != 0:

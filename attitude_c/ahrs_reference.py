@@ -34,7 +34,7 @@ _DEFAULTS: dict[str, Any] = {
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
-    "acc_delay": 0.0, "mag_delay": 0.0,
+    "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
@@ -68,6 +68,33 @@ def _undelay(x: F, rate: F, d: float) -> F:
         return x
     W = _skew(rate * d)
     return (np.eye(3) - W + 0.5 * (W @ W)) @ x
+
+
+def _tilt_step(z: F, fnav: F, dt: float, tau: float) -> F:
+    """One step of the reported inclination's low-pass (docs/ahrs.md, "Reported inclination").
+
+    Per axis the second-order system f̈ + 2ζω0 ḟ + ω0² f = ω0² a, ζ = 1/√2, ω0 = √2/τ,
+    written as ż = A z + B a with z = (f, ḟ); implicit Euler: (I − dt A) z⁺ = z + dt B a,
+    solved as a linear system. z is (2, 3): row 0 the filtered vector, row 1 its rate.
+    """
+    w0 = math.sqrt(2.0) / tau
+    zeta = 1.0 / math.sqrt(2.0)
+    A = np.array([[0.0, 1.0], [-w0 * w0, -2.0 * zeta * w0]])
+    B = np.array([[0.0], [w0 * w0]])
+    return np.asarray(np.linalg.solve(np.eye(2) - dt * A, z + dt * B @ fnav[None, :]), dtype=np.float64)
+
+
+def _level(q: F, f: F) -> F:
+    """q turned by the smallest rotation that takes the navigation-frame vector f to up
+    (rotation vector along f × e_z, angle between f and e_z), while f is above the horizon."""
+    v = f / np.linalg.norm(f)
+    if v[2] <= 0.0:
+        return q
+    axis = np.cross(v, [0.0, 0.0, 1.0])
+    s = float(np.linalg.norm(axis))
+    if s == 0.0:
+        return q
+    return _qmul(_exp(axis / s * math.atan2(s, float(v[2]))), q)
 
 
 def _dcm(q: F) -> F:
@@ -117,6 +144,10 @@ class ReferenceAhrs:
         self.rest_g: F | None = None
         self.rest_a = np.zeros(3)
         self.rest_t = 0.0
+        self.tilt: F | None = None  # (2, 3): tilt_tau's low-pass of the specific force and its rate
+        # the start: the samples so far (each carried through the corrections since) and their dt
+        self.tilt_start: F | None = np.zeros((0, 3))
+        self.tilt_dts: list[float] = []
         self.flags = 0
 
     # -- the Kalman pieces -------------------------------------------------
@@ -211,6 +242,20 @@ class ReferenceAhrs:
             R = s["acc_noise"] ** 2 / dt
             for j in (0, 1):
                 self._scalar(x, j, float(y[j]), R, (0, 1, 3, 4, 5))
+            if s["tilt_tau"] > 0:
+                # at rest the time constant grows as the state's does (no model error)
+                tau = s["tilt_tau"] * (s["gyr_noise"] / s["gyr_noise_rest"] if rest else 1.0)
+                if self.tilt_start is not None:  # the start: the plain mean until it spans τ
+                    self.tilt_start = np.vstack([self.tilt_start, fnav])
+                    self.tilt_dts.append(dt)
+                    span = sum(self.tilt_dts)
+                    mean = np.asarray(self.tilt_dts) @ self.tilt_start / span
+                    self.tilt = np.vstack([mean, np.zeros(3)])
+                    if span >= tau:
+                        self.tilt_start = None
+                else:
+                    assert self.tilt is not None
+                    self.tilt = _tilt_step(self.tilt, fnav, dt, tau)
         # magnetometer
         if m is not None:
             mn = C @ _undelay(m, wc, s["mag_delay"])
@@ -268,11 +313,21 @@ class ReferenceAhrs:
         # injection
         self.q = _qmul(_exp(x[:3]), self.q)
         self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
+        if self.tilt is not None:
+            self.tilt = self.tilt + np.cross(x[:3], self.tilt)
+        if self.tilt_start is not None and len(self.tilt_start):
+            self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
         self.flags = flags
+        out = self.reported()
         if s["sensor_delay"]:
-            return _qmul(self.q, _exp((w - self.b) * s["sensor_delay"]))
-        return self.q.copy()
+            return _qmul(out, _exp((w - self.b) * s["sensor_delay"]))
+        return out
+
+    def reported(self) -> F:
+        """The reported attitude: the state's, levelled by the tilt_tau low-pass when on."""
+        assert self.q is not None
+        return self.q.copy() if self.tilt is None else _level(self.q, self.tilt[0])
 
 
 def ahrs_reference(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float = 100.0,

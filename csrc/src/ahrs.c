@@ -49,6 +49,7 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->sensor_delay = ATT_R(0.0);
     set->acc_delay = ATT_R(0.0);
     set->mag_delay = ATT_R(0.0);
+    set->tilt_tau = ATT_R(3.0);
 }
 
 static int fin(att_real x)
@@ -85,8 +86,8 @@ att_status att_ahrs_check_settings(const att_ahrs_settings *set)
     /* zero = off */
     if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
           && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
-          && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0)
-          && att_fabs(t->declination) <= ATT_PI)) {
+          && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0) && fin(t->tilt_tau)
+          && t->tilt_tau >= 0 && att_fabs(t->declination) <= ATT_PI)) {
         return ATT_E_AHRS_SETTINGS;
     }
     /* aiding-sensor time skew */
@@ -145,6 +146,8 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     for (i = 0; i < 3; i++) {
         s->bias[i] = 0;
         s->acc_lp[i] = 0;
+        s->tilt_f[i] = 0;
+        s->tilt_fd[i] = 0;
         s->rest_gyr[i] = 0;
         s->rest_acc[i] = 0;
     }
@@ -164,6 +167,9 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->acc_init = 0;
     s->mag_ref_valid = 0;
     s->rest_init = 0;
+    s->tilt_init = 0;
+    s->tilt_mean = 1;
+    s->tilt_t = 0;
     s->flags = 0;
     return ATT_OK;
 }
@@ -202,6 +208,16 @@ static void delay_comp(const att_real gyr[3], const att_real b[3], att_real d, c
     out[0] = x[0] - c0 + ATT_R(0.5) * (t1 * c2 - t2 * c1);
     out[1] = x[1] - c1 + ATT_R(0.5) * (t2 * c0 - t0 * c2);
     out[2] = x[2] - c2 + ATT_R(0.5) * (t0 * c1 - t1 * c0);
+}
+
+/* v ← (I + [θ×]) v: a navigation-frame vector carried through the injection
+ * of a small correction θ (as acc_lp). */
+static void rotate_small(const att_real th[3], att_real v[3])
+{
+    att_real v0 = v[0], v1 = v[1], v2 = v[2];
+    v[0] = v0 + (th[1] * v2 - th[2] * v1);
+    v[1] = v1 + (th[2] * v0 - th[0] * v2);
+    v[2] = v2 + (th[0] * v1 - th[1] * v0);
 }
 
 static att_real norm3(const att_real v[3])
@@ -408,7 +424,8 @@ static void propagate_cov(att_real P[NX][NX], const att_real C[9], att_real dt, 
 static int finite_state(const att_ahrs *s)
 {
     int i;
-    if (!att__finite4(s->integ.q) || !att__finite3(s->bias) || !att__finite3(s->acc_lp)) {
+    if (!att__finite4(s->integ.q) || !att__finite3(s->bias) || !att__finite3(s->acc_lp)
+        || !att__finite3(s->tilt_f) || !att__finite3(s->tilt_fd)) {
         return 0;
     }
     for (i = 0; i < NX; i++) {
@@ -419,13 +436,37 @@ static int finite_state(const att_ahrs *s)
     return 1;
 }
 
+/* The reported attitude: the state's q, or with tilt_tau on, r ⊗ q where r is
+ * the smallest rotation taking v = tilt_f/|tilt_f| (navigation frame) to up:
+ * axis v × e_z = (v_y, −v_x, 0), angle acos(v_z), half-angle form
+ * r = (√((1 + v_z)/2), v_y/(2 r_0), −v_x/(2 r_0), 0), unit for a unit v. Only
+ * while v is above the horizon (v_z > 0: r_0 > 0.707). */
+static void report_q(const att_ahrs *s, att_real out[4])
+{
+    const att_real *q = s->integ.q;
+    att_real n, vz, r0, r1, r2;
+    n = s->tilt_init ? norm3(s->tilt_f) : 0;
+    vz = (n > 0) ? s->tilt_f[2] / n : 0;
+    if (vz <= 0) {
+        out[0] = q[0];
+        out[1] = q[1];
+        out[2] = q[2];
+        out[3] = q[3];
+        return;
+    }
+    r0 = att_sqrt((1 + vz) * ATT_R(0.5));
+    r1 = s->tilt_f[1] / (2 * r0 * n);
+    r2 = -s->tilt_f[0] / (2 * r0 * n);
+    out[0] = r0 * q[0] - r1 * q[1] - r2 * q[2];
+    out[1] = r0 * q[1] + r1 * q[0] + r2 * q[3];
+    out[2] = r0 * q[2] - r1 * q[3] + r2 * q[0];
+    out[3] = r0 * q[3] + r1 * q[2] - r2 * q[1];
+}
+
 static att_status write_q(const att_ahrs *s, att_real q_out[4])
 {
     if (q_out != NULL) {
-        q_out[0] = s->integ.q[0];
-        q_out[1] = s->integ.q[1];
-        q_out[2] = s->integ.q[2];
-        q_out[3] = s->integ.q[3];
+        report_q(s, q_out);
     }
     return ATT_OK;
 }
@@ -458,6 +499,22 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_mag = set->mag_noise * set->mag_noise / dt;
         c->r_rest = set->rest_noise * set->rest_noise / dt;
         c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
+        c->tilt = set->tilt_tau > 0;
+        if (c->tilt) {
+            /* ζω0 = 1/τ, ω0² = 2/τ²; at rest τ grows as the state's own inclination
+             * time constant does, by gyr_noise/gyr_noise_rest */
+            att_real tr = set->tilt_tau * set->gyr_noise / set->gyr_noise_rest;
+            att_real u = dt / set->tilt_tau, ur = dt / tr;
+            c->k_tilt_v = 1 / (1 + 2 * u + 2 * u * u);
+            c->k_tilt_x = 2 * u / set->tilt_tau * c->k_tilt_v;
+            c->k_tilt_v_rest = 1 / (1 + 2 * ur + 2 * ur * ur);
+            c->k_tilt_x_rest = 2 * ur / tr * c->k_tilt_v_rest;
+        } else {
+            c->k_tilt_v = 0;
+            c->k_tilt_x = 0;
+            c->k_tilt_v_rest = 0;
+            c->k_tilt_x_rest = 0;
+        }
     }
     return c;
 }
@@ -636,6 +693,33 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
             if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
                 update_acc(s->P, x, 0, y0, k->r_acc);
                 update_acc(s->P, x, 1, y1, k->r_acc);
+                if (k->tilt) {
+                    /* the reported inclination's low-pass, implicit Euler of
+                     * f'' + 2ζω0 f' + ω0² f = ω0² a_n:
+                     * f' ← (f' + dt ω0² (a_n − f))/(1 + 2ζω0 dt + ω0² dt²), f ← f + dt f' */
+                    if (s->tilt_mean) {
+                        /* start: the mean of the samples so far, until it spans the
+                         * low-pass's own τ (as VQF starts its filter) */
+                        att_real wgt;
+                        s->tilt_t += dt;
+                        wgt = dt / s->tilt_t;
+                        for (i = 0; i < 3; i++) {
+                            s->tilt_f[i] += wgt * (an_n[i] - s->tilt_f[i]);
+                        }
+                        s->tilt_init = 1;
+                        if (s->tilt_t >= (rest ? set->tilt_tau * set->gyr_noise / set->gyr_noise_rest
+                                               : set->tilt_tau)) {
+                            s->tilt_mean = 0;
+                        }
+                    } else {
+                        att_real kv = rest ? k->k_tilt_v_rest : k->k_tilt_v;
+                        att_real kx = rest ? k->k_tilt_x_rest : k->k_tilt_x;
+                        for (i = 0; i < 3; i++) {
+                            s->tilt_fd[i] = kv * s->tilt_fd[i] + kx * (an_n[i] - s->tilt_f[i]);
+                            s->tilt_f[i] += dt * s->tilt_fd[i];
+                        }
+                    }
+                }
             }
         }
     }
@@ -723,18 +807,21 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         }
     }
 
-    /* inject the error state: q ← exp(δθ) ⊗ q, b ← b + δb, acc_lp ← (I + [δθ×]) acc_lp */
+    /* inject the error state: q ← exp(δθ) ⊗ q, b ← b + δb, acc_lp (and tilt_f, tilt_fd) ←
+     * (I + [δθ×]) acc_lp */
     if (x[0] != 0 || x[1] != 0 || x[2] != 0) {
         att_real d[4], q0 = s->integ.q[0], q1 = s->integ.q[1], q2 = s->integ.q[2], q3 = s->integ.q[3];
-        att_real l0 = s->acc_lp[0], l1 = s->acc_lp[1], l2 = s->acc_lp[2];
         att__rotvec_delta(x, d);
         s->integ.q[0] = q0 + (d[0] * q0 - d[1] * q1 - d[2] * q2 - d[3] * q3);
         s->integ.q[1] = q1 + (d[0] * q1 + d[1] * q0 + d[2] * q3 - d[3] * q2);
         s->integ.q[2] = q2 + (d[0] * q2 - d[1] * q3 + d[2] * q0 + d[3] * q1);
         s->integ.q[3] = q3 + (d[0] * q3 + d[1] * q2 - d[2] * q1 + d[3] * q0);
-        s->acc_lp[0] = l0 + (x[1] * l2 - x[2] * l1);
-        s->acc_lp[1] = l1 + (x[2] * l0 - x[0] * l2);
-        s->acc_lp[2] = l2 + (x[0] * l1 - x[1] * l0);
+        rotate_small(x, s->acc_lp);
+        if (s->tilt_init) {
+            /* the reported inclination's filter lives in the same frame */
+            rotate_small(x, s->tilt_f);
+            rotate_small(x, s->tilt_fd);
+        }
     }
     s->bias[0] += x[3];
     s->bias[1] += x[4];
@@ -746,7 +833,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     }
     if (q_out != NULL && set->sensor_delay != 0) {
         /* output predicted over the sensor delay with the corrected rate */
-        att_real ph[3], d[4], *q = s->integ.q;
+        att_real ph[3], d[4], q[4];
+        report_q(s, q);
         for (i = 0; i < 3; i++) {
             ph[i] = (gyr[i] - s->bias[i]) * set->sensor_delay;
         }

@@ -142,25 +142,47 @@ typedef struct {
                                  the compensated field feeds the norm/dip checks, the
                                  reference and the heading. 0 (off, no work) by default;
                                  attitude_c.aiding_delay estimates it from a recording */
+    att_real tilt_tau;            /* [s] the reported inclination's low-pass, 3.0 (0 = off: the
+                                 Kalman state's own). The specific force in the filter's
+                                 navigation frame (the sample the inclination update uses)
+                                 passes a second-order low-pass, ζ = 1/√2, ω0 = √2/tilt_tau
+                                 (VQF's accelerometer filter and time constant; the step
+                                 response is 1 − e^(−t/τ)(cos(t/τ) + sin(t/τ))), discretized by
+                                 implicit Euler (stable for any dt); samples the gate rejects
+                                 are not fed; while rest is detected τ is longer by
+                                 gyr_noise/gyr_noise_rest (15 s with the defaults), as the
+                                 state's own inclination time constant is. It starts as the
+                                 mean of the samples fed so far until they span τ (VQF's
+                                 start). The reported attitude (q_out, att_ahrs_attitude)
+                                 is the state's turned by the smallest rotation that makes
+                                 the filtered vector vertical (while it is within 90° of up);
+                                 heading, covariance and bias are the state's. See
+                                 docs/ahrs.md, "Reported inclination" */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
  * the state and recomputed only when dt changes (part of the state: treat
  * as opaque). */
 typedef struct {
-    att_real dt;         /* [s] the step they are for; 0 = none yet */
-    att_real k_norm;     /* dt/(10 s + dt): low-pass of |a| (unit check) */
-    att_real k_rest;     /* dt/(rest_tau + dt) */
-    att_real k_acc;      /* dt/(acc_tau + dt), 1 when acc_tau = 0 */
-    att_real k_mag;      /* dt/(mag_ref_tau + dt) */
-    att_real q_att;      /* gyr_noise²·dt */
-    att_real q_att_rest; /* gyr_noise_rest²·dt */
-    att_real q_bias;     /* bias_noise²·dt */
-    att_real r_acc;      /* acc_noise²/dt */
-    att_real r_mag;      /* mag_noise²/dt */
-    att_real r_rest;     /* rest_noise²/dt */
-    int delays;          /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
+    att_real dt;            /* [s] the step they are for; 0 = none yet */
+    att_real k_norm;        /* dt/(10 s + dt): low-pass of |a| (unit check) */
+    att_real k_rest;        /* dt/(rest_tau + dt) */
+    att_real k_acc;         /* dt/(acc_tau + dt), 1 when acc_tau = 0 */
+    att_real k_mag;         /* dt/(mag_ref_tau + dt) */
+    att_real q_att;         /* gyr_noise²·dt */
+    att_real q_att_rest;    /* gyr_noise_rest²·dt */
+    att_real q_bias;        /* bias_noise²·dt */
+    att_real r_acc;         /* acc_noise²/dt */
+    att_real r_mag;         /* mag_noise²/dt */
+    att_real r_rest;        /* rest_noise²/dt */
+    att_real k_tilt_v;      /* 1/(1 + 2 dt/τ + 2 dt²/τ²), τ = tilt_tau: implicit Euler of the
+                            reported inclination's low-pass */
+    att_real k_tilt_x;      /* (2 dt/τ²)·k_tilt_v */
+    att_real k_tilt_v_rest; /* the same with τ·gyr_noise/gyr_noise_rest (at rest) */
+    att_real k_tilt_x_rest;
+    int delays; /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
                             sample: a float compare is a library call on soft-float targets) */
+    int tilt;   /* 1 when tilt_tau > 0 (the same reason) */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
@@ -173,6 +195,9 @@ typedef struct {
     att_real bias[3];      /* gyro bias estimate b_est [rad/s], body frame */
     att_real P[6][6];      /* error covariance [δθ (rad); δb (rad/s)] */
     att_real acc_lp[3];    /* low-pass specific force, estimate's navigation frame [m/s²] */
+    att_real tilt_f[3];    /* tilt_tau's low-pass of the specific force, navigation frame [m/s²] */
+    att_real tilt_fd[3];   /* its rate [m/s³] (the second-order filter's other state) */
+    att_real tilt_t;       /* [s] time fed, during the running-mean start */
     att_real acc_norm_lp;  /* slow average of |a| [m/s²] (unit check) */
     att_real acc_rej_time; /* [s] continuous accelerometer rejection */
     att_real mag_ref[2];   /* reference field norm (input units) and dip [rad] */
@@ -187,6 +212,8 @@ typedef struct {
     int acc_init;          /* 1 once acc_lp holds a value */
     int mag_ref_valid;     /* 1 once mag_ref holds a value */
     int rest_init;         /* 1 once the rest low-passes hold a value */
+    int tilt_init;         /* 1 once tilt_f holds a value */
+    int tilt_mean;         /* 1 while tilt_f is still the running mean of its start */
     int flags;             /* ATT_AHRS_F_* of the last update */
 } att_ahrs;
 
@@ -224,9 +251,10 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
                           size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index);
 
-/* Current attitude q of the state (body → ENU, unit, at the time of the
- * last sample, without the sensor_delay prediction; ATT_E_STATE before
- * alignment). */
+/* Current reported attitude (body → ENU, unit, at the time of the last
+ * sample): the state's q levelled by tilt_tau's low-pass (the state's own
+ * with tilt_tau = 0), without the sensor_delay prediction; ATT_E_STATE
+ * before alignment. */
 att_status att_ahrs_attitude(const att_ahrs *s, att_real q[4]);
 
 /* Current gyro-bias estimate [rad/s], body frame. */
