@@ -315,17 +315,22 @@ def cross_validate(trials: list[Any], rounds: int) -> tuple[list[tuple[str, dict
 def armv4t_counts(delays: bool = False, precisions: tuple[str, ...] = ("f32", "f64")) -> list[tuple[str, float]]:
     """Instructions per sample (acc + mag every sample) on the emulated ARM920T; ``delays``:
     with acc_delay 5 ms and mag_delay 13 ms (``-DBENCH_AHRS_DELAYS``, bench/broad_timing.py)."""
+    from attitude_c.ahrs_filter import default_settings
     from toolchain import targets as T
     from toolchain.qemu_count import per_iteration
 
     t = T.load("armv4t-bare")
+    # the steady per-sample path: the difference of two runs that both end after the reported
+    # inclination's running-mean start (tilt_tau at bench_ahrs.c's 200 Hz, in motion), one
+    # field-table period (256 samples) apart
+    n_small = math.ceil(default_settings()["tilt_tau"] * 200.0) + 100
     rows = []
     with tempfile.TemporaryDirectory() as d:
         for prec in precisions:
             defines = (["ATT_REAL_F32"] if prec == "f32" else []) + (["BENCH_AHRS_DELAYS"] if delays else [])
             exe = t.build_program([ROOT / "csrc" / "vectors" / "bench_ahrs.c"], Path(d) / f"bench_ahrs_{prec}",
                                   defines=defines)
-            rows.append((prec, per_iteration(exe, lambda m: [str(m)], 300, 556)))
+            rows.append((prec, per_iteration(exe, lambda m: [str(m)], n_small, n_small + 256)))
     return rows
 
 

@@ -153,6 +153,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     }
     set_initial_cov(s);
     s->step.dt = 0;
+    s->step.tilt = 0; /* read by att_ahrs_attitude before the first update */
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -167,7 +168,6 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->acc_init = 0;
     s->mag_ref_valid = 0;
     s->rest_init = 0;
-    s->tilt_init = 0;
     s->tilt_mean = 1;
     s->tilt_t = 0;
     s->flags = 0;
@@ -445,7 +445,7 @@ static void report_q(const att_ahrs *s, att_real out[4])
 {
     const att_real *q = s->integ.q;
     att_real n, vz, r0, r1, r2;
-    n = s->tilt_init ? norm3(s->tilt_f) : 0;
+    n = s->step.tilt ? norm3(s->tilt_f) : 0; /* tilt_f = 0 until its first sample */
     vz = (n > 0) ? s->tilt_f[2] / n : 0;
     if (vz <= 0) {
         out[0] = q[0];
@@ -505,6 +505,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
              * time constant does, by gyr_noise/gyr_noise_rest */
             att_real tr = set->tilt_tau * set->gyr_noise / set->gyr_noise_rest;
             att_real u = dt / set->tilt_tau, ur = dt / tr;
+            c->tilt_tau_rest = tr;
             c->k_tilt_v = 1 / (1 + 2 * u + 2 * u * u);
             c->k_tilt_x = 2 * u / set->tilt_tau * c->k_tilt_v;
             c->k_tilt_v_rest = 1 / (1 + 2 * ur + 2 * ur * ur);
@@ -514,6 +515,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
             c->k_tilt_x = 0;
             c->k_tilt_v_rest = 0;
             c->k_tilt_x_rest = 0;
+            c->tilt_tau_rest = 0;
         }
     }
     return c;
@@ -706,9 +708,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
                         for (i = 0; i < 3; i++) {
                             s->tilt_f[i] += wgt * (an_n[i] - s->tilt_f[i]);
                         }
-                        s->tilt_init = 1;
-                        if (s->tilt_t >= (rest ? set->tilt_tau * set->gyr_noise / set->gyr_noise_rest
-                                               : set->tilt_tau)) {
+                        if (s->tilt_t >= (rest ? k->tilt_tau_rest : set->tilt_tau)) {
                             s->tilt_mean = 0;
                         }
                     } else {
@@ -817,7 +817,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         s->integ.q[2] = q2 + (d[0] * q2 - d[1] * q3 + d[2] * q0 + d[3] * q1);
         s->integ.q[3] = q3 + (d[0] * q3 + d[1] * q2 - d[2] * q1 + d[3] * q0);
         rotate_small(x, s->acc_lp);
-        if (s->tilt_init) {
+        if (k->tilt) {
             /* the reported inclination's filter lives in the same frame */
             rotate_small(x, s->tilt_f);
             rotate_small(x, s->tilt_fd);

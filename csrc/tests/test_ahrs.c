@@ -341,7 +341,7 @@ static void test_tilt_not_below_the_horizon(void)
     CHECK_EQ_INT(att_ahrs_init(&s0, &set, q0), ATT_OK);
     CHECK_EQ_INT(att_ahrs_update(&s, w, f, NULL, (att_real)0.01, q), ATT_OK);
     CHECK_EQ_INT(att_ahrs_update(&s0, w, f, NULL, (att_real)0.01, qs), ATT_OK);
-    CHECK(s.tilt_init);
+    CHECK(s.tilt_f[2] < 0); /* the low-pass took the sample: below the horizon */
     CHECK(memcmp(q, qs, sizeof q) == 0);
     CHECK(qangle(q, q0) > 0.01); /* the state itself moved: the update was made */
 }

@@ -4,7 +4,8 @@
  * gyro, specific force and field (the full per-sample path). The motion is
  * a steady turn about the vertical, one turn per TABLE samples at 200 Hz,
  * tabulated at start-up (start-up cancels out in toolchain/qemu_count.py's
- * difference of two N).
+ * difference of two N; bench/broad.py takes both N past the filter's own
+ * start, the reported inclination's running mean over tilt_tau).
  *
  * The filter is chosen at compile time, so that each build calls its
  * filter directly (the counts are those of the filter alone):

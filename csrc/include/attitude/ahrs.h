@@ -180,9 +180,10 @@ typedef struct {
     att_real k_tilt_x;      /* (2 dt/τ²)·k_tilt_v */
     att_real k_tilt_v_rest; /* the same with τ·gyr_noise/gyr_noise_rest (at rest) */
     att_real k_tilt_x_rest;
-    int delays; /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
+    att_real tilt_tau_rest; /* [s] tilt_tau·gyr_noise/gyr_noise_rest, τ while at rest */
+    int delays;             /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
                             sample: a float compare is a library call on soft-float targets) */
-    int tilt;   /* 1 when tilt_tau > 0 (the same reason) */
+    int tilt;               /* 1 when tilt_tau > 0 (the same reason) */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
@@ -195,7 +196,8 @@ typedef struct {
     att_real bias[3];      /* gyro bias estimate b_est [rad/s], body frame */
     att_real P[6][6];      /* error covariance [δθ (rad); δb (rad/s)] */
     att_real acc_lp[3];    /* low-pass specific force, estimate's navigation frame [m/s²] */
-    att_real tilt_f[3];    /* tilt_tau's low-pass of the specific force, navigation frame [m/s²] */
+    att_real tilt_f[3];    /* tilt_tau's low-pass of the specific force, navigation frame [m/s²];
+                              0 until its first sample */
     att_real tilt_fd[3];   /* its rate [m/s³] (the second-order filter's other state) */
     att_real tilt_t;       /* [s] time fed, during the running-mean start */
     att_real acc_norm_lp;  /* slow average of |a| [m/s²] (unit check) */
@@ -212,7 +214,6 @@ typedef struct {
     int acc_init;          /* 1 once acc_lp holds a value */
     int mag_ref_valid;     /* 1 once mag_ref holds a value */
     int rest_init;         /* 1 once the rest low-passes hold a value */
-    int tilt_init;         /* 1 once tilt_f holds a value */
     int tilt_mean;         /* 1 while tilt_f is still the running mean of its start */
     int flags;             /* ATT_AHRS_F_* of the last update */
 } att_ahrs;
