@@ -91,12 +91,10 @@ def _have_vqf() -> bool:
 def vqf_predicted(t: Any, d: float) -> np.ndarray:
     """VQF's 9-D output (defaults, as in bench/broad.py) turned forward by d seconds:
     q ⊗ exp((ω − b̂)·d), b̂ VQF's own bias estimate (``sensor_delay``'s formula)."""
-    from vqf import VQF
-
     from attitude_c import reference as ref
+    from bench.broad import run_vqf_batch
 
-    out = VQF(1.0 / t.rate).updateBatch(np.ascontiguousarray(t.gyr), np.ascontiguousarray(t.acc),
-                                        np.ascontiguousarray(t.mag))
+    out = run_vqf_batch(t)
     w = np.asarray(t.gyr, float) - np.asarray(out["bias"], float)
     return np.asarray(ref.quat_multiply(np.asarray(out["quat9D"], float), ref.rotvec_to_quat(w * d)))
 
