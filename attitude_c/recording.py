@@ -10,9 +10,11 @@ file's own (``{"gx": "GyroX", ...}``), ``units`` gives each sensor's unit
 the returned :class:`Recording` is in rad/s, m/s², µT and the library's
 body frame (x right, y forward, z up), the reference rotated to match.
 
-:func:`gyro_scale` measures the gyro's scale against the magnetometer; a
-gyro in °/s read as rad/s is 57.3× too fast, and :func:`read_csv` refuses it
-unless ``units`` says the gyro's unit.
+:func:`gyro_scale` measures the gyro's scale against the magnetometer: a
+gyro in °/s read as rad/s is 57.3× too fast. Unless ``units`` gives the
+gyro's unit, :func:`read_csv` refuses a gyro whose scale is below
+:data:`DEG_PER_S_SCALE` or, without a magnetometer, one above
+:data:`MAX_RAD_S` (docs/ahrs.md, "Command").
 """
 
 from __future__ import annotations
