@@ -14,7 +14,8 @@ body frame (x right, y forward, z up), the reference rotated to match.
 gyro in °/s read as rad/s is 57.3× too fast. Unless ``units`` gives the
 gyro's unit, :func:`read_csv` refuses a gyro whose scale is below
 :data:`DEG_PER_S_SCALE` or, without a magnetometer, one above
-:data:`MAX_RAD_S` (docs/ahrs.md, "Command").
+:data:`MAX_RAD_S` (docs/ahrs.md, "Command"); without the accelerometer's
+unit, one whose median norm is near 1 (g, not m/s²).
 """
 
 from __future__ import annotations
@@ -176,6 +177,8 @@ def read_csv(path: str | Path, columns: dict[str, str] | None = None, units: dic
     k = None if mag is None else gyro_scale(gyr, mag, rate)
     if "gyr" not in units:
         _refuse_deg_per_s(gyr, k)
+    if "acc" not in units:
+        _refuse_g(acc)
     return Recording(t=t, rate=rate, gyr=gyr, acc=acc, mag=mag, ref=ref, gyr_scale=k)
 
 
@@ -190,6 +193,15 @@ def _refuse_deg_per_s(gyr: FloatArray, k: float | None) -> None:
         return
     raise InvalidArgument(f"the gyro looks like deg/s: {why}; give its unit (--gyr-unit deg/s, or rad/s if it "
                           "is; units={'gyr': ...} in Python)")
+
+
+def _refuse_g(acc: FloatArray) -> None:
+    """The specific force's median norm is g (gravity at rest, its average in motion): within
+    0.25..4 of 1 it is in g (the filter's alignment bounds, ahrs.h, around 1 instead of 9.81)."""
+    med = float(np.median(np.linalg.norm(acc, axis=1)))
+    if 0.25 <= med <= 4.0:
+        raise InvalidArgument(f"the accelerometer looks like g: its median norm is {med:.3g} (m/s^2: about "
+                              "9.81); give its unit (--acc-unit g, or m/s2 if it is; units={'acc': ...} in Python)")
 
 
 def _times(q: FloatArray, r: FloatArray) -> FloatArray:

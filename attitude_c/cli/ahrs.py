@@ -27,7 +27,8 @@ in NED: yaw is the heading, clockwise from north).
 
 A gyro that looks like deg/s (its rotation 57x the rotation the magnetometer
 sees, or above 2000 deg/s read as rad/s) is refused unless --gyr-unit gives
-its unit.
+its unit; an accelerometer that looks like g (median norm near 1) unless
+--acc-unit does.
 
 Output (--out DIR): attitude.csv (t, quaternion body -> ENU, yaw/pitch/roll
 in degrees; its first line states the frames), attitude.png (estimate and

@@ -64,8 +64,10 @@ def _draw(tr: Trace, path: Path, title: str) -> None:
                           fontsize=8.5, loc="left")
         k = 3
         if tr.errors is not None:
-            for e, lab in zip(tr.errors, ("total", "heading", "inclination")):
-                axes[k].plot(tr.t, e, lw=0.8, label=lab)
+            total, heading, incl = tr.errors
+            axes[k].plot(tr.t, heading, color="C1", lw=0.7, label="heading")
+            axes[k].plot(tr.t, incl, color="C2", lw=0.7, label="inclination")
+            axes[k].plot(tr.t, total, color="black", lw=0.6, label="total")
             axes[k].set_ylabel("error / °")
             axes[k].legend(loc="upper right", fontsize=7, ncol=3)
             k += 1
@@ -74,8 +76,8 @@ def _draw(tr: Trace, path: Path, title: str) -> None:
             axes[k].fill_between(tr.tb, j - 0.35, j + 0.35, where=on, step="post", color=f"C{j + 3}", lw=0)
         axes[k].set_yticks(range(len(FLAGS)), [lab for _, lab in FLAGS], fontsize=7)
         axes[k].set_ylim(-0.6, len(FLAGS) - 0.4)
-        for i, lab in enumerate("xyz"):
-            axes[k + 1].plot(tr.tb, tr.bias[:, i], lw=0.9, label=f"bias {lab}")
+        for i, lab in enumerate(("x (right)", "y (forward)", "z (up)")):
+            axes[k + 1].plot(tr.tb, tr.bias[:, i], lw=0.9, label=lab)
         axes[k + 1].set_ylabel("gyro bias / °/s")
         axes[k + 1].legend(loc="upper right", fontsize=7, ncol=3)
         if tr.movement is not None:
