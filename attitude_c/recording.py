@@ -32,7 +32,7 @@ from .core import dcm_to_quat
 from .errors import InvalidArgument
 from .frames import axes_matrix
 
-__all__ = ["COLUMNS", "DEG_PER_S_SCALE", "MAX_RAD_S", "UNITS", "Recording", "gyro_scale", "read_csv"]
+__all__ = ["COLUMNS", "DEG_PER_S_SCALE", "MAX_RAD_S", "MIN_CORRELATION", "UNITS", "Recording", "gyro_scale", "read_csv"]
 
 FloatArray = NDArray[np.float64]
 
@@ -50,6 +50,11 @@ UNITS = {"gyr": {"rad/s": 1.0, "deg/s": math.pi / 180.0},
 #: π/180 (°/s read as rad/s), a factor 7.6 from either. On the 15 BROAD trials
 #: (../shared/data/broad) the scale of the rad/s gyro lies in 0.91..1.09.
 DEG_PER_S_SCALE = math.sqrt(math.pi / 180.0)
+
+#: :func:`gyro_scale` judges only a recording whose field turns with the gyro: the correlation
+#: of ``du/dt`` and ``u × ω`` (scale-free) is 0.40..0.99 over the 15 BROAD trials, at most 0.15
+#: over their rest phases before the first movement (noise alone: near 0).
+MIN_CORRELATION = 0.3
 
 #: A gyro column above this (rad/s) is °/s: 2000 °/s, the largest full scale of common MEMS
 #: gyros (MPU-6050/9250, ICM-20948, BMI160, LSM6DS3: ±2000 °/s). The test without a field.
@@ -73,8 +78,8 @@ def gyro_scale(gyr: FloatArray, field: FloatArray, rate: float) -> float:
     """The gyro's scale measured against the field: a fixed world vector seen in
     the body turns as ``du/dt = u × ω`` (u its unit vector); the least-squares
     ``k`` of ``du/dt ≈ k (u × ω)`` over the recording (both smoothed over 50 ms).
-    1 for a gyro in rad/s, π/180 for one in °/s read as rad/s; NaN if the gyro
-    never turns the field."""
+    1 for a gyro in rad/s, π/180 for one in °/s read as rad/s; NaN when the field's
+    turning and the gyro's correlate below :data:`MIN_CORRELATION` (no motion to judge by)."""
     w = max(1, int(round(0.05 * rate)))
     ker = np.ones(w) / w
 
@@ -85,14 +90,15 @@ def gyro_scale(gyr: FloatArray, field: FloatArray, rate: float) -> float:
     u = s / np.linalg.norm(s, axis=1, keepdims=True)
     du = (u[2:] - u[:-2]) * (rate / 2.0)
     p = np.cross(u[1:-1], smooth(gyr)[1:-1])
-    den = float(np.sum(p * p))
-    return float(np.sum(du * p)) / den if den > 0 else math.nan
+    num, den = float(np.sum(du * p)), float(np.sum(p * p))
+    r = num / math.sqrt(den * float(np.sum(du * du))) if den > 0 else 0.0
+    return num / den if r >= MIN_CORRELATION else math.nan
 
 
 def _header(path: Path) -> tuple[list[str], str | None, int]:
     """The header's names (lower case), the delimiter (None: spaces) and the header's line number
     (0-based: comment lines starting with # may come first)."""
-    with open(path, encoding="utf-8", newline="") as fh:
+    with open(path, encoding="utf-8-sig", newline="") as fh:  # -sig: a spreadsheet's byte-order mark
         for k, line in enumerate(fh):
             if line.strip() and not line.lstrip().startswith("#"):
                 break

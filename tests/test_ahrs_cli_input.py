@@ -232,6 +232,17 @@ def test_the_gyro_scale_is_1_on_rad_per_s_and_pi_over_180_on_deg_per_s():
     assert math.pi / 180 < DEG_PER_S_SCALE < 1.0
 
 
+def test_a_recording_at_rest_is_not_judged_by_the_field(tmp_path, capsys):
+    """At rest the field does not turn: the scale is noise over noise, not a verdict."""
+    from attitude_c.recording import gyro_scale
+
+    t = np.arange(500) / 100.0
+    gyr0, acc0, mag0, truth0 = motion(500, 100.0, (0, 0, 0), noise=0.001, seed=3)
+    assert math.isnan(gyro_scale(gyr0, mag0, 100.0))
+    src = _write(tmp_path / "rest.csv", [t, gyr0, acc0, mag0, truth0])
+    assert main(["ahrs", str(src), "--out", str(tmp_path / "o"), "--no-plots"]) == 0
+
+
 @pytest.mark.parametrize("argv, words", [
     (["--axes", "xyz"], "--axes: give three letters of r l f b u d"),
     (["--axes", "ffu"], "names one direction twice"),
@@ -250,6 +261,25 @@ def test_csv_option_mistakes_are_one_line(tmp_path, capsys, argv, words):
         rc = exc.code
     assert rc == 2
     assert words in _one_error_line(capsys)
+
+
+def test_a_spreadsheet_export_reads(tmp_path):
+    """Byte-order mark, CRLF line ends, upper-case names, ';' between the columns."""
+    from attitude_c.recording import read_csv
+
+    t, gyr, acc, mag, truth = _recording(n=50)
+    rows = "\r\n".join(";".join(f"{v:.9g}" for v in r) for r in np.column_stack([t, gyr, acc]))
+    path = tmp_path / "export.csv"
+    path.write_bytes(("\ufeffT;GX;GY;GZ;AX;AY;AZ\r\n" + rows + "\r\n").encode("utf-8"))
+    rec = read_csv(path)
+    assert np.allclose(rec.gyr, gyr, rtol=1e-8) and np.allclose(rec.t, t) and rec.mag is None
+
+
+def test_an_unwritable_out_is_refused_before_the_run(tmp_path, capsys):
+    t, gyr, acc, mag, truth = _recording(n=50)
+    src = _write(tmp_path / "r.csv", [t, gyr, acc, mag, truth])
+    assert main(["ahrs", str(src), "--out", str(src)]) == 1
+    assert "exists and is not a directory" in _one_error_line(capsys)
 
 
 def test_the_header_lacks_columns_names_them(tmp_path, capsys):

@@ -49,7 +49,7 @@ from typing import Any
 
 import numpy as np
 
-from .._io import write_text, write_with
+from .._io import check_output_dir, write_text, write_with
 from .options import positive
 
 PROG = "attitude ahrs"
@@ -206,6 +206,7 @@ def _main(args: argparse.Namespace) -> int:
     if not path.is_file():
         raise FileNotFoundError(2, "no such file", str(path))
     settings = _settings(args.set)
+    out = check_output_dir(Path(args.out) if args.out else Path("results") / f"ahrs-{path.stem}")
     rec, movement = _read(path, args)
     mag = None if args.six_axis else rec.mag
     if args.estimate_mag_delay and mag is None:
@@ -214,8 +215,6 @@ def _main(args: argparse.Namespace) -> int:
         print(f"{PROG}: warning: with --gyr-unit {args.gyr_unit} the gyro's rotation is "
               f"{1 / rec.gyr_scale:.3g}x the rotation the magnetometer sees (1x expected)", file=sys.stderr)
     q, ends, flags, bias = _run(rec, mag, args.precision, settings)
-    out = Path(args.out) if args.out else Path("results") / f"ahrs-{path.stem}"
-    out.mkdir(parents=True, exist_ok=True)
     summary = _summary(args, path, rec, mag, settings, out, flags, bias)
     if args.estimate_mag_delay:
         from ..timing import aiding_delay
