@@ -90,7 +90,7 @@ def test_plot_and_summary_with_a_reference(tmp_path, capsys):
     # ideal sensors (1e-3 noise), constant rate: well under 1° (tests/test_ahrs_cli.py)
     assert printed["errors_deg"]["total"] < 1.0 and printed["errors_over"] == "all samples"
     assert set(printed["flag_fractions"]) == {"rest", "acc gated out", "mag disturbed"}
-    assert printed["flag_fractions"]["rest"] == 0.0  # turning at 0.76 rad/s throughout: never at rest
+    assert printed["flag_fractions"]["rest"] == 0.0  # turning at |W| = 0.71 rad/s throughout: never at rest
     assert not list(out.glob(".*tmp*"))  # no temporary file left behind
 
 
