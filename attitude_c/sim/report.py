@@ -10,12 +10,12 @@ import contextlib
 import csv
 import json
 import math
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
+from .._plot import panels as _panels
 from .chain import PAPER_MAXIMA, SimResult
 
 __all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "sensor_rows", "to_jsonable",
@@ -43,37 +43,6 @@ def to_jsonable(x: Any) -> Any:
         v = float(x)
         return v if math.isfinite(v) else None
     return x
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@contextlib.contextmanager
-def _panels(path: Path, dpi: int, height: float, title: str, legend: bool = True) -> Iterator[Any]:
-    """Three stacked panels over t (the block draws into the axes it gets), then
-    the frame every figure shares: dotted grid, legend in the first panel, t
-    axis, ``title``; saved as PNG to ``path`` as it is (the caller makes the
-    write atomic) and closed."""
-    plt = _plt()
-    fig, axes = plt.subplots(3, 1, figsize=(7.0, height), sharex=True)
-    try:
-        yield axes
-        for ax in axes:
-            ax.grid(True, linestyle=":", linewidth=0.6)
-        if legend:
-            axes[0].legend(loc="upper right", fontsize=8)
-        axes[-1].set_xlabel("t / s")
-        fig.suptitle(title, fontsize=9.5)
-        fig.tight_layout()
-        fig.savefig(path, dpi=dpi, format="png")
-    finally:
-        plt.close(fig)
 
 
 def _title(res: SimResult) -> str:
