@@ -195,7 +195,7 @@ def test_replay_of_a_broad_trial_runs_the_estimator(tmp_path: Path, method: str)
     f = tmp_path / "01_constant_rate.mat"
     rate = 100.0
     truth = _constant_rate_trial(f, w, q0, 200, rate)
-    src = sources.ReplaySource(f, speed=50.0, method=method)
+    src = sources.ReplaySource(f, speed=50.0, estimator="integrator", method=method)
     assert src.description == f"replay of 01_constant_rate.mat (BROAD trial, integrator {method}) at 50x"
     hub = Hub(recorder=Recorder())
     src.start(hub)
@@ -214,6 +214,49 @@ def test_replay_of_a_broad_trial_runs_the_estimator(tmp_path: Path, method: str)
     _same_attitude(tq[has], truth[n[has]], 1e-9)
     assert np.isnan(tq[~has]).all()
     hub.recorder.close()
+
+
+def test_replay_of_a_nine_axis_trial_runs_the_filter_by_default(tmp_path: Path) -> None:
+    """--estimator auto (the default): a trial with accelerometer and magnetometer
+    data runs the attitude filter -- the recording equals attitude_c.ahrs over the same
+    samples from the same start -- and the description says so and why; an explicit
+    choice and an integrator method are honoured; a trial whose magnetometer holds no
+    data runs the integrator."""
+    from attitude_c.ahrs_filter import ahrs
+    from attitude_c.view.estimators import AhrsEstimator, IntegratorEstimator
+
+    w = np.array([0.2, -0.1, 0.3])
+    q0 = attitude_c.euler_to_quat([0.3, -0.2, 0.1])
+    f = tmp_path / "02_nine_axis.mat"
+    rate = 100.0
+    _constant_rate_trial(f, w, q0, 120, rate)
+    src = sources.ReplaySource(f, speed=50.0)
+    assert isinstance(src.estimator, AhrsEstimator)
+    assert src.description == ("replay of 02_nine_axis.mat (BROAD trial, ahrs (rv3-reuse); auto: the source has "
+                               "accelerometer and magnetometer data) at 50x")
+    hub = Hub(recorder=Recorder())
+    src.start(hub)
+    _drain(hub, lambda: hub.state()[0] == "ended")
+    rows = _recording(hub)
+    trial = src.rec.trial
+    expect = ahrs(trial.gyr, trial.acc, trial.mag, rate=rate, q0=q0)
+    assert [int(r["n"]) for r in rows] == list(range(120))  # one attitude per sample
+    # the same C filter on the same samples, one by one vs in one batch: rounding of the CSV's 9 digits only
+    _same_attitude(_q(rows), expect, 5e-9)
+    hub.recorder.close()
+    assert isinstance(sources.ReplaySource(f, estimator="integrator").estimator, IntegratorEstimator)
+    by_method = sources.ReplaySource(f, method="rv3-reuse")
+    assert by_method.estimator.label == "integrator rv3-reuse"
+    assert "auto: an integrator method was given" in by_method.description
+    from scipy.io import loadmat, savemat
+
+    d = loadmat(f)
+    d["imu_mag"][:] = np.nan  # a six-axis recording
+    g = tmp_path / "03_six_axis.mat"
+    savemat(g, {k: v for k, v in d.items() if not k.startswith("__")})
+    six = sources.ReplaySource(g)
+    assert six.estimator.label == "integrator rv3"
+    assert "auto: the source has no accelerometer and magnetometer data" in six.description
 
 
 def test_replay_of_a_shipped_broad_trial_matches_the_reference() -> None:
