@@ -92,11 +92,19 @@ def test_line_reader_understands_csv_headers() -> None:
     assert r.feed("t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg").kind == "skip"
     s = r.feed("0.06,2,2100,2048,2000,1,0,0,0,0.5,0.25,-0.125,359.5").sample
     assert s[:6] == (0.06, 2, 1, 0, 0, 0) and s[13] == pytest.approx(0.5 * DEG) and s[16] == pytest.approx(359.5 * DEG)
-    r = sources.LineReader()  # attitude simulate's timeseries.csv (angles in rad)
-    r.feed("t_s,yaw_true,pitch_true,roll_true,yaw_est,pitch_est,roll_est,err_yaw,err_pitch,err_roll,err_heading,"
-           "err_angle,q0_est,q1_est,q2_est,q3_est,q0_true,q1_true,q2_true,q3_true")
-    s = r.feed("0.24,0,0,0,0.1,0.2,0.3,0,0,0,0,0,1,0,0,0,0.5,0.5,0.5,0.5").sample
-    assert s[0] == 0.24 and s[2:6] == (1, 0, 0, 0) and s[9:13] == (0.5, 0.5, 0.5, 0.5) and s[13:16] == (0.1, 0.2, 0.3)
+    from attitude_c.sim.report import TIMESERIES_COLUMNS
+
+    old = ("t_s,yaw_true,pitch_true,roll_true,yaw_est,pitch_est,roll_est,err_yaw,err_pitch,err_roll,err_heading,"
+           "err_angle,q0_est,q1_est,q2_est,q3_est,q0_true,q1_true,q2_true,q3_true")  # before units in the names
+    for head in (",".join(TIMESERIES_COLUMNS), old):  # attitude simulate's timeseries.csv (angles in rad)
+        r = sources.LineReader()
+        r.feed(head)
+        values = {"t_s": 0.24, "yaw_est_rad": 0.1, "pitch_est_rad": 0.2, "roll_est_rad": 0.3, "q0_est": 1,
+                  "q1_est": 0, "q2_est": 0, "q3_est": 0, **{f"q{i}_true": 0.5 for i in range(4)}}
+        values.update({k.removesuffix("_rad"): v for k, v in values.items()})
+        s = r.feed(",".join(str(values.get(c, 0)) for c in head.split(","))).sample
+        assert s[0] == 0.24 and s[2:6] == (1, 0, 0, 0) and s[9:13] == (0.5, 0.5, 0.5, 0.5)
+        assert s[13:16] == (0.1, 0.2, 0.3)
     r = sources.LineReader()
     with pytest.raises(ValueError, match="needs a time column"):
         r.feed("a,b,c")

@@ -121,7 +121,8 @@ _CSV_TIME = ("t", "t_s", "time")
 _CSV_Q = (("q0", "q1", "q2", "q3"), ("q0_est", "q1_est", "q2_est", "q3_est"))
 _CSV_TRUE_Q = (("true_q0", "true_q1", "true_q2", "true_q3"), ("q0_true", "q1_true", "q2_true", "q3_true"))
 _CSV_EULER_DEG = ("yaw_deg", "pitch_deg", "roll_deg")
-_CSV_EULER_RAD = ("yaw_est", "pitch_est", "roll_est")  # attitude simulate's timeseries.csv
+# attitude simulate's timeseries.csv (attitude_c.sim.report.TIMESERIES_COLUMNS; before issue 27, without units)
+_CSV_EULER_RAD = (("yaw_est_rad", "pitch_est_rad", "roll_est_rad"), ("yaw_est", "pitch_est", "roll_est"))
 _CSV_RATE_DPS = ("rate_x_dps", "rate_y_dps", "rate_z_dps")
 
 
@@ -236,7 +237,7 @@ class LineReader:
         r["q"] = next((g for g in _CSV_Q if all(c in cols for c in g)), None)
         r["true_q"] = next((g for g in _CSV_TRUE_Q if all(c in cols for c in g)), None)
         r["euler_deg"] = _CSV_EULER_DEG if all(c in cols for c in _CSV_EULER_DEG) else None
-        r["euler_rad"] = _CSV_EULER_RAD if all(c in cols for c in _CSV_EULER_RAD) else None
+        r["euler_rad"] = next((g for g in _CSV_EULER_RAD if all(c in cols for c in g)), None)
         r["rate"] = _CSV_RATE_DPS if all(c in cols for c in _CSV_RATE_DPS) else None
         r["heading"] = "heading_deg" if "heading_deg" in cols else None
         r["n"] = "n" if "n" in cols else None
