@@ -44,7 +44,7 @@ def register(sub: Any) -> None:
                      "simulate's timeseries.csv, or a BROAD trial (.mat, run through the estimator)")
     src.add_argument("--simulate", nargs=argparse.REMAINDER, metavar="SIMULATE_OPTIONS",
                      help="run the simulator with the truth drawn beside the estimate; every argument after "
-                     "--simulate is an `attitude simulate` option (so put it last), e.g. --simulate "
+                     "--simulate is an option of attitude simulate (so put it last), e.g. --simulate "
                      "--period 0.005 --duration 600")
     g = p.add_argument_group("server")
     g.add_argument("--bind", default="127.0.0.1", metavar="ADDRESS",
