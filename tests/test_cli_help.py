@@ -44,7 +44,7 @@ def _texts(name: str) -> Iterator[tuple[str, str]]:
 def test_docs_cli_lists_every_subcommand() -> None:
     text = (ROOT / "docs" / "cli.md").read_text(encoding="utf-8")
     table = text.split("## The subcommands", 1)[1].split("\n## ", 1)[0]
-    listed = re.findall(r"^\| `([a-z0-9-]+)` \|", table, flags=re.M)
+    listed = re.findall(r"^\| `([a-z0-9-]+)` \|", table, flags=re.MULTILINE)
     assert sorted(listed) == sorted(SUB.choices), "docs/cli.md's table of subcommands is not the parser's"
     assert len(listed) == len(set(listed))
 

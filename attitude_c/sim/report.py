@@ -262,8 +262,8 @@ def format_table(summary: dict[str, Any]) -> str:
          f"precision {p['precision']}, sensors {p['sensors']} ({p['gyro']['name']}), "
          f"period {p['period_s']:g} s, {p['duration_s']:g} s, seed {p['seed']}"),
         "",
-        f"{'error':<16}{'max rad':>11}{'min rad':>11}{'RMS rad':>11}{'max °':>9}{'min °':>9}{'RMS °':>9}"
-        f"{'paper max rad':>15}{'× better':>10}",
+        (f"{'error':<16}{'max rad':>11}{'min rad':>11}{'RMS rad':>11}{'max °':>9}{'min °':>9}{'RMS °':>9}"
+         f"{'paper max rad':>15}{'× better':>10}"),
     ]
     better = summary.get("times_better_than_paper", {})
     for key in ("heading", "pitch", "roll", "attitude_angle"):
