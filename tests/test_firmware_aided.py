@@ -64,6 +64,17 @@ def test_aided_image_fits_the_at89s52(out: Path) -> None:
     assert 115200 in tool.BAUD_RATES_T2 and 57600 in tool.BAUD_RATES_T2
 
 
+def test_crc_table_is_crc32c() -> None:
+    """The aided image's CRC table (toolchain.firmware.crc32c_table, ATT_LINK2_CRC_TABLE)
+    gives CRC-32C's check value on "123456789" (0xE3069283, docs/link.md); the image's own
+    lookup code prints it in every sim run below."""
+    t = tool.crc32c_table()
+    reg = 0xFFFFFFFF
+    for b in b"123456789":
+        reg = (reg >> 8) ^ t[(reg ^ b) & 0xFF]
+    assert reg ^ 0xFFFFFFFF == 0xE3069283
+
+
 def _uart_cycles(output: str) -> int:
     line = next(ln for ln in output.splitlines() if ln.startswith("UART "))
     return int(line.split()[1], 16)

@@ -35,7 +35,7 @@
 #define FW_SIM_SAMPLES 0 /* 0: the sample count does not stop the run */
 #endif
 
-#if defined(FW_BENCH)
+#if defined(FW_BENCH) || FW_AIDED
 /* Machine-cycle timestamp (16 bits, wraps every 65536 cycles = 71 ms):
  * TH0:TL0, read high-low-high so a carry between the reads is seen. */
 static uint16_t cycles_now(void)
@@ -47,6 +47,9 @@ static uint16_t cycles_now(void)
     } while (h != TH0);
     return (uint16_t)(((uint16_t)h << 8) | l);
 }
+#endif
+
+#if defined(FW_BENCH)
 
 /* Bench counters (machine cycles from cycles_now()). They live in SFR cells
  * the C51 core does not implement (uCsim keeps them as memory), so the
@@ -315,16 +318,6 @@ static void sim_finish(void)
  * bit time x 10, 8N1): from one byte's end (the interrupt's tx_free) to the
  * end of the next, written at once; both are 0x00, link v2's frame
  * delimiter, which a receiver skips. */
-static uint16_t sim_cycles(void)
-{
-    uint8_t h, l;
-    do {
-        h = TH0;
-        l = TL0;
-    } while (h != TH0);
-    return (uint16_t)(((uint16_t)h << 8) | l);
-}
-
 static void sim_uart_zero(void)
 {
     tx_free = 0;
@@ -337,9 +330,9 @@ static void sim_uart_time(void)
 {
     uint16_t t;
     sim_uart_zero();
-    t = sim_cycles();
+    t = cycles_now();
     sim_uart_zero();
-    t = (uint16_t)(sim_cycles() - t);
+    t = (uint16_t)(cycles_now() - t);
     fw_sim_puts("UART ");
     fw_sim_puthex(t);
     fw_sim_putc('\n');

@@ -69,26 +69,16 @@ static const int16_t quarter_sine[65] = {
 #else
 #define FW_SIM_NCH 3
 #endif
-static const uint16_t gyro_off[FW_SIM_NCH] = { FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF,
 #if FW_AIDED
-                                               FW_SIM_AUX_OFF
+#define AUX(list) , list /* the six more inputs' parameters after the gyros' */
+#else
+#define AUX(list)
 #endif
-};
-static const uint8_t gyro_sh[FW_SIM_NCH] = { FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH,
-#if FW_AIDED
-                                             FW_SIM_AUX_SH
-#endif
-};
-static const uint8_t gyro_step[FW_SIM_NCH] = { FW_SIM_X_STEP, FW_SIM_Y_STEP, FW_SIM_Z_STEP,
-#if FW_AIDED
-                                               FW_SIM_AUX_STEP
-#endif
-};
-static const uint8_t gyro_phase[FW_SIM_NCH] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH,
-#if FW_AIDED
-                                                FW_SIM_AUX_PH
-#endif
-};
+static const uint16_t gyro_off[FW_SIM_NCH] = { FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF AUX(FW_SIM_AUX_OFF) };
+static const uint8_t gyro_sh[FW_SIM_NCH] = { FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH AUX(FW_SIM_AUX_SH) };
+static const uint8_t gyro_step[FW_SIM_NCH] = { FW_SIM_X_STEP, FW_SIM_Y_STEP,
+                                               FW_SIM_Z_STEP AUX(FW_SIM_AUX_STEP) };
+static const uint8_t gyro_phase[FW_SIM_NCH] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH AUX(FW_SIM_AUX_PH) };
 
 /* Model state beyond tlc_hal_sim.h's cells: SFR cells too, no RAM. */
 __sfr __at(0xBD) m_started; /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
