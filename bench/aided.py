@@ -122,7 +122,9 @@ def run(quick: bool) -> str:
                   "figure is that of a stalled link waiting for acknowledgements, not a feasible load.",
               "", f"A group's scan (3, 6 or 9 conversions + power-down): {min(scan):.0f}..{max(scan):.0f} machine "
                   "cycles on average per plan.", "",
-              "Accuracy on BROAD (att_ahrs defaults; total error, RMS per trial, deg; "
+              "Accuracy on BROAD (Laidig, Caruso, Cereatti, Seel, Data 6(7), 2021; the trials in "
+              "../shared/data/broad taken at the board's instants, att_ahrs defaults, the accelerometer and "
+              "magnetometer in every k-th sample only; total error, RMS per trial, deg; "
               f"{next(iter(acc.values()))['n']} trials):", "",
               "| gyro rate | acc every | mag every | mean | worst |", "|---:|---:|---:|---:|---:|"]
     for (step, (ka, km)), a in acc.items():
