@@ -28,6 +28,8 @@ from test_view_sources import CODES, K, send_boot_and_samples
 
 import attitude_c
 
+pytestmark = pytest.mark.system  # starts attitude view servers
+
 
 def _aiohttp() -> None:
     try:
