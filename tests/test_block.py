@@ -263,6 +263,7 @@ SDCC = ["sdcc", "-mmcs51", "--model-small", "--iram-size", "128", "--xram-size",
         "-DATT_REAL_F32", f"-I{ROOT / 'csrc' / 'include'}"]
 
 
+@pytest.mark.system
 def test_block_sources_compile_for_the_8051_and_the_encoders_stay_small(tmp_path: Path) -> None:
     """block.c (what the firmware links), block_channels.c (what the aided firmware adds), block_decode.c
     and block_sums.c compile warning-free with SDCC; the encoders are leaf functions whose parameters

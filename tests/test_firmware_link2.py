@@ -28,6 +28,8 @@ from conftest import require_target, require_tools
 
 from toolchain import firmware as tool
 
+pytestmark = pytest.mark.system  # runs the link v2 firmware in s51
+
 #: Stack the v2 sim image uses at most in s51 (SP starts at 0x65; max SP 0x76 measured
 #: with both hosts below) plus the margin tests/test_firmware.py requires (4 bytes).
 V2_STACK = 0x76 - 0x65

@@ -14,6 +14,8 @@ import pytest
 
 from attitude_c.cli import main
 
+pytestmark = pytest.mark.system  # runs attitude simulate end to end
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -23,6 +25,7 @@ def _env() -> dict[str, str]:
     return env
 
 
+@pytest.mark.system
 def test_help_lists_the_options() -> None:
     r = subprocess.run([sys.executable, "-m", "attitude_c", "simulate", "--help"],
                        capture_output=True, text=True, env=_env(), cwd=ROOT, timeout=60,

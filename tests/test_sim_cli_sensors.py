@@ -15,6 +15,8 @@ import pytest
 from attitude_c.cli import main
 from attitude_c.cli.simulate import build_config, register
 
+pytestmark = pytest.mark.system  # runs attitude simulate end to end
+
 
 def _args(*argv: str) -> argparse.Namespace:
     p = argparse.ArgumentParser()

@@ -410,6 +410,7 @@ def test_serial_reference_records_the_failing_run(reference):
     assert row["mean"] == pytest.approx(rv3.mean(), rel=1e-12) and row["min"] <= row["p50"] <= row["max"]
 
 
+@pytest.mark.system
 def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
     spec, ref = reference
     df = sweeps.sweep(spec, None, workers=2, out=tmp_path / "out")
@@ -424,6 +425,7 @@ def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
           ref.fillna({"error": ""}))
 
 
+@pytest.mark.system
 def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path, capsys):
     spec, ref = reference
     rc = main(["sweep", str(spec), "--scheduler", scheduler, "--out", str(tmp_path / "out"), "--no-plots"])
@@ -435,6 +437,7 @@ def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path,
     _same(df.fillna({"error": ""}), ref.fillna({"error": ""}))
 
 
+@pytest.mark.system
 def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tmp_path):
     from distributed import Client
 
@@ -465,6 +468,7 @@ def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tm
 # resume
 # ---------------------------------------------------------------------------
 
+@pytest.mark.system
 def test_interrupted_sweep_resumes_running_only_the_missing_runs(reference, scheduler, tmp_path):
     """The command is killed (SIGKILL: no clean-up at all) mid-sweep on the loopback
     cluster, then run again serially: only the runs it has no record of run."""

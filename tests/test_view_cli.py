@@ -28,6 +28,8 @@ from test_view_sources import CODES, K, _constant_rate_trial, send_boot_and_samp
 
 import attitude_c
 
+pytestmark = pytest.mark.system  # starts attitude view servers
+
 
 def _aiohttp() -> None:
     try:
