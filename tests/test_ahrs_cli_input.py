@@ -56,6 +56,7 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
+@pytest.mark.system
 def test_a_mat_file_without_scipy_is_one_line_naming_the_extra(tmp_path):
     trial = tmp_path / "01_trial.mat"
     trial.write_bytes(b"MATLAB 5.0 MAT-file")  # SciPy is asked for before the file is read
@@ -289,6 +290,7 @@ def test_the_header_lacks_columns_names_them(tmp_path, capsys):
     assert "the header lacks column(s) gx, gy, gz" in _one_error_line(capsys)
 
 
+@pytest.mark.system
 def test_the_example_is_what_its_script_writes(tmp_path):
     r = subprocess.run([sys.executable, str(ROOT / "examples" / "make_imu_csv.py"), str(tmp_path / "imu.csv")],
                        capture_output=True, text=True, cwd=tmp_path, timeout=300)

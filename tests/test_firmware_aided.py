@@ -31,6 +31,8 @@ from conftest import require_target, require_tools
 from attitude_c.link import block
 from toolchain import firmware as tool
 
+pytestmark = pytest.mark.system  # builds the aided firmware and runs it in s51
+
 #: the margin of stack s51 never saw used that tests/test_firmware.py requires too
 STACK_MARGIN = 4
 #: the test's plan: 50 samples/s, accelerometer every 2nd, magnetometer every 4th sample
