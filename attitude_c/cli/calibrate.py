@@ -1,0 +1,244 @@
+"""attitude calibrate: calibrate the aided board's accelerometer and magnetometer
+from recorded codes and write the attitude-rx config file (docs/sensor.md).
+
+Input: CSV files with a header naming their columns (other columns are ignored;
+lines starting with # are skipped; an empty cell is a sensor absent from that row):
+  acc_x, acc_y, acc_z   accelerometer words of each sample
+  pose                  the static position of the row: 0, 1, 2, ...; empty or
+                        negative while the board is moved between positions
+  mag_x, mag_y, mag_z   magnetometer words of each sample
+One file may hold both sensors (give it to --acc and --mag). Words are sums of
+--oversample conversions (the stream's OVERSAMPLE; 1: plain 12-bit codes).
+
+Accelerometer: hold the board still in each position. Six positions (each axis
+up, then down) fit per-axis zero and scale (model diagonal); twelve or more
+positions (the six, then tilts between them) also fit the non-orthogonality of
+the axes (model full). Magnetometer: turn the board slowly through as many
+directions as you can (all three axes), away from iron, for a minute.
+
+Output (--out FILE): the attitude-rx config file with the keys acc-zero,
+acc-scale, acc-axes, acc-matrix, acc-bias and mag-zero, mag-scale, mag-axes,
+mag-matrix, mag-bias; the file's other lines are kept, the keys replaced. It is
+written to a temporary name, then renamed. A report goes to standard output.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import sensorcal
+from .._io import write_text
+from ..errors import InvalidArgument
+from ..sim.frontend import ACCEL_FRONTENDS, MAG_FRONTENDS
+from .options import integer, positive, triple
+
+PROG = "attitude calibrate"
+#: Beyond the shared 0 / 1 / 2 (docs/cli.md):
+EXIT_REFUSED = 3  # the recording cannot calibrate: too few positions, too little rotation, no convergence
+ACC_PART, MAG_PART = ACCEL_FRONTENDS["adxl335"], MAG_FRONTENDS["hmc1043-ad623"]
+ACC_COLS, MAG_COLS = ("acc_x", "acc_y", "acc_z"), ("mag_x", "mag_y", "mag_z")
+WARN_ACC_RMS = 0.02  # of g: an RMS residual above it means a position was not still, or the part is not linear
+MAG_ZERO = 2047.5  # the set/reset code of zero field, (c_set + 4095 − c_reset) / 2 (attitude_c.sim.frontend)
+
+
+class _Usage(Exception):
+    """A mistake in the input file or the options (exit status 2)."""
+
+
+class _Refused(Exception):
+    """The recording does not determine the calibration (exit status 3)."""
+
+
+def register(sub: Any) -> None:
+    p = sub.add_parser(
+        "calibrate", help="calibrate the accelerometer and magnetometer from recorded codes; write the "
+        "attitude-rx config", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog="exit statuses: 0 written; 1 an input cannot be read or the config cannot be written; 2 bad "
+        "option or file content; 3 the recording cannot calibrate (too few positions, too little rotation, "
+        "no convergence). See docs/sensor.md.")
+    p.add_argument("--acc", metavar="CSV", type=Path, help="static positions: acc_x, acc_y, acc_z, pose")
+    p.add_argument("--mag", metavar="CSV", type=Path, help="a rotation: mag_x, mag_y, mag_z")
+    p.add_argument("--out", metavar="FILE", type=Path, required=True,
+                   help="the attitude-rx config file to write (updated if it exists)")
+    p.add_argument("--oversample", type=integer("--oversample", 1, 16), default=1, metavar="N",
+                   help="conversions summed into each word (default 1)")
+    p.add_argument("--acc-zero", type=triple("--acc-zero"), default=(2048.0,) * 3, metavar="C[,C,C]",
+                   help="nominal code at 0 g (default 2048: Vs/2 on REF+ = Vs)")
+    p.add_argument("--acc-scale", type=triple("--acc-scale"), default=(ACC_PART.units_per_code,) * 3,
+                   metavar="K[,K,K]", help=f"nominal m/s^2 per code (default {ACC_PART.units_per_code:.6g}: "
+                   f"{ACC_PART.name} on the TLC2543)")
+    p.add_argument("--acc-axes", default="x,y,z", metavar="AXES", help="body axes from channels, as attitude-rx's axes")
+    p.add_argument("--acc-model", choices=sensorcal.ACCEL_MODELS, default="auto",
+                   help="diagonal (6+ positions), full (12+), auto: full from 12 positions (default)")
+    p.add_argument("--gravity", type=positive("--gravity"), default=9.80665, metavar="G",
+                   help="local gravity, m/s^2 (default 9.80665)")
+    p.add_argument("--mag-zero", type=triple("--mag-zero"), default=(MAG_ZERO,) * 3, metavar="C[,C,C]",
+                   help=f"nominal code at zero field (default {MAG_ZERO})")
+    p.add_argument("--mag-scale", type=triple("--mag-scale"), default=(MAG_PART.units_per_code,) * 3,
+                   metavar="K[,K,K]", help=f"nominal uT per code (default {MAG_PART.units_per_code:.6g}: "
+                   f"{MAG_PART.name} on the TLC2543)")
+    p.add_argument("--mag-axes", default="x,y,z", metavar="AXES", help="body axes from channels, as attitude-rx's axes")
+    p.add_argument("--mag-model", choices=("full", "diagonal", "offset"), default="full",
+                   help="soft iron: full (default), diagonal, offset (hard iron only)")
+    p.add_argument("--mag-field", type=positive("--mag-field"), default=None, metavar="UT",
+                   help="local field strength in uT (a geomagnetic model's F): scale the correction to it")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(func=main)
+
+
+def _cell(text: str, what: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise _Usage(f"{what}: {text!r} is not a number") from None
+    if not math.isfinite(v):
+        raise _Usage(f"{what}: {text!r} is not a finite number")
+    return v
+
+
+def _read_columns(path: Path, cols: tuple[str, ...]) -> tuple[np.ndarray, list[int]]:
+    """The rows of ``path`` that have every one of ``cols`` (N, len(cols)), and their line numbers."""
+    with open(path, encoding="utf-8", newline="") as fh:
+        lines = [(i, ln) for i, ln in enumerate(fh, 1) if ln.strip() and not ln.lstrip().startswith("#")]
+    reader = csv.reader(ln for _, ln in lines)
+    header = [h.strip() for h in next(reader, [])]
+    missing = [c for c in cols if c not in header]
+    if missing:
+        raise _Usage(f"{path}: no column {', '.join(missing)} in the header {','.join(header) or '(empty)'}")
+    idx = [header.index(c) for c in cols]
+    rows, where = [], []
+    for (lineno, _), row in zip(lines[1:], reader):
+        cells = [row[i].strip() if i < len(row) else "" for i in idx]
+        if all(cells):
+            rows.append([_cell(c, f"{path}:{lineno}") for c in cells])
+            where.append(lineno)
+    return np.array(rows, dtype=float).reshape(-1, len(cols)), where
+
+
+def _words(path: Path, cols: tuple[str, ...], n: int) -> tuple[np.ndarray, list[int]]:
+    data, where = _read_columns(path, cols)
+    w = data[:, :3]
+    bad = ~((w == np.round(w)) & (w >= 0) & (w <= n * 4095)).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise _Usage(f"{path}:{where[i]}: {w[i].tolist()} are not words of {n} 12-bit code(s) (0..{n * 4095})")
+    return data, where
+
+
+def _nominal(prefix: str, zero: Any, scale: Any, axes: str) -> sensorcal.SensorConfig:
+    try:
+        return sensorcal.SensorConfig(prefix, zero, scale, axes)  # type: ignore[arg-type]
+    except InvalidArgument as exc:
+        raise _Usage(f"--{prefix}-zero/--{prefix}-scale/--{prefix}-axes: {exc}") from None
+
+
+def _accel(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, Any]]:
+    nominal = _nominal("acc", args.acc_zero, args.acc_scale, args.acc_axes)
+    data, _ = _words(args.acc, (*ACC_COLS, "pose"), args.oversample)
+    if data.size and (data[:, 3] != np.round(data[:, 3])).any():
+        raise _Usage(f"{args.acc}: pose must be an integer label (negative or empty: not a position)")
+    pose = data[:, 3].astype(int)
+    means, counts, _, labels = sensorcal.pose_means(nominal.convert(data[:, :3].astype(int), args.oversample,
+                                                                    corrected=False), pose)
+    stds = sensorcal.pose_means(data[:, :3] / args.oversample, pose)[2]
+    try:
+        fit = sensorcal.fit_accel(means, nominal, args.gravity, args.acc_model)
+    except InvalidArgument as exc:
+        raise _Refused(f"accelerometer: {exc}") from None
+    poses = [{"pose": int(k), "rows": int(c), "norm_error_mg": float(r / args.gravity * 1e3),
+              "code_std": s.round(3).tolist()} for k, c, r, s in zip(labels, counts, fit.residuals, stds)]
+    return fit.config, {"model": fit.model, "positions": len(labels), "rms_mg": fit.rms / args.gravity * 1e3,
+                        "condition": fit.condition, "poses": poses}
+
+
+def _mag(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, Any]]:
+    nominal = _nominal("mag", args.mag_zero, args.mag_scale, args.mag_axes)
+    data, _ = _words(args.mag, MAG_COLS, args.oversample)
+    try:
+        fit = sensorcal.fit_mag(data.astype(int), nominal, args.oversample, args.mag_field, args.mag_model)
+    except InvalidArgument as exc:
+        raise _Refused(f"magnetometer: {exc}") from None
+    return fit.config, {"model": args.mag_model, "samples": int(fit.cal.n), "span": fit.cal.span,
+                        "field_ut": fit.field, "fit_field_ut": fit.cal.field, "rms_ut": fit.rms,
+                        "max_ut": float(np.abs(fit.norm_error).max()), "hard_iron_ut": fit.cal.h.tolist()}
+
+
+def merged_config(old: str, configs: list[sensorcal.SensorConfig]) -> str:
+    """The config text ``old`` with the configs' keys replaced (at the first
+    occurrence of each sensor's keys, else appended) and every other line kept."""
+    ours = {k for c in configs for k in c.keys()}
+    out: list[str] = []
+    placed: set[str] = set()
+    for line in old.splitlines():
+        key = line.split("#", 1)[0].split("=", 1)[0].strip()
+        if key not in ours:
+            out.append(line)
+            continue
+        for c in configs:
+            if key in c.keys() and c.prefix not in placed:
+                out.extend(c.lines())
+                placed.add(c.prefix)
+    for c in configs:
+        if c.prefix not in placed:
+            out.extend(["# attitude calibrate", *c.lines()])
+    return "\n".join(out) + "\n"
+
+
+def _print_report(report: dict[str, Any], out: Path) -> None:
+    acc, mag = report.get("acc"), report.get("mag")
+    if acc:
+        print(f"accelerometer: {acc['positions']} positions, model {acc['model']}, |a| - g RMS "
+              f"{acc['rms_mg']:.2f} mg (condition {acc['condition']:.3g})")
+        for p in acc["poses"]:
+            print(f"  pose {p['pose']:3d}: {p['rows']:6d} rows, |a| - g {p['norm_error_mg']:+8.2f} mg, code std "
+                  + " ".join(f"{s:.2f}" for s in p["code_std"]))
+    if mag:
+        print(f"magnetometer: {mag['samples']} samples, model {mag['model']}, span {mag['span']:.3f}, field "
+              f"{mag['field_ut']:.2f} uT, |m| - field RMS {mag['rms_ut']:.3f} uT (max {mag['max_ut']:.3f}), "
+              "hard iron " + ",".join(f"{h:.2f}" for h in mag["hard_iron_ut"]) + " uT")
+    print(f"written: {out}")
+
+
+def _run(args: argparse.Namespace) -> dict[str, Any]:
+    if args.acc is None and args.mag is None:
+        raise _Usage("give --acc CSV, --mag CSV or both")
+    configs, report = [], {}
+    for name, step, given in (("acc", _accel, args.acc), ("mag", _mag, args.mag)):
+        if given is not None:
+            config, report[name] = step(args)
+            configs.append(config)
+    old = args.out.read_text(encoding="utf-8") if args.out.exists() else ""
+    write_text(args.out, merged_config(old, configs))
+    return report
+
+
+def main(args: argparse.Namespace) -> int:
+    from . import EXIT_OK, EXIT_OS, EXIT_USAGE, fail, os_error_line  # the package's, once it is loaded
+
+    try:
+        report = _run(args)
+    except _Usage as exc:
+        return fail(PROG, str(exc), EXIT_USAGE)
+    except _Refused as exc:
+        return fail(PROG, str(exc), EXIT_REFUSED)
+    except UnicodeDecodeError as exc:
+        return fail(PROG, f"an input is not a text file: {exc.reason}", EXIT_USAGE)
+    except OSError as exc:
+        return fail(PROG, os_error_line(exc), EXIT_OS)
+    acc = report.get("acc")
+    if acc and acc["rms_mg"] > WARN_ACC_RMS * 1e3:
+        print(f"{PROG}: warning: the positions disagree by {acc['rms_mg']:.0f} mg RMS: was every position "
+              "still?", file=sys.stderr)
+    if args.json:
+        print(json.dumps(report, indent=1))
+    else:
+        _print_report(report, args.out)
+    return EXIT_OK
