@@ -287,21 +287,21 @@ def fit_accel(means: ArrayLike, nominal: SensorConfig, gravity: float = 9.80665,
         raise InvalidArgument(f"gravity must be a finite number > 0 (m/s^2), got {gravity!r}")
     base = SensorConfig(nominal.prefix, nominal.zero, nominal.scale, nominal.axes)
     v = _vec(means, "means", (len(np.asarray(means)), 3))
-    model = _pick_model(model, len(v))
+    kind = _pick_model(model, len(v))
     b0 = v.mean(axis=0)  # positions spread over the sphere average to about the offset
     s0 = gravity / np.linalg.norm(v - b0, axis=1).mean()
-    p0 = np.concatenate([b0, [s0] * 3 if model == "diagonal" else [s0, 0, 0, s0, 0, s0]])
-    p, jac = _levenberg_marquardt(p0, v, gravity, model)
+    p0 = np.concatenate([b0, [s0] * 3 if kind == "diagonal" else [s0, 0, 0, s0, 0, s0]])
+    p, jac = _levenberg_marquardt(p0, v, gravity, kind)
     sv = np.linalg.svd(jac, compute_uv=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     if not cond < 1e6:
-        raise InvalidArgument(f"the {len(v)} positions do not determine the {model} model (condition {cond:.3g}): "
+        raise InvalidArgument(f"the {len(v)} positions do not determine the {kind} model (condition {cond:.3g}): "
                               "hold each axis pointing up and pointing down, and more tilts between")
-    c, b = _unpack(p, model)
+    c, b = _unpack(p, kind)
     if not (np.isfinite(p).all() and np.linalg.det(c) > 0):
         raise InvalidArgument("the accelerometer fit did not converge: check that every position was still")
-    r, _ = _residuals(p, v, gravity, model)
-    return AccelFit(_factor(base, c, b), model, r, float(gravity), c, b, cond)
+    r, _ = _residuals(p, v, gravity, kind)
+    return AccelFit(_factor(base, c, b), kind, r, float(gravity), c, b, cond)
 
 
 # --------------------------------------------------------------------------- magnetometer
