@@ -22,7 +22,7 @@ AIDED-SPEC section 3): per body axis i reading channel c = ``axes[i]``::
   one that rotates nothing (as the magnetometer's soft iron). The result is
   factored into per-channel zero (codes at 0 g) and scale and a unit-diagonal
   matrix M (cross-axis), bias 0.
-* **Magnetometer, a rotation** (:func:`fit_mag`): the samples of a slow
+* **Magnetometer, a rotation** (:func:`fit_mag`): the values of a slow
   rotation through many directions go to the library's ellipsoid fit
   (:func:`attitude_c.magcal.fit`: hard iron h, soft iron S, det S = 1); M =
   S · F/B when the local field strength F is given (the corrected field then
@@ -323,20 +323,20 @@ class MagFit:
         return float(np.sqrt(np.mean(self.norm_error**2)))
 
 
-def fit_mag(words: ArrayLike, nominal: SensorConfig, n: int = 1, field_ut: float | None = None,
+def fit_mag(values: ArrayLike, nominal: SensorConfig, field_ut: float | None = None,
             model: magcal.Model = "full", min_span: float = 0.1) -> MagFit:
-    """Fit hard and soft iron to the words (N, 3) of a rotation through many
-    directions, converted with the ``nominal`` zero, scale and axes. ``field_ut``:
-    the local field strength (e.g. from a geomagnetic model), to scale M so that
-    the corrected field has that norm. Refusals of the ellipsoid fit (too few
+    """Fit hard and soft iron to the values (N, 3) of a rotation through many
+    directions, converted with the ``nominal`` zero, scale and axes and no
+    correction (``nominal.convert(words, n, corrected=False)``). ``field_ut``: the
+    local field strength (e.g. from a geomagnetic model), to scale M so that the
+    corrected field has that norm. Refusals of the ellipsoid fit (too few
     samples, too little spread: rotate about more axes) raise InvalidArgument."""
     if field_ut is not None and not (isinstance(field_ut, (int, float)) and math.isfinite(field_ut)
                                      and field_ut > 0):
         raise InvalidArgument(f"field_ut must be a finite number > 0 (uT) or None, got {field_ut!r}")
-    base = SensorConfig(nominal.prefix, nominal.zero, nominal.scale, nominal.axes)
-    v = base.convert(words, n, corrected=False)
+    v = _vec(values, "values", (len(np.asarray(values)), 3))
     cal = magcal.fit(v, model, min_span=min_span)
     k = 1.0 if field_ut is None else field_ut / cal.field
-    config = SensorConfig(base.prefix, base.zero, base.scale, base.axes, cal.S * k, cal.h)
+    config = SensorConfig(nominal.prefix, nominal.zero, nominal.scale, nominal.axes, cal.S * k, cal.h)
     strength = cal.field * k
-    return MagFit(config, cal, strength, np.linalg.norm(config.convert(words, n), axis=1) - strength)
+    return MagFit(config, cal, strength, np.linalg.norm((v - cal.h) @ config.matrix.T, axis=1) - strength)

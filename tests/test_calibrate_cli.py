@@ -62,7 +62,8 @@ def test_writes_the_keys_of_both_fits(tmp_path: Path, capsys) -> None:
     keys = _keys(out.read_text())
     nominal_a = SensorConfig("acc", 2048, ACC.units_per_code)
     want_a = fit_accel(pose_means(nominal_a.convert(acc, corrected=False), pose)[0], nominal_a).config
-    want_m = fit_mag(mag, SensorConfig("mag", 2047.5, MAG.units_per_code), field_ut=50.0).config
+    nominal_m = SensorConfig("mag", 2047.5, MAG.units_per_code)
+    want_m = fit_mag(nominal_m.convert(mag, corrected=False), nominal_m, field_ut=50.0).config
     for cfg in (want_a, want_m):
         for line in cfg.lines():
             k, v = (x.strip() for x in line.split("=", 1))
@@ -142,7 +143,7 @@ def test_refusals_exit_3_and_leave_the_config(tmp_path: Path, capsys) -> None:
 
 def test_usage_and_os_errors(tmp_path: Path, capsys) -> None:
     out = tmp_path / "rx.conf"
-    _one_line(capsys, main(["calibrate", "--out", str(out)]), EXIT_USAGE, "--acc CSV, --mag CSV")
+    _one_line(capsys, main(["calibrate", "--out", str(out)]), EXIT_USAGE, "--acc FILE..., --mag FILE...")
     _one_line(capsys, main(["calibrate", "--acc", str(tmp_path / "none.csv"), "--out", str(out)]), EXIT_OS,
               "none.csv", "No such file")
     rec = tmp_path / "rec.csv"
@@ -155,3 +156,40 @@ def test_usage_and_os_errors(tmp_path: Path, capsys) -> None:
         main(["calibrate", "--acc", str(rec), "--out", str(out), "--gravity", "-1"])
     assert ei.value.code == EXIT_USAGE
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["rec.csv"]  # no temporary left
+
+
+def _print_decoded(acc: np.ndarray, mag: np.ndarray, n: int) -> None:
+    """``attitude link-rx --decode`` output of an aided board's stream carrying these
+    accelerometer and magnetometer words (sums of n codes; the gyros at mid-scale):
+    the printer of link-rx itself, fed the records."""
+    from attitude_c.cli.link import _block_printer
+    from attitude_c.link import block
+
+    show = _block_printer()
+    recs = [block.encode_boot(72, 9600), block.encode_oversample(n),
+            block.encode_channels("aided9", ["gyr", "acc", "mag"], 1, 1)]
+    for a, m in zip(acc, mag):
+        recs += [block.encode_sums([2048 * n] * 3, n), block.encode_sums(a, n), block.encode_sums(m, n)]
+    show(b"".join(recs))
+
+
+def test_link_rx_decode_recordings_one_file_per_position(tmp_path: Path, capsys) -> None:
+    """Six positions recorded as six files with link-rx --decode, oversampled by 4: the
+    same calibration as the codes' CSV with pose labels."""
+    rec = tmp_path / "rec.csv"
+    acc, pose, mag = _recording(rec, positions=6, rows=20, seed=3)
+    files = []
+    for k in range(6):
+        sel = pose == k
+        _print_decoded(acc[sel] * 4, mag[sel] * 4, 4)  # 4 identical conversions: the same codes, ×4
+        path = tmp_path / f"pos{k}.jsonl"
+        path.write_text(capsys.readouterr().out)
+        files.append(str(path))
+    assert '"part": "acc"' in Path(files[0]).read_text()
+    out_csv, out_jsonl = tmp_path / "a.conf", tmp_path / "b.conf"
+    assert main(["calibrate", "--acc", str(rec), "--mag", str(rec), "--out", str(out_csv)]) == EXIT_OK
+    assert main(["calibrate", "--acc", *files, "--mag", *files, "--out", str(out_jsonl)]) == EXIT_OK
+    assert out_jsonl.read_text() == out_csv.read_text()
+    (tmp_path / "bad.jsonl").write_text('{"report": "OVERSAMPLE", "n": 99}\n')
+    _one_line(capsys, main(["calibrate", "--mag", str(tmp_path / "bad.jsonl"), "--out", str(out_csv)]), EXIT_USAGE,
+              "bad.jsonl:1", "OVERSAMPLE")

@@ -147,7 +147,7 @@ def test_magnetometer_hard_and_soft_iron_round_trip() -> None:
     soft = np.array([[1.06, 0.04, -0.02], [0.04, 0.95, 0.03], [-0.02, 0.03, 1.01]])  # symmetric
     hard = np.array([14.0, -9.0, 6.0])
     words = _mag_words(errors, m @ soft.T + hard, rng)
-    fit = fit_mag(words, _nominal("mag"), field_ut=field)
+    fit = fit_mag(_nominal("mag").convert(words, corrected=False), _nominal("mag"), field_ut=field)
     k = (1 + errors.bridge.scale)[:, None] * soft  # v = K m + o
     o = (1 + errors.bridge.scale) * hard - 0.25 * MAG.units_per_code  # the flip code's floor: −0.25 code
     # per sample ≈ 0.4 code (0.05 µT) of quantization with little noise (0.13 code) to dither it: the
@@ -165,13 +165,14 @@ def test_magnetometer_without_field_keeps_det_one_and_refuses_a_level_turn() -> 
     rng = np.random.default_rng(15)
     m = _directions(rng, 500) * 48.0
     words = _mag_words(AmrErrors(SensorErrors.none(), np.zeros(3)), m, rng)
-    fit = fit_mag(words, _nominal("mag"))
+    fit = fit_mag(_nominal("mag").convert(words, corrected=False), _nominal("mag"))
     assert np.linalg.det(fit.config.matrix) == pytest.approx(1.0, abs=1e-9)
     assert fit.field == pytest.approx(48.0, rel=0.01)  # nominal scale exact for a perfect part: LSB/48 µT
     level = m.copy()
     level[:, 2] = -30.0
     with pytest.raises(InvalidArgument):
-        fit_mag(_mag_words(AmrErrors(SensorErrors.none(), np.zeros(3)), level, rng), _nominal("mag"))
+        words = _mag_words(AmrErrors(SensorErrors.none(), np.zeros(3)), level, rng)
+        fit_mag(_nominal("mag").convert(words, corrected=False), _nominal("mag"))
 
 
 def test_sensor_config_lines_and_checks() -> None:

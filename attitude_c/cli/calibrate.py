@@ -1,14 +1,18 @@
 """attitude calibrate: calibrate the aided board's accelerometer and magnetometer
 from recorded codes and write the attitude-rx config file (docs/sensor.md).
 
-Input: CSV files with a header naming their columns (other columns are ignored;
-lines starting with # are skipped; an empty cell is a sensor absent from that row):
-  acc_x, acc_y, acc_z   accelerometer words of each sample
-  pose                  the static position of the row: 0, 1, 2, ...; empty or
-                        negative while the board is moved between positions
-  mag_x, mag_y, mag_z   magnetometer words of each sample
-One file may hold both sensors (give it to --acc and --mag). Words are sums of
---oversample conversions (the stream's OVERSAMPLE; 1: plain 12-bit codes).
+Input, per sensor one file or several:
+* JSON Lines recorded by "attitude link-rx --port DEV --decode > FILE.jsonl" from an
+  aided board: its accelerometer ("part": "acc") or magnetometer ("part": "mag")
+  records; the stream's OVERSAMPLE report gives the conversions per word.
+* CSV with a header naming its columns (others are ignored; lines starting with #
+  are skipped; an empty cell is a sensor absent from that row):
+    acc_x, acc_y, acc_z   accelerometer words
+    mag_x, mag_y, mag_z   magnetometer words
+    pose                  optional: the static position of the row, 0, 1, 2, ...;
+                          empty or negative while the board is moved
+  Words are sums of --oversample conversions (1: plain 12-bit codes).
+A file without pose labels (every JSON Lines file) is one static position.
 
 Accelerometer: hold the board still in each position. Six positions (each axis
 up, then down) fit per-axis zero and scale (model diagonal); twelve or more
@@ -29,6 +33,7 @@ import csv
 import json
 import math
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +49,6 @@ PROG = "attitude calibrate"
 #: Beyond the shared 0 / 1 / 2 (docs/cli.md):
 EXIT_REFUSED = 3  # the recording cannot calibrate: too few positions, too little rotation, no convergence
 ACC_PART, MAG_PART = ACCEL_FRONTENDS["adxl335"], MAG_FRONTENDS["hmc1043-ad623"]
-ACC_COLS, MAG_COLS = ("acc_x", "acc_y", "acc_z"), ("mag_x", "mag_y", "mag_z")
 WARN_ACC_RMS = 0.02  # of g: an RMS residual above it means a position was not still, or the part is not linear
 MAG_ZERO = 2047.5  # the set/reset code of zero field, (c_set + 4095 − c_reset) / 2 (attitude_c.sim.frontend)
 
@@ -64,8 +68,9 @@ def register(sub: Any) -> None:
         epilog="exit statuses: 0 written; 1 an input cannot be read or the config cannot be written; 2 bad "
         "option or file content; 3 the recording cannot calibrate (too few positions, too little rotation, "
         "no convergence). See docs/sensor.md.")
-    p.add_argument("--acc", metavar="CSV", type=Path, help="static positions: acc_x, acc_y, acc_z, pose")
-    p.add_argument("--mag", metavar="CSV", type=Path, help="a rotation: mag_x, mag_y, mag_z")
+    p.add_argument("--acc", metavar="FILE", type=Path, nargs="+",
+                   help="static positions: a CSV with a pose column, or one file per position")
+    p.add_argument("--mag", metavar="FILE", type=Path, nargs="+", help="a rotation (one file or several)")
     p.add_argument("--out", metavar="FILE", type=Path, required=True,
                    help="the attitude-rx config file to write (updated if it exists)")
     p.add_argument("--oversample", type=integer("--oversample", 1, 16), default=1, metavar="N",
@@ -94,6 +99,16 @@ def register(sub: Any) -> None:
     p.set_defaults(func=main)
 
 
+@dataclass
+class _Rows:
+    """One sensor's records from the input files: ``words`` (N, 3), ``n`` (N,)
+    conversions per word, ``pose`` (N,) position labels (−1: none)."""
+
+    words: np.ndarray
+    n: np.ndarray
+    pose: np.ndarray
+
+
 def _cell(text: str, what: str) -> float:
     try:
         v = float(text)
@@ -104,33 +119,97 @@ def _cell(text: str, what: str) -> float:
     return v
 
 
-def _read_columns(path: Path, cols: tuple[str, ...]) -> tuple[np.ndarray, list[int]]:
-    """The rows of ``path`` that have every one of ``cols`` (N, len(cols)), and their line numbers."""
+def _check_words(path: Path, rows: _Rows, where: list[int]) -> _Rows:
+    w = rows.words
+    bad = ~((w == np.round(w)) & (w >= 0) & (w <= rows.n[:, None] * 4095)).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise _Usage(f"{path}:{where[i]}: {w[i].tolist()} are not words of {rows.n[i]} 12-bit code(s) "
+                     f"(0..{rows.n[i] * 4095})")
+    return _Rows(w.astype(np.int64), rows.n, rows.pose)
+
+
+def _read_csv(path: Path, prefix: str, oversample: int) -> _Rows:
+    """The rows of a CSV that have all three of the sensor's columns; its pose column if any."""
     with open(path, encoding="utf-8", newline="") as fh:
         lines = [(i, ln) for i, ln in enumerate(fh, 1) if ln.strip() and not ln.lstrip().startswith("#")]
     reader = csv.reader(ln for _, ln in lines)
     header = [h.strip() for h in next(reader, [])]
+    cols = [f"{prefix}_{a}" for a in "xyz"]
     missing = [c for c in cols if c not in header]
     if missing:
         raise _Usage(f"{path}: no column {', '.join(missing)} in the header {','.join(header) or '(empty)'}")
     idx = [header.index(c) for c in cols]
-    rows, where = [], []
+    ip = header.index("pose") if "pose" in header else None
+    words, pose, where = [], [], []
     for (lineno, _), row in zip(lines[1:], reader):
         cells = [row[i].strip() if i < len(row) else "" for i in idx]
         if all(cells):
-            rows.append([_cell(c, f"{path}:{lineno}") for c in cells])
+            words.append([_cell(c, f"{path}:{lineno}") for c in cells])
+            label = row[ip].strip() if ip is not None and ip < len(row) else ""
+            pose.append(_cell(label, f"{path}:{lineno}: pose") if label else -1)
             where.append(lineno)
-    return np.array(rows, dtype=float).reshape(-1, len(cols)), where
+    p = np.array(pose, dtype=float)
+    if (p != np.round(p)).any():
+        raise _Usage(f"{path}: pose must be an integer label (negative or empty: not a position)")
+    w = np.array(words, dtype=float).reshape(-1, 3)
+    return _check_words(path, _Rows(w, np.full(len(w), oversample), p.astype(np.int64)), where)
 
 
-def _words(path: Path, cols: tuple[str, ...], n: int) -> tuple[np.ndarray, list[int]]:
-    data, where = _read_columns(path, cols)
-    w = data[:, :3]
-    bad = ~((w == np.round(w)) & (w >= 0) & (w <= n * 4095)).all(axis=1)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise _Usage(f"{path}:{where[i]}: {w[i].tolist()} are not words of {n} 12-bit code(s) (0..{n * 4095})")
-    return data, where
+def _read_jsonl(path: Path, prefix: str) -> _Rows:
+    """The sensor's records of an ``attitude link-rx --decode`` recording (JSON
+    Lines): those with ``"part": PREFIX`` and no error; the stream's OVERSAMPLE
+    report sets n, a BOOT resets it to 1."""
+    words, ns, where = [], [], []
+    n = 1
+    with open(path, encoding="utf-8") as fh:
+        for lineno, line in enumerate(fh, 1):
+            if not line.strip():
+                continue
+            try:
+                rec = json.loads(line)
+            except ValueError:
+                raise _Usage(f"{path}:{lineno}: not a JSON line of attitude link-rx --decode") from None
+            if not isinstance(rec, dict):
+                raise _Usage(f"{path}:{lineno}: not a JSON object")
+            if rec.get("report") in ("BOOT", "OVERSAMPLE"):
+                n = rec.get("n", 1)
+                if not isinstance(n, int) or not 1 <= n <= 16:
+                    raise _Usage(f"{path}:{lineno}: OVERSAMPLE n must be 1..16, got {n!r}")
+            elif rec.get("part") == prefix and "error" not in rec:
+                codes = rec.get("codes")
+                if not (isinstance(codes, list) and len(codes) == 3 and all(isinstance(c, int) for c in codes)):
+                    raise _Usage(f"{path}:{lineno}: codes must be three integers, got {codes!r}")
+                words.append([float(c) for c in codes])
+                ns.append(n)
+                where.append(lineno)
+    w = np.array(words, dtype=float).reshape(-1, 3)
+    return _check_words(path, _Rows(w, np.array(ns, dtype=np.int64), np.full(len(w), -1)), where)
+
+
+def _read(paths: list[Path], prefix: str, oversample: int) -> _Rows:
+    """Every file's records of the sensor; a file without pose labels is one position."""
+    parts, next_label = [], 0
+    for path in paths:
+        with open(path, "rb") as fh:
+            jsonl = fh.read(4096).lstrip().startswith(b"{")
+        rows = _read_jsonl(path, prefix) if jsonl else _read_csv(path, prefix, oversample)
+        if (rows.pose < 0).all():
+            rows.pose[:] = next_label
+        else:
+            rows.pose[rows.pose >= 0] += next_label
+        next_label = int(rows.pose.max(initial=next_label - 1)) + 1
+        parts.append(rows)
+    return _Rows(*(np.concatenate([getattr(r, f) for r in parts]) for f in ("words", "n", "pose")))
+
+
+def _uncorrected(nominal: sensorcal.SensorConfig, rows: _Rows) -> np.ndarray:
+    """The values (N, 3) with the nominal zero, scale and axes, through the C converter (one call per n)."""
+    out = np.empty(rows.words.shape)
+    for n in np.unique(rows.n):
+        sel = rows.n == n
+        out[sel] = nominal.convert(rows.words[sel], int(n), corrected=False)
+    return out
 
 
 def _nominal(prefix: str, zero: Any, scale: Any, axes: str) -> sensorcal.SensorConfig:
@@ -142,13 +221,9 @@ def _nominal(prefix: str, zero: Any, scale: Any, axes: str) -> sensorcal.SensorC
 
 def _accel(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, Any]]:
     nominal = _nominal("acc", args.acc_zero, args.acc_scale, args.acc_axes)
-    data, _ = _words(args.acc, (*ACC_COLS, "pose"), args.oversample)
-    if data.size and (data[:, 3] != np.round(data[:, 3])).any():
-        raise _Usage(f"{args.acc}: pose must be an integer label (negative or empty: not a position)")
-    pose = data[:, 3].astype(int)
-    means, counts, _, labels = sensorcal.pose_means(nominal.convert(data[:, :3].astype(int), args.oversample,
-                                                                    corrected=False), pose)
-    stds = sensorcal.pose_means(data[:, :3] / args.oversample, pose)[2]
+    rows = _read(args.acc, "acc", args.oversample)
+    means, counts, _, labels = sensorcal.pose_means(_uncorrected(nominal, rows), rows.pose)
+    stds = sensorcal.pose_means(rows.words / rows.n[:, None], rows.pose)[2]
     try:
         fit = sensorcal.fit_accel(means, nominal, args.gravity, args.acc_model)
     except InvalidArgument as exc:
@@ -161,9 +236,9 @@ def _accel(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, 
 
 def _mag(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, Any]]:
     nominal = _nominal("mag", args.mag_zero, args.mag_scale, args.mag_axes)
-    data, _ = _words(args.mag, MAG_COLS, args.oversample)
+    rows = _read(args.mag, "mag", args.oversample)
     try:
-        fit = sensorcal.fit_mag(data.astype(int), nominal, args.oversample, args.mag_field, args.mag_model)
+        fit = sensorcal.fit_mag(_uncorrected(nominal, rows), nominal, args.mag_field, args.mag_model)
     except InvalidArgument as exc:
         raise _Refused(f"magnetometer: {exc}") from None
     return fit.config, {"model": args.mag_model, "samples": int(fit.cal.n), "span": fit.cal.span,
@@ -209,7 +284,7 @@ def _print_report(report: dict[str, Any], out: Path) -> None:
 
 def _run(args: argparse.Namespace) -> dict[str, Any]:
     if args.acc is None and args.mag is None:
-        raise _Usage("give --acc CSV, --mag CSV or both")
+        raise _Usage("give --acc FILE..., --mag FILE... or both")
     configs, report = [], {}
     for name, step, given in (("acc", _accel, args.acc), ("mag", _mag, args.mag)):
         if given is not None:
