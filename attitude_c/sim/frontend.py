@@ -42,8 +42,8 @@ calibration tests and ``attitude calibrate`` do.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
-from typing import Literal
+from dataclasses import dataclass, field, fields, replace
+from typing import Any, Literal
 
 import numpy as np
 
@@ -68,10 +68,16 @@ _MAX_CODE = _FULL - 1
 Flip = Literal[1, -1]
 
 
-def _positive(name: str, **values: float) -> None:
-    for key, v in values.items():
+def _check(part: Any, *nonzero: str) -> None:
+    """Every number of a part (its float fields) finite and >= 0; those named > 0."""
+    for f in fields(part):
+        v = getattr(part, f.name)
+        if f.type != "float":
+            continue
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
-            raise InvalidArgument(f"{name}: {key} must be a finite number >= 0, got {v!r}")
+            raise InvalidArgument(f"{part.name}: {f.name} must be a finite number >= 0, got {v!r}")
+        if f.name in nonzero and v == 0:
+            raise InvalidArgument(f"{part.name}: {f.name} must be > 0")
 
 
 def _draw(rng: np.random.Generator, zero_sigma: float, gain_sigma: float, cross_sigma: float) -> SensorErrors:
@@ -116,12 +122,7 @@ class RatiometricAccel:
     sources: dict[str, str] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        _positive(self.name, range_g=self.range_g, sens_v_per_g=self.sens_v_per_g, vs_spec=self.vs_spec,
-                  supply_v=self.supply_v, zero_sigma_v=self.zero_sigma_v, sens_sigma=self.sens_sigma,
-                  cross_sigma=self.cross_sigma, noise_density_g=self.noise_density_g,
-                  r_filt_ohm=self.r_filt_ohm, c_filt_f=self.c_filt_f, swing_v=self.swing_v)
-        if min(self.range_g, self.sens_v_per_g, self.vs_spec, self.supply_v, self.r_filt_ohm, self.c_filt_f) <= 0:
-            raise InvalidArgument(f"{self.name}: range, sensitivity, supplies and the output filter must be > 0")
+        _check(self, "range_g", "sens_v_per_g", "vs_spec", "supply_v", "r_filt_ohm", "c_filt_f")
 
     @property
     def ratio_per_g(self) -> float:
@@ -214,13 +215,7 @@ class AmrMagnetometer:
     sources: dict[str, str] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        _positive(self.name, range_gauss=self.range_gauss, sens_v_per_v_gauss=self.sens_v_per_v_gauss,
-                  sens_sigma=self.sens_sigma, offset_sigma_v_per_v=self.offset_sigma_v_per_v,
-                  cross_sigma=self.cross_sigma, noise_density_v=self.noise_density_v, gain=self.gain,
-                  amp_offset_sigma_v=self.amp_offset_sigma_v, bandwidth_hz=self.bandwidth_hz,
-                  supply_v=self.supply_v, swing_v=self.swing_v)
-        if min(self.range_gauss, self.sens_v_per_v_gauss, self.gain, self.bandwidth_hz, self.supply_v) <= 0:
-            raise InvalidArgument(f"{self.name}: range, sensitivity, gain, bandwidth and supply must be > 0")
+        _check(self, "range_gauss", "sens_v_per_v_gauss", "gain", "bandwidth_hz", "supply_v")
 
     @property
     def codes_per_ut(self) -> float:
