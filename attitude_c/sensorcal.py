@@ -128,7 +128,7 @@ class SensorConfig:
         scale = _vec(self.scale, "scale", (3,))
         if (zero < 0).any() or (zero > 65535).any() or (scale == 0).any():
             raise InvalidArgument(f"zero must be 0..65535 codes and scale non-zero, got {zero}, {scale}")
-        parse_axes(self.axes)
+        object.__setattr__(self, "axes", format_axes(*parse_axes(self.axes)))  # as attitude-rx spells it
         matrix = _vec(self.matrix, "matrix", (3, 3))
         if not abs(np.linalg.det(matrix)) >= 1.0 / names.C["ATT_SENSOR_DET_RECIP"]:
             raise InvalidArgument(f"matrix must be invertible, |det| >= 1/ATT_SENSOR_DET_RECIP, got det "

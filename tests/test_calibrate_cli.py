@@ -190,6 +190,9 @@ def test_link_rx_decode_recordings_one_file_per_position(tmp_path: Path, capsys)
     assert main(["calibrate", "--acc", str(rec), "--mag", str(rec), "--out", str(out_csv)]) == EXIT_OK
     assert main(["calibrate", "--acc", *files, "--mag", *files, "--out", str(out_jsonl)]) == EXIT_OK
     assert out_jsonl.read_text() == out_csv.read_text()
+    (tmp_path / "gyro.jsonl").write_text('{"n": 0, "codes": [1, 2, 3]}\n')
+    _one_line(capsys, main(["calibrate", "--acc", str(tmp_path / "gyro.jsonl"), "--out", str(out_csv)]),
+              EXIT_USAGE, 'no "part": "acc" records')
     (tmp_path / "bad.jsonl").write_text('{"report": "OVERSAMPLE", "n": 99}\n')
     _one_line(capsys, main(["calibrate", "--mag", str(tmp_path / "bad.jsonl"), "--out", str(out_csv)]), EXIT_USAGE,
               "bad.jsonl:1", "OVERSAMPLE")

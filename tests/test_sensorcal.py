@@ -197,7 +197,7 @@ def test_magnetometer_without_field_keeps_det_one_and_refuses_a_level_turn() -> 
 
 
 def test_sensor_config_lines_and_checks() -> None:
-    cfg = SensorConfig("mag", [2047.5, 2047, 2048], [0.12] * 3, "-y,x,z", np.eye(3) * 1.1, [1, 2, 3])
+    cfg = SensorConfig("mag", [2047.5, 2047, 2048], [0.12] * 3, "-Y, +x,z", np.eye(3) * 1.1, [1, 2, 3])
     assert cfg.lines() == ["mag-zero = 2047.5,2047,2048", "mag-scale = 0.12,0.12,0.12", "mag-axes = -y,x,z",
                            "mag-matrix = 1.1,0,0,0,1.1,0,0,0,1.1", "mag-bias = 1,2,3"]
     with pytest.raises(InvalidArgument, match="invertible"):

@@ -194,6 +194,9 @@ def _read(paths: list[Path], prefix: str, oversample: int) -> _Rows:
         with open(path, "rb") as fh:
             jsonl = fh.read(4096).lstrip().startswith(b"{")
         rows = _read_jsonl(path, prefix) if jsonl else _read_csv(path, prefix, oversample)
+        if not len(rows.words):
+            what = f'"part": "{prefix}" records' if jsonl else f"rows with {prefix}_x, {prefix}_y, {prefix}_z"
+            raise _Usage(f"{path}: no {what}")
         if (rows.pose < 0).all():
             rows.pose[:] = next_label
         else:
