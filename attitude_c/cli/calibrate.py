@@ -42,7 +42,7 @@ import numpy as np
 from .. import sensorcal
 from .._io import write_text
 from ..errors import InvalidArgument
-from ..sim.frontend import ACCEL_FRONTENDS, MAG_FRONTENDS
+from ..sim.frontend import ACCEL_FRONTENDS, FLIP_ZERO, MAG_FRONTENDS
 from .options import integer, positive, triple
 
 PROG = "attitude calibrate"
@@ -50,7 +50,6 @@ PROG = "attitude calibrate"
 EXIT_REFUSED = 3  # the recording cannot calibrate: too few positions, too little rotation, no convergence
 ACC_PART, MAG_PART = ACCEL_FRONTENDS["adxl335"], MAG_FRONTENDS["hmc1043-ad623"]
 WARN_ACC_RMS = 0.02  # of g: an RMS residual above it means a position was not still, or the part is not linear
-MAG_ZERO = 2047.5  # the set/reset code of zero field, (c_set + 4095 − c_reset) / 2 (attitude_c.sim.frontend)
 
 
 class _Usage(Exception):
@@ -80,17 +79,19 @@ def register(sub: Any) -> None:
     p.add_argument("--acc-scale", type=triple("--acc-scale"), default=(ACC_PART.units_per_code,) * 3,
                    metavar="K[,K,K]", help=f"nominal m/s^2 per code (default {ACC_PART.units_per_code:.6g}: "
                    f"{ACC_PART.name} on the TLC2543)")
-    p.add_argument("--acc-axes", default="x,y,z", metavar="AXES", help="body axes from channels, as attitude-rx's axes")
+    p.add_argument("--acc-axes", default="x,y,z", metavar="AXES",
+                   help="body axes from channels, as attitude-rx's axes (default x,y,z)")
     p.add_argument("--acc-model", choices=sensorcal.ACCEL_MODELS, default="auto",
                    help="diagonal (6+ positions), full (12+), auto: full from 12 positions (default)")
     p.add_argument("--gravity", type=positive("--gravity"), default=9.80665, metavar="G",
                    help="local gravity, m/s^2 (default 9.80665)")
-    p.add_argument("--mag-zero", type=triple("--mag-zero"), default=(MAG_ZERO,) * 3, metavar="C[,C,C]",
-                   help=f"nominal code at zero field (default {MAG_ZERO})")
+    p.add_argument("--mag-zero", type=triple("--mag-zero"), default=(FLIP_ZERO,) * 3, metavar="C[,C,C]",
+                   help=f"nominal code at zero field (default {FLIP_ZERO}: set/reset codes)")
     p.add_argument("--mag-scale", type=triple("--mag-scale"), default=(MAG_PART.units_per_code,) * 3,
                    metavar="K[,K,K]", help=f"nominal uT per code (default {MAG_PART.units_per_code:.6g}: "
                    f"{MAG_PART.name} on the TLC2543)")
-    p.add_argument("--mag-axes", default="x,y,z", metavar="AXES", help="body axes from channels, as attitude-rx's axes")
+    p.add_argument("--mag-axes", default="x,y,z", metavar="AXES",
+                   help="body axes from channels, as attitude-rx's axes (default x,y,z)")
     p.add_argument("--mag-model", choices=("full", "diagonal", "offset"), default="full",
                    help="soft iron: full (default), diagonal, offset (hard iron only)")
     p.add_argument("--mag-field", type=positive("--mag-field"), default=None, metavar="UT",

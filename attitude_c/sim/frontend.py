@@ -53,6 +53,7 @@ from .adc import AdcModel
 
 __all__ = [
     "ACCEL_FRONTENDS",
+    "FLIP_ZERO",
     "MAG_FRONTENDS",
     "AmrErrors",
     "AmrMagnetometer",
@@ -64,6 +65,8 @@ __all__ = [
 _GAUSS_UT = 100.0  # µT per gauss
 _FULL = 4096  # TLC2543: 12-bit codes, code = round(v / REF+ · 4096)
 _MAX_CODE = _FULL - 1
+#: The :func:`flip_code` of zero field: (c_set + 4095 − c_reset) / 2 with c_set = c_reset.
+FLIP_ZERO = _MAX_CODE / 2
 
 Flip = Literal[1, -1]
 
