@@ -16,6 +16,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -35,12 +36,11 @@ def _directions(rng: np.random.Generator, k: int) -> np.ndarray:
     return d / np.linalg.norm(d, axis=1)[:, None]
 
 
-def _read_config(path: Path, prefix: str) -> SensorConfig:
+def _read_config(path: Path, prefix: Literal["acc", "mag"]) -> SensorConfig:
     keys = dict(line.split(" = ", 1) for line in path.read_text().splitlines() if line.startswith(prefix + "-"))
     vals = {k.split("-", 1)[1]: v for k, v in keys.items()}
     num = {k: np.array([float(x) for x in v.split(",")]) for k, v in vals.items() if k != "axes"}
-    return SensorConfig(prefix, num["zero"], num["scale"], vals["axes"], num["matrix"].reshape(3, 3),
-                        num["bias"])  # type: ignore[arg-type]
+    return SensorConfig(prefix, num["zero"], num["scale"], vals["axes"], num["matrix"].reshape(3, 3), num["bias"])
 
 
 def main() -> int:
@@ -68,7 +68,8 @@ def main() -> int:
     if rc != 0:
         return rc
     out_a = pose_means(_read_config(conf, "acc").convert(acc), pose)[0]
-    raw_a = pose_means(SensorConfig("acc", 2048, ACC.units_per_code).convert(acc), pose)[0]
+    nominal = SensorConfig("acc", np.full(3, 2048.0), np.full(3, ACC.units_per_code))
+    raw_a = pose_means(nominal.convert(acc), pose)[0]
     out_m = _read_config(conf, "mag").convert(mag)
     cross = np.abs(acc_err.misalignment - np.eye(3)).max()
     print(f"truth: zero-g errors {np.round(acc_err.bias * 4096, 1).tolist()} codes, sensitivity errors "
