@@ -128,6 +128,7 @@ def test_nominal_scales() -> None:
     assert ACC.codes_per_g == pytest.approx(409.6)
     assert ACC.units_per_code == pytest.approx(G0 / 409.6)
     assert ACC.bandwidth_hz == pytest.approx(1 / (2 * math.pi * 32e3 * 0.1e-6))
+    assert ACC.tau == pytest.approx(32e3 * 0.1e-6) and MAG.tau == pytest.approx(1 / (2 * math.pi * 50))
     assert MAG.units_per_code == pytest.approx(100 / (200 * 1.0e-3 * 4096))
 
 

@@ -148,6 +148,12 @@ class RatiometricAccel:
         return 1.0 / (2 * math.pi * self.r_filt_ohm * self.c_filt_f)
 
     @property
+    def tau(self) -> float:
+        """Time constant of the output filter (s): a moving body's specific force goes
+        through it first (``accelmag.filtered(fn, t, part.tau)``) before :meth:`volts`."""
+        return 1.0 / (2 * math.pi * self.bandwidth_hz)
+
+    @property
     def noise_sigma_codes(self) -> float:
         """1σ of the filtered output noise in codes at ``supply_v`` (N·S·√(π/2·f_c) V over REF+/4096)."""
         v = self.noise_density_g * self.sens_v_per_g * math.sqrt(math.pi / 2 * self.bandwidth_hz)
@@ -230,6 +236,11 @@ class AmrMagnetometer:
     def units_per_code(self) -> float:
         """Nominal µT per code: what ``mag-scale`` starts from."""
         return 1.0 / self.codes_per_ut
+
+    @property
+    def tau(self) -> float:
+        """Time constant of the output filter (s), for a moving body's field (as the accelerometer's)."""
+        return 1.0 / (2 * math.pi * self.bandwidth_hz)
 
     @property
     def noise_sigma_codes(self) -> float:
