@@ -54,6 +54,7 @@ __all__ = [
     "format_axes",
     "parse_axes",
     "pose_means",
+    "still_segments",
 ]
 
 Prefix = Literal["acc", "mag"]
@@ -177,6 +178,45 @@ def pose_means(values: ArrayLike, pose: ArrayLike) -> tuple[NDArray[np.float64],
     counts = np.array([int((lab == k).sum()) for k in labels], dtype=np.int64)
     stds = np.array([w[lab == k].std(axis=0) for k in labels]).reshape(-1, 3)
     return means, counts, stds, labels.astype(np.int64)
+
+
+def still_segments(codes: ArrayLike, window: int = 20, still: float = 4.0, merge: float = 10.0,
+                   min_windows: int = 3) -> NDArray[np.int64]:
+    """Position labels (N,) for a recording (N, 3) of codes (one conversion each) in
+    which the board was held still in several positions and moved between them:
+    windows of ``window`` rows whose every axis has a standard deviation of at most
+    ``still`` codes are still; consecutive still windows whose means agree with the
+    first one's within ``merge`` codes form a position (a slow turn is no position), less its first and last window (they may hold
+    the end of a movement); a run of fewer than ``min_windows`` windows (≥ 3) and
+    every moving row get −1."""
+    c = np.asarray(codes, dtype=float)
+    if c.ndim != 2 or c.shape[1] != 3:
+        raise InvalidArgument(f"codes must be (N, 3), got {c.shape}")
+    if window < 2 or min_windows < 3 or not (still > 0 and merge > 0):
+        raise InvalidArgument(f"need window >= 2, min_windows >= 3, still and merge > 0, got {window}, "
+                              f"{min_windows}, {still}, {merge}")
+    k = len(c) // window
+    blocks = c[:k * window].reshape(k, window, 3)
+    quiet = blocks.std(axis=1).max(axis=1) <= still
+    means = blocks.mean(axis=1)
+    labels = np.full(len(c), -1, dtype=np.int64)
+    run: list[int] = []
+
+    def close(label: int) -> int:
+        if len(run) >= min_windows:  # its first and last windows may hold the end of a movement: left out
+            labels[(run[0] + 1) * window:run[-1] * window] = label
+            return label + 1
+        return label
+
+    label = 0
+    for i in range(k):
+        if quiet[i] and run and np.abs(means[i] - means[run[0]]).max() <= merge:  # no slow drift
+            run.append(i)
+            continue
+        label = close(label)
+        run = [i] if quiet[i] else []
+    close(label)
+    return labels
 
 
 # --------------------------------------------------------------------------- accelerometer

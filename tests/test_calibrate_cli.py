@@ -173,23 +173,50 @@ def _print_decoded(acc: np.ndarray, mag: np.ndarray, n: int) -> None:
     show(b"".join(recs))
 
 
-def test_link_rx_decode_recordings_one_file_per_position(tmp_path: Path, capsys) -> None:
-    """Six positions recorded as six files with link-rx --decode, oversampled by 4: the
-    same calibration as the codes' CSV with pose labels."""
-    rec = tmp_path / "rec.csv"
-    acc, pose, mag = _recording(rec, positions=6, rows=20, seed=3)
-    files = []
+def _session(rng: np.random.Generator, rows: int = 120, ramp: int = 30) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Accelerometer codes of the six faces held ``rows`` samples each, the board turned
+    between them over ``ramp`` samples (pose −1), and magnetometer codes of a rotation."""
+    faces = np.vstack([np.eye(3), -np.eye(3)]) * G0
+    f, pose = [], []
     for k in range(6):
-        sel = pose == k
-        _print_decoded(acc[sel] * 4, mag[sel] * 4, 4)  # 4 identical conversions: the same codes, ×4
-        path = tmp_path / f"pos{k}.jsonl"
-        path.write_text(capsys.readouterr().out)
-        files.append(str(path))
-    assert '"part": "acc"' in Path(files[0]).read_text()
+        f.append(np.repeat(faces[k:k + 1], rows, axis=0))
+        pose += [k] * rows
+        if k < 5:
+            f.append(np.linspace(faces[k], faces[k + 1], ramp))  # a straight path: |f| dips, it is moving anyway
+            pose += [-1] * ramp
+    fa = np.vstack(f)
+    acc = tlc2543_codes(ACC.volts(fa, ACC.draw_errors(rng), 0.01, rng), ACC.supply_v)
+    u = rng.normal(size=(len(fa), 3))
+    mag = flip_code(*MAG.set_reset_codes(u / np.linalg.norm(u, axis=1)[:, None] * 50.0, MAG.draw_errors(rng), 0.01,
+                                         rng))
+    return acc, np.array(pose), mag
+
+
+def test_link_rx_decode_recording_cut_into_still_positions(tmp_path: Path, capsys) -> None:
+    """One link-rx --decode recording of an aided board, oversampled by 4, the board
+    turned from face to face: the six positions are found, and the calibration agrees
+    with the CSV of the same codes labelled with the true positions."""
+    acc, pose, mag = _session(np.random.default_rng(3))
+    rec, jsonl = tmp_path / "rec.csv", tmp_path / "session.jsonl"
+    lines = ["pose,acc_x,acc_y,acc_z,mag_x,mag_y,mag_z"]
+    lines += [f"{p},{','.join(map(str, a))},{','.join(map(str, m))}" for p, a, m in zip(pose, acc, mag)]
+    rec.write_text("\n".join(lines) + "\n")
+    _print_decoded(acc * 4, mag * 4, 4)  # 4 identical conversions: the same codes, ×4
+    jsonl.write_text(capsys.readouterr().out)
+    assert '"part": "acc"' in jsonl.read_text()
     out_csv, out_jsonl = tmp_path / "a.conf", tmp_path / "b.conf"
-    assert main(["calibrate", "--acc", str(rec), "--mag", str(rec), "--out", str(out_csv)]) == EXIT_OK
-    assert main(["calibrate", "--acc", *files, "--mag", *files, "--out", str(out_jsonl)]) == EXIT_OK
-    assert out_jsonl.read_text() == out_csv.read_text()
+    assert main(["calibrate", "--acc", str(rec), "--out", str(out_csv)]) == EXIT_OK
+    capsys.readouterr()
+    assert main(["calibrate", "--acc", str(jsonl), "--mag", str(jsonl), "--out", str(out_jsonl), "--json"]) == EXIT_OK
+    report = json.loads(capsys.readouterr().out)
+    assert report["acc"]["positions"] == 6 and all(p["rows"] >= 120 - 3 * 20 for p in report["acc"]["poses"])
+    a, b = _keys(out_csv.read_text()), _keys(out_jsonl.read_text())
+    # the segmented positions hold ≥ 60 of each position's 120 samples: a mean moves by about the
+    # noise's 0.57 code/√60 = 0.07 code, a zero (the mean of two) by 0.05; 0.3 code is 6 of those.
+    # A scale comes from two means 819 codes apart: 0.07·√2/819 = 1.2e-4 relative; 1.5e-3 is 12 of those
+    np.testing.assert_allclose(b["acc-zero"], a["acc-zero"], atol=0.3)
+    np.testing.assert_allclose(b["acc-scale"], a["acc-scale"], rtol=1.5e-3)
+    assert "mag-matrix" in b and "mag-matrix" not in a
     (tmp_path / "gyro.jsonl").write_text('{"n": 0, "codes": [1, 2, 3]}\n')
     _one_line(capsys, main(["calibrate", "--acc", str(tmp_path / "gyro.jsonl"), "--out", str(out_csv)]),
               EXIT_USAGE, 'no "part": "acc" records')

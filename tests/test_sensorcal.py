@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from attitude_c.errors import InvalidArgument
-from attitude_c.sensorcal import SensorConfig, fit_accel, fit_mag, parse_axes, pose_means
+from attitude_c.sensorcal import SensorConfig, fit_accel, fit_mag, parse_axes, pose_means, still_segments
 from attitude_c.sim.accelmag import G0, SensorErrors
 from attitude_c.sim.frontend import ACCEL_FRONTENDS, MAG_FRONTENDS, AmrErrors, flip_code, tlc2543_codes
 
@@ -206,3 +206,28 @@ def test_sensor_config_lines_and_checks() -> None:
         SensorConfig("acc", 2048, 0.02, "x,x,z")
     with pytest.raises(InvalidArgument, match="zero"):
         SensorConfig("acc", 70000, 0.02)
+
+
+def test_still_segments_finds_the_positions_and_no_movement() -> None:
+    """Seven positions of 150-300 samples (σ 0.6 code) joined by 60-sample straight moves:
+    seven labels, each on rows of one position only, each holding all of its position but
+    less than four windows' worth (the partial windows at both ends, under two windows,
+    and the first and last whole ones, which the search leaves out)."""
+    rng = np.random.default_rng(17)
+    pos = rng.uniform(1600, 2500, (7, 3))
+    parts, truth = [], []
+    for i, p in enumerate(pos):
+        n = int(rng.integers(150, 300))
+        parts.append(p + rng.normal(0, 0.6, (n, 3)))
+        truth += [i] * n
+        if i < 6:
+            parts.append(np.linspace(p, pos[i + 1], 60) + rng.normal(0, 0.6, (60, 3)))
+            truth += [-1] * 60
+    t = np.array(truth)
+    labels = still_segments(np.round(np.vstack(parts)), window=20)
+    assert sorted(set(labels.tolist())) == [-1, *range(7)]
+    for k in range(7):
+        assert set(t[labels == k].tolist()) == {k}
+        assert (labels == k).sum() >= (t == k).sum() - 4 * 20
+    with pytest.raises(InvalidArgument, match="window"):
+        still_segments(np.zeros((10, 3)), window=1)

@@ -12,7 +12,10 @@ Input, per sensor one file or several:
     pose                  optional: the static position of the row, 0, 1, 2, ...;
                           empty or negative while the board is moved
   Words are sums of --oversample conversions (1: plain 12-bit codes).
-A file without pose labels (every JSON Lines file) is one static position.
+A file without pose labels (every JSON Lines file) is cut into its still positions:
+windows of --window rows in which no axis varies by more than --still codes (standard
+deviation), consecutive ones agreeing within 10 codes, at least three windows long (less
+the first and last, which may hold the end of a movement). The report lists them.
 
 Accelerometer: hold the board still in each position. Six positions (each axis
 up, then down) fit per-axis zero and scale (model diagonal); twelve or more
@@ -68,7 +71,7 @@ def register(sub: Any) -> None:
         "option or file content; 3 the recording cannot calibrate (too few positions, too little rotation, "
         "no convergence). See docs/sensor.md.")
     p.add_argument("--acc", metavar="FILE", type=Path, nargs="+",
-                   help="static positions: a CSV with a pose column, or one file per position")
+                   help="static positions: CSV with a pose column, or recordings cut into still positions")
     p.add_argument("--mag", metavar="FILE", type=Path, nargs="+", help="a rotation (one file or several)")
     p.add_argument("--out", metavar="FILE", type=Path, required=True,
                    help="the attitude-rx config file to write (updated if it exists)")
@@ -83,6 +86,12 @@ def register(sub: Any) -> None:
                    help="body axes from channels, as attitude-rx's axes (default x,y,z)")
     p.add_argument("--acc-model", choices=sensorcal.ACCEL_MODELS, default="auto",
                    help="diagonal (6+ positions), full (12+), auto: full from 12 positions (default)")
+    p.add_argument("--window", type=integer("--window", 2), default=20, metavar="ROWS",
+                   help="accelerometer files without a pose column: rows per window of the search for still "
+                   "positions (default 20)")
+    p.add_argument("--still", type=positive("--still"), default=4.0, metavar="CODES",
+                   help="a window is still when no axis varies by more than this standard deviation in codes "
+                   "(default 4)")
     p.add_argument("--gravity", type=positive("--gravity"), default=9.80665, metavar="G",
                    help="local gravity, m/s^2 (default 9.80665)")
     p.add_argument("--mag-zero", type=triple("--mag-zero"), default=(FLIP_ZERO,) * 3, metavar="C[,C,C]",
@@ -188,8 +197,9 @@ def _read_jsonl(path: Path, prefix: str) -> _Rows:
     return _check_words(path, _Rows(w, np.array(ns, dtype=np.int64), np.full(len(w), -1)), where)
 
 
-def _read(paths: list[Path], prefix: str, oversample: int) -> _Rows:
-    """Every file's records of the sensor; a file without pose labels is one position."""
+def _read(paths: list[Path], prefix: str, oversample: int, window: int = 0, still: float = 0.0) -> _Rows:
+    """Every file's records of the sensor. ``window`` > 0: a file without pose labels is
+    cut into its still positions (sensorcal.still_segments)."""
     parts, next_label = [], 0
     for path in paths:
         with open(path, "rb") as fh:
@@ -198,8 +208,9 @@ def _read(paths: list[Path], prefix: str, oversample: int) -> _Rows:
         if not len(rows.words):
             what = f'"part": "{prefix}" records' if jsonl else f"rows with {prefix}_x, {prefix}_y, {prefix}_z"
             raise _Usage(f"{path}: no {what}")
-        if (rows.pose < 0).all():
-            rows.pose[:] = next_label
+        if (rows.pose < 0).all() and window:
+            found = sensorcal.still_segments(rows.words / rows.n[:, None], window, still)
+            rows.pose[found >= 0] = found[found >= 0] + next_label
         else:
             rows.pose[rows.pose >= 0] += next_label
         next_label = int(rows.pose.max(initial=next_label - 1)) + 1
@@ -225,7 +236,7 @@ def _nominal(prefix: str, zero: Any, scale: Any, axes: str) -> sensorcal.SensorC
 
 def _accel(args: argparse.Namespace) -> tuple[sensorcal.SensorConfig, dict[str, Any]]:
     nominal = _nominal("acc", args.acc_zero, args.acc_scale, args.acc_axes)
-    rows = _read(args.acc, "acc", args.oversample)
+    rows = _read(args.acc, "acc", args.oversample, args.window, args.still)
     means, counts, _, labels = sensorcal.pose_means(_uncorrected(nominal, rows), rows.pose)
     stds = sensorcal.pose_means(rows.words / rows.n[:, None], rows.pose)[2]
     try:
