@@ -3,7 +3,8 @@ from recorded codes and write the attitude-rx config file (docs/sensor.md).
 
 Input, per sensor one file or several:
 * JSON Lines recorded by "attitude link-rx --port DEV --decode > FILE.jsonl" from an
-  aided board: its accelerometer ("part": "acc") or magnetometer ("part": "mag")
+  aided board, started before the board (the recording needs its BOOT and CHANNELS
+  reports): its accelerometer ("part": "acc") or magnetometer ("part": "mag")
   records; the stream's OVERSAMPLE report gives the conversions per word.
 * CSV with a header naming its columns (others are ignored; lines starting with #
   are skipped; an empty cell is a sensor absent from that row):
