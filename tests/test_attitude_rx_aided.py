@@ -266,3 +266,119 @@ def test_constant_turn_with_decimated_aiding(rx_builds, build: str) -> None:
     assert err_h[-100:].max() < quant, np.degrees(err_h[-100:].max())
     assert err_h[-100:].max() < err_h[:10].min() / 3  # decaying
     _assert_library(lines, gyr, acc, mag, 1, 2, build, tilt_tau=1.5, gyr_noise=0.02)
+
+
+def test_losses_and_a_cut_group_in_an_aided_stream(rx_builds) -> None:
+    """A GAVE_UP report for sample 20 (its group never sent) and an OVERRUN for sample 31 that
+    arrives before sample 30's magnetometer record (the group cut short): 20 and 31 are held
+    (the last rate, no aiding), 30 is filtered with its gyro and accelerometer alone; every
+    sample numbered once; equal to the library's filter fed exactly that."""
+    from attitude_c.link import block
+
+    n = 50
+    gyr, acc, mag = _static_board(n, -60.0)
+    gyr = gyr + np.array([3, -2, 5])  # a small constant rate: the held rate is not zero
+    recs = _records(gyr, acc, mag)
+    i20 = recs.index(block.encode_sample(gyr[20]), 2 + 3 * 20)
+    recs[i20:i20 + 3] = [block.encode_loss("gave_up", 20, 1)]
+    i30 = 2 + 3 * 30 - 2  # (one group fewer before it)
+    assert recs[i30] == block.encode_sample(gyr[30])
+    recs[i30 + 2:i30 + 6] = [block.encode_loss("overrun", 31, 1)]  # mag of 30 and group 31 lost
+    out, err = _run(rx_builds["host"], recs, n, "--config", _config_file(rx_builds, "loss"))
+    lines = _lines(out)
+    assert [r["n"] for r in lines] == list(range(n))
+    assert "GAVE_UP inside" not in err and "OVERRUN inside a sample's group: its magnetometer record never" in err
+    assert "held=2 missing=2" in err and "seq_errors=1" in err
+    g = _converted(gyr, GYR_SCALE)
+    a, m = _converted(acc, ACC_SCALE), _converted(mag, MAG_SCALE)
+    g[20], g[31] = g[19], g[30]
+    a_k = [None if k in (20, 31) else a[k] for k in range(n)]
+    m_k = [None if k in (20, 30, 31) else m[k] for k in range(n)]
+    q, b, _ = _library_filter(g, a_k, m_k)
+    np.testing.assert_array_equal([r["q"] for r in lines], q)  # host: the same double arithmetic
+    assert [("acc_ms2" in r, "mag_ut" in r) for r in lines] == [(x is not None, y is not None)
+                                                                  for x, y in zip(a_k, m_k)]
+
+
+def test_estimator_choice(rx_builds) -> None:
+    """auto: the filter only when CHANNELS announces accelerometer and magnetometer; an
+    accelerometer alone: the integrator (its records counted, unused), or with --estimator
+    ahrs the six-axis filter (magnetometer NULL); --estimator ahrs on a gyro-only stream:
+    a warning, and the integrator, exactly as without it."""
+    import attitude_c
+    from attitude_c.link import block
+
+    n = 30
+    gyr, acc, mag = _static_board(n, 0.0)
+    gyr = gyr + np.array([40, -25, 60])
+    six = [block.encode_boot(TICKS, 9600, link="v2"), block.encode_channels("aided9", ["gyr", "acc"], 1, 0)]
+    for k in range(n):
+        six += [block.encode_sample(gyr[k]), block.encode_sample(acc[k])]
+    cfg = _config_file(rx_builds, "choice")
+    dtheta = _converted(gyr, GYR_SCALE) * DT
+    out, err = _run(rx_builds["host"], six, n // 3, "--config", cfg)  # auto, rv3: an update per 3 samples
+    assert "estimator: integrator" in err and f"acc_records={n} mag_records=0 unused={n}" in err
+    np.testing.assert_array_equal([r["q"] for r in _lines(out)], attitude_c.integrate(dtheta, method="rv3"))
+    out, err = _run(rx_builds["host"], six, n, "--config", cfg, "--estimator", "ahrs")
+    q, _, _ = _library_filter(_converted(gyr, GYR_SCALE), list(_converted(acc, ACC_SCALE)), [None] * n)
+    np.testing.assert_array_equal([r["q"] for r in _lines(out)], q)
+    gyro_only = [block.encode_boot(TICKS, 9600, link="v2")] + [block.encode_sample(c) for c in gyr]
+    out, err = _run(rx_builds["host"], gyro_only, n, "--estimator", "ahrs", "--method", "rv1")
+    assert "warning: --estimator ahrs, but the stream has no accelerometer (gyro only)" in err
+    assert "estimator: integrator" in err
+    np.testing.assert_array_equal([r["q"] for r in _lines(out)], attitude_c.integrate(dtheta, method="rv1"))
+
+
+def _real_fields() -> list[str]:
+    """att_ahrs_settings' floating-point fields, as the compiled library declares them."""
+    from attitude_c._lib import ffi_lib
+
+    ffi = ffi_lib("f64")[0]
+    return [name for name, f in ffi.typeof("att_ahrs_settings").fields if f.type.cname in ("double", "float")]
+
+
+def test_filter_settings_by_field_name_and_errors(rx_builds, tmp_path: Path) -> None:
+    """--help lists every floating-point field of att_ahrs_settings with its library default
+    (the table attitude-rx reads them by); each is a config key and a --option; a value outside
+    the domain (att_ahrs_check_settings) is one line naming the setting, exit 78."""
+    from attitude_c import ahrs_filter
+
+    exe = rx_builds["host"]
+
+    def run(*args: str) -> tuple[int, str, str]:
+        p = subprocess.run([*exe, *args], capture_output=True, timeout=20, check=False)
+        return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+    rc, out, _ = run("--help")
+    listed = out.split("Filter settings", 1)[1].split("\n", 2)[2].split("\n  method:")[0]
+    pairs = [x.split() for x in listed.replace(",\n", ", ").replace("\n", "").split(", ")]
+    defaults = ahrs_filter.Ahrs(rate=100.0).settings
+    assert [p[0] for p in pairs] == _real_fields()
+    assert all(float(v) == pytest.approx(defaults[k], rel=1e-5) for k, v in pairs)  # %g: 6 digits
+    assert "the filter's default: rv3-reuse" in out
+    nope = str(tmp_path / "nope")
+    for name in _real_fields():  # every one is an option: the run gets to the port (66: no such port)
+        assert run("--port", nope, f"--{name}", str(defaults[name]))[0] == 66, name
+    cases = [
+        (("--gyr_noise", "-1"), "gyr_noise: -1 is outside its domain"),
+        (("--tilt_tau", "nan"), "tilt_tau: 'nan' is not a number"),
+        (("--estimator", "kalman"), "estimator: 'kalman' must be auto, ahrs or integrator"),
+        (("--estimator", "ahrs", "--method", "rk4"), "method: rk4 cannot run in the filter"),
+        (("--acc-matrix", "1,0,0,0,1,0,0,0,0"), "acc-matrix: '1,0,0,0,1,0,0,0,0' must be 9 numbers"),
+        (("--mag-zero", "70000"), "mag-zero: '70000' must be CODE or CODE,CODE,CODE (0..65535)"),
+        (("--acc-scale", "0"), "acc-scale: '0' must be M_PER_S2_PER_CODE"),
+        (("--mag-axes", "x,x,z"), "mag-axes: 'x,x,z' must name each channel once"),
+        (("--mag-bias", "1,2"), "mag-bias: '1,2' must be B or B,B,B (uT)"),
+    ]
+    for args, want in cases:
+        rc, _, err = run("--port", nope, *args)
+        assert rc == 78 and want in err and err.count("\n") == 1, (args, err)
+    cfg = tmp_path / "f.conf"
+    cfg.write_text("tilt_tau = 2\nmag_reject_factor = 0.5\n")
+    rc, _, err = run("--port", nope, "--config", str(cfg))
+    assert rc == 78 and "f.conf:2: mag_reject_factor: 0.5 is outside its domain" in err
+    cfg.write_text("gyr_nosie = 0.01\n")
+    rc, _, err = run("--port", nope, "--config", str(cfg))
+    assert rc == 78 and "f.conf:1: unknown setting 'gyr_nosie'" in err
+    assert run("--port", nope, "--estimator", "integrator", "--method", "rk4")[0] == 66
+    assert run("--port", nope, "--method", "rk4")[0] == 66  # auto: the filter keeps its default method
