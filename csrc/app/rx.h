@@ -208,8 +208,11 @@ int rx_port_write(rx_stop *s, int fd, const uint8_t *p, size_t n);
 int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
 /* 1 if baud is one the termios layer knows. */
 int rx_serial_baud_ok(long baud);
-/* Close the port without waiting for its unsent output (a tty's close
- * would wait for it to drain, up to 30 s on a UART whose flow is stopped). */
+/* Close the port once what was written has gone out: the last answer
+ * (the 0x00 of a block the app delivered, a link v2 ACK) reaches the
+ * sender. Discarding it (TCOFLUSH; on a pty that empties the other end's
+ * input) made the sender resend a block the app had acknowledged. The port
+ * has no flow control, so its output drains at the line's rate. */
 void rx_serial_close(int fd);
 
 #endif /* ATTITUDE_RX_H */

@@ -422,6 +422,6 @@ int rx_serial_open(const char *path, long baud, char *msg, size_t len)
 
 void rx_serial_close(int fd)
 {
-    tcflush(fd, TCOFLUSH);
+    (void)tcdrain(fd);
     close(fd);
 }
