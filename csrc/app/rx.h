@@ -210,9 +210,15 @@ int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
 int rx_serial_baud_ok(long baud);
 /* Close the port once what was written has gone out: the last answer
  * (the 0x00 of a block the app delivered, a link v2 ACK) reaches the
- * sender. Discarding it (TCOFLUSH; on a pty that empties the other end's
- * input) made the sender resend a block the app had acknowledged. The port
- * has no flow control, so its output drains at the line's rate. */
+ * sender. Discarding it (TCOFLUSH; on a pty that empties what the other
+ * end has not taken in yet) made a slow sender resend a block the app had
+ * acknowledged. The port has no flow control, so its output drains at the
+ * line's rate; output that does not move for RX_DRAIN_STUCK_MS (flow
+ * stopped: tcflow TCOOFF) is dropped, as a tty's close() would wait for it
+ * up to 30 s. */
+enum {
+    RX_DRAIN_STUCK_MS = 100
+};
 void rx_serial_close(int fd);
 
 #endif /* ATTITUDE_RX_H */
