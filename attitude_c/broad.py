@@ -7,7 +7,7 @@ T. Seel, "BROAD — A Benchmark for Robust Inertial Orientation Estimation",
 results on it are shown. A subset ships with the project in
 ``../shared/data/broad/``; the upstream ``data_mat/`` folder works too.
 
-Each trial file (MATLAB v5, read with SciPy) holds ``imu_gyr`` (rad/s),
+Each trial file (MATLAB v5, read with SciPy: ``pip install 'attitude-c[broad]'``) holds ``imu_gyr`` (rad/s),
 ``imu_acc`` (m/s², specific force: +9.81 upward at rest), ``imu_mag`` (µT),
 ``opt_quat`` (w, x, y, z of the IMU relative to ENU; NaN where the cameras
 lost the markers), ``opt_pos`` (m), ``movement`` (1 in movement phases) and
@@ -109,14 +109,15 @@ def _groups_from_name(stem: str) -> tuple[str, ...]:
 
 
 def load_trial(path: str | Path) -> Trial:
-    """Read one BROAD ``.mat`` file (needs SciPy)."""
+    """Read one BROAD ``.mat`` file (needs SciPy: ``pip install 'attitude-c[broad]'``; without it
+    ImportError saying so)."""
     p = Path(path)
     if not p.is_file():
         raise InvalidArgument(f"path: no BROAD trial file at {str(p)!r}")
     try:
         from scipy.io import loadmat
     except ImportError as exc:  # pragma: no cover - depends on install
-        raise ImportError("reading BROAD .mat files needs SciPy: pip install scipy") from exc
+        raise ImportError(f"{p.name}: reading BROAD .mat files needs SciPy: pip install 'attitude-c[broad]'") from exc
     try:
         d = loadmat(str(p))
     except Exception as exc:

@@ -13,6 +13,7 @@ fails, because CI installs every toolchain (see scripts/setup.sh).
 
 from __future__ import annotations
 
+import _posixsubprocess
 import os
 import shutil
 import subprocess
@@ -49,6 +50,82 @@ def require_target(name: str) -> _targets.Target:
     if missing:
         _missing(f"target {name} needs {', '.join(missing)}: {t.install_hint()}")
     return t
+
+
+# ---- test tiers ----
+# A `system` test builds a toolchain target, starts a process or runs the simulator end to
+# end; `invoke test --fast` (pytest --fast) runs the others: unit and differential tests on
+# the host, what a developer runs on every change. The marks are kept true by a guard: a test
+# without the mark that starts a process fails (in its body on every run; in its fixtures too
+# under --fast, where session fixtures are not shared with system tests).
+
+SYSTEM_MARKS = ("system", "qemu", "s51", "slow")  # each implies the system tier
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line("markers", "system: builds a toolchain target, starts a process or runs the "
+                            "simulator end to end (not in the fast tier: invoke test --fast)")
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--fast", action="store_true",
+                     help="the fast tier: deselect `system` tests (toolchains, processes, simulator runs)")
+
+
+def is_system(item: pytest.Item) -> bool:
+    return any(item.get_closest_marker(m) is not None for m in SYSTEM_MARKS)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if not config.getoption("--fast"):
+        return
+    keep = [it for it in items if not is_system(it)]
+    gone = [it for it in items if is_system(it)]
+    if gone:
+        config.hook.pytest_deselected(items=gone)
+        items[:] = keep
+
+
+class _ProcessGuard:
+    """While active, every way of starting a process raises: the fork/exec primitives
+    under subprocess, multiprocessing, pty and os.system."""
+
+    NAMES = ((subprocess, "_fork_exec"), (_posixsubprocess, "fork_exec"), (os, "fork"), (os, "forkpty"),
+             (os, "posix_spawn"), (os, "posix_spawnp"), (os, "system"))
+
+    def __init__(self, item: pytest.Item) -> None:
+        self.item = item
+        self.saved: list[tuple[object, str, object]] = []
+
+    def refuse(self, *args: object, **kwargs: object) -> None:
+        raise RuntimeError(f"{self.item.nodeid} starts a process but is not marked system: add "
+                           "@pytest.mark.system (tests/conftest.py, test tiers)")
+
+    def __enter__(self) -> None:
+        for mod, name in self.NAMES:
+            if hasattr(mod, name):
+                self.saved.append((mod, name, getattr(mod, name)))
+                setattr(mod, name, self.refuse)
+
+    def __exit__(self, *exc: object) -> None:
+        for mod, name, orig in self.saved:
+            setattr(mod, name, orig)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_setup(item: pytest.Item):
+    if item.config.getoption("--fast") and not is_system(item):
+        with _ProcessGuard(item):
+            return (yield)
+    return (yield)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item: pytest.Item):
+    if is_system(item):
+        return (yield)
+    with _ProcessGuard(item):
+        return (yield)
 
 
 @pytest.fixture(scope="session")

@@ -12,6 +12,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, require_target
 
+pytestmark = pytest.mark.system  # builds and runs the spidev HAL programs
+
 PLATFORM = ROOT / "csrc" / "platform" / "linux"
 TEST_SRC = PLATFORM / "tests" / "test_ad7927_spidev.c"
 

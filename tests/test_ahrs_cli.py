@@ -26,9 +26,9 @@ def test_csv_with_reference(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     # ideal sensors (1e-3 noise), aligned from the first sample: well under 1°
     assert summary["errors_deg"]["total"] < 1.0
-    a = np.loadtxt(out / "attitude.csv", delimiter=",", skiprows=1)
+    a = np.loadtxt(out / "attitude.csv", delimiter=",", skiprows=2)  # the frames line, the header
     assert a.shape == (500, 8)
-    assert (out / "errors.json").is_file() and not (out / "errors.png").exists()
+    assert (out / "summary.json").is_file() and not (out / "attitude.png").exists()
 
 
 def test_errors_are_one_line(tmp_path, capsys):

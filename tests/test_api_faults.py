@@ -164,6 +164,7 @@ def test_batch_functions_bit_identical_under_8_threads(precision: str) -> None:
             assert np.array_equal(a, b)
 
 
+@pytest.mark.system
 def test_shared_integrator_is_consistent_under_8_threads() -> None:
     """One Integrator fed by 8 threads: before the lock this corrupted the
     heap (free(): invalid pointer: one thread sized its output for the frame

@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 from conftest import require_target, require_tools
 
+pytestmark = pytest.mark.system  # builds and runs attitude-rx against pty links
+
 SCALE = (90.0 * math.pi / 180.0) / 2048.0  # the app's default rad/s per code
 PERIOD = 0.01
 

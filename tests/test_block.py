@@ -21,7 +21,14 @@ from hypothesis import strategies as st
 from attitude_c.errors import BlockFormatError, InvalidArgument, InvalidType
 from attitude_c.link import block
 
-KINDS = ["boot", "selftest", "gave_up", "overrun", "adc_error", "oversample"]
+KINDS = ["boot", "selftest", "gave_up", "overrun", "adc_error", "oversample", "channels"]
+
+
+def _channels_ok(board: int, ch: int, acc: int, mag: int) -> bool:
+    """CHANNELS' fields by block.h's list: board 1 (gyros alone) or 2; gyros always; no bit
+    above the magnetometer's; a decimation exactly for each of accelerometer, magnetometer."""
+    return ((board == 2 or (board == 1 and ch == 1)) and ch & 1 == 1 and ch < 8
+            and (ch & 2 != 0) == (acc != 0) and (ch & 4 != 0) == (mag != 0))
 
 
 def _spec(raw: bytes) -> tuple[str, bool]:
@@ -37,7 +44,8 @@ def _spec(raw: bytes) -> tuple[str, bool]:
           "selftest": raw[2] >= 0x80 and w34 <= 4095,
           "gave_up": w45 != 0, "overrun": w45 != 0,
           "adc_error": raw[4] >= 0x80 and raw[5] == 0,
-          "oversample": 1 <= raw[2] <= 16 and raw[3:] == b"\0\0\0"}[kind]
+          "oversample": 1 <= raw[2] <= 16 and raw[3:] == b"\0\0\0",
+          "channels": _channels_ok(*raw[2:])}[kind]
     return kind, ok
 
 
@@ -109,7 +117,9 @@ def test_encoders_check_their_arguments() -> None:
 @settings(max_examples=3000, deadline=None)
 @given(st.binary(min_size=6, max_size=6) | st.builds(lambda k, t: bytes([0xFE, k]) + t,
                                                      st.integers(0, 7), st.binary(min_size=4, max_size=4))
-       | st.builds(lambda n: bytes([0xFE, 5, n, 0, 0, 0]), st.integers(0, 20)))
+       | st.builds(lambda n: bytes([0xFE, 5, n, 0, 0, 0]), st.integers(0, 20))
+       | st.builds(lambda *f: bytes([0xFE, 6, *f]), st.integers(0, 3), st.integers(0, 15),
+                   st.sampled_from([0, 1, 2, 255]), st.sampled_from([0, 1, 4, 255])))
 def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
     kind, ok = _spec(raw)
     rec, status = block.try_decode(raw)
@@ -126,7 +136,9 @@ def test_decoder_agrees_with_the_table_on_any_bytes(raw: bytes) -> None:
                  "gave_up": lambda: block.encode_loss("gave_up", rec.first, rec.count),
                  "overrun": lambda: block.encode_loss("overrun", rec.first, rec.count),
                  "adc_error": lambda: block.encode_adc_error(rec.first, rec.status),
-                 "oversample": lambda: block.encode_oversample(rec.oversample)}[rec.kind]()
+                 "oversample": lambda: block.encode_oversample(rec.oversample),
+                 "channels": lambda: block.encode_channels(rec.board, rec.channels,  # type: ignore[arg-type]
+                                                           rec.acc_every, rec.mag_every)}[rec.kind]()
         assert again == raw
 
 
@@ -188,19 +200,77 @@ def test_oversampled_stream_keeps_the_sums() -> None:
     assert tr.oversample == 1
 
 
+def test_channels_report_announces_the_aided_stream() -> None:
+    """CHANNELS (block.h): board, channel set, decimations, in the bytes of the table."""
+    assert block.encode_channels("aided9", ["gyr", "acc", "mag"], 1, 4) == bytes.fromhex("fe0602070104")
+    assert block.encode_channels("gyro3", ["gyr"]) == bytes.fromhex("fe0601010000")
+    assert block.encode_channels("aided9", ["gyr", "mag"], 0, 2) == bytes.fromhex("fe0602050002")
+    r = block.decode(bytes.fromhex("fe0602070104"))
+    assert (r.kind, r.board, r.channels, r.acc_every, r.mag_every) == (
+        "channels", "aided9", ("gyr", "acc", "mag"), 1, 4)
+    assert r.as_dict() == {"report": "CHANNELS", "board": "aided9", "channels": ["gyr", "acc", "mag"],
+                           "acc_every": 1, "mag_every": 4}
+    with pytest.raises(BlockFormatError, match="report field out of range"):
+        block.decode(bytes.fromhex("fe0601030100"))  # a gyro3 board with an accelerometer
+    for args, msg in [(("aided8", ["gyr"]), "board must be one of"),
+                      (("aided9", ["acc"], 1), "must include 'gyr'"),
+                      (("aided9", ["gyr", "baro"]), "channels must be among"),
+                      (("gyro3", ["gyr", "acc"], 1), "'gyro3' board has the gyros alone"),
+                      (("aided9", ["gyr", "acc"], 0), "acc_every must be 1..255, got 0"),
+                      (("aided9", ["gyr", "acc"], 256), "acc_every must be 1..255, got 256"),
+                      (("aided9", ["gyr"], 0, 3), "mag_every must be 0 when 'mag' is not in channels")]:
+        with pytest.raises(InvalidArgument, match=msg):
+            block.encode_channels(*args)  # type: ignore[arg-type]
+    with pytest.raises(InvalidType, match="sequence of names"):
+        block.encode_channels("aided9", "gyr")  # type: ignore[arg-type]
+
+
+def _aided_group(n: int, acc_every: int, mag_every: int) -> list[tuple[str, int]]:
+    """(part, sample) of the records of sample n, from block.h's rule for groups."""
+    return ([("gyr", n)] + ([("acc", n)] if n % acc_every == 0 else [])
+            + ([("mag", n)] if n % mag_every == 0 else []))
+
+
+def test_tracker_places_every_record_of_an_aided_stream() -> None:
+    """Sample n = its gyro record, then accelerometer (n % acc_every == 0), then magnetometer
+    (n % mag_every == 0); losses count whole samples; a report inside a group cuts it short."""
+    rec = block.encode_sample([1, 2, 3])
+    head = [block.encode_boot(36, 57600, "v2"), block.encode_channels("aided9", ["gyr", "acc", "mag"], 2, 3)]
+    want = [g for n in range(7) for g in _aided_group(n, 2, 3)]
+    out = block.number_stream(head + [rec] * len(want) + [block.encode_loss("overrun", 7, 2), rec])
+    assert out[1][0].as_dict()["acc_every"] == 2
+    assert [(sp.part, sp.first) for _, sp in out[2:-2]] == want
+    assert [(sp.first, sp.count, sp.part) for _, sp in out[-2:]] == [(7, 2, "gyr"), (9, 1, "gyr")]
+    # sample 6's group (gyr, acc, mag) cut after its gyro record: E_SEQ naming the record due
+    cut = head + [rec] * (len(want) - 2) + [block.encode_loss("gave_up", 7, 1)]
+    with pytest.raises(BlockFormatError, match=r"record \d+ .*report out of sequence \(it cut sample 6's group "
+                                               r"short before its acc record\)"):
+        block.number_stream(cut)
+    out = block.number_stream(cut + [rec], strict=False)
+    assert [(sp.first, sp.count, sp.slip, sp.part) for _, sp in out[-3:]] == [
+        (6, 1, 0, "gyr"), (7, 1, 0, "acc"), (8, 1, 0, "gyr")]
+    tr = block.SeqTracker()
+    for raw in head + [rec]:
+        tr.decode(raw)
+    assert (tr.channels, tr.acc_every, tr.mag_every, tr.part, tr.next) == (("gyr", "acc", "mag"), 2, 3, "acc", 1)
+    tr.decode(head[0])  # a BOOT: gyro-only again
+    assert (tr.channels, tr.acc_every, tr.mag_every, tr.part) == (("gyr",), 0, 0, "gyr")
+
+
 # -- the 8051 side ------------------------------------------------------------------
 
 SDCC = ["sdcc", "-mmcs51", "--model-small", "--iram-size", "128", "--xram-size", "0", "--std-c99", "--Werror",
         "-DATT_REAL_F32", f"-I{ROOT / 'csrc' / 'include'}"]
 
 
+@pytest.mark.system
 def test_block_sources_compile_for_the_8051_and_the_encoders_stay_small(tmp_path: Path) -> None:
-    """block.c (what the firmware links), block_decode.c and block_sums.c compile warning-free with SDCC;
-    the encoders are leaf functions whose parameters SDCC overlays: no RAM of their own,
-    and code small enough for the 4 KB image (294 bytes when written)."""
+    """block.c (what the firmware links), block_channels.c (what the aided firmware adds), block_decode.c
+    and block_sums.c compile warning-free with SDCC; the encoders are leaf functions whose parameters
+    SDCC overlays: no RAM of their own, and code small enough for the 4 KB image (294 bytes when written)."""
     require_tools("sdcc", apt="sdcc")
     segs = {}
-    for src in ("block.c", "block_decode.c", "block_sums.c"):
+    for src in ("block.c", "block_channels.c", "block_decode.c", "block_sums.c"):
         rel = tmp_path / src.replace(".c", ".rel")
         proc = subprocess.run([*SDCC, "-c", str(ROOT / "csrc" / "src" / src), "-o", str(rel)],
                               capture_output=True, text=True, timeout=120, check=False)
@@ -211,6 +281,8 @@ def test_block_sources_compile_for_the_8051_and_the_encoders_stay_small(tmp_path
     assert enc["DSEG"] == 0, enc
     assert enc["OSEG"] <= 8, enc
     assert enc["CSEG"] <= 320, f"block.c grew to {enc['CSEG']} bytes of 8051 code"
+    ch = segs["block_channels.c"]
+    assert ch.get("DSEG", 0) == 0 and ch.get("OSEG", 0) <= 8, ch
 
 
 def test_the_format_is_written_down_once() -> None:

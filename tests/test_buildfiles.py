@@ -17,6 +17,8 @@ from conftest import ROOT, require_target, require_tools
 from toolchain import buildfiles
 from toolchain import targets as T
 
+pytestmark = pytest.mark.system  # configures and builds with make and CMake
+
 # Flags each build system adds on its own (the language level and warnings),
 # besides include paths and defines: not target flags.
 OWN_FLAGS = {"-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror", "--std-c99", "--Werror"}

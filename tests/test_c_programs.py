@@ -18,6 +18,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, require_target
 
+pytestmark = pytest.mark.system  # builds and runs the C test programs (sanitizers, every compiler)
+
 C_TESTS = sorted((ROOT / "csrc" / "tests").glob("test_*.c"))
 INCLUDE_DIRS = [ROOT / "csrc" / "host", ROOT / "csrc" / "tests"]
 _ARCHIVES: dict[tuple[str, str], Path] = {}

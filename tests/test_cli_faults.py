@@ -72,6 +72,7 @@ def _read_one_line_then_close(proc: subprocess.Popen) -> bytes:
     return line
 
 
+@pytest.mark.system
 def test_link_tx_into_a_closed_pipe_ends_quietly() -> None:
     with PtyPair() as (p0, p1):
         stop = threading.Event()
@@ -93,6 +94,7 @@ def test_link_tx_into_a_closed_pipe_ends_quietly() -> None:
     assert "Traceback" not in err and "BrokenPipe" not in err and "Exception ignored" not in err, err
 
 
+@pytest.mark.system
 def test_link_rx_into_a_closed_pipe_ends_quietly() -> None:
     with PtyPair() as (p0, p1):
         rx = subprocess.Popen([sys.executable, "-m", "attitude_c", "link-rx", "--port", p1],
@@ -114,12 +116,14 @@ def test_link_rx_into_a_closed_pipe_ends_quietly() -> None:
     assert "Traceback" not in err and "BrokenPipe" not in err and "Exception ignored" not in err, err
 
 
+@pytest.mark.system
 def test_stdout_on_a_full_device_is_one_line() -> None:
     with open("/dev/full", "w") as full:
         proc = _attitude("link-test", "--blocks", "50", "--json", stdout=full, stderr=subprocess.PIPE)
     _one_line(proc, EXIT_OS, "No space left on device", "standard output")
 
 
+@pytest.mark.system
 def test_port_that_does_not_exist_is_one_line() -> None:
     proc = _attitude("link-rx", "--port", "/dev/nonexistent-attitude-port")
     assert proc.returncode == EXIT_OS and "Traceback" not in proc.stderr
@@ -127,6 +131,7 @@ def test_port_that_does_not_exist_is_one_line() -> None:
 
 # ---- item 6: the output location checked first; results complete or absent ----
 
+@pytest.mark.system
 def test_simulate_out_is_a_file_fails_before_simulating(tmp_path: Path) -> None:
     f = tmp_path / "results"
     f.write_text("not a directory\n")
@@ -135,11 +140,13 @@ def test_simulate_out_is_a_file_fails_before_simulating(tmp_path: Path) -> None:
     _one_line(proc, EXIT_OS, str(f), "not a directory")
 
 
+@pytest.mark.system
 def test_simulate_out_on_dev_full_is_one_line() -> None:
     proc = _attitude(*SIM, "--duration", "100000", "--out", "/dev/full", timeout=30)
     _one_line(proc, EXIT_OS, "/dev/full")
 
 
+@pytest.mark.system
 def test_simulate_unwritable_dir_fails_before_simulating(tmp_path: Path) -> None:
     if os.geteuid() == 0:  # root writes through permissions: a read-only filesystem instead
         ctx: contextlib.AbstractContextManager[Path] = _tmpfs(tmp_path / "ro", "ro,size=64k")
@@ -152,6 +159,7 @@ def test_simulate_unwritable_dir_fails_before_simulating(tmp_path: Path) -> None
     _one_line(proc, EXIT_OS, str(d / "run"))
 
 
+@pytest.mark.system
 def test_simulate_on_a_full_filesystem_leaves_complete_files_or_none(tmp_path: Path) -> None:
     with _tmpfs(tmp_path / "small", "size=64k") as d:
         out = d / "run"
@@ -254,6 +262,7 @@ def test_numeric_option_rejects_nan_and_garbage(cmd: str, option: str, kind: str
 
 @pytest.mark.parametrize("argv", [["--duration", "nan"], ["--count", "-5"], ["--duration", "-5"],
                                   ["--idle-eof", "-1"]], ids=lambda a: " ".join(a))
+@pytest.mark.system
 def test_link_rx_bad_limits_are_usage_errors_not_a_run(argv: list[str]) -> None:
     # before: --duration nan never ended; the others exited 0 at once
     proc = _attitude("link-rx", "--port", "loop://", *argv, timeout=20)

@@ -31,6 +31,8 @@ from conftest import ROOT, clean_copy, require_target, require_tools
 from attitude_c._build import version as attitude_version
 from toolchain import armv4t_check
 
+pytestmark = pytest.mark.system  # builds consumer projects against installed packages
+
 CONSUMER = ROOT / "tests" / "consumer"
 # q = [cos(0.015), 0, 0, sin(0.015)] to 6 decimals (the same in float and double)
 Q_TEXT = "q=0.999888 0.014999"

@@ -13,6 +13,8 @@ from conftest import ROOT, require_target, require_tools
 from toolchain import armv4t_check
 from toolchain.tasks.cross import cross_build_target
 
+pytestmark = pytest.mark.system  # cross-builds the library and attitude-rx, runs them under qemu
+
 # A small user program: what a mini2440 application does with the library (the
 # consumer project's, tests/consumer/main.c).
 EXAMPLE_C = (ROOT / "tests" / "consumer" / "main.c").read_text()

@@ -15,6 +15,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, require_target
 
+pytestmark = pytest.mark.system  # builds and runs ARMv4T bare-metal targets under qemu
+
 C_TESTS = sorted((ROOT / "csrc" / "tests").glob("test_*.c"))
 # test_integrator's long runs (10^6 updates) take ~30 s per build on the emulated core: run it
 # in float only (the soft-float build the ARM920T cares about); the double integrator is

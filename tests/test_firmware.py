@@ -21,6 +21,8 @@ from conftest import require_target, require_tools
 
 from toolchain import firmware as tool
 
+pytestmark = pytest.mark.system  # builds the firmware and runs it in s51
+
 #: Stack margin we require in the production RAM layout: the highest SP
 #: s51 sees running the bench image (production code, RAM layout and call
 #: depth) must leave at least this many bytes below 0x80.

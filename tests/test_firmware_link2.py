@@ -28,6 +28,8 @@ from conftest import require_target, require_tools
 
 from toolchain import firmware as tool
 
+pytestmark = pytest.mark.system  # runs the link v2 firmware in s51
+
 #: Stack the v2 sim image uses at most in s51 (SP starts at 0x65; max SP 0x76 measured
 #: with both hosts below) plus the margin tests/test_firmware.py requires (4 bytes).
 V2_STACK = 0x76 - 0x65
@@ -58,39 +60,9 @@ def test_both_link_builds_fit_the_at89s51(out: Path) -> None:
 
 
 def _run_v2(img: tool.Image, timeout: float, late: bool = False) -> tuple[tool.SimOutput, list[bytes], dict[str, int]]:
-    """Run a v2 sim image against the Python receiver; (firmware output, records, receiver stats).
-
-    ``late``: once records flow, the receiver holds its answers back until the firmware has
-    sent a frame again (its retransmission timeout ran out), then sends them: what a host
-    descheduled on a loaded machine does, made certain by waiting for the event."""
-    import serial  # pyserial
-
-    from attitude_c.link.v2 import Receiver2, Result2
-
-    room = 64
-    rx = Receiver2(room=room)
-    got: list[bytes] = []
-    held = bytearray()
-    with tool.Session(img, timeout) as sess:
-        port = serial.Serial(str(sess.port), img.config.baud, timeout=0.005)
-
-        def pump() -> None:
-            for b in port.read(max(1, port.in_waiting)):
-                if rx.sink(b) == Result2.DELIVERED:
-                    got.extend(rx.delivered)
-                    rx.set_room(room)  # the test keeps up with any rate: the room never shrinks
-            while True:
-                res, byte = rx.poll()
-                if res != Result2.SEND or byte is None:
-                    break
-                held.append(byte)
-            if held and not (late and got and rx.stats.duplicates == 0):
-                port.write(bytes(held))
-                held.clear()
-
-        fw = sess.run(pump=pump)
-        port.close()
-    return fw, got, rx.stats.as_dict()
+    """Run a v2 sim image against the Python receiver; (firmware output, records, receiver stats)."""
+    res = tool.run_v2(img, "python", timeout=timeout, late=late)
+    return res, res.records, res.receiver
 
 
 def _assert_every_record_once_in_order(img: tool.Image, fw: tool.SimOutput, recs: list[bytes],

@@ -24,6 +24,8 @@ from conftest import ROOT, require_target
 
 from toolchain.fixed_harness import KERNEL_SIZES, KERNEL_UPDATES, KERNELS, replay, s51_kernel_run
 
+pytestmark = pytest.mark.system  # builds the fixed-point code for every target
+
 SRC = ROOT / "csrc" / "src"
 FIXED_SOURCES = sorted(SRC.glob("fixed*.c"))
 # the vectors program uses the fixed-point module only

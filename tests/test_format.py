@@ -14,6 +14,8 @@ from conftest import ROOT
 # and the consumer project.
 from toolchain.tasks.core import C_FORMAT_GLOBS as C_GLOBS
 
+pytestmark = pytest.mark.system  # runs clang-format
+
 
 def c_files() -> list[Path]:
     out: set[Path] = set()

@@ -18,6 +18,8 @@ from attitude_c.link.sim2 import record
 from attitude_c.link.transport import PtyPair, SocketRelay, open_port
 from attitude_c.link.transport2 import run_receiver2, run_sender2
 
+pytestmark = pytest.mark.system  # runs link v2 ends over pty pairs in processes
+
 PAIRS = list(itertools.product(("c", "python"), ("c", "python")))
 PAIR_IDS = [f"{a}-to-{b}" for a, b in PAIRS]
 

@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 from conftest import ROOT, require_tools
 
+pytestmark = pytest.mark.system  # compiles the link sources with SDCC and gcc
+
 SDCC_FLAGS = ["-mmcs51", "--model-small", "--iram-size", "128", "--xram-size", "0", "--std-c99",
               "--Werror", "-DATT_REAL_F32", f"-I{ROOT / 'csrc' / 'include'}"]
 FUZZ_SECONDS = 10  # CI smoke run per target; `invoke fuzz --seconds N` for longer runs (docs/link.md)

@@ -22,6 +22,8 @@ from attitude_c.errors import LinkError
 from attitude_c.link import ChannelConfig
 from attitude_c.link.transport import PtyPair, SocketRelay, open_port, run_receiver, run_sender
 
+pytestmark = pytest.mark.system  # runs link ends over pty pairs in processes
+
 PAIRS = list(itertools.product(("c", "python"), ("c", "python")))
 PAIR_IDS = [f"{a}-to-{b}" for a, b in PAIRS]
 BLOCKS = [bytes([i, 0xAA, i ^ 0x55, 0xBB, 0xFF - i, 0x00]) for i in range(25)]

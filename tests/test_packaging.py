@@ -24,6 +24,8 @@ from pathlib import Path
 import pytest
 from conftest import _missing, clean_copy
 
+pytestmark = pytest.mark.system  # builds the sdist and wheel, installs into a fresh venv
+
 # Every module the smoke test must import from the installed wheel: all
 # modules of the package whose dotted name has no part starting with "_".
 _IMPORT_ALL = r"""

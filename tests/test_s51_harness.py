@@ -14,6 +14,8 @@ from conftest import ROOT, require_target
 
 from toolchain import s51
 
+pytestmark = pytest.mark.system  # runs s51
+
 HERE = ROOT / "tests" / "s51"
 
 

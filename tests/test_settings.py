@@ -81,6 +81,7 @@ def test_the_domain_error_names_the_bad_setting() -> None:
     assert thesis_ekf.run(g, a, m, rate=100.0, gn_max_iter=1000).q.shape == (5, 4)
 
 
+@pytest.mark.system
 def test_importing_the_filters_loads_no_extension() -> None:
     code = ("import sys, attitude_c.ahrs_filter, attitude_c.thesis_ekf\n"
             "assert not [m for m in sys.modules if m.startswith('attitude_c._att_')], sys.modules")

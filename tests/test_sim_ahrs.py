@@ -131,6 +131,7 @@ def test_default_run_is_still_the_integrator() -> None:
     assert cfg.estimator == "integrator" and "estimator" not in cfg.params()
 
 
+@pytest.mark.system
 def test_cli_options_reach_the_filter(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "run"
     rc = main(["simulate", "--trajectory", "static", "--duration", "4", "--adc", "ideal", "--link", "none",

@@ -20,6 +20,10 @@ from __future__ import annotations
 
 from toolchain.ahrs_acceptance import SHORT, TARGETS, bias_step, disturbance, static, turntable
 
+import pytest
+
+pytestmark = pytest.mark.system  # runs the simulator's acceptance scenarios
+
 
 def test_static_tilt_is_the_accelerometers() -> None:
     """Roll and pitch within 0.05° of the tilt the accelerometer's own errors

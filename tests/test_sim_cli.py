@@ -14,6 +14,8 @@ import pytest
 
 from attitude_c.cli import main
 
+pytestmark = pytest.mark.system  # runs attitude simulate end to end
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -23,6 +25,7 @@ def _env() -> dict[str, str]:
     return env
 
 
+@pytest.mark.system
 def test_help_lists_the_options() -> None:
     r = subprocess.run([sys.executable, "-m", "attitude_c", "simulate", "--help"],
                        capture_output=True, text=True, env=_env(), cwd=ROOT, timeout=60,
@@ -55,6 +58,87 @@ def test_default_run_writes_every_output(tmp_path, capsys) -> None:
         img = mpimg.imread(out / png)
         assert img.ndim == 3 and img.shape[0] > 300 and img.shape[1] > 500
         assert np.std(img) > 0.01  # not blank
+
+
+def _noisy(x: float) -> bool:
+    """A float printed with float64's rounding noise: 15 or more significant digits in
+    its repr that round, at 12, to a short decimal (29.999999999999996, 46.900000000000006)."""
+    import re
+
+    def digits(v: float) -> int:
+        return len(re.sub(r"[^0-9]", "", repr(v).split("e")[0]).strip("0"))
+
+    return digits(x) >= 15 and digits(float(f"{x:.12g}")) <= 8
+
+
+def _floats(x, path=""):
+    if isinstance(x, dict):
+        for k, v in x.items():
+            yield from _floats(v, f"{path}.{k}")
+    elif isinstance(x, list):
+        for i, v in enumerate(x):
+            yield from _floats(v, f"{path}[{i}]")
+    elif isinstance(x, float):
+        yield path, x
+
+
+def test_errors_in_degrees_beside_radians_units_in_the_csv_names_no_float_noise(tmp_path, capsys,
+                                                                                   monkeypatch) -> None:
+    """The table and errors.png give each error in degrees beside radians; every CSV column
+    name ends in its unit (the degree columns are the radian ones converted); the summary's
+    numbers carry no float64 rounding noise (the paper's 30° amplitude stays 30.0)."""
+    import math
+
+    from matplotlib.figure import Figure
+
+    figures = []
+    save = Figure.savefig
+
+    def keep(fig, *a, **k):
+        fig.canvas.draw()  # the secondary axes take their limits at draw time
+        figures.append(fig)
+        return save(fig, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", keep)
+    out = tmp_path / "run"
+    assert main(["simulate", "--duration", "8", "--adc", "ideal", "--calibration", "1", "--accel", "adxl202",
+                 "--no-progress", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert [p for p, x in _floats(summary) if _noisy(x)] == []
+    tr = summary["parameters"]["trajectory"]
+    assert tr["amplitude_deg"] == [30.0, 20.0, 25.0] and tr["phase_deg"] == [0.0, 30.0, 60.0]
+    assert summary["parameters"]["environment"]["inclination_deg"] == 46.9
+    assert summary["elapsed_s"] == round(summary["elapsed_s"], 3)  # a wall time, to the millisecond
+    # the table: max, min, RMS in rad then in degrees (3 significant digits)
+    head = next(ln for ln in text.splitlines() if ln.startswith("error"))
+    assert head.split()[1:8] == ["max", "rad", "min", "rad", "RMS", "rad", "max"]
+    for key in ("heading", "pitch", "roll", "attitude_angle"):
+        row = next(ln for ln in text.splitlines() if ln.startswith(key + " ")).split()
+        e = summary["errors_rad"][key]
+        assert [float(v) for v in row[1:4]] == [float(f"{e[k]:.3e}") for k in ("max", "min", "rms")]
+        assert [float(v) for v in row[4:7]] == [float(f"{math.degrees(e[k]):.3g}") for k in ("max", "min", "rms")]
+    # the CSV files: units in every name; the degrees are the radians converted
+    with open(out / "timeseries.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    names = list(rows[0])
+    assert [n for n in names if not n.endswith(("_s", "_rad", "_deg")) and not n.startswith("q")] == []
+    for e in ("yaw", "pitch", "roll", "heading", "angle"):
+        rad = np.array([float(r[f"err_{e}_rad"]) for r in rows])
+        deg = np.array([float(r[f"err_{e}_deg"]) for r in rows])
+        np.testing.assert_allclose(deg, np.degrees(rad), rtol=1e-11, atol=0)  # 13 digits printed in each
+    with open(out / "sensors.csv") as fh:
+        head = next(csv.reader(fh))
+    assert head[:3] == ["sample", "t_start_s", "t_mid_s"]
+    assert all(n.endswith(("_rad_s", "_m_s2")) for n in head[3:]), head
+    # errors.png: each panel's error axis in rad with the same axis in degrees on its right
+    errs = next(f for f in figures if f.texts and f.texts[0].get_text().startswith("Attitude error curves"))
+    for ax in errs.axes:
+        assert ax.get_ylabel() == "error / rad"
+        (deg_ax,) = ax.child_axes
+        assert deg_ax.get_ylabel() == "error / °"
+        np.testing.assert_allclose(deg_ax.get_ylim(), np.degrees(ax.get_ylim()), rtol=1e-12)
+        assert "°" in ax.get_title(loc="right")
 
 
 def test_seed_reproducible(tmp_path) -> None:

@@ -15,6 +15,8 @@ import pytest
 from attitude_c.cli import main
 from attitude_c.cli.simulate import build_config, register
 
+pytestmark = pytest.mark.system  # runs attitude simulate end to end
+
 
 def _args(*argv: str) -> argparse.Namespace:
     p = argparse.ArgumentParser()
@@ -72,12 +74,13 @@ def test_sensors_end_to_end_write_the_streams_and_truth(tmp_path, capsys) -> Non
         rows = list(csv.DictReader(fh))
     assert len(rows) == 75
     cols = set(rows[0])
-    for c in ("accel_x", "accel_true_z", "mag_y", "mag_true_x", "mag_disturbance_x", "gyro_z", "gyro_true_y"):
+    for c in ("accel_x_m_s2", "accel_true_z_m_s2", "mag_y_ut", "mag_true_x_ut", "mag_disturbance_x_ut",
+              "gyro_z_rad_s", "gyro_true_y_rad_s"):
         assert c in cols
-    m = np.array([[float(r[f"mag_true_{a}"]) for a in "xyz"] for r in rows])
+    m = np.array([[float(r[f"mag_true_{a}_ut"]) for a in "xyz"] for r in rows])
     # the period mean of a 48 µT vector turning at ω is shorter by ≈ (ωh)²/24: ≤ 3e-4 at ω ≤ 1.1 rad/s
     np.testing.assert_allclose(np.linalg.norm(m, axis=1), 48.0, rtol=5e-4)
-    f = np.array([[float(r[f"accel_{a}"]) - float(r[f"accel_true_{a}"]) for a in "xyz"] for r in rows])
+    f = np.array([[float(r[f"accel_{a}_m_s2"]) - float(r[f"accel_true_{a}_m_s2"]) for a in "xyz"] for r in rows])
     assert np.abs(f).max() < 1.0  # ADIS16488: 16 mg bias, 0.5 % scale of ≤ 13 m/s², 0.035°: ≪ 1 m/s²
 
 

@@ -15,6 +15,10 @@ from toolchain import firmware as tool  # registers the "s51" source
 from toolchain.firmware import FirmwareTrajectory
 from toolchain.simulate import main
 
+import pytest
+
+pytestmark = pytest.mark.system  # runs the firmware's trajectory through the simulator and s51
+
 # cg-l53 through the default conditioning: 90 °/s ↔ 0.9 · 2048 codes
 K = 90.0 * DEG / (0.9 * 2048)
 

@@ -22,6 +22,7 @@ def res() -> Any:
     return simulate(SimConfig(adc=AdcModel(backend="ideal"), link="none", duration=2.0))
 
 
+@pytest.mark.system
 def test_one_rename_per_result_file(res: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     renames: list[tuple[Path, Path]] = []
     real = os.replace

@@ -172,6 +172,120 @@ method = "rk4"
         (5.0, 8.0, (20.0, 0.0, 0.0), 0.0, "body"), (12.0, 14.0, (0.0, 10.0, 0.0), 1.0, "nav")]
 
 
+CUT = """
+[sweep]
+seeds = 3
+[fixed]
+duration = 4
+calibration = 1
+adc = "ideal"
+[grid]
+method = ["rv1", "rv3"]
+period = [0.02, 0.04]
+[random]
+draws = 2
+ber = {log_uniform = [1e-6, 1e-4]}
+attempts = {int = [2, 9]}
+"""
+
+
+def test_set_seeds_and_limit_cut_a_spec_down_without_editing_it(tmp_path, capsys):
+    """--set pins a parameter over the grid and the draws (the other draws unchanged),
+    --seeds replaces the seed list, --limit keeps the first runs in spec order; each
+    goes through the spec's own checks, and an error names the key."""
+    spec = _write(tmp_path, CUT)
+    full = sweeps.load_spec(spec)
+    assert len(full.runs) == 2 * 2 * 2 * 3 and full.axes == ["method", "period", "attempts", "ber"]
+    cut = sweeps.load_spec(spec, sets={"period": 0.01, "ber": 0.0})
+    assert len(cut.runs) == 2 * 2 * 3 and cut.axes == ["method", "attempts"] and cut.random_axes == ["attempts"]
+    assert {(r.params["period"], r.params["ber"]) for r in cut.runs} == {(0.01, 0.0)}
+    # the draws of the parameters left are those of the whole spec (every draw is still made)
+    assert [r.params["attempts"] for r in cut.runs] == [r.params["attempts"] for r in full.runs
+                                                        if r.params["period"] == 0.02]
+    assert [r.params["seed"] for r in sweeps.load_spec(spec, seeds=[7]).runs] == [7] * 8
+    assert {r.params["seed"] for r in sweeps.load_spec(spec, seeds=2).runs} == {0, 1}
+    assert sweeps.load_spec(spec, limit=3).axes == []  # the first point's first draw over the 3 seeds
+    first = sweeps.load_spec(spec, limit=4)
+    assert [r.key for r in first.runs] == [r.key for r in full.runs[:4]]
+    assert first.axes == ["attempts", "ber"]  # ... and the second draw's first seed
+    for argv, line in [
+        (["--set", "perod=1"], "--set perod: not an option of attitude simulate"),
+        (["--set", "period=-1"], "--set period: --period: must be a finite number > 0, got '-1'"),
+        (["--set", "method=rv9"], "--set method: argument --method: invalid choice: 'rv9'"),
+        (["--set", "seed=3"], "--set seed: the sweep sets the seed"),
+        (["--set", "sensors=ideal"], "needs the sensor chain"),  # with the spec's ber: the combination check
+        (["--set", "period"], "argument --set: --set expects NAME=VALUE, got 'period'"),
+        (["--seeds", "0"], "argument --seeds: give a count >= 1 or a list of integers >= 0"),
+        (["--seeds", "1,x"], "argument --seeds: give a count >= 1"),
+        (["--limit", "0"], "argument --limit: must be"),
+    ]:
+        try:
+            rc = main(["sweep", str(spec), "--dry-run", *argv])
+        except SystemExit as exc:  # argparse's own usage errors
+            rc = exc.code
+        err = capsys.readouterr().err.strip().splitlines()
+        assert rc == 2 and len(err) == 1 and line in err[0], (argv, err)
+    # the command: the cut spec runs, and the spec.toml left in the folder says how it was cut
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--serial", "--no-plots", "--no-progress", "--out", str(out),
+                 "--set", "duration=2", "--set", "method=rv3", "--seeds", "5,", "--limit", "3"]) == 0
+    import pandas as pd
+
+    df = pd.read_csv(out / "runs.csv")
+    assert len(df) == 3 and (df["duration"] == 2).all() and (df["method"] == "rv3").all()
+    assert (df["seed"] == 5).all() and (df["error"].isna()).all()
+    assert (out / "spec.toml").read_text().endswith(
+        '# run with: --set duration=2 --set method="rv3" --seeds [5] --limit 3\n')
+
+
+def _plot_table(spec):
+    """A table of the spec's runs with a known figure per run (no simulation): 1e-3 x the
+    run's index + 1, so every point's median over the seeds is known."""
+    import pandas as pd
+
+    rows = [{**r.params, "err_attitude_angle_rms": 1e-3 * (i + 1), "total_deg": 0.1 * (i + 1)}
+            for i, r in enumerate(spec.runs)]
+    return pd.DataFrame(rows)
+
+
+def test_plots_label_units_and_join_no_categories(tmp_path):
+    """A sweep's plot: axes labelled with their units; over a category (method) markers
+    and 5–95 % bars at the medians and no line between the categories; over a number
+    (period) a line through the medians."""
+    _need_dask()
+    import matplotlib.pyplot as plt
+
+    spec = sweeps.load_spec(_write(tmp_path, CUT), sets={"ber": 0.0, "attempts": 5})
+    df = _plot_table(spec)
+    fig = sweeps.plot_axis(df, spec, "method")
+    try:
+        axes = [ax for ax in fig.axes if ax.get_visible()]
+        assert len(axes) == 1  # one other swept parameter (period): one line each, no panels
+        ax = axes[0]
+        assert ax.get_xlabel() == "method" and ax.get_ylabel() == "err_attitude_angle_rms (rad)"
+        assert ax.lines and all(ln.get_linestyle() == "None" for ln in ax.lines)  # markers and caps only
+        assert not ax.collections or all(type(c).__name__ == "LineCollection" for c in ax.collections)  # bars
+        for period in (0.02, 0.04):
+            med = df[df["period"] == period].groupby("method", sort=False)["err_attitude_angle_rms"].median()
+            (bars,) = [c for c in ax.containers if c.get_label() == f"period={period}"]
+            np.testing.assert_allclose(bars.lines[0].get_ydata(), med.to_numpy(), rtol=1e-12)
+    finally:
+        plt.close(fig)
+    fig = sweeps.plot_axis(df, spec, "period")
+    try:
+        ax = fig.axes[0]
+        assert ax.get_xlabel() == "period (s)"
+        assert any(ln.get_linestyle() == "-" for ln in ax.lines)  # a number: the medians joined
+    finally:
+        plt.close(fig)
+    assert sweeps.unit_of(spec, "cone_angle") == "°" and sweeps.unit_of(spec, "cone_frequency") == "Hz"
+    assert sweeps.unit_of(spec, "turntable_rate") == "°/s" and sweeps.unit_of(spec, "ber") is None
+    assert sweeps.unit_of(spec, "field") is None  # µT and degrees: no one unit
+    assert sweeps.unit_of(spec, "link_time_s") == "s" and sweeps.unit_of(spec, "updates") is None
+    rec = sweeps.Spec(name="r", kind="recordings", runs=[], axes=[], random_axes=[], over=[], figure="total_deg")
+    assert sweeps.unit_of(rec, "total_deg") == "°" and sweeps.unit_of(rec, "estimator_bias_rad_s_2") == "rad/s"
+
+
 def test_every_simulate_option_is_sweepable_with_no_change_here(monkeypatch, capsys):
     """The option set is read from `attitude simulate`'s parser: an option added there
     (as the accelerometer/magnetometer options will be) can be swept as it is."""
@@ -296,6 +410,7 @@ def test_serial_reference_records_the_failing_run(reference):
     assert row["mean"] == pytest.approx(rv3.mean(), rel=1e-12) and row["min"] <= row["p50"] <= row["max"]
 
 
+@pytest.mark.system
 def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
     spec, ref = reference
     df = sweeps.sweep(spec, None, workers=2, out=tmp_path / "out")
@@ -310,6 +425,7 @@ def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
           ref.fillna({"error": ""}))
 
 
+@pytest.mark.system
 def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path, capsys):
     spec, ref = reference
     rc = main(["sweep", str(spec), "--scheduler", scheduler, "--out", str(tmp_path / "out"), "--no-plots"])
@@ -321,6 +437,7 @@ def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path,
     _same(df.fillna({"error": ""}), ref.fillna({"error": ""}))
 
 
+@pytest.mark.system
 def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tmp_path):
     from distributed import Client
 
@@ -351,6 +468,7 @@ def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tm
 # resume
 # ---------------------------------------------------------------------------
 
+@pytest.mark.system
 def test_interrupted_sweep_resumes_running_only_the_missing_runs(reference, scheduler, tmp_path):
     """The command is killed (SIGKILL: no clean-up at all) mid-sweep on the loopback
     cluster, then run again serially: only the runs it has no record of run."""
@@ -442,6 +560,9 @@ precision = ["f64", "f32"]
 method = "rk4"
 precision = "f32"
 """)
+        one = sweeps.load_spec(spec, sets={"trial": "const_z", "method": "rv3"})  # --set: one trial, one method
+        assert [(r.params["trial"], r.params["method"], r.params["precision"]) for r in one.runs] == [
+            ("const_z", "rv3", "f64"), ("const_z", "rv3", "f32")]
         df = sweeps.sweep(spec, "serial", out=tmp_path / "out", plots=False)
         assert len(df) == 2 * 5 and (df["error"] == "").all()
         # constant rate: every method is exact up to rounding; the trapezoid of a constant rate is exact

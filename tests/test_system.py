@@ -30,6 +30,8 @@ from attitude_c.reference import quat_angle as quat_angle_between
 from toolchain import firmware as tool
 from toolchain.firmware import FirmwareTrajectory
 
+pytestmark = pytest.mark.system  # runs the firmware in s51 into attitude-rx
+
 H_TICKS = 72  # the firmware's default sampling period: 20 ms
 H = H_TICKS / tool.TICK_HZ
 #: X, Y: quadrature pair about mid-scale, ±1024 LSB (shift 1), 2 cycles per 256 samples

@@ -178,6 +178,7 @@ def test_bench_output_lag_recovers_a_known_lag(d):
     assert after < 0.01 * before
 
 
+@pytest.mark.system
 def test_bench_smoke():
     """bench/broad_timing.py's output prediction (item 5) on two BROAD trials (the full run:
     invoke bench --only broad_timing): an output turned forward by d — VQF's by the module's

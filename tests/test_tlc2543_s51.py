@@ -16,6 +16,10 @@ from conftest import ROOT, require_target
 
 from toolchain import s51
 
+import pytest
+
+pytestmark = pytest.mark.system  # builds the TLC2543 driver with SDCC and runs it in s51
+
 DRIVER = ROOT / "csrc" / "src" / "tlc2543.c"
 
 

@@ -10,6 +10,10 @@ from pathlib import Path
 
 from conftest import ROOT, _missing
 
+import pytest
+
+pytestmark = pytest.mark.system  # runs mypy
+
 SNIPPET = '''\
 import numpy as np
 import attitude_c as ac

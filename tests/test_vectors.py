@@ -19,6 +19,8 @@ from conftest import ROOT, require_target
 
 from toolchain import vectors as V
 
+pytestmark = pytest.mark.system  # builds and runs the test-vector programs on every target
+
 
 @pytest.fixture(scope="module")
 def vector_file(tmp_path_factory: pytest.TempPathFactory) -> tuple[list[V.Case], Path]:

@@ -11,6 +11,7 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
+import pytest
 from conftest import ROOT, require_tools
 
 import attitude_c
@@ -55,6 +56,7 @@ def test_python_and_the_compiled_libraries_agree() -> None:
     assert metadata.version("attitude-c") == want
 
 
+@pytest.mark.system
 def test_invoke_make_and_cmake_agree(tmp_path: Path) -> None:
     """The shared library's file name and soname and the attitude.pc Version
     from every build path."""

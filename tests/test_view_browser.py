@@ -63,11 +63,15 @@ def _view(*args: str, **kw):
 
 class Feeder:
     """attitude-rx-shaped JSON Lines at ``rate_hz`` into a view's stdin, holding
-    one attitude (Euler angles in degrees), until stopped."""
+    one attitude (Euler angles in degrees; the yaw turning at ``yaw_rate_dps``),
+    until stopped."""
 
-    def __init__(self, proc: subprocess.Popen, euler_deg: tuple[float, float, float], rate_hz: float = 100.0) -> None:
+    def __init__(self, proc: subprocess.Popen, euler_deg: tuple[float, float, float], rate_hz: float = 100.0,
+                 yaw_rate_dps: float = 0.0) -> None:
         self.proc = proc
-        self.q = attitude_c.euler_to_quat(np.radians(euler_deg)).tolist()
+        self.euler = np.radians(euler_deg)
+        self.yaw_rate = math.radians(yaw_rate_dps)
+        self.q = attitude_c.euler_to_quat(self.euler).tolist()
         self.rate = rate_hz
         self.stop = threading.Event()
         self.th = threading.Thread(target=self._run, daemon=True)
@@ -77,7 +81,10 @@ class Feeder:
         k = 0
         t0 = time.monotonic()
         while not self.stop.is_set():
-            line = json.dumps({"t": k / self.rate, "n": k, "q": self.q}) + "\n"
+            q = self.q
+            if self.yaw_rate:
+                q = attitude_c.euler_to_quat(self.euler + [self.yaw_rate * k / self.rate, 0.0, 0.0]).tolist()
+            line = json.dumps({"t": k / self.rate, "n": k, "q": q}) + "\n"
             try:
                 self.proc.stdin.write(line.encode())
                 self.proc.stdin.flush()
@@ -197,6 +204,69 @@ def test_known_attitude_readouts_and_horizon(browser) -> None:
         rate = page.text_content("#rate")
         assert "samples/s" in rate
         _shot(page, "view-known-attitude")
+    finally:
+        page.close()
+        feeder.close()
+        v.kill()
+
+
+# Per pixel column of the angle chart's plot area, the rows drawn in the yaw trace's
+# colour: opaque (alpha >= 128: the trace line itself, not the 35 % envelope band) and
+# within 40 of --yaw in each channel. The plot area's margins are drawChart's (L 46, R 8,
+# T 6, B 20 CSS px).
+YAW_ROWS_JS = """
+(c) => {
+  const ctx = c.getContext('2d');
+  const dpr = window.devicePixelRatio || 1;
+  const W = c.width, H = c.height;
+  const img = ctx.getImageData(0, 0, W, H).data;
+  const hex = getComputedStyle(document.documentElement).getPropertyValue('--yaw').trim();
+  const yaw = [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16));
+  const x0 = Math.ceil(47 * dpr), x1 = Math.floor(W - 9 * dpr), y0 = Math.ceil(7 * dpr), y1 = Math.floor(H - 21 * dpr);
+  const rows = [];
+  for (let x = x0; x < x1; x++) {
+    const col = [];
+    for (let y = y0; y < y1; y++) {
+      const i = 4 * (y * W + x);
+      if (img[i + 3] >= 128 && Math.abs(img[i] - yaw[0]) <= 40 && Math.abs(img[i + 1] - yaw[1]) <= 40
+          && Math.abs(img[i + 2] - yaw[2]) <= 40) col.push(y);
+    }
+    rows.push(col);
+  }
+  return {rows, plotHeight: y1 - y0};
+}
+"""
+
+
+def test_angle_chart_breaks_the_line_where_yaw_wraps(browser) -> None:
+    """A yaw turning at 120°/s wraps from +180° to −180° every 3 s: on a 5-s window the
+    chart shows wraps, each drawn as two line ends at the chart's ±180° edges. No
+    stretch of 32 pixel columns covers more than a third of the chart's rows, as a line
+    joining +179° to −179° across one frame's step would (about 0.9 of them)."""
+    v = _view("--port", "0", "--stdin", stdin=subprocess.PIPE)
+    feeder = Feeder(v.proc, (0.0, 10.0, -20.0), yaw_rate_dps=120.0)
+    page = browser.new_page(viewport={"width": 1280, "height": 1000})
+    try:
+        page.goto(v.url)
+        page.wait_for_selector("body[data-state=live]", timeout=20_000)
+        page.select_option("#window", "5")
+        _wait_attr(page, "chart-angles", "window", "5")
+        # 7 s of source time: the 5-s window then holds at least one wrap (one every 3 s)
+        page.wait_for_function("() => (window.attitudeView.S.last || {}).t >= 7", timeout=60_000)
+        page.click("#pause")  # a still picture to read the pixels of
+        page.wait_for_selector("body[data-drawn-paused=true]", timeout=10_000)
+        chart = page.query_selector("#chart-angles")
+        assert int(chart.get_attribute("data-wraps") or 0) >= 1
+        got = page.evaluate(YAW_ROWS_JS, chart)
+        rows, height = got["rows"], got["plotHeight"]
+        assert sum(1 for r in rows if r) > len(rows) / 2  # the trace is drawn across the chart
+        # The line climbs the chart's 418° (360° + 2 × 8 % padding) at 600° per ~1200 px: ~0.3 row per
+        # column, so 32 columns cover ~10 rows of line, ~20 at a wrap drawn as two ends. A stroke across
+        # the chart covers ~0.9 of the rows within one frame's step (~8 columns at 25 frames/s; 32
+        # columns allow a hub ticking 4 times late on a loaded machine).
+        widest = max(len(set().union(*map(set, rows[i:i + 32]))) for i in range(len(rows) - 32))
+        assert widest < height / 3, (widest, height)
+        _shot(page, "view-yaw-wraps")
     finally:
         page.close()
         feeder.close()

@@ -24,9 +24,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from conftest import ROOT, _missing, require_target
-from test_view_sources import CODES, K, send_boot_and_samples
+from test_view_sources import CODES, K, _constant_rate_trial, send_boot_and_samples
 
 import attitude_c
+
+pytestmark = pytest.mark.system  # starts attitude view servers
 
 
 def _aiohttp() -> None:
@@ -120,6 +122,24 @@ def test_usage_and_source_errors_are_one_line_with_their_exit_status(tmp_path: P
     _one_line_error(_run(), 2, "one of the arguments --stdin --serial --replay --simulate is required")
     _one_line_error(_run("--stdin", "--record", str(tmp_path / "no" / "dir" / "r.csv")), 1,
                     "cannot write the recording")
+
+
+def test_a_nine_axis_replay_says_it_runs_the_filter(tmp_path: Path) -> None:
+    """attitude view --replay TRIAL.mat with no --estimator: the attitude filter, named on
+    the URL line (the page shows the same description); --method asks for the integrator."""
+    _aiohttp()
+    f = tmp_path / "01_nine_axis.mat"
+    _constant_rate_trial(f, np.array([0.1, 0.0, 0.2]), np.array([1.0, 0, 0, 0]), 100, 100.0)
+    cases = [((), "BROAD trial, ahrs (rv3-reuse); auto: the source has accelerometer and magnetometer"),
+             (("--method", "rv1"), "BROAD trial, integrator rv1; auto: an integrator method was given")]
+    for args, says in cases:
+        v = View("--replay", str(f), *args)
+        try:
+            assert says in v.line, v.line
+        finally:
+            v.kill()
+    _one_line_error(_run("--stdin", "--estimator", "ahrs"), 2, "--estimator and --method are for --serial")
+    _one_line_error(_run("--serial", "loop://", "--estimator", "ahrs"), 2, "needs accelerometer samples")
 
 
 def test_address_in_use_is_exit_3() -> None:

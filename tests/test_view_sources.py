@@ -92,11 +92,19 @@ def test_line_reader_understands_csv_headers() -> None:
     assert r.feed("t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg").kind == "skip"
     s = r.feed("0.06,2,2100,2048,2000,1,0,0,0,0.5,0.25,-0.125,359.5").sample
     assert s[:6] == (0.06, 2, 1, 0, 0, 0) and s[13] == pytest.approx(0.5 * DEG) and s[16] == pytest.approx(359.5 * DEG)
-    r = sources.LineReader()  # attitude simulate's timeseries.csv (angles in rad)
-    r.feed("t_s,yaw_true,pitch_true,roll_true,yaw_est,pitch_est,roll_est,err_yaw,err_pitch,err_roll,err_heading,"
-           "err_angle,q0_est,q1_est,q2_est,q3_est,q0_true,q1_true,q2_true,q3_true")
-    s = r.feed("0.24,0,0,0,0.1,0.2,0.3,0,0,0,0,0,1,0,0,0,0.5,0.5,0.5,0.5").sample
-    assert s[0] == 0.24 and s[2:6] == (1, 0, 0, 0) and s[9:13] == (0.5, 0.5, 0.5, 0.5) and s[13:16] == (0.1, 0.2, 0.3)
+    from attitude_c.sim.report import TIMESERIES_COLUMNS
+
+    old = ("t_s,yaw_true,pitch_true,roll_true,yaw_est,pitch_est,roll_est,err_yaw,err_pitch,err_roll,err_heading,"
+           "err_angle,q0_est,q1_est,q2_est,q3_est,q0_true,q1_true,q2_true,q3_true")  # before units in the names
+    for head in (",".join(TIMESERIES_COLUMNS), old):  # attitude simulate's timeseries.csv (angles in rad)
+        r = sources.LineReader()
+        r.feed(head)
+        values = {"t_s": 0.24, "yaw_est_rad": 0.1, "pitch_est_rad": 0.2, "roll_est_rad": 0.3, "q0_est": 1,
+                  "q1_est": 0, "q2_est": 0, "q3_est": 0, **{f"q{i}_true": 0.5 for i in range(4)}}
+        values.update({k.removesuffix("_rad"): v for k, v in values.items()})
+        s = r.feed(",".join(str(values.get(c, 0)) for c in head.split(","))).sample
+        assert s[0] == 0.24 and s[2:6] == (1, 0, 0, 0) and s[9:13] == (0.5, 0.5, 0.5, 0.5)
+        assert s[13:16] == (0.1, 0.2, 0.3)
     r = sources.LineReader()
     with pytest.raises(ValueError, match="needs a time column"):
         r.feed("a,b,c")
@@ -195,7 +203,7 @@ def test_replay_of_a_broad_trial_runs_the_estimator(tmp_path: Path, method: str)
     f = tmp_path / "01_constant_rate.mat"
     rate = 100.0
     truth = _constant_rate_trial(f, w, q0, 200, rate)
-    src = sources.ReplaySource(f, speed=50.0, method=method)
+    src = sources.ReplaySource(f, speed=50.0, estimator="integrator", method=method)
     assert src.description == f"replay of 01_constant_rate.mat (BROAD trial, integrator {method}) at 50x"
     hub = Hub(recorder=Recorder())
     src.start(hub)
@@ -214,6 +222,49 @@ def test_replay_of_a_broad_trial_runs_the_estimator(tmp_path: Path, method: str)
     _same_attitude(tq[has], truth[n[has]], 1e-9)
     assert np.isnan(tq[~has]).all()
     hub.recorder.close()
+
+
+def test_replay_of_a_nine_axis_trial_runs_the_filter_by_default(tmp_path: Path) -> None:
+    """--estimator auto (the default): a trial with accelerometer and magnetometer
+    data runs the attitude filter -- the recording equals attitude_c.ahrs over the same
+    samples from the same start -- and the description says so and why; an explicit
+    choice and an integrator method are honoured; a trial whose magnetometer holds no
+    data runs the integrator."""
+    from attitude_c.ahrs_filter import ahrs
+    from attitude_c.view.estimators import AhrsEstimator, IntegratorEstimator
+
+    w = np.array([0.2, -0.1, 0.3])
+    q0 = attitude_c.euler_to_quat([0.3, -0.2, 0.1])
+    f = tmp_path / "02_nine_axis.mat"
+    rate = 100.0
+    _constant_rate_trial(f, w, q0, 120, rate)
+    src = sources.ReplaySource(f, speed=50.0)
+    assert isinstance(src.estimator, AhrsEstimator)
+    assert src.description == ("replay of 02_nine_axis.mat (BROAD trial, ahrs (rv3-reuse); auto: the source has "
+                               "accelerometer and magnetometer data) at 50x")
+    hub = Hub(recorder=Recorder())
+    src.start(hub)
+    _drain(hub, lambda: hub.state()[0] == "ended")
+    rows = _recording(hub)
+    trial = src.rec.trial
+    expect = ahrs(trial.gyr, trial.acc, trial.mag, rate=rate, q0=q0)
+    assert [int(r["n"]) for r in rows] == list(range(120))  # one attitude per sample
+    # the same C filter on the same samples, one by one vs in one batch: rounding of the CSV's 9 digits only
+    _same_attitude(_q(rows), expect, 5e-9)
+    hub.recorder.close()
+    assert isinstance(sources.ReplaySource(f, estimator="integrator").estimator, IntegratorEstimator)
+    by_method = sources.ReplaySource(f, method="rv3-reuse")
+    assert by_method.estimator.label == "integrator rv3-reuse"
+    assert "auto: an integrator method was given" in by_method.description
+    from scipy.io import loadmat, savemat
+
+    d = loadmat(f)
+    d["imu_mag"][:] = np.nan  # a six-axis recording
+    g = tmp_path / "03_six_axis.mat"
+    savemat(g, {k: v for k, v in d.items() if not k.startswith("__")})
+    six = sources.ReplaySource(g)
+    assert six.estimator.label == "integrator rv3"
+    assert "auto: the source has no accelerometer and magnetometer data" in six.description
 
 
 def test_replay_of_a_shipped_broad_trial_matches_the_reference() -> None:

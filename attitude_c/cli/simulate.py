@@ -413,6 +413,7 @@ def run(args: argparse.Namespace) -> int:
 def _run(args: argparse.Namespace) -> int:
     from .._io import check_output_dir, write_results
     from ..sim import format_budget, format_table, plot_budget, run_budget, simulate, write_run
+    from ..sim.chain import WALL_DECIMALS
     from ..sim.report import to_jsonable
 
     cfg = build_config(args)
@@ -428,7 +429,7 @@ def _run(args: argparse.Namespace) -> int:
         if args.budget:
             b = run_budget(cfg, methods=args.methods, ber=args.budget_ber, progress=prog)
             d = b.to_dict()
-            d["elapsed_s"] = time.perf_counter() - t0
+            d["elapsed_s"] = round(time.perf_counter() - t0, WALL_DECIMALS)
             steps: list[tuple[Path, Callable[[Path], object]]] = [
                 (out / "budget.json", lambda p: p.write_text(json.dumps(to_jsonable(d), indent=2) + "\n")),
                 (out / "budget.md", lambda p: p.write_text(format_budget(b, markdown=True) + "\n"))]

@@ -66,9 +66,52 @@ def register(subparsers: Any) -> None:
     p.add_argument("--list-options", action="store_true",
                    help="list the attitude simulate options a spec can sweep, and the registered "
                    "estimators of kind = \"recordings\"")
+    g = p.add_argument_group("cutting a spec down (no need to edit it)")
+    g.add_argument("--set", dest="sets", action="append", type=_setting, default=None, metavar="NAME=VALUE",
+                   help="pin a parameter for every run, over the spec's fixed, grid, random and case values "
+                   "of NAME (an attitude simulate option, an estimator setting, or trial); VALUE as in the "
+                   "spec (TOML: 0.01, true, [30, 20, 25]; a bare word is a string: rv3); repeatable")
+    g.add_argument("--seeds", type=_seeds, default=None, metavar="N|A,B,...",
+                   help="replace the spec's seeds: a count N (seeds 0 .. N-1) or a list of seeds "
+                   "(3,17,42; one seed: 7,)")
+    g.add_argument("--limit", type=integer("--limit", 1), default=None, metavar="N",
+                   help="run only the first N runs of the spec, in its order")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG files")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
+
+
+def _setting(text: str) -> tuple[str, Any]:
+    """NAME=VALUE of --set: the value read as TOML (a number, a boolean, a string in quotes,
+    an array), else as the bare string."""
+    import datetime
+
+    name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name or not value:
+        raise argparse.ArgumentTypeError(f"--set expects NAME=VALUE, got {text!r}")
+    from ..sim.sweeps import SpecError, _toml_loads
+
+    try:
+        v = _toml_loads(f"v = {value}")["v"]
+    except SpecError:
+        return name, value
+    if isinstance(v, (datetime.date, datetime.time, dict)):  # TOML's dates and tables are no parameter
+        return name, value
+    return name, v
+
+
+def _seeds(text: str) -> int | list[int]:
+    """--seeds: a count N, or a comma-separated list (one seed: "7,")."""
+    parts = text.replace(" ", "").split(",")
+    try:
+        nums = [int(x) for x in parts if x != ""]
+    except ValueError:
+        nums = []
+    if not nums or any(n < 0 for n in nums) or "," not in text and nums[0] < 1:
+        raise argparse.ArgumentTypeError(f"--seeds: give a count >= 1 or a list of integers >= 0 "
+                                         f"(3,17,42; one seed: 7,), got {text!r}")
+    return nums if "," in text else nums[0]
 
 
 def _list_options() -> int:
@@ -101,7 +144,7 @@ def run(args: argparse.Namespace) -> int:
     from ..sim import sweeps
 
     try:
-        spec = sweeps.load_spec(args.spec)
+        spec = sweeps.load_spec(args.spec, sets=dict(args.sets or ()), seeds=args.seeds, limit=args.limit)
     except (AttitudeError, ValueError, TypeError) as exc:
         return fail(prog, f"{args.spec}: {exc}", EXIT_SPEC)
     except ImportError as exc:

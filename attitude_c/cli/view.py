@@ -44,7 +44,7 @@ def register(sub: Any) -> None:
                      "simulate's timeseries.csv, or a BROAD trial (.mat, run through the estimator)")
     src.add_argument("--simulate", nargs=argparse.REMAINDER, metavar="SIMULATE_OPTIONS",
                      help="run the simulator with the truth drawn beside the estimate; every argument after "
-                     "--simulate is an `attitude simulate` option (so put it last), e.g. --simulate "
+                     "--simulate is an option of attitude simulate (so put it last), e.g. --simulate "
                      "--period 0.005 --duration 600")
     g = p.add_argument_group("server")
     g.add_argument("--bind", default="127.0.0.1", metavar="ADDRESS",
@@ -81,11 +81,13 @@ def register(sub: Any) -> None:
                    help="rad/s per code (default 90 deg/s per 2048 codes, as attitude-rx)")
     g = p.add_argument_group("estimator (serial port, BROAD recordings)")
     from ..core import METHODS
-    from ..view.estimators import ESTIMATORS
+    from ..view.estimators import AUTO, ESTIMATORS
 
-    g.add_argument("--estimator", choices=sorted(ESTIMATORS), default="integrator",
-                   help="attitude estimator (default integrator)")
-    g.add_argument("--method", choices=METHODS, default="rv3", help="integrator method (default rv3)")
+    g.add_argument("--estimator", choices=[AUTO, *sorted(ESTIMATORS)], default=AUTO,
+                   help="attitude estimator (default auto: ahrs when the recording has accelerometer and "
+                   "magnetometer data, as BROAD trials do, else the integrator; the page says which runs)")
+    g.add_argument("--method", choices=METHODS, default=None,
+                   help="integrator method (default rv3; with --estimator auto it asks for the integrator)")
     p.set_defaults(func=run)
 
 
@@ -116,26 +118,26 @@ def _make_source(args: argparse.Namespace) -> Any:
 
 
 def _usage_problems(args: argparse.Namespace) -> str | None:
+    from ..view.estimators import AUTO, ESTIMATORS
+
     serial_only = {"baud": 9600, "block_size": 6, "impl": "c", "gap_timeout_ms": 20, "period": None,
                    "gyro_zero": None, "gyro_scale": None}
     if args.serial is None:
         given = [k for k, d in serial_only.items() if getattr(args, k) != d]
         if given:
             return f"--{given[0].replace('_', '-')} is an option of --serial"
-    if args.serial is None and args.replay is None and (args.estimator != "integrator" or args.method != "rv3"):
+    if args.serial is None and args.replay is None and (args.estimator != AUTO or args.method is not None):
         return ("--estimator and --method are for --serial and --replay (with --simulate, give simulate's "
                 "--method after --simulate)")
     if args.speed != 1.0 and args.replay is None and args.simulate is None:
         return "--speed is for --replay and --simulate"
-    from ..view.estimators import ESTIMATORS
-
     if args.serial is not None:
         from ..link import block
 
         size = block.fmt().size
         if args.block_size % size:
             return f"--block-size: must be a multiple of {size} (records of the block format), got {args.block_size}"
-    if args.serial is not None and ESTIMATORS[args.estimator].needs_acc:
+    if args.serial is not None and args.estimator != AUTO and ESTIMATORS[args.estimator].needs_acc:
         return f"--estimator {args.estimator} needs accelerometer samples, which the serial link does not carry"
     return None
 

@@ -9,10 +9,13 @@ library (``lib.ATT_BLOCK_*``); nothing of the format is written again here.
   :func:`try_decode` (returns the C status) turn 6 bytes read alone into a
   :class:`Record`;
 - ``encode_*`` build records (what the firmware sends; ``encode_oversample``
-  and ``encode_sums``: a board that sends sums of n conversions);
+  and ``encode_sums``: a board that sends sums of n conversions;
+  ``encode_channels``: a board that sends more than the gyros);
 - :class:`SeqTracker` decodes the records of one stream (its limit for sample
-  words included), numbers the samples and places every loss report
-  (``att_block_seq_*``); :func:`number_stream` does that for a list of blocks.
+  words included), numbers the samples, tells which record of its sample's
+  group each sample record is (gyro, accelerometer, magnetometer: ``Span.part``)
+  and places every loss report (``att_block_seq_*``); :func:`number_stream`
+  does that for a list of blocks.
 """
 
 from __future__ import annotations
@@ -24,11 +27,18 @@ from typing import Any, Literal, Union
 from .._lib import ffi_lib
 from ..errors import BlockFormatError, InvalidArgument, InvalidType, raise_for_status
 
-Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error", "oversample"]
+Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error", "oversample", "channels"]
+#: CHANNELS' board types (``att_block_board``: ATT_BLOCK_BOARD_GYRO3, _AIDED9)
+Board = Literal["gyro3", "aided9"]
+#: the channels of a stream (``att_block_channel`` bits), and which record of a group a
+#: sample record is (``att_block_part``): the same three names
+Channel = Literal["gyr", "acc", "mag"]
 LossKind = Literal["gave_up", "overrun"]
 Bytes = Union[bytes, bytearray, memoryview]
 
 __all__ = [
+    "Board",
+    "Channel",
     "Format",
     "Kind",
     "LossKind",
@@ -38,6 +48,7 @@ __all__ = [
     "decode",
     "encode_adc_error",
     "encode_boot",
+    "encode_channels",
     "encode_loss",
     "encode_oversample",
     "encode_sample",
@@ -64,6 +75,9 @@ class Format:
     sum_max: int       #: largest word of an oversampled sample
     boot_link2: int    #: BOOT period word: the flag of a link v2 board
     kinds: dict[int, Kind] = field(repr=False)  #: C kind value -> name
+    boards: dict[int, Board] = field(repr=False)  #: CHANNELS board value -> name
+    channel_bits: dict[Channel, int] = field(repr=False)  #: channel name -> its bit in the set
+    parts: dict[int, Channel] = field(repr=False)  #: att_block_part value -> name
     errors: dict[int, str] = field(repr=False)  #: C status -> what it means
 
 
@@ -74,22 +88,29 @@ def _c() -> tuple[Any, Any]:
     return ffi_lib("f64")
 
 
+def _enum(ffi: Any, ctype: str, prefix: str) -> dict[int, Any]:
+    """A C enum of block.h as value -> lower-case name without the prefix."""
+    return {v: n[len(prefix):].lower() for v, n in ffi.typeof(ctype).elements.items()}
+
+
 def fmt() -> Format:
     """The block format's constants (loaded from the C library on first use)."""
     global _fmt
     if _fmt is None:
         ffi, lib = _c()
-        kinds: dict[int, Kind] = {v: n[len("ATT_BLOCK_"):].lower()  # type: ignore[misc]
-                                  for v, n in ffi.typeof("att_block_kind").elements.items()}
+        kinds: dict[int, Kind] = _enum(ffi, "att_block_kind", "ATT_BLOCK_")
         errors = {lib.ATT_BLOCK_E_CODE: f"sample code above {lib.ATT_BLOCK_CODE_MAX}",  # plain streams
                   lib.ATT_BLOCK_E_KIND: "unknown report kind",
                   lib.ATT_BLOCK_E_FIELD: "report field out of range",
-                  lib.ATT_BLOCK_E_SEQ: "loss report disagrees with the sample count"}
+                  lib.ATT_BLOCK_E_SEQ: "report out of sequence"}  # a slip, or a group cut short
         _fmt = Format(size=lib.ATT_BLOCK_SIZE, code_max=lib.ATT_BLOCK_CODE_MAX, mark=lib.ATT_BLOCK_MARK,
                       version=lib.ATT_BLOCK_VERSION, tick_hz=lib.ATT_BLOCK_TICK_HZ,
                       period_max=lib.ATT_BLOCK_PERIOD_MAX, baud_unit=lib.ATT_BLOCK_BAUD_UNIT,
                       oversample_max=lib.ATT_BLOCK_OVERSAMPLE_MAX, sum_max=lib.ATT_BLOCK_SUM_MAX,
-                      boot_link2=lib.ATT_BLOCK_BOOT_LINK2, kinds=kinds, errors=errors)
+                      boot_link2=lib.ATT_BLOCK_BOOT_LINK2, kinds=kinds,
+                      boards=_enum(ffi, "att_block_board", "ATT_BLOCK_BOARD_"),
+                      channel_bits={n: v for v, n in _enum(ffi, "att_block_channel", "ATT_BLOCK_CH_").items()},
+                      parts=_enum(ffi, "att_block_part", "ATT_BLOCK_PART_"), errors=errors)
     return _fmt
 
 
@@ -117,6 +138,10 @@ class Record:
     attempt: int = 0       #: selftest: attempt number
     oversample: int = 0    #: oversample: conversions summed per word of the samples that follow
     link: Literal["legacy", "v2"] = "legacy"  #: boot: the board's link protocol (top bit of the period word)
+    board: Board | None = None  #: channels: the board type (None for other kinds, or a value out of range)
+    channels: tuple[Channel, ...] = ()  #: channels: the channel set, in record order ("gyr" first)
+    acc_every: int = 0     #: channels: an accelerometer record in sample n when n % acc_every == 0 (0: none)
+    mag_every: int = 0     #: channels: the same for the magnetometer
 
     @property
     def is_report(self) -> bool:
@@ -145,6 +170,9 @@ class Record:
             out.update(status=self.status, bad_code=self.bad_code, attempt=self.attempt)
         elif self.kind == "oversample":
             out["n"] = self.oversample
+        elif self.kind == "channels":
+            out.update(board=self.board, channels=list(self.channels), acc_every=self.acc_every,
+                       mag_every=self.mag_every)
         else:
             out.update(first=self.first, count=self.count)
             if self.kind == "adc_error":
@@ -182,6 +210,11 @@ def try_decode(raw: Bytes, index: int | None = None) -> tuple[Record | None, int
     return _record(b, out), st
 
 
+def _channel_names(bits: int) -> tuple[Channel, ...]:
+    """The names of the channel bits set in ``bits``, in record order."""
+    return tuple(n for n, v in sorted(fmt().channel_bits.items(), key=lambda kv: kv[1]) if bits & v)
+
+
 def _record(b: bytes, out: Any) -> Record | None:
     """The Record of a decoded ``att_block`` (None for an unknown kind)."""
     kind = fmt().kinds.get(out.kind)
@@ -190,7 +223,9 @@ def _record(b: bytes, out: Any) -> Record | None:
     return Record(kind=kind, raw=b, codes=(out.code[0], out.code[1], out.code[2]), first=out.first,
                   count=out.count, period_ticks=out.period_ticks, baud=out.baud_div * fmt().baud_unit,
                   version=out.version, status=out.status, bad_code=out.bad_code, attempt=out.attempt,
-                  oversample=out.oversample, link="v2" if out.link == 2 else "legacy")
+                  oversample=out.oversample, link="v2" if out.link == 2 else "legacy",
+                  board=fmt().boards.get(out.board), channels=_channel_names(out.channels),
+                  acc_every=out.acc_every, mag_every=out.mag_every)
 
 
 def decode(raw: Bytes, index: int | None = None) -> Record:
@@ -297,6 +332,33 @@ def encode_sums(sums: Sequence[int], n: int) -> bytes:
     return _encode("att_block_encode_sums", ffi.new("uint16_t[3]", c), n)
 
 
+def encode_channels(board: Board, channels: Sequence[Channel], acc_every: int = 0, mag_every: int = 0) -> bytes:
+    """CHANNELS: the board type, its channel set (``"gyr"`` always; ``"acc"``, ``"mag"``) and
+    the decimations: sample n carries an accelerometer record when n % acc_every == 0
+    (1..255 when ``"acc"`` is in the set, else 0), likewise ``mag_every``. A ``"gyro3"``
+    board has the gyros alone."""
+    if board not in fmt().boards.values():
+        raise InvalidArgument(f"board must be one of {sorted(fmt().boards.values())}, got {board!r}")
+    if isinstance(channels, str):
+        raise InvalidType(f"channels must be a sequence of names, got the string {channels!r}")
+    bits = 0
+    for c in channels:
+        if c not in fmt().channel_bits:
+            raise InvalidArgument(f"channels must be among {list(fmt().channel_bits)}, got {c!r}")
+        bits |= fmt().channel_bits[c]
+    if "gyr" not in channels:
+        raise InvalidArgument(f"channels must include 'gyr', got {list(channels)}")
+    if board == "gyro3" and bits != fmt().channel_bits["gyr"]:
+        raise InvalidArgument(f"a 'gyro3' board has the gyros alone, got channels {list(channels)}")
+    for name, every, ch in (("acc_every", acc_every, "acc"), ("mag_every", mag_every, "mag")):
+        if ch in channels:
+            _check(name, every, 1, 255)
+        elif _check(name, every, 0, 255) != 0:
+            raise InvalidArgument(f"{name} must be 0 when {ch!r} is not in channels, got {every}")
+    code = {n: v for v, n in fmt().boards.items()}[board]
+    return _encode("att_block_encode_channels", code, bits, acc_every, mag_every)
+
+
 @dataclass(frozen=True)
 class Span:
     """Where a record falls in the numbering (``att_block_span``)."""
@@ -304,6 +366,9 @@ class Span:
     first: int  #: sample: its number; loss report: first sample missing; boot/selftest: next number
     count: int  #: sample: 1; loss report: samples missing here (unreported gap included); else 0
     slip: int   #: loss report: its first minus the number expected (0 when the count agrees)
+    #: sample: which record of sample ``first``'s group it is ("gyr" in a gyro-only stream); a
+    #: report that cut a group short (status ``E_SEQ``): the record that was due; else "gyr"
+    part: Channel = "gyr"
 
 
 class SeqTracker:
@@ -328,6 +393,27 @@ class SeqTracker:
         return max(1, int(self._s.oversample))
 
     @property
+    def channels(self) -> tuple[Channel, ...]:
+        """The stream's channel set: ``("gyr",)`` until a CHANNELS report (a BOOT: again)."""
+        return _channel_names(self._s.channels) or ("gyr",)
+
+    @property
+    def acc_every(self) -> int:
+        """CHANNELS' accelerometer decimation (0: no accelerometer records)."""
+        return int(self._s.acc_every)
+
+    @property
+    def mag_every(self) -> int:
+        """CHANNELS' magnetometer decimation (0: no magnetometer records)."""
+        return int(self._s.mag_every)
+
+    @property
+    def part(self) -> Channel:
+        """The record the next sample record is: "gyr" (a new sample's, and the last
+        sample's group is complete), or "acc"/"mag" of the last sample's group."""
+        return fmt().parts[self._s.part]
+
+    @property
     def code_limit(self) -> int:
         """Largest sample word of this stream (4095, or min(n × 4095, 0xFDFF))."""
         return min(self.oversample * fmt().code_max, fmt().sum_max)
@@ -344,14 +430,16 @@ class SeqTracker:
         above the stream's limit: numbered, never integrate it);
         ``lib.ATT_BLOCK_E_KIND`` / ``E_FIELD`` (span None: no place in the
         numbering; record None for an unknown kind); ``lib.ATT_BLOCK_E_SEQ``
-        (a loss report after a slip: the numbering follows it from now on)."""
+        (a loss report after a slip: the numbering follows it from now on; or a
+        report that cut a group short: ``span.part`` is the record that was due)."""
         b = _raw(raw, _where(index))
         st = self._lib.att_block_seq_decode(self._s, b, self._b, self._span)
         if st < 0 and st not in fmt().errors:
             raise_for_status(st, "att_block_seq_decode")
         rec = _record(b, self._b)
         placed = st in (0, self._lib.ATT_BLOCK_E_CODE, self._lib.ATT_BLOCK_E_SEQ)
-        span = Span(int(self._span.first), int(self._span.count), int(self._span.slip)) if placed else None
+        span = (Span(int(self._span.first), int(self._span.count), int(self._span.slip),
+                     fmt().parts[self._span.part]) if placed else None)
         return rec, span, st
 
     def feed(self, rec: Record) -> tuple[Span, int]:
@@ -388,7 +476,9 @@ def number_stream(blocks: Iterable[Bytes], *, strict: bool = True) -> list[tuple
             rec, span, st = tr.decode(b[k:k + n], i)
             if st != 0 and strict:
                 what = tr.error(st)
-                if st == tr._lib.ATT_BLOCK_E_SEQ and rec is not None:
+                if st == tr._lib.ATT_BLOCK_E_SEQ and span is not None and span.part != "gyr":
+                    what += f" (it cut sample {expected - 1}'s group short before its {span.part} record)"
+                elif st == tr._lib.ATT_BLOCK_E_SEQ and rec is not None:
                     what += f" (its first sample is {rec.first}, expected {expected & 0xFFFF})"
                 raise BlockFormatError(f"record {i} {b[k:k + n].hex(' ')}: {what}", st, i)
             if rec is not None and span is not None:

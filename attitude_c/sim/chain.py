@@ -52,6 +52,28 @@ __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult",
            "register_source", "simulate", "source"]
 
 
+#: Significant digits of the parameters a summary echoes. The values given in decimal come
+#: back through unit conversions (degrees -> radians -> degrees, mg -> m/s²) with their last
+#: binary digits changed (30 -> 29.999999999999996); 12 digits keep every value as typed
+#: (and every derived one, such as a gain, to 1e-12) and drop that noise (float64 holds 15.9).
+PARAM_DIGITS = 12
+#: Decimal places of the wall times in a summary (``elapsed_s``): a millisecond, finer than
+#: a run's repeatability on a shared machine.
+WALL_DECIMALS = 3
+
+
+def decimal_params(x: Any) -> Any:
+    """``x`` (nested dicts, lists, tuples) with every float rounded to :data:`PARAM_DIGITS`
+    significant digits (the parameters of a summary; results keep every digit)."""
+    if isinstance(x, dict):
+        return {k: decimal_params(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [decimal_params(v) for v in x]
+    if isinstance(x, float) and math.isfinite(x):
+        return float(f"{x:.{PARAM_DIGITS}g}")
+    return x
+
+
 def _package_version() -> str:
     """attitude_c.__version__ (read at use: the package resolves it lazily)."""
     import attitude_c
@@ -216,7 +238,9 @@ class SimConfig:
         return h, soft
 
     def params(self) -> dict[str, Any]:
-        return {
+        """Every parameter of the run, JSON-ready, as decimal as they were given
+        (:func:`decimal_params`)."""
+        return decimal_params({
             "trajectory": self.trajectory.params(),
             "duration_s": self.duration,
             "period_s": self.period,
@@ -236,7 +260,7 @@ class SimConfig:
             "seed": self.seed,
             "firmware": self.firmware,
             **self._extra_params(),
-        }
+        })
 
     def _extra_params(self) -> dict[str, Any]:
         """Parameters of the stages beside the paper's (only those in use: the
@@ -563,7 +587,7 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
         summary["denoise"] = denoise_summary
     if est.info:
         summary["estimator"] = _estimator_summary(est, dec, cfg)
-    summary["elapsed_s"] = time.perf_counter() - t_wall
+    summary["elapsed_s"] = round(time.perf_counter() - t_wall, WALL_DECIMALS)
     period_t = cfg.trajectory.t_start + np.arange(acq.samples) * cfg.period
     return SimResult(config=cfg, t=res.t, q_est=res.q_est, q_true=res.q_true, euler_est=res.euler_est,
                      euler_true=res.euler_true, err=res.err, err_angle=res.err_angle,

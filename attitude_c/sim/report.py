@@ -10,12 +10,12 @@ import contextlib
 import csv
 import json
 import math
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any, Callable
 
 import numpy as np
 
+from .._plot import panels as _panels
 from .chain import PAPER_MAXIMA, SimResult
 
 __all__ = ["format_ratio", "format_table", "plot_attitude", "plot_errors", "sensor_rows", "to_jsonable",
@@ -45,37 +45,6 @@ def to_jsonable(x: Any) -> Any:
     return x
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@contextlib.contextmanager
-def _panels(path: Path, dpi: int, height: float, title: str, legend: bool = True) -> Iterator[Any]:
-    """Three stacked panels over t (the block draws into the axes it gets), then
-    the frame every figure shares: dotted grid, legend in the first panel, t
-    axis, ``title``; saved as PNG to ``path`` as it is (the caller makes the
-    write atomic) and closed."""
-    plt = _plt()
-    fig, axes = plt.subplots(3, 1, figsize=(7.0, height), sharex=True)
-    try:
-        yield axes
-        for ax in axes:
-            ax.grid(True, linestyle=":", linewidth=0.6)
-        if legend:
-            axes[0].legend(loc="upper right", fontsize=8)
-        axes[-1].set_xlabel("t / s")
-        fig.suptitle(title, fontsize=9.5)
-        fig.tight_layout()
-        fig.savefig(path, dpi=dpi, format="png")
-    finally:
-        plt.close(fig)
-
-
 def _title(res: SimResult) -> str:
     c = res.config
     est = c.method if c.estimator == "integrator" else c.estimator
@@ -91,20 +60,29 @@ def plot_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
 
 
 def _draw_errors(res: SimResult, path: Path, dpi: int = 90) -> None:
-    series = [("a. heading error", res.err_heading, "heading"),
-              ("b. pitch error", res.err[:, 1], "pitch"),
-              ("c. roll error", res.err[:, 2], None)]
+    series = [("a. heading", res.err_heading, "heading"),
+              ("b. pitch", res.err[:, 1], "pitch"),
+              ("c. roll", res.err[:, 2], None)]
     with _panels(path, dpi, 7.0, "Attitude error curves — " + _title(res), legend=False) as axes:
         for ax, (label, e, key) in zip(axes, series):
             ax.plot(res.t, e, color="black", linewidth=0.9)
             ax.axhline(0.0, color="0.6", linewidth=0.6)
             ax.set_ylabel("error / rad")
-            txt = f"{label}: max {np.max(e, initial=0):.2e}, min {np.min(e, initial=0):.2e} rad"
+            deg = ax.secondary_yaxis("right", functions=(np.degrees, np.radians))  # the same axis in degrees
+            deg.set_ylabel("error / °")
+            hi_e, lo_e = np.max(e, initial=0), np.min(e, initial=0)
+            txt = (f"{label}: max {hi_e:.2e}, min {lo_e:.2e} rad "
+                   f"({_deg(hi_e)}°, {_deg(lo_e)}°)")
             if key is not None:
                 lo, hi = PAPER_MAXIMA[key]
-                txt += f"  (paper: {lo:+.2f} … {hi:+.2f} rad)"
+                txt += f"; paper {lo:+.2f} … {hi:+.2f} rad"
             ax.set_title(txt, fontsize=8.5, loc="right")
             ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 2))
+
+
+def _deg(rad: float) -> str:
+    """An angle given in radians, in degrees to 3 significant digits."""
+    return f"{math.degrees(rad):.3g}"
 
 
 def plot_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
@@ -154,15 +132,22 @@ def write_csv(res: SimResult, path: Path) -> None:
         _write_csv(res, tmp)
 
 
+_ERRORS = ("err_yaw", "err_pitch", "err_roll", "err_heading", "err_angle")
+#: timeseries.csv's columns, each named with its unit (quaternions are unitless)
+TIMESERIES_COLUMNS = (
+    "t_s", *(f"{a}_{w}_rad" for w in ("true", "est") for a in ("yaw", "pitch", "roll")),
+    *(f"{e}_rad" for e in _ERRORS), *(f"{e}_deg" for e in _ERRORS),
+    *(f"q{i}_{w}" for w in ("est", "true") for i in range(4)))
+
+
 def _write_csv(res: SimResult, path: Path) -> None:
+    err = np.column_stack([res.err, -res.err[:, 0], res.err_angle]) if len(res.t) else np.zeros((0, 5))
     with open(path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
-        w.writerow(["t_s", "yaw_true", "pitch_true", "roll_true", "yaw_est", "pitch_est", "roll_est",
-                    "err_yaw", "err_pitch", "err_roll", "err_heading", "err_angle",
-                    "q0_est", "q1_est", "q2_est", "q3_est", "q0_true", "q1_true", "q2_true", "q3_true"])
+        w.writerow(TIMESERIES_COLUMNS)
         for k in range(len(res.t)):
-            row = [res.t[k], *res.euler_true[k], *res.euler_est[k], *res.err[k], -res.err[k, 0],
-                   res.err_angle[k], *res.q_est[k], *res.q_true[k]]
+            row = [res.t[k], *res.euler_true[k], *res.euler_est[k], *err[k], *np.degrees(err[k]),
+                   *res.q_est[k], *res.q_true[k]]
             w.writerow([f"{v:.6f}" if j == 0 else f"{v:.12e}" for j, v in enumerate(row)])
 
 
@@ -170,13 +155,13 @@ def sensor_rows(res: SimResult) -> tuple[list[str], np.ndarray]:
     """The per-period sensor streams of a run: header and rows (n, columns).
 
     One row per sample period k: ``sample``, ``t_start_s``, ``t_mid_s``; the
-    gyro rates the estimator got (``gyro_x..z``, rad/s: the host's increments
+    gyro rates the estimator got (``gyro_x_rad_s..``: the host's increments
     over h, after the denoiser when it runs; NaN for a sample never delivered)
-    beside the exact mean rates (``gyro_true_x..z``); then for each extra
-    sensor its host readings (``accel_x..z`` m/s², ``mag_x..z`` µT) beside the
+    beside the exact mean rates (``gyro_true_x_rad_s..``); then for each extra
+    sensor its host readings (``accel_x_m_s2..``, ``mag_x_ut..``) beside the
     exact period means (``accel_true_*``: specific force; ``mag_true_*``: the
     geomagnetic field in the body frame) and, for the magnetometer, the
-    disturbance field (``mag_disturbance_*``)."""
+    disturbance field (``mag_disturbance_*_ut``). Every name ends in its unit."""
     c = res.config
     n = 0 if res.period_t is None else len(res.period_t)
     h = c.period
@@ -184,6 +169,7 @@ def sensor_rows(res: SimResult) -> tuple[list[str], np.ndarray]:
     k = np.arange(n)
     cols: list[np.ndarray] = [k.astype(float), t0 + k * h, t0 + (k + 0.5) * h]
     head = ["sample", "t_start_s", "t_mid_s"]
+    unit = {"gyro": "rad_s", "accel": "m_s2", "mag": "ut"}
     gyro = np.full((n, 3), np.nan)
     idx = np.asarray(res.sample_index, dtype=np.int64)
     first = np.unique(idx, return_index=True)[1]  # a duplicated sample: its first delivery
@@ -191,14 +177,14 @@ def sensor_rows(res: SimResult) -> tuple[list[str], np.ndarray]:
     gyro[idx[first][ok]] = np.asarray(res.increments)[first][ok] / h
     true = c.trajectory.increments(t0, h, n) / h if n else np.zeros((0, 3))
     for name, arr in (("gyro", gyro), ("gyro_true", true)):
-        head += [f"{name}_{a}" for a in "xyz"]
+        head += [f"{name}_{a}_{unit['gyro']}" for a in "xyz"]
         cols += list(arr.T)
     for name, s in res.aux.items():
         parts = [(name, s.values), (f"{name}_true", s.truth)]
         if name == "mag":
             parts.append(("mag_disturbance", s.disturbance))
         for label, arr in parts:
-            head += [f"{label}_{a}" for a in "xyz"]
+            head += [f"{label}_{a}_{unit[name]}" for a in "xyz"]
             cols += list(np.asarray(arr, dtype=float).T)
     return head, np.column_stack(cols) if n else np.zeros((0, len(head)))
 
@@ -245,16 +231,19 @@ def format_table(summary: dict[str, Any]) -> str:
          f"precision {p['precision']}, sensors {p['sensors']} ({p['gyro']['name']}), "
          f"period {p['period_s']:g} s, {p['duration_s']:g} s, seed {p['seed']}"),
         "",
-        f"{'error (rad)':<16}{'max':>12}{'min':>12}{'RMS':>12}{'paper max':>12}{'× better':>10}",
+        (f"{'error':<16}{'max rad':>11}{'min rad':>11}{'RMS rad':>11}{'max °':>9}{'min °':>9}{'RMS °':>9}"
+         f"{'paper max rad':>15}{'× better':>10}"),
     ]
     better = summary.get("times_better_than_paper", {})
     for key in ("heading", "pitch", "roll", "attitude_angle"):
         s = e[key]
         pm = summary["paper_maxima_rad"].get(key)
-        pm_s = f"{pm:>12.2f}" if pm is not None else f"{'':>12}"
+        pm_s = f"{pm:>15.2f}" if pm is not None else f"{'':>15}"
         b = better.get(key)
         b_s = f"{format_ratio(b):>10}" if b is not None else f"{'':>10}"
-        lines.append(f"{key:<16}{s['max']:>12.3e}{s['min']:>12.3e}{s['rms']:>12.3e}{pm_s}{b_s}")
+        rad = "".join(f"{s[k]:>11.3e}" for k in ("max", "min", "rms"))
+        deg = "".join(f"{_deg(s[k]):>9}" for k in ("max", "min", "rms"))
+        lines.append(f"{key:<16}{rad}{deg}{pm_s}{b_s}")
     if any(v < 1 for v in better.values()):
         lines.append("(× better below 1: the error is larger than the paper's maximum)")
     lk = summary.get("link", {})

@@ -61,9 +61,11 @@ __all__ = [
     "SpecError",
     "integrate_trial",
     "load_spec",
+    "plot_axis",
     "register_estimator",
     "simulate_options",
     "sweep",
+    "unit_of",
 ]
 
 Kind = Literal["simulate", "recordings"]
@@ -125,7 +127,8 @@ class _RaisingParser(argparse.ArgumentParser):
     """An ArgumentParser that raises instead of printing usage and exiting."""
 
     def error(self, message: str) -> Any:  # type: ignore[override]
-        raise _ParseError(message)
+        opt = message.partition(": ")[0].removeprefix("argument ")
+        raise _ParseError(message.replace(f"argument {opt}: {opt}: ", f"{opt}: ", 1))  # the validators name it
 
 
 @dataclass(frozen=True)
@@ -137,6 +140,7 @@ class Option:
     kind: Literal["value", "flag", "append"]  #: ``flag``: a switch (true/false); ``append``: repeatable
     choices: tuple[Any, ...] | None
     help: str
+    unit: str | None = None  #: the value's unit (plot axes), from the option's metavar or help
 
 
 #: argument groups of ``attitude simulate`` that say how a run is shown or stored, not what
@@ -165,8 +169,48 @@ def _options() -> dict[str, Option]:
         flag = max(a.option_strings, key=len)
         kind: Literal["value", "flag", "append"] = (
             "flag" if a.nargs == 0 else "append" if isinstance(a, argparse._AppendAction) else "value")
-        out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "")
+        out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "",
+                             _option_unit(a.metavar, a.help or ""))
     return out
+
+
+#: Units an option's metavar names (``--period S``), and those its help gives in brackets
+#: (``(deg)``, ``(Hz)``, ``(deg/s; ...)``), as a plot axis writes them.
+_METAVAR_UNITS = {"S": "s", "DEG": "°", "HZ": "Hz", "DEG_S": "°/s", "M_S2": "m/s²"}
+_HELP_UNITS = {"s": "s", "deg": "°", "Hz": "Hz", "deg/s": "°/s", "µT": "µT", "m": "m"}
+
+
+def _option_unit(metavar: Any, help_text: str) -> str | None:
+    """The unit of an option's value: its metavar's, else the one unit its help gives in
+    brackets (None for none, or for several: a triple of mixed units)."""
+    import re
+
+    if isinstance(metavar, str) and metavar in _METAVAR_UNITS:
+        return _METAVAR_UNITS[metavar]
+    found = {_HELP_UNITS[m] for m in re.findall(r"\((s|deg|Hz|deg/s|µT|m)[;,)]", help_text)}
+    return found.pop() if len(found) == 1 else None
+
+
+#: Units of result and setting names by their ending (vectors' ``_0``.. stripped first).
+_SUFFIX_UNITS = (("_rad_s", "rad/s"), ("_deg", "°"), ("_rad", "rad"), ("_dps", "°/s"), ("_s", "s"),
+                 ("_hz", "Hz"), ("_ut", "µT"), ("_m_s2", "m/s²"))
+
+
+def unit_of(spec: Spec, name: str) -> str | None:
+    """The unit of a column of a sweep's table (a parameter or a figure), or None: a
+    simulate option's own; ``err_*`` figures are summary.json's ``errors_rad``; else the
+    name's ending (``total_deg``, ``link_time_s``, ``..._rad_s_0``)."""
+    if spec.kind == "simulate" and name in _options():
+        return _options()[name].unit
+    if spec.kind == "simulate" and name.startswith("err_"):
+        return "rad"
+    base = name.rstrip("0123456789").removesuffix("_") if name[-1:].isdigit() else name
+    return next((u for suffix, u in _SUFFIX_UNITS if base.endswith(suffix)), None)
+
+
+def _labelled(spec: Spec, name: str) -> str:
+    unit = unit_of(spec, name)
+    return f"{name} ({unit})" if unit else name
 
 
 def simulate_options() -> dict[str, Option]:
@@ -419,13 +463,44 @@ def _table(doc: Mapping[str, Any], name: str) -> dict[str, Any]:
     return t
 
 
-def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | None = None) -> Spec:
+def _check_seeds(seeds_v: Any, where: str) -> list[int]:
+    """A seeds value (a count >= 1 or a list of integers >= 0) as the list of seeds."""
+    if isinstance(seeds_v, bool) or not (isinstance(seeds_v, int) and seeds_v >= 1 or isinstance(seeds_v, list)
+                                          and seeds_v and all(isinstance(s, int) and not isinstance(s, bool)
+                                                              and 0 <= s < 2**63 for s in seeds_v)):
+        raise SpecError(f"{where} must be a count >= 1 or a list of integers >= 0, got {seeds_v!r}")
+    return list(range(seeds_v)) if isinstance(seeds_v, int) else list(seeds_v)
+
+
+def _override_note(sets: Mapping[str, Any], seeds: Any, limit: int | None) -> str:
+    """The command-line cuts of a sweep, as TOML comments for the spec.toml it leaves."""
+    parts = [f"--set {k}={json.dumps(_jsonable(v))}" for k, v in sets.items()]
+    if seeds is not None:
+        parts.append(f"--seeds {json.dumps(seeds)}")
+    if limit is not None:
+        parts.append(f"--limit {limit}")
+    return f"\n# run with: {' '.join(parts)}\n" if parts else ""
+
+
+def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | None = None,
+              sets: Mapping[str, Any] | None = None, seeds: int | list[int] | None = None,
+              limit: int | None = None) -> Spec:
     """Read and expand a spec: a TOML file's path, or the parsed document.
+
+    The spec can be cut down without editing it (``attitude sweep --set``,
+    ``--seeds``, ``--limit``): ``sets`` pins parameters for every run (over the
+    spec's fixed, grid, random and case values of the same names; a recordings
+    spec's ``trial`` replaces ``[sweep] trials``), ``seeds`` replaces ``[sweep]
+    seeds`` (a count or a list), ``limit`` keeps the first runs in spec order.
+    They go through the spec's own checks, errors naming ``--set NAME``.
 
     Raises :class:`SpecError` (one line) for anything that cannot run:
     unknown keys or options, bad values (checked by the simulate command's
     own parser and ``SimConfig.validate``), unknown estimators or trials.
     """
+    sets = dict(sets or {})
+    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
+        raise SpecError(f"--limit must be an integer >= 1, got {limit!r}")
     source: Path | None = None
     if isinstance(spec, Mapping):
         doc, text = dict(spec), ""
@@ -449,12 +524,10 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     if kind not in KINDS:
         raise SpecError(f"[sweep] kind must be one of {list(KINDS)}, got {kind!r}")
     name = str(head.get("name") or (source.stem if source else "sweep"))
-    seeds_v = head.get("seeds", 1)
-    if isinstance(seeds_v, bool) or not (isinstance(seeds_v, int) and seeds_v >= 1 or isinstance(seeds_v, list)
-                                          and seeds_v and all(isinstance(s, int) and not isinstance(s, bool)
-                                                              and 0 <= s < 2**63 for s in seeds_v)):
-        raise SpecError(f"[sweep] seeds must be a count >= 1 or a list of integers >= 0, got {seeds_v!r}")
-    seeds = list(range(seeds_v)) if isinstance(seeds_v, int) else list(seeds_v)
+    seed_list = _check_seeds(head.get("seeds", 1), "[sweep] seeds") if seeds is None else \
+        _check_seeds(seeds, "--seeds")
+    if text:
+        text += _override_note(sets, seeds, limit)
     retries, chunk = head.get("retries", 2), head.get("chunk", 1)
     for k, v, lo in (("retries", retries, 0), ("chunk", chunk, 1)):
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
@@ -481,16 +554,18 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
 
     def norm(section: str, d: Mapping[str, Any]) -> dict[str, Any]:
         out = {}
+        where = "--set" if section == "set" else f"[{section}]"
         for k, v in d.items():
             n = _option_name(k)
             if section == "cases" and n == "label":
                 n, v = "case", str(v)
             if n == "seed" and section != "exclude":
-                raise SpecError(f"[{section}] seed: the sweep sets the seed; use [sweep] seeds = N or [list]")
+                raise SpecError(f"{where} seed: the sweep sets the seed; use [sweep] seeds = N or [list] "
+                                "(or --seeds)")
             if n == "case" and section not in ("cases", "exclude"):
-                raise SpecError(f"[{section}] case: reserved for the label of a [[cases]] entry")
+                raise SpecError(f"{where} case: reserved for the label of a [[cases]] entry")
             if kind == "simulate" and n not in _options() and n not in RESERVED:
-                raise SpecError(f"[{section}] {k}: not an option of attitude simulate (sweepable: "
+                raise SpecError(f"{where} {k}: not an option of attitude simulate (sweepable: "
                                 f"{', '.join(sorted(_options()))})")
             if n.endswith(("_file", "_path")) and section != "exclude":  # a path: from the spec's folder
                 v = [_path(base, x) for x in v] if section == "grid" and isinstance(v, list) else _path(base, v)
@@ -500,16 +575,27 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     fixed, grid, rnd = norm("fixed", fixed), norm("grid", grid), norm("random", rnd)
     cases = [norm("cases", c) for c in cases]
     excl = [norm("exclude", e) for e in excl]
+    pinned = norm("set", sets)
     clash = set(grid) & set(rnd)
     if clash:
         raise SpecError(f"parameter(s) {sorted(clash)} both in [grid] and [random]")
+    for k, v in pinned.items() if kind == "simulate" else ():
+        try:  # each value alone, through the command's parser: the error names the key
+            _simulate_namespace({k: v})
+        except _ParseError as exc:
+            raise SpecError(f"--set {k}: {exc}") from None
+    if kind == "recordings" and "trial" in pinned:
+        t = pinned.pop("trial")
+        head = {**head, "trials": t if isinstance(t, (str, list)) else str(t)}
+    for k in pinned:  # pinned: off the grid (the draws stay as drawn, so the others' do not change)
+        grid.pop(k, None)
 
-    random_axes = sorted(rnd)
     drawn: list[dict[str, Any]] = [{}]
     if rnd:
         rng = np.random.default_rng(rseed)
-        cols = {k: _draw(k, rnd[k], rng, draws) for k in random_axes}
-        drawn = [{k: cols[k][i] for k in random_axes} for i in range(draws)]
+        cols = {k: _draw(k, rnd[k], rng, draws) for k in sorted(rnd)}
+        drawn = [{k: cols[k][i] for k in sorted(rnd)} for i in range(draws)]
+    random_axes = sorted(k for k in rnd if k not in pinned)
 
     data: Path | None = None
     trial_files: dict[str, Path] = {}
@@ -547,10 +633,10 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
         for combo in itertools.product(*(grid[k] for k in gkeys)):
             for draw in drawn:
                 # a case pins what it names: over the grid and the draws
-                point = {**fixed, **dict(zip(gkeys, combo)), **draw, **case}
+                point = {**fixed, **dict(zip(gkeys, combo)), **draw, **case, **pinned}
                 if kind == "recordings":
                     point.setdefault("estimator", "integrator")
-                live = [s for s in seeds if not any(all({**point, "seed": s}.get(k, _MISSING) == v
+                live = [s for s in seed_list if not any(all({**point, "seed": s}.get(k, _MISSING) == v
                                                         for k, v in e.items()) for e in excl)]
                 if not live:
                     continue
@@ -563,10 +649,13 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
                         runs.append(Run(key, params))
     if not runs:
         raise SpecError("the spec expands to no run (everything excluded?)")
+    runs = runs[:limit]
 
     axes = [k for k in gkeys if len({json.dumps(_jsonable(v)) for v in grid[k]}) > 1] + random_axes
     if len(cases) > 1:
         axes.insert(0, "case")
+    if limit is not None:  # the axes the runs kept still sweep
+        axes = [a for a in axes if len({json.dumps(r.params.get(a)) for r in runs}) > 1]
     over_v = head.get("summary_over", list(DEFAULT_OVER[kind]))
     if not (isinstance(over_v, list) and all(isinstance(x, str) for x in over_v)):
         raise SpecError(f"[sweep] summary_over must be a list of parameter names, got {over_v!r}")
@@ -942,77 +1031,33 @@ _MAX_PANELS = 9
 _MAX_LINES = 10
 
 
-def _band(ax: Any, sub: Any, axis: str, fig_col: str, numeric: bool, pos: dict[Any, int], label: str) -> None:
+def _band(ax: Any, sub: Any, axis: str, fig_col: str, numeric: bool, pos: dict[Any, int], label: str,
+          dodge: float = 0.0) -> None:
+    """The median and 5–95 % band of ``fig_col`` per value of ``axis``: a line and a band
+    over a numeric axis; over categories (no order, nothing between them) markers with
+    5–95 % bars, moved sideways by ``dodge`` so that several lines stay apart."""
     st = sub.groupby(axis, sort=True)[fig_col].quantile([0.05, 0.5, 0.95]).unstack()
-    x = np.asarray(st.index, dtype=float) if numeric else np.array([pos[v] for v in st.index], float)
-    line, = ax.plot(x, st[0.5], "o-", label=label, lw=1.3, ms=3)
-    ax.fill_between(x, st[0.05], st[0.95], color=line.get_color(), alpha=0.15, lw=0)
+    if numeric:
+        x = np.asarray(st.index, dtype=float)
+        line, = ax.plot(x, st[0.5], "o-", label=label, lw=1.3, ms=3)
+        ax.fill_between(x, st[0.05], st[0.95], color=line.get_color(), alpha=0.15, lw=0)
+        return
+    x = np.array([pos[v] for v in st.index], float) + dodge
+    mid = st[0.5].to_numpy()
+    ax.errorbar(x, mid, yerr=[mid - st[0.05].to_numpy(), st[0.95].to_numpy() - mid], fmt="o", ms=4, lw=1,
+                capsize=3, label=label)
 
 
 def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
-    """One PNG per swept parameter: ``spec.figure`` against it, median and 5–95 % band
-    over the replicates (``spec.over``). With two or more other swept parameters, one
-    panel per value of the first (up to 9) and one line per combination of the rest
-    (up to 10); a randomly drawn parameter is shown as a scatter of every run."""
-    import matplotlib
-
-    matplotlib.use("Agg")
+    """One PNG per swept parameter (:func:`plot_axis`), ``<figure>-vs-<parameter>.png``."""
     import matplotlib.pyplot as plt
 
-    fig_col = spec.figure
     files: list[Path] = []
-    if fig_col not in df.columns or df[fig_col].notna().sum() == 0:
+    if spec.figure not in df.columns or df[spec.figure].notna().sum() == 0:
         return files
-    ok = df[df[fig_col].notna()]
-    reps = ", ".join(spec.over)
     for axis in spec.axes:
-        numeric = _is_num(ok[axis])
-        others = [a for a in spec.axes if a != axis and a not in spec.random_axes]
-        facet, lines = (others[0], others[1:]) if len(others) >= 2 else (None, others)
-        panels = list(dict.fromkeys(ok[facet].tolist()))[:_MAX_PANELS] if facet else [None]
-        ncol = min(3, len(panels))
-        nrow = math.ceil(len(panels) / ncol)
-        fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol + 1.2, 3.3 * nrow + 0.6), sharey=True,
-                                squeeze=False)
-        xs_all = list(dict.fromkeys(ok[axis].tolist()))
-        pos = {x: i for i, x in enumerate(xs_all)}
-        for k, panel in enumerate(panels):
-            ax = axs[k // ncol][k % ncol]
-            sub = ok if facet is None else ok[ok[facet] == panel]
-            if axis in spec.random_axes:
-                ax.scatter(sub[axis], sub[fig_col], s=8, alpha=0.6)
-            else:
-                groups = sub.groupby(lines, sort=False, dropna=False) if lines else [((), sub)]
-                for i, (label, part) in enumerate(groups):
-                    if i >= _MAX_LINES:
-                        break
-                    vals = label if isinstance(label, tuple) else (label,)
-                    _band(ax, part, axis, fig_col, numeric, pos,
-                          ", ".join(f"{o}={v}" for o, v in zip(lines, vals)) or fig_col)
-                if not numeric:
-                    ax.set_xticks(range(len(xs_all)), [str(v) for v in xs_all], rotation=30, ha="right",
-                                  fontsize=7)
-            if (ok[fig_col] > 0).all():
-                ax.set_yscale("log")
-            if numeric and (ok[axis] > 0).all() and ok[axis].max() / ok[axis].min() >= 10:
-                ax.set_xscale("log")
-            if facet is not None:
-                ax.set_title(f"{facet}={panel}", fontsize=8)
-            ax.set_xlabel(axis, fontsize=8)
-            if k % ncol == 0:
-                ax.set_ylabel(fig_col, fontsize=8)
-            ax.grid(True, which="both", alpha=0.3)
-            ax.tick_params(labelsize=7)
-        for k in range(len(panels), nrow * ncol):
-            axs[k // ncol][k % ncol].set_visible(False)
-        handles, labels = axs[0][0].get_legend_handles_labels()
-        if len(handles) > 1:
-            fig.legend(handles, labels, fontsize=7, loc="center right")
-            fig.tight_layout(rect=(0, 0, 0.80, 0.95))
-        else:
-            fig.tight_layout(rect=(0, 0, 1, 0.95))
-        fig.suptitle(f"{spec.name}: {fig_col} vs {axis} (median, 5–95 % over {reps})", fontsize=9)
-        path = out / f"{fig_col}-vs-{axis}.png"
+        fig = plot_axis(df, spec, axis)
+        path = out / f"{spec.figure}-vs-{axis}.png"
 
         def save(p: Path, fig: Any = fig) -> None:
             fig.savefig(p, dpi=100)
@@ -1020,6 +1065,73 @@ def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
         plt.close(fig)
         files.append(path)
     return files
+
+
+def plot_axis(df: Any, spec: Spec, axis: str) -> Any:
+    """``spec.figure`` against the swept parameter ``axis`` (a matplotlib Figure; the
+    caller closes it): median and 5–95 % band over the replicates (``spec.over``), a
+    line over a numeric axis, markers and bars over categories. With two or more other
+    swept parameters, one panel per value of the first (up to 9) and one line per
+    combination of the rest (up to 10); a randomly drawn parameter is shown as a
+    scatter of every run. Axes labelled with their units (:func:`unit_of`)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig_col = spec.figure
+    ok = df[df[fig_col].notna()]
+    numeric = _is_num(ok[axis])
+    others = [a for a in spec.axes if a != axis and a not in spec.random_axes]
+    facet, lines = (others[0], others[1:]) if len(others) >= 2 else (None, others)
+    panels = list(dict.fromkeys(ok[facet].tolist()))[:_MAX_PANELS] if facet else [None]
+    ncol = min(3, len(panels))
+    nrow = math.ceil(len(panels) / ncol)
+    fig, axs = plt.subplots(nrow, ncol, figsize=(4.2 * ncol + 1.2, 3.3 * nrow + 0.6), sharey=True, squeeze=False)
+    xs_all = list(dict.fromkeys(ok[axis].tolist()))
+    pos = {x: i for i, x in enumerate(xs_all)}
+    for k, panel in enumerate(panels):
+        ax = axs[k // ncol][k % ncol]
+        sub = ok if facet is None else ok[ok[facet] == panel]
+        if axis in spec.random_axes:
+            ax.scatter(sub[axis], sub[fig_col], s=8, alpha=0.6)
+        else:
+            _bands(ax, sub, axis, fig_col, numeric, pos, lines)
+            if not numeric:
+                ax.set_xticks(range(len(xs_all)), [str(v) for v in xs_all], rotation=30, ha="right", fontsize=7)
+        if (ok[fig_col] > 0).all():
+            ax.set_yscale("log")
+        if numeric and (ok[axis] > 0).all() and ok[axis].max() / ok[axis].min() >= 10:
+            ax.set_xscale("log")
+        if facet is not None:
+            ax.set_title(f"{facet}={panel}", fontsize=8)
+        ax.set_xlabel(_labelled(spec, axis), fontsize=8)
+        if k % ncol == 0:
+            ax.set_ylabel(_labelled(spec, fig_col), fontsize=8)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.tick_params(labelsize=7)
+    for k in range(len(panels), nrow * ncol):
+        axs[k // ncol][k % ncol].set_visible(False)
+    handles, labels = axs[0][0].get_legend_handles_labels()
+    if len(handles) > 1:
+        fig.legend(handles, labels, fontsize=7, loc="center right")
+        fig.tight_layout(rect=(0, 0, 0.80, 0.95))
+    else:
+        fig.tight_layout(rect=(0, 0, 1, 0.95))
+    reps = ", ".join(spec.over)
+    fig.suptitle(f"{spec.name}: {fig_col} vs {axis} (median, 5–95 % over {reps})", fontsize=9)
+    return fig
+
+
+def _bands(ax: Any, sub: Any, axis: str, fig_col: str, numeric: bool, pos: dict[Any, int],
+           lines: list[str]) -> None:
+    """One :func:`_band` per combination of the ``lines`` parameters (up to 10)."""
+    groups = list(sub.groupby(lines, sort=False, dropna=False))[:_MAX_LINES] if lines else [((), sub)]
+    for i, (label, part) in enumerate(groups):
+        vals = label if isinstance(label, tuple) else (label,)
+        dodge = 0.0 if numeric else (i - (len(groups) - 1) / 2) * min(0.15, 0.6 / len(groups))
+        _band(ax, part, axis, fig_col, numeric, pos, ", ".join(f"{o}={v}" for o, v in zip(lines, vals)) or fig_col,
+              dodge)
 
 
 # ---------------------------------------------------------------------------

@@ -15,6 +15,10 @@ settings; it needs the accelerometer, so ``needs_acc`` makes the sources
 without one, such as the legacy serial link, refuse it with a clear
 message). Another estimator plugs in by one :func:`register` call with a
 factory building an object with this ``update``.
+
+``"auto"`` (:data:`AUTO`, ``attitude view``'s default) is not an estimator but a
+rule, :func:`choose`: the attitude filter for a source that delivers both the
+accelerometer and the magnetometer (a BROAD trial), else the integrator.
 """
 
 from __future__ import annotations
@@ -29,8 +33,8 @@ from numpy.typing import ArrayLike, NDArray
 from .. import core
 from ..errors import InvalidArgument
 
-__all__ = ["ESTIMATORS", "AhrsEstimator", "Estimator", "EstimatorSpec", "IntegratorEstimator", "make_estimator",
-           "register"]
+__all__ = ["AUTO", "ESTIMATORS", "AhrsEstimator", "Estimator", "EstimatorSpec", "IntegratorEstimator", "choose",
+           "make_estimator", "register"]
 
 
 class Estimator(Protocol):
@@ -108,6 +112,24 @@ register(EstimatorSpec("integrator", "strapdown integrator of the gyro rates (--
                        IntegratorEstimator))
 register(EstimatorSpec("ahrs", "the attitude filter: gyro + accelerometer (+ magnetometer), default settings "
                        "(docs/ahrs.md)", True, AhrsEstimator))
+
+
+#: The name that asks :func:`choose` to pick the estimator from what the source delivers.
+AUTO = "auto"
+
+
+def choose(name: str, *, has_acc: bool, has_mag: bool, method_given: bool = False) -> tuple[str, str]:
+    """The estimator to run for ``name`` and why: ``(name, "")`` for a name given,
+    for :data:`AUTO` the attitude filter (``"ahrs"``) when the source delivers the
+    accelerometer and the magnetometer, else ``"integrator"``; a ``method_given``
+    (an integrator method asked for) keeps the integrator."""
+    if name != AUTO:
+        return name, ""
+    if method_given:
+        return "integrator", "auto: an integrator method was given"
+    if has_acc and has_mag:
+        return "ahrs", "auto: the source has accelerometer and magnetometer data"
+    return "integrator", "auto: the source has no accelerometer and magnetometer data"
 
 
 def make_estimator(name: str, *, has_acc: bool, **kw: Any) -> Estimator:

@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ..errors import AttitudeError, InvalidArgument
-from .estimators import Estimator, make_estimator
+from .estimators import AUTO, Estimator, choose, make_estimator
 from .stream import Hub, row
 
 __all__ = ["BlockPipeline", "LineReader", "ReplaySource", "SerialSource", "Source", "StdinSource",
@@ -121,7 +121,8 @@ _CSV_TIME = ("t", "t_s", "time")
 _CSV_Q = (("q0", "q1", "q2", "q3"), ("q0_est", "q1_est", "q2_est", "q3_est"))
 _CSV_TRUE_Q = (("true_q0", "true_q1", "true_q2", "true_q3"), ("q0_true", "q1_true", "q2_true", "q3_true"))
 _CSV_EULER_DEG = ("yaw_deg", "pitch_deg", "roll_deg")
-_CSV_EULER_RAD = ("yaw_est", "pitch_est", "roll_est")  # attitude simulate's timeseries.csv
+# attitude simulate's timeseries.csv (attitude_c.sim.report.TIMESERIES_COLUMNS; before issue 27, without units)
+_CSV_EULER_RAD = (("yaw_est_rad", "pitch_est_rad", "roll_est_rad"), ("yaw_est", "pitch_est", "roll_est"))
 _CSV_RATE_DPS = ("rate_x_dps", "rate_y_dps", "rate_z_dps")
 
 
@@ -236,7 +237,7 @@ class LineReader:
         r["q"] = next((g for g in _CSV_Q if all(c in cols for c in g)), None)
         r["true_q"] = next((g for g in _CSV_TRUE_Q if all(c in cols for c in g)), None)
         r["euler_deg"] = _CSV_EULER_DEG if all(c in cols for c in _CSV_EULER_DEG) else None
-        r["euler_rad"] = _CSV_EULER_RAD if all(c in cols for c in _CSV_EULER_RAD) else None
+        r["euler_rad"] = next((g for g in _CSV_EULER_RAD if all(c in cols for c in g)), None)
         r["rate"] = _CSV_RATE_DPS if all(c in cols for c in _CSV_RATE_DPS) else None
         r["heading"] = "heading_deg" if "heading_deg" in cols else None
         r["n"] = "n" if "n" in cols else None
@@ -415,29 +416,43 @@ def _broad_items(trial: Any, estimator: Estimator) -> Iterator[Item]:
         yield ((k + 1) * dt, "sample", row((k + 1) * dt, q, n=k, rate=gyr[k], q_true=tq))
 
 
+def _has_data(a: NDArray[np.float64]) -> bool:
+    """A sensor's columns hold at least one finite sample."""
+    return bool(np.isfinite(a).all(axis=1).any())
+
+
 class ReplaySource(Source):
     """A recording replayed at ``speed`` times real time. BROAD trials run
     through an estimator (``estimator``, ``method``) started at the first
-    valid optical reference attitude, with the reference drawn as the truth."""
+    valid optical reference attitude, with the reference drawn as the truth.
 
-    def __init__(self, path: str | Path, speed: float = 1.0, estimator: str = "integrator",
-                 method: str = "rv3") -> None:
+    ``estimator="auto"`` (the default) runs the attitude filter when the trial has
+    accelerometer and magnetometer data, else the integrator
+    (:func:`~attitude_c.view.estimators.choose`); a ``method`` given asks for the
+    integrator (default ``rv3``). The description says which runs, and why."""
+
+    def __init__(self, path: str | Path, speed: float = 1.0, estimator: str = AUTO,
+                 method: str | None = None) -> None:
         super().__init__()
         if not (math.isfinite(speed) and speed > 0):
             raise InvalidArgument(f"speed must be a finite number > 0, got {speed!r}")
         self.speed = speed
         self.rec = load_recording(path)
         self.estimator: Estimator | None = None
+        what = "recording"
         if self.rec.kind == "broad":
             trial = self.rec.trial
             ok = np.isfinite(trial.quat).all(axis=1)
             q0 = trial.quat[int(np.flatnonzero(ok)[0])] if ok.any() else None
-            self.estimator = make_estimator(estimator, has_acc=True, method=method, q0=q0, rate=trial.rate)
-        what = f"BROAD trial, {self.estimator.label}" if self.estimator else "recording"
+            name, why = choose(estimator, has_acc=_has_data(trial.acc), has_mag=_has_data(trial.mag),
+                               method_given=method is not None)
+            self.estimator = make_estimator(name, has_acc=True, method=method or "rv3", q0=q0, rate=trial.rate)
+            what = f"BROAD trial, {self.estimator.label}" + (f"; {why}" if why else "")
         self.description = f"replay of {self.rec.name} ({what}) at {speed:g}x"
 
     def run(self, hub: Hub) -> None:
-        hub.status("running", f"replaying {self.rec.name} at {self.speed:g}x")
+        through = f" through {self.estimator.label}" if self.estimator else ""
+        hub.status("running", f"replaying {self.rec.name} at {self.speed:g}x{through}")
         if self.rec.kind == "broad":
             assert self.estimator is not None
             items: Iterable[Item] = _broad_items(self.rec.trial, self.estimator)
@@ -562,7 +577,7 @@ class SerialSource(Source):
     :data:`REOPEN_S` seconds."""
 
     def __init__(self, url: str, *, baud: int = 9600, block_size: int = 6, impl: str = "c",
-                 gap_timeout_ms: int = 20, estimator: str = "integrator", method: str = "rv3",
+                 gap_timeout_ms: int = 20, estimator: str = AUTO, method: str | None = None,
                  period: float | None = None, zero: Triple = DEFAULT_ZERO_CODE,
                  scale: Triple = DEFAULT_SCALE) -> None:
         super().__init__()
@@ -578,7 +593,8 @@ class SerialSource(Source):
         self.gap_timeout_ms = gap_timeout_ms
         self._make_rx = lambda: make_receiver(impl, block_size=block_size, gap_timeout=gap_timeout_ms)  # type: ignore[arg-type]
         self._rx = self._make_rx()  # checks block size and timeout
-        self.estimator = make_estimator(estimator, has_acc=False, method=method)
+        name, _ = choose(estimator, has_acc=False, has_mag=False)  # the link carries the gyros only
+        self.estimator = make_estimator(name, has_acc=False, method=method or "rv3")
         self.period_fixed = period is not None
         self.period = period if period is not None else DEFAULT_PERIOD_TICKS / block.fmt().tick_hz
         self.zero, self.scale = zero, scale

@@ -12,7 +12,7 @@
  *  - decode: a record whose byte 0 is not the mark is a sample with the
  *    big-endian codes, ATT_OK exactly when every code is <= 4095 (else
  *    ATT_BLOCK_E_CODE); a report has kind = byte 1, ATT_BLOCK_E_KIND
- *    above OVERSAMPLE, ATT_BLOCK_E_FIELD exactly when a field is out of
+ *    above CHANNELS, ATT_BLOCK_E_FIELD exactly when a field is out of
  *    its range; the fields a kind does not use are 0; every record it
  *    accepts encodes back to the same 6 bytes, and every field it rejects
  *    is rejected by the encoder too.
@@ -21,7 +21,13 @@
  *    the numbering is fixed, then its slip is its first minus the count
  *    (in -32768..32767), ATT_BLOCK_E_SEQ exactly when it is not 0, and the
  *    count goes on after the report's samples; OVERSAMPLE n sets the
- *    stream's n (BOOT sets it back to 1) and takes no number; rejected
+ *    stream's n (BOOT sets it back to 1) and takes no number; CHANNELS
+ *    sets the channel set and decimations (BOOT: gyro-only again); in an
+ *    aided stream a sample record is the gyro record of the next number
+ *    or, as the group of sample n (gyro, then accelerometer when n %
+ *    acc_every == 0, then magnetometer when n % mag_every == 0) says, a
+ *    record of the last one; a report other than BOOT inside a group
+ *    closes it with ATT_BLOCK_E_SEQ and span.part the record due; rejected
  *    records change nothing.
  *  - att_block_seq_decode: the same record and placement as decode + feed,
  *    except that a sample's words are checked against the stream's limit
@@ -52,6 +58,32 @@ static uint16_t be16(const uint8_t *p)
 static int8_t s8(uint8_t b)
 {
     return (int8_t)(b >= 128 ? (int)b - 256 : (int)b);
+}
+
+/* CHANNELS' fields, from the header's list: board 1 (GYR alone) or 2, GYR set,
+ * no bit above MAG, a decimation exactly for each sensor in the set. */
+static int channels_valid(unsigned board, unsigned ch, unsigned acc, unsigned mag)
+{
+    return (board == 2 || (board == 1 && ch == 1)) && (ch & 1) && ch <= 7 && !!(ch & 2) == (acc != 0)
+           && !!(ch & 4) == (mag != 0);
+}
+
+/* The record of sample n's group after record `part` (0 gyro, 1 acc, 2 mag), 0 when it was the last. */
+static uint8_t part_after(const att_block_seq *s, uint32_t n, uint8_t part)
+{
+    int acc = (s->channels & 2) && s->acc_every && n % s->acc_every == 0;
+    int mag = (s->channels & 4) && s->mag_every && n % s->mag_every == 0;
+    if (part == 0 && acc) {
+        return 1;
+    }
+    return (uint8_t)(part < 2 && mag ? 2 : 0);
+}
+
+static int same_stream(const att_block_seq *a, const att_block_seq *b)
+{
+    return a->next == b->next && a->synced == b->synced && a->oversample == b->oversample
+           && a->channels == b->channels && a->acc_every == b->acc_every && a->mag_every == b->mag_every
+           && a->part == b->part;
 }
 
 static int is_loss(unsigned kind)
@@ -140,6 +172,17 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
             check(e == st);
         }
         break;
+    case ATT_BLOCK_CHANNELS:
+        check(b->board == raw[2] && b->channels == raw[3] && b->acc_every == raw[4]
+              && b->mag_every == raw[5]);
+        check(st == (channels_valid(raw[2], raw[3], raw[4], raw[5]) ? ATT_OK : ATT_BLOCK_E_FIELD));
+        zero.board = b->board;
+        zero.channels = b->channels;
+        zero.acc_every = b->acc_every;
+        zero.mag_every = b->mag_every;
+        e = att_block_encode_channels(enc, b->board, b->channels, b->acc_every, b->mag_every);
+        check(e == st);
+        break;
     default:
         check(st == ATT_BLOCK_E_KIND);
         return;
@@ -148,60 +191,90 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
     check(st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0);
 }
 
+/* A sample record fed to the tracker: its place in the numbering and its group. */
+static void check_sample(const att_block_seq *before, const att_block_seq *s, const att_block_span *sp,
+                         int st)
+{
+    int inside = before->next > 0 && (before->part == 1 || before->part == 2);
+    check(st == ATT_OK && sp->count == 1 && sp->slip == 0 && s->synced == before->synced);
+    if (inside) {
+        check(sp->first == before->next - 1 && sp->part == before->part && s->next == before->next);
+    } else {
+        check(sp->first == before->next && sp->part == 0 && s->next == before->next + 1);
+    }
+    check(s->part == part_after(before, sp->first, sp->part));
+    check(s->oversample == before->oversample && s->channels == before->channels
+          && s->acc_every == before->acc_every && s->mag_every == before->mag_every);
+}
+
+/* A loss report (count >= 1) placed by the tracker: adopted, or its slip. */
+static void check_loss(const att_block_seq *before, const att_block_seq *s, const att_block_span *sp,
+                       const att_block *b, int cut, int st)
+{
+    int32_t d;
+    uint16_t u;
+    if (!before->synced) { /* adopted as it is */
+        check(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp->first == b->first && sp->count == b->count
+              && sp->slip == 0);
+        check(s->synced && s->next == (uint32_t)b->first + b->count);
+        return;
+    }
+    u = (uint16_t)(b->first - (uint16_t)before->next);
+    d = u < 0x8000u ? (int32_t)u : (int32_t)u - 65536;
+    check(sp->slip == d && st == (d == 0 && !cut ? ATT_OK : ATT_BLOCK_E_SEQ));
+    if (d >= 0) {
+        check(sp->first == before->next && sp->count == (uint32_t)d + b->count);
+    } else {
+        check(sp->first == ((uint32_t)-d > before->next ? 0u : before->next - (uint32_t)-d)
+              && sp->count == b->count);
+    }
+    check(s->next == sp->first + sp->count && s->synced);
+}
+
 /* Feed b to the tracker and check the span against the contract. */
 static void check_seq(att_block_seq *s, const att_block *b)
 {
     att_block_seq before = *s;
     att_block_span sp;
     int st = att_block_seq_feed(s, b, &sp);
-    int32_t d;
-    uint16_t u;
+    int cut = before.next > 0 && (before.part == 1 || before.part == 2);
+    int valid;
     if (b->kind == (uint16_t)ATT_BLOCK_SAMPLE) {
-        check(st == ATT_OK && sp.first == before.next && sp.count == 1 && sp.slip == 0);
-        check(s->next == before.next + 1 && s->synced == before.synced);
+        check_sample(&before, s, &sp, st);
         return;
     }
     if (b->kind == ATT_BLOCK_BOOT) {
-        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && s->next == 0 && s->synced
-              && s->oversample == 1);
+        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && sp.part == 0 && s->next == 0 && s->synced
+              && s->oversample == 1 && s->channels == 1 && s->acc_every == 0 && s->mag_every == 0
+              && s->part == 0);
         return;
     }
-    if (b->kind == ATT_BLOCK_OVERSAMPLE && (b->oversample < 1 || b->oversample > ATT_BLOCK_OVERSAMPLE_MAX)) {
-        check(st == ATT_BLOCK_E_FIELD && s->next == before.next && s->synced == before.synced
-              && s->oversample == before.oversample); /* rejected: nothing changes */
+    valid = b->kind == ATT_BLOCK_SELFTEST
+            || (b->kind == ATT_BLOCK_OVERSAMPLE && b->oversample >= 1
+                && b->oversample <= ATT_BLOCK_OVERSAMPLE_MAX)
+            || (b->kind == ATT_BLOCK_CHANNELS
+                && channels_valid(b->board, b->channels, b->acc_every, b->mag_every))
+            || (is_loss(b->kind) && b->count != 0);
+    if (!valid) { /* rejected: nothing changes */
+        int known = is_loss(b->kind) || b->kind == ATT_BLOCK_OVERSAMPLE || b->kind == ATT_BLOCK_CHANNELS;
+        check(st == (known ? ATT_BLOCK_E_FIELD : ATT_BLOCK_E_KIND) && same_stream(s, &before));
         return;
     }
-    if (b->kind == ATT_BLOCK_OVERSAMPLE) {
-        check(st == ATT_OK && sp.first == before.next && sp.count == 0 && s->next == before.next
-              && s->synced == before.synced && s->oversample == b->oversample);
-        return;
-    }
-    check(s->oversample == before.oversample); /* only BOOT and OVERSAMPLE change n */
-    if (b->kind == ATT_BLOCK_SELFTEST) {
-        check(st == ATT_OK && sp.first == before.next && sp.count == 0 && s->next == before.next
-              && s->synced == before.synced);
-        return;
-    }
-    if (!is_loss(b->kind) || b->count == 0) { /* rejected: nothing changes */
-        check(st == (is_loss(b->kind) ? ATT_BLOCK_E_FIELD : ATT_BLOCK_E_KIND));
-        check(s->next == before.next && s->synced == before.synced);
-        return;
-    }
-    if (!before.synced) { /* adopted as it is */
-        check(st == ATT_OK && sp.first == b->first && sp.count == b->count && sp.slip == 0);
-        check(s->synced && s->next == (uint32_t)b->first + b->count);
-        return;
-    }
-    u = (uint16_t)(b->first - (uint16_t)before.next);
-    d = u < 0x8000u ? (int32_t)u : (int32_t)u - 65536;
-    check(sp.slip == d && st == (d == 0 ? ATT_OK : ATT_BLOCK_E_SEQ));
-    if (d >= 0) {
-        check(sp.first == before.next && sp.count == (uint32_t)d + b->count);
+    /* placed: a group it interrupts is closed, span.part names the record that was due */
+    check(s->part == 0 && sp.part == (cut ? before.part : 0));
+    check(s->oversample == (b->kind == ATT_BLOCK_OVERSAMPLE ? b->oversample : before.oversample));
+    if (b->kind == ATT_BLOCK_CHANNELS) {
+        check(s->channels == b->channels && s->acc_every == b->acc_every && s->mag_every == b->mag_every);
     } else {
-        check(sp.first == ((uint32_t)-d > before.next ? 0u : before.next - (uint32_t)-d)
-              && sp.count == b->count);
+        check(s->channels == before.channels && s->acc_every == before.acc_every
+              && s->mag_every == before.mag_every);
     }
-    check(s->next == sp.first + sp.count && s->synced);
+    if (is_loss(b->kind)) {
+        check_loss(&before, s, &sp, b, cut, st);
+        return;
+    }
+    check(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp.first == before.next && sp.count == 0 && sp.slip == 0
+          && s->next == before.next && s->synced == before.synced);
 }
 
 /* An encoder with arguments from p: ATT_OK exactly in range, and its record decodes back. */
@@ -210,7 +283,7 @@ static void check_encode(uint8_t which, const uint8_t *p)
     uint8_t enc[ATT_BLOCK_SIZE];
     att_block b;
     int e, want, d;
-    switch (which % 7) {
+    switch (which % 8) {
     case 0: {
         uint16_t codes[3];
         codes[0] = (uint16_t)(be16(p) & 0x1FFF); /* mostly in range, sometimes not */
@@ -305,6 +378,20 @@ static void check_encode(uint8_t which, const uint8_t *p)
         }
         return;
     }
+    case 7:
+        e = att_block_encode_channels(enc, (uint8_t)(p[0] & 3), (uint8_t)(p[1] & 15),
+                                      (uint8_t)(p[2] >> (p[4] & 7)),
+                                      (uint8_t)(p[3] >> (p[5] & 7))); /* small values, 0s: mostly in range */
+        check(e
+              == (channels_valid(p[0] & 3u, p[1] & 15u, (uint8_t)(p[2] >> (p[4] & 7)),
+                                 (uint8_t)(p[3] >> (p[5] & 7)))
+                      ? ATT_OK
+                      : ATT_BLOCK_E_FIELD));
+        if (e == ATT_OK) {
+            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_CHANNELS && b.board == (p[0] & 3)
+                  && b.channels == (p[1] & 15) && b.acc_every == enc[4] && b.mag_every == enc[5]);
+        }
+        return;
     default:
         e = att_block_encode_adc_error(enc, be16(p), s8(p[2]));
         check(e == (s8(p[2]) < 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
@@ -335,6 +422,7 @@ static void misuse(void)
           && att_block_encode_selftest(NULL, -1, 0, 1) == ATT_E_NULL);
     check(att_block_encode_loss(NULL, ATT_BLOCK_GAVE_UP, 0, 1) == ATT_E_NULL);
     check(att_block_encode_adc_error(NULL, 0, -1) == ATT_E_NULL);
+    check(att_block_encode_channels(NULL, ATT_BLOCK_BOARD_AIDED9, 7, 1, 1) == ATT_E_NULL);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -363,16 +451,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             if (b.kind == (uint16_t)ATT_BLOCK_SAMPLE) {
                 int big = b.code[0] > lim || b.code[1] > lim || b.code[2] > lim;
                 check(memcmp(b2.code, b.code, sizeof b.code) == 0 && b2.kind == b.kind);
-                check(st2 == (big ? ATT_BLOCK_E_CODE : ATT_OK) && sp2.first == seq.next && sp2.count == 1);
+                check(st2 == (big ? ATT_BLOCK_E_CODE : ATT_OK) && sp2.first + 1 == seq2.next
+                      && sp2.count == 1);
                 b.kind = (uint16_t)ATT_BLOCK_SAMPLE; /* feed it as a sample, as seq_decode did */
             } else if (st == ATT_BLOCK_E_KIND || st == ATT_BLOCK_E_FIELD) {
-                check(st2 == st && seq2.next == seq.next && seq2.synced == seq.synced
-                      && seq2.oversample == seq.oversample); /* not placed */
+                check(st2 == st && same_stream(&seq2, &seq)); /* not placed */
             }
             check_seq(&seq, &b);
-            if (b.kind != (uint16_t)ATT_BLOCK_SAMPLE && st == ATT_OK) {
-                check(seq2.next == seq.next && seq2.synced == seq.synced
-                      && seq2.oversample == seq.oversample);
+            if (st == ATT_OK || b.kind == (uint16_t)ATT_BLOCK_SAMPLE) {
+                check(same_stream(&seq2, &seq)); /* the same placement as decode + feed */
             }
         } else {
             check_encode((uint8_t)(data[i] >> 1), raw);

@@ -19,6 +19,15 @@ static int8_t s8(uint8_t b)
     return (int8_t)((b & 0x80u) != 0u ? (int)b - 256 : (int)b);
 }
 
+/* A CHANNELS report's fields: ATT_OK or ATT_BLOCK_E_FIELD (the encoder's checks, the one copy). */
+static int channels_check(const att_block *b)
+{
+    uint8_t tmp[ATT_BLOCK_SIZE];
+    return att_block_encode_channels(tmp, b->board, b->channels, b->acc_every, b->mag_every) == ATT_OK
+               ? ATT_OK
+               : ATT_BLOCK_E_FIELD;
+}
+
 int att_block_decode(const uint8_t *raw, att_block *out)
 {
     uint8_t i;
@@ -80,6 +89,13 @@ int att_block_decode(const uint8_t *raw, att_block *out)
             st = ATT_BLOCK_E_FIELD;
         }
         break;
+    case ATT_BLOCK_CHANNELS:
+        out->board = raw[2];
+        out->channels = raw[3];
+        out->acc_every = raw[4];
+        out->mag_every = raw[5];
+        st = channels_check(out);
+        break;
     default:
         st = ATT_BLOCK_E_KIND;
         break;
@@ -92,55 +108,72 @@ void att_block_seq_init(att_block_seq *s)
     if (s == NULL) {
         return;
     }
-    s->next = 0;
-    s->synced = 0;
+    memset(s, 0, sizeof *s);
     s->oversample = 1;
+    s->channels = (uint8_t)ATT_BLOCK_CH_GYR;
 }
 
-int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span)
+/* The record of a group that is due next (GYR: none, the next sample's gyro record). */
+static uint8_t due(const att_block_seq *s)
+{
+    if (s->next == 0u || (s->part != (uint8_t)ATT_BLOCK_PART_ACC && s->part != (uint8_t)ATT_BLOCK_PART_MAG)) {
+        return (uint8_t)ATT_BLOCK_PART_GYR;
+    }
+    return s->part;
+}
+
+/* Whether sample n has a record of the sensor with this channel bit and decimation. */
+static int has(const att_block_seq *s, uint32_t n, uint8_t bit, uint8_t every)
+{
+    return (s->channels & bit) != 0u && every != 0u && n % every == 0u;
+}
+
+/* A sample record: the part that is due, of the group it belongs to; then what follows it. */
+static void place_sample(att_block_seq *s, att_block_span *span)
+{
+    uint8_t p = due(s);
+    if (p == (uint8_t)ATT_BLOCK_PART_GYR) {
+        s->next++;
+    }
+    span->first = s->next - 1u;
+    span->count = 1;
+    span->part = p;
+    if (p == (uint8_t)ATT_BLOCK_PART_GYR && has(s, span->first, (uint8_t)ATT_BLOCK_CH_ACC, s->acc_every)) {
+        s->part = (uint8_t)ATT_BLOCK_PART_ACC;
+    } else if (p != (uint8_t)ATT_BLOCK_PART_MAG
+               && has(s, span->first, (uint8_t)ATT_BLOCK_CH_MAG, s->mag_every)) {
+        s->part = (uint8_t)ATT_BLOCK_PART_MAG;
+    } else {
+        s->part = (uint8_t)ATT_BLOCK_PART_GYR;
+    }
+}
+
+/* Whether the tracker can place report b: ATT_OK, ATT_BLOCK_E_FIELD or ATT_BLOCK_E_KIND. */
+static int report_check(const att_block *b)
+{
+    switch (b->kind) {
+    case ATT_BLOCK_SELFTEST:
+        return ATT_OK;
+    case ATT_BLOCK_OVERSAMPLE:
+        return b->oversample < 1u || b->oversample > (uint8_t)ATT_BLOCK_OVERSAMPLE_MAX ? ATT_BLOCK_E_FIELD
+                                                                                       : ATT_OK;
+    case ATT_BLOCK_CHANNELS:
+        return channels_check(b);
+    case ATT_BLOCK_GAVE_UP:
+    case ATT_BLOCK_OVERRUN:
+    case ATT_BLOCK_ADC_ERROR:
+        return b->count == 0u ? ATT_BLOCK_E_FIELD : ATT_OK;
+    default:
+        return ATT_BLOCK_E_KIND;
+    }
+}
+
+/* A loss report (count >= 1): its samples, and a slip against the count. */
+static int place_loss(att_block_seq *s, const att_block *b, att_block_span *span)
 {
     uint16_t u;
     int32_t d;
     uint32_t first;
-    if (s == NULL || b == NULL || span == NULL) {
-        return ATT_E_NULL;
-    }
-    span->slip = 0;
-    switch (b->kind) {
-    case ATT_BLOCK_SAMPLE:
-        span->first = s->next;
-        span->count = 1;
-        s->next++;
-        return ATT_OK;
-    case ATT_BLOCK_BOOT:
-        s->next = 0;
-        s->synced = 1;
-        s->oversample = 1; /* a new stream: plain until it says otherwise */
-        span->first = 0;
-        span->count = 0;
-        return ATT_OK;
-    case ATT_BLOCK_SELFTEST:
-        span->first = s->next;
-        span->count = 0;
-        return ATT_OK;
-    case ATT_BLOCK_OVERSAMPLE:
-        if (b->oversample < 1u || b->oversample > (uint8_t)ATT_BLOCK_OVERSAMPLE_MAX) {
-            return ATT_BLOCK_E_FIELD;
-        }
-        s->oversample = b->oversample;
-        span->first = s->next;
-        span->count = 0;
-        return ATT_OK;
-    case ATT_BLOCK_GAVE_UP:
-    case ATT_BLOCK_OVERRUN:
-    case ATT_BLOCK_ADC_ERROR:
-        break;
-    default:
-        return ATT_BLOCK_E_KIND;
-    }
-    if (b->count == 0u) {
-        return ATT_BLOCK_E_FIELD;
-    }
     if (!s->synced) { /* joined after BOOT: the report fixes the numbering */
         s->synced = 1;
         span->first = b->first;
@@ -162,6 +195,50 @@ int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *spa
     }
     s->next = span->first + span->count;
     return d == 0 ? ATT_OK : ATT_BLOCK_E_SEQ;
+}
+
+int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span)
+{
+    int st;
+    uint8_t cut;
+    if (s == NULL || b == NULL || span == NULL) {
+        return ATT_E_NULL;
+    }
+    span->slip = 0;
+    span->part = (uint8_t)ATT_BLOCK_PART_GYR;
+    if (b->kind == (uint16_t)ATT_BLOCK_SAMPLE) {
+        place_sample(s, span);
+        return ATT_OK;
+    }
+    if (b->kind == (uint16_t)ATT_BLOCK_BOOT) { /* a new stream: plain and gyro-only until it says otherwise */
+        att_block_seq_init(s);
+        s->synced = 1;
+        span->first = 0;
+        span->count = 0;
+        return ATT_OK;
+    }
+    st = report_check(b);
+    if (st != ATT_OK) {
+        return st; /* nothing changes */
+    }
+    cut = due(s); /* a report inside a group closes it */
+    s->part = (uint8_t)ATT_BLOCK_PART_GYR;
+    span->first = s->next;
+    span->count = 0;
+    if (b->kind == (uint16_t)ATT_BLOCK_OVERSAMPLE) {
+        s->oversample = b->oversample;
+    } else if (b->kind == (uint16_t)ATT_BLOCK_CHANNELS) {
+        s->channels = b->channels;
+        s->acc_every = b->acc_every;
+        s->mag_every = b->mag_every;
+    } else if (b->kind != (uint16_t)ATT_BLOCK_SELFTEST) {
+        st = place_loss(s, b, span);
+    }
+    if (cut != (uint8_t)ATT_BLOCK_PART_GYR) {
+        span->part = cut;
+        return ATT_BLOCK_E_SEQ;
+    }
+    return st;
 }
 
 int att_block_seq_decode(att_block_seq *s, const uint8_t *raw, att_block *out, att_block_span *span)

@@ -42,7 +42,8 @@ static const struct {
     { ATT_BLOCK_E_CODE, "sample code above its stream's limit" },
     { ATT_BLOCK_E_KIND, "unknown report kind" },
     { ATT_BLOCK_E_FIELD, "report field out of range" },
-    { ATT_BLOCK_E_SEQ, "loss report disagrees with the sample count" },
+    { ATT_BLOCK_E_SEQ, "report out of sequence: a loss report disagrees with the sample count, or a report "
+                       "cut a group short" },
     /* aiding.h */
     { ATT_AID_E_ZERO_F, "specific force is zero: no up direction" },
     { ATT_AID_E_ZERO_M, "magnetic field is zero: no north direction" },

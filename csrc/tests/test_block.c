@@ -1,7 +1,8 @@
 /*
  * Tests of the block format (attitude/block.h): encoders against the bytes
- * the header specifies, the decoder's range checks, round trips, and the
- * sequence tracker's loss accounting (slips both ways, late join, BOOT).
+ * the header specifies, the decoder's range checks, round trips, the
+ * sequence tracker's loss accounting (slips both ways, late join, BOOT),
+ * and aided streams (the CHANNELS report, groups, a group cut short).
  */
 #include <string.h>
 
@@ -136,9 +137,9 @@ static void test_decoder_rejects(void)
     }
     CHECK_EQ_INT(v, 0x10000L);
     r[0] = 0xFE;
-    r[1] = 6; /* no such kind */
+    r[1] = 7; /* no such kind */
     CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
-    CHECK_EQ_INT(d.kind, 6);
+    CHECK_EQ_INT(d.kind, 7);
     r[1] = 0xFF;
     CHECK_EQ_INT(att_block_decode(r, &d), ATT_BLOCK_E_KIND);
     CHECK(d.kind != ATT_BLOCK_SAMPLE);
@@ -410,6 +411,188 @@ static void test_oversampled_streams(void)
     CHECK_EQ_INT(att_block_seq_decode(&s, raw, &d, NULL), ATT_E_NULL);
 }
 
+/* CHANNELS' rule, read from block.h's field list by hand: the second opinion. */
+static int channels_valid(unsigned board, unsigned ch, unsigned acc, unsigned mag)
+{
+    int gyro_only = ch == 1u;
+    return (board == 2u || (board == 1u && gyro_only)) && (ch & 1u) != 0u && ch <= 7u
+           && ((ch & 2u) != 0u) == (acc != 0u) && ((ch & 4u) != 0u) == (mag != 0u);
+}
+
+static void test_channels_report(void)
+{
+    uint8_t b[ATT_BLOCK_SIZE];
+    static const uint8_t aided[6] = { 0xFE, 0x06, 0x02, 0x07, 0x01, 0x04 }; /* AIDED9, all, 1, 4 */
+    static const uint8_t gyro3[6] = { 0xFE, 0x06, 0x01, 0x01, 0x00, 0x00 };
+    static const uint8_t everies[] = { 0, 1, 2, 255 };
+    att_block d;
+    unsigned board, ch, i, j;
+
+    CHECK_EQ_INT(ATT_BLOCK_CHANNELS, 6);
+    CHECK_EQ_INT(att_block_encode_channels(b, ATT_BLOCK_BOARD_AIDED9, 7, 1, 4), ATT_OK);
+    CHECK(bytes_eq(b, aided));
+    CHECK_EQ_INT(att_block_decode(aided, &d), ATT_OK);
+    CHECK(d.kind == ATT_BLOCK_CHANNELS && d.board == 2 && d.channels == 7 && d.acc_every == 1
+          && d.mag_every == 4);
+    CHECK(d.code[0] == 0 && d.first == 0 && d.oversample == 0); /* fields of other kinds are 0 */
+    CHECK_EQ_INT(att_block_encode_channels(b, ATT_BLOCK_BOARD_GYRO3, ATT_BLOCK_CH_GYR, 0, 0), ATT_OK);
+    CHECK(bytes_eq(b, gyro3));
+    CHECK_EQ_INT(att_block_encode_channels(NULL, 2, 7, 1, 1), ATT_E_NULL);
+    /* every board and set with decimations at both ends: encoder and decoder both follow the rule */
+    for (board = 0; board < 4u; board++) {
+        for (ch = 0; ch < 16u; ch++) {
+            for (i = 0; i < sizeof everies; i++) {
+                for (j = 0; j < sizeof everies; j++) {
+                    int want = channels_valid(board, ch, everies[i], everies[j]) ? ATT_OK : ATT_BLOCK_E_FIELD;
+                    uint8_t raw[6] = { 0xFE, 0x06, 0, 0, 0, 0 };
+                    raw[2] = (uint8_t)board;
+                    raw[3] = (uint8_t)ch;
+                    raw[4] = everies[i];
+                    raw[5] = everies[j];
+                    if (att_block_encode_channels(b, raw[2], raw[3], raw[4], raw[5]) != want
+                        || att_block_decode(raw, &d) != want || d.kind != ATT_BLOCK_CHANNELS
+                        || d.board != board || d.channels != ch || d.acc_every != raw[4]
+                        || d.mag_every != raw[5] || (want == ATT_OK && !bytes_eq(b, raw))) {
+                        CHECK_EQ_INT(board * 1000000u + ch * 10000u + i * 100u + j, -1);
+                        return;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/* Feed the records of sample n of an aided stream (acc every 2, mag every 4)
+ * and check each one's place; returns the records fed. */
+static int feed_group(att_block_seq *t, uint32_t n)
+{
+    static const uint16_t c[3] = { 100, 200, 300 };
+    uint8_t smp[ATT_BLOCK_SIZE];
+    att_block_span sp;
+    int fed = 0;
+    att_block_encode_sample(smp, c);
+    CHECK_EQ_INT(feed(t, smp, &sp), ATT_OK);
+    CHECK(sp.first == n && sp.count == 1 && sp.part == ATT_BLOCK_PART_GYR && sp.slip == 0);
+    fed++;
+    if (n % 2u == 0u) {
+        CHECK_EQ_INT(t->part, ATT_BLOCK_PART_ACC);
+        CHECK_EQ_INT(feed(t, smp, &sp), ATT_OK);
+        CHECK(sp.first == n && sp.count == 1 && sp.part == ATT_BLOCK_PART_ACC);
+        fed++;
+    }
+    if (n % 4u == 0u) {
+        CHECK_EQ_INT(t->part, ATT_BLOCK_PART_MAG);
+        CHECK_EQ_INT(feed(t, smp, &sp), ATT_OK);
+        CHECK(sp.first == n && sp.count == 1 && sp.part == ATT_BLOCK_PART_MAG);
+        fed++;
+    }
+    CHECK_EQ_INT(t->part, ATT_BLOCK_PART_GYR); /* the group is complete */
+    CHECK_EQ_INT(t->next, n + 1u);
+    return fed;
+}
+
+static void test_tracker_numbers_aided_groups(void)
+{
+    att_block_seq t;
+    att_block_span sp;
+    uint8_t raw[ATT_BLOCK_SIZE];
+    uint16_t c[3] = { 1, 2, 3 };
+    uint32_t n;
+    int records = 0;
+    att_block_seq_init(&t);
+    CHECK(t.channels == ATT_BLOCK_CH_GYR && t.part == ATT_BLOCK_PART_GYR);
+    att_block_encode_boot(raw, 72, 48);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    att_block_encode_channels(raw, ATT_BLOCK_BOARD_AIDED9, 7, 2, 4);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    CHECK(sp.first == 0 && sp.count == 0 && sp.part == ATT_BLOCK_PART_GYR);
+    CHECK(t.channels == 7 && t.acc_every == 2 && t.mag_every == 4 && t.next == 0);
+    for (n = 0; n < 12u; n++) {
+        records += feed_group(&t, n);
+    }
+    CHECK_EQ_INT(records, 12 + 6 + 3); /* 12 gyro, 6 accelerometer, 3 magnetometer records */
+    /* losses count whole samples */
+    att_block_encode_loss(raw, ATT_BLOCK_OVERRUN, 12, 2);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    CHECK(sp.first == 12 && sp.count == 2 && sp.part == ATT_BLOCK_PART_GYR);
+    (void)feed_group(&t, 14);
+    /* sample 15 has no acc/mag; 16's group is cut after its gyro record (acc, mag lost) */
+    (void)feed_group(&t, 15);
+    att_block_encode_sample(raw, c);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    CHECK(sp.first == 16 && t.part == ATT_BLOCK_PART_ACC);
+    att_block_encode_loss(raw, ATT_BLOCK_GAVE_UP, 17, 1);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_BLOCK_E_SEQ);
+    CHECK(sp.first == 17 && sp.count == 1 && sp.slip == 0 && sp.part == ATT_BLOCK_PART_ACC);
+    CHECK(t.next == 18 && t.part == ATT_BLOCK_PART_GYR);
+    (void)feed_group(&t, 18);
+    /* 20's group cut after its accelerometer record: the magnetometer's was due */
+    att_block_encode_sample(raw, c);
+    (void)feed_group(&t, 19);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+    CHECK(sp.first == 20 && sp.part == ATT_BLOCK_PART_ACC && t.part == ATT_BLOCK_PART_MAG);
+    att_block_encode_adc_error(raw, 23, -40); /* and 21, 22 vanished: a slip as well */
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_BLOCK_E_SEQ);
+    CHECK(sp.first == 21 && sp.count == 3 && sp.slip == 2 && sp.part == ATT_BLOCK_PART_MAG);
+    (void)feed_group(&t, 24);
+    /* a rejected CHANNELS changes nothing; a BOOT makes the stream gyro-only again */
+    raw[0] = 0xFE;
+    raw[1] = 0x06;
+    raw[2] = 0x02;
+    raw[3] = 0x03;
+    raw[4] = 0x00; /* ACC with acc_every 0 */
+    raw[5] = 0x00;
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, NULL, &sp), ATT_E_NULL);
+    {
+        att_block d;
+        CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_BLOCK_E_FIELD);
+        CHECK_EQ_INT(att_block_seq_feed(&t, &d, &sp), ATT_BLOCK_E_FIELD);
+    }
+    CHECK(t.channels == 7 && t.acc_every == 2 && t.next == 25);
+    att_block_encode_sample(raw, c);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK); /* gyro of 25 */
+    att_block_encode_boot(raw, 72, 48);
+    CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK); /* a reboot, not a cut group */
+    CHECK(t.channels == ATT_BLOCK_CH_GYR && t.acc_every == 0 && t.mag_every == 0
+          && t.part == ATT_BLOCK_PART_GYR);
+    att_block_encode_sample(raw, c);
+    for (n = 0; n < 3u; n++) {
+        CHECK_EQ_INT(feed(&t, raw, &sp), ATT_OK);
+        CHECK(sp.first == n && sp.part == ATT_BLOCK_PART_GYR);
+    }
+}
+
+/* An oversampled aided stream: OVERSAMPLE then CHANNELS after BOOT; every
+ * record of a group has the stream's limit; a zeroed tracker is gyro-only. */
+static void test_oversampled_aided_stream(void)
+{
+    att_block_seq t;
+    att_block_span sp;
+    att_block d;
+    uint8_t raw[ATT_BLOCK_SIZE];
+    uint16_t w[3] = { 4u * 4095u, 0, 1 };
+    att_block_seq_init(&t);
+    att_block_encode_boot(raw, 36, 96);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK);
+    att_block_encode_oversample(raw, 4);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK);
+    att_block_encode_channels(raw, ATT_BLOCK_BOARD_AIDED9, ATT_BLOCK_CH_GYR | ATT_BLOCK_CH_ACC, 1, 0);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK);
+    att_block_encode_sums(raw, w, 4);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK);
+    CHECK(sp.first == 0 && sp.part == ATT_BLOCK_PART_GYR);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK);
+    CHECK(sp.first == 0 && sp.part == ATT_BLOCK_PART_ACC && d.code[0] == 4u * 4095u);
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_OK); /* gyro of sample 1 */
+    raw[0] = 0x40; /* 0x40FC > 4 x 4095 in the accelerometer record of sample 1 */
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_BLOCK_E_CODE);
+    CHECK(sp.first == 1 && sp.part == ATT_BLOCK_PART_ACC && t.part == ATT_BLOCK_PART_GYR);
+    memset(&t, 0, sizeof t); /* zeroed: gyro-only */
+    CHECK_EQ_INT(att_block_seq_decode(&t, raw, &d, &sp), ATT_BLOCK_E_CODE);
+    CHECK(sp.part == ATT_BLOCK_PART_GYR && t.part == ATT_BLOCK_PART_GYR && t.next == 1);
+}
+
 int main(void)
 {
     test_encoders_write_the_specified_bytes();
@@ -421,5 +604,8 @@ int main(void)
     test_tracker_numbers_across_losses();
     test_tracker_wraps_and_late_join();
     test_oversampled_streams();
+    test_channels_report();
+    test_tracker_numbers_aided_groups();
+    test_oversampled_aided_stream();
     return ATT_TEST_REPORT();
 }

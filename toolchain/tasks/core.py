@@ -74,10 +74,14 @@ def build(c, force=False):
     "k": "only tests matching this pytest -k expression",
     "jobs": "parallel pytest workers (pytest-xdist); 0 = serial",
     "extra": "extra arguments passed to pytest verbatim",
+    "fast": "the fast tier only: unit and differential tests on the host, no toolchain, process "
+            "or simulator run (tests/conftest.py, test tiers); the full run is CI's",
 })
-def test(c, k="", jobs=2, extra=""):
-    """Run the test suite (pytest; C, ARMv4T and 8051 targets included)."""
+def test(c, k="", jobs=2, extra="", fast=False):
+    """Run the test suite (pytest; C, ARMv4T and 8051 targets included), or its fast tier."""
     args = [sys.executable, "-m", "pytest", "tests"]
+    if fast:
+        args.append("--fast")
     if jobs:
         args += ["-n", str(jobs)]
     if k:
@@ -139,7 +143,7 @@ def clean(c):
 # Each module bench/<name>.py defines TITLE and run(quick: bool) -> str (a
 # Markdown section body). `invoke bench` runs them all (or --only NAME) and
 # rewrites that module's section of docs/benchmarks.md, keeping the others.
-BENCH_ORDER = ("host", "armv4t", "fixed", "tlc2543", "ad7927", "firmware", "link", "peers")
+BENCH_ORDER = ("host", "armv4t", "fixed", "tlc2543", "ad7927", "firmware", "aided", "link", "peers")
 
 
 def _bench_modules() -> list[str]:

@@ -528,7 +528,30 @@
     return 10 * mag;
   }
 
-  // Strip chart. traces: [{c: column of the value, lo, hi: envelope columns, color, dash}].
+  // The pen through a trace's per-column values. A trace with wrap: W (angles in
+  // (-W, W]) is broken where two neighbours jump across ±W (|Δ| > W): the line runs
+  // to the edge it leaves by and starts again from the opposite edge, instead of a
+  // vertical stroke across the chart. Returns the number of wraps drawn so.
+  function tracePath(ctx, X, Y, bval, bt, brk, wrap) {
+    let pen = false, px0 = 0, v0 = 0, wraps = 0;
+    for (let x = 0; x < bval.length; x++) {
+      if (isNaN(bval[x])) continue;
+      const v = bval[x], px = X(bt[x]);
+      if (!pen || brk[x]) ctx.moveTo(px, Y(v));
+      else if (wrap && Math.abs(v - v0) > wrap) {
+        const edge = v0 > 0 ? wrap : -wrap; // left by this edge, back in by the other
+        const f = (edge - v0) / (v + 2 * edge - v0); // where the unwrapped segment crosses it
+        const xc = px0 + f * (px - px0);
+        ctx.lineTo(xc, Y(edge)); ctx.moveTo(xc, Y(-edge)); ctx.lineTo(px, Y(v));
+        wraps++;
+      } else ctx.lineTo(px, Y(v));
+      pen = true; px0 = px; v0 = v;
+    }
+    return wraps;
+  }
+
+  // Strip chart. traces: [{c: column of the value, lo, hi: envelope columns, color, dash,
+  // wrap: W for an angle in (-W, W]}]. Returns the points shown and the wraps broken.
   function drawChart(canvas, traces, tEnd, span) {
     const { ctx, w, h } = prepare(canvas);
     const L = 46, Rm = 8, T = 6, B = 20;
@@ -574,6 +597,7 @@
     ctx.beginPath(); ctx.rect(L, T, pw, ph); ctx.clip();
     const gap = Math.max(1.0, 10 / S.displayRate);
     const cols = Math.max(1, Math.floor(pw));
+    let wraps = 0;
     for (const tr of traces) {
       // per pixel column: min, max and the newest value (decimation that keeps the peaks)
       const bmin = new Float64Array(cols).fill(NaN), bmax = new Float64Array(cols).fill(NaN);
@@ -586,6 +610,7 @@
         if (v == null) { prevT = null; continue; }
         const x = Math.min(cols - 1, Math.max(0, Math.floor((p[0] - t0) / span * pw)));
         const a = tr.lo != null && p[tr.lo] != null ? p[tr.lo] : v, b = tr.hi != null && p[tr.hi] != null ? p[tr.hi] : v;
+        if (tr.wrap && Math.abs(v - bval[x]) > tr.wrap) { bmin[x] = NaN; bmax[x] = NaN; } // wrapped in this column: its envelope restarts
         if (!(bmin[x] <= a)) bmin[x] = a;
         if (!(bmax[x] >= b)) bmax[x] = b;
         bval[x] = v; bt[x] = p[0];
@@ -604,19 +629,13 @@
       ctx.lineWidth = tr.dash ? 1.5 : 1.6;
       ctx.setLineDash(tr.dash ? [6, 4] : []);
       ctx.beginPath();
-      let pen = false;
-      for (let x = 0; x < cols; x++) {
-        if (isNaN(bval[x])) continue;
-        const px = X(bt[x]), py = Y(bval[x]);
-        if (!pen || brk[x]) ctx.moveTo(px, py); else ctx.lineTo(px, py);
-        pen = true;
-      }
+      wraps += tracePath(ctx, X, Y, bval, bt, brk, tr.wrap);
       ctx.stroke();
       ctx.setLineDash([]);
     }
     ctx.restore();
     ctx.strokeStyle = COLORS.line; ctx.strokeRect(L + 0.5, T + 0.5, pw, ph);
-    return last - first;
+    return { shown: last - first, wraps };
   }
 
   function fixed(v, d) { // no "-0.0"
@@ -662,22 +681,24 @@
     const c = S.col;
     if (c.t !== undefined) {
       const hasTruth = pts.length && pts[pts.length - 1][c.true_yaw] != null;
-      const ang = [
-        { c: c.yaw, lo: c.yaw_min, hi: c.yaw_max, color: COLORS.yaw },
-        { c: c.pitch, lo: c.pitch_min, hi: c.pitch_max, color: COLORS.pitch },
-        { c: c.roll, lo: c.roll_min, hi: c.roll_max, color: COLORS.roll },
+      const ang = [ // yaw and roll in (-180°, 180°], pitch in [-90°, 90°]
+        { c: c.yaw, lo: c.yaw_min, hi: c.yaw_max, color: COLORS.yaw, wrap: 180 },
+        { c: c.pitch, lo: c.pitch_min, hi: c.pitch_max, color: COLORS.pitch, wrap: 180 },
+        { c: c.roll, lo: c.roll_min, hi: c.roll_max, color: COLORS.roll, wrap: 180 },
       ];
       if (hasTruth) {
-        ang.push({ c: c.true_yaw, color: COLORS.yaw, dash: true }, { c: c.true_pitch, color: COLORS.pitch, dash: true },
-                 { c: c.true_roll, color: COLORS.roll, dash: true });
+        ang.push({ c: c.true_yaw, color: COLORS.yaw, dash: true, wrap: 180 },
+                 { c: c.true_pitch, color: COLORS.pitch, dash: true, wrap: 180 },
+                 { c: c.true_roll, color: COLORS.roll, dash: true, wrap: 180 });
       }
-      const shown = drawChart($("chart-angles"), ang, tEnd, S.windowS);
+      const drawn = drawChart($("chart-angles"), ang, tEnd, S.windowS);
       drawChart($("chart-rates"), [
         { c: c.rate_x, lo: c.rate_x_min, hi: c.rate_x_max, color: COLORS.yaw },
         { c: c.rate_y, lo: c.rate_y_min, hi: c.rate_y_max, color: COLORS.pitch },
         { c: c.rate_z, lo: c.rate_z_min, hi: c.rate_z_max, color: COLORS.roll },
       ], tEnd, S.windowS);
-      $("chart-angles").dataset.points = String(shown);
+      $("chart-angles").dataset.points = String(drawn.shown);
+      $("chart-angles").dataset.wraps = String(drawn.wraps); // lines broken at ±180° in the last draw
       $("chart-angles").dataset.tEnd = String(tEnd);
       $("chart-angles").dataset.window = String(S.windowS);
     }

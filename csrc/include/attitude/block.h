@@ -35,6 +35,12 @@
  *                                                               conversions per word, right
  *                                                               after BOOT
  *
+ *     kind         byte 2     byte 3        byte 4      byte 5     sent
+ *     6 CHANNELS   board (8)  channels (8)  acc_every   mag_every  by a board whose stream is
+ *                                           (8)         (8)        not gyro-only, right after
+ *                                                                  BOOT (after OVERSAMPLE when
+ *                                                                  both)
+ *
  * Fields (the decoder checks every range; a report outside them is
  * rejected with ATT_BLOCK_E_FIELD, an unknown kind with ATT_BLOCK_E_KIND):
  *   version   ATT_BLOCK_VERSION (1), the format this header describes; a
@@ -58,6 +64,18 @@
  *             count - 1. ADC_ERROR always loses one sample (count 1).
  *   n         OVERSAMPLE: conversions summed into each word of the sample
  *             records that follow, 1..ATT_BLOCK_OVERSAMPLE_MAX (16).
+ *   board     CHANNELS: the board type (att_block_board): ATT_BLOCK_BOARD_GYRO3
+ *             (1: the paper's AT89S51 board, three gyros) or
+ *             ATT_BLOCK_BOARD_AIDED9 (2: the AT89S52 board, nine channels of
+ *             its TLC2543: three gyros, accelerometer, magnetometer).
+ *   channels  CHANNELS: the channel set (att_block_channel bits): ATT_BLOCK_CH_GYR
+ *             (bit 0, always set), ATT_BLOCK_CH_ACC (bit 1: three-axis
+ *             accelerometer), ATT_BLOCK_CH_MAG (bit 2: three-axis
+ *             magnetometer); bits 3-7 are 0. A GYRO3 board's set is GYR alone.
+ *   acc_every CHANNELS: the accelerometer's decimation, 1..255 when ACC is in
+ *             the set (sample n carries an accelerometer record when
+ *             n % acc_every == 0), 0 when it is not.
+ *   mag_every CHANNELS: the same for the magnetometer (MAG).
  *
  * Oversampled streams. A board that converts each channel n times per
  * sample period and sends the sums (the paper's increment formation, the
@@ -79,6 +97,20 @@
  * stream's. A receiver that joins after the OVERSAMPLE report reads the
  * sums as plain codes: those above 4095 are rejected, never integrated.
  *
+ * Aided streams. A board that sends more than the gyros announces its
+ * channel set with a CHANNELS report right after BOOT (after OVERSAMPLE
+ * when both); a stream with no CHANNELS after its BOOT is gyro-only (every
+ * board before this report), and a BOOT makes a stream gyro-only again.
+ * Sample n of a stream with CHANNELS is a group of sample records, in this
+ * order: its gyro record (X, Y, Z angular rate channels), then, if ACC is in
+ * the set and n % acc_every == 0, an accelerometer record (X, Y, Z), then,
+ * if MAG is in the set and n % mag_every == 0, a magnetometer record
+ * (X, Y, Z). Each is an ordinary sample record, plain codes or sums as the
+ * stream's OVERSAMPLE says (the same limit for every record), so a link
+ * carries them unchanged; the records themselves do not say which sensor
+ * they hold: their place in the group does. A board never puts a report
+ * inside a group (loss reports count whole samples: groups).
+ *
  * Loss accounting by sequence number. Samples are numbered from 0, the
  * first sample after BOOT (the self-test runs before sampling starts);
  * sample records carry no number. Every sample that will never be sent
@@ -91,13 +123,29 @@
  * record lost or duplicated on the way: the link's known duplicate, a
  * receiver started after BOOT). att_block_seq_feed keeps that count,
  * reports a slip (ATT_BLOCK_E_SEQ) and resynchronizes on the report.
+ * In an aided stream it numbers the samples by their gyro records and
+ * tells which record of its group each sample record is
+ * (att_block_span.part). A report that arrives inside a group, before
+ * the group's accelerometer or magnetometer record (records lost on the
+ * way), cuts the group short: that sample keeps only the records already
+ * received (a receiver uses it gyro-only, or with the accelerometer alone),
+ * the tracker reports ATT_BLOCK_E_SEQ (span.part says which record was
+ * due) and handles the report as in a gyro-only stream; a BOOT simply
+ * starts a new stream. A record lost or duplicated inside a group's
+ * records cannot be seen in the bytes (samples carry no sensor tag): the
+ * records are read one place off until the next report, as a lost sample
+ * shifts the numbering until the next loss report. A receiver that joins
+ * after the CHANNELS report reads the stream as gyro-only (as one that
+ * joins after OVERSAMPLE reads it as plain): its sample records are not
+ * all gyro records, so such a receiver must wait for a BOOT.
  *
  * Encoders (block.c) are what the firmware links: portable C99 that SDCC
  * compiles for the AT89S51 (leaf functions, 8/16-bit arithmetic, buffers
  * in __data memory there: ATT_LINK_MEM). The encoders of oversampled
- * streams (block_sums.c), the decoder and the sequence tracker
- * (block_decode.c) are kept in their own translation units so that an
- * 8051 image does not carry them.
+ * streams (block_sums.c), the CHANNELS encoder (block_channels.c: the aided
+ * AT89S52 image links it, the AT89S51 gyro-only image does not), the
+ * decoder and the sequence tracker (block_decode.c) are kept in their own
+ * translation units so that an 8051 image carries only what it sends.
  */
 #ifndef ATTITUDE_BLOCK_H
 #define ATTITUDE_BLOCK_H
@@ -127,8 +175,29 @@ typedef enum {
     ATT_BLOCK_OVERRUN = 3,
     ATT_BLOCK_ADC_ERROR = 4,
     ATT_BLOCK_OVERSAMPLE = 5,
+    ATT_BLOCK_CHANNELS = 6,
     ATT_BLOCK_SAMPLE = 0x100 /* a sample record (not a byte value: never a report kind) */
 } att_block_kind;
+
+/* CHANNELS: board types (byte 2). 0 and other values: ATT_BLOCK_E_FIELD. */
+typedef enum {
+    ATT_BLOCK_BOARD_GYRO3 = 1, /* AT89S51, three gyros: the paper's board (channel set GYR alone) */
+    ATT_BLOCK_BOARD_AIDED9 = 2 /* AT89S52, nine TLC2543 channels: gyros, accelerometer, magnetometer */
+} att_block_board;
+
+/* CHANNELS: the channel set (byte 3), bits of these values; other bits 0. */
+typedef enum {
+    ATT_BLOCK_CH_GYR = 1, /* three gyros: always in the set (the first record of every group) */
+    ATT_BLOCK_CH_ACC = 2, /* three-axis accelerometer: a record every acc_every samples */
+    ATT_BLOCK_CH_MAG = 4  /* three-axis magnetometer: a record every mag_every samples */
+} att_block_channel;
+
+/* Which record of its sample's group a sample record is (att_block_span.part). */
+typedef enum {
+    ATT_BLOCK_PART_GYR = 0, /* the gyro record: the first of the group, numbers the sample */
+    ATT_BLOCK_PART_ACC = 1, /* the accelerometer record */
+    ATT_BLOCK_PART_MAG = 2  /* the magnetometer record */
+} att_block_part;
 
 /* Status codes of this module (range -100..-119 of common.h). */
 enum {
@@ -136,7 +205,8 @@ enum {
                                  n x ATT_BLOCK_CODE_MAX capped at ATT_BLOCK_SUM_MAX) */
     ATT_BLOCK_E_KIND = -101,  /* a report kind this format does not define */
     ATT_BLOCK_E_FIELD = -102, /* a report field outside its range (see above) */
-    ATT_BLOCK_E_SEQ = -103    /* a loss report's first disagrees with the sample count */
+    ATT_BLOCK_E_SEQ = -103    /* a loss report's first disagrees with the sample count, or a
+                                 report cut a group short (aided streams) */
 };
 
 /* ------------------------------------------------------------------ */
@@ -165,6 +235,13 @@ int att_block_encode_loss(uint8_t ATT_LINK_MEM *blk, uint8_t kind, uint16_t firs
 /* ADC_ERROR: sample `first` lost to a scan that failed with status -128..-1
  * (else ATT_BLOCK_E_FIELD). */
 int att_block_encode_adc_error(uint8_t ATT_LINK_MEM *blk, uint16_t first, int8_t status);
+
+/* CHANNELS (block_channels.c: what the aided firmware adds): board
+ * ATT_BLOCK_BOARD_GYRO3 or _AIDED9; channels a set of ATT_BLOCK_CH_* bits
+ * with GYR, GYR alone for GYRO3; acc_every 1..255 when ACC is in the set,
+ * else 0; mag_every likewise for MAG (else ATT_BLOCK_E_FIELD). */
+int att_block_encode_channels(uint8_t ATT_LINK_MEM *blk, uint8_t board, uint8_t channels, uint8_t acc_every,
+                              uint8_t mag_every);
 
 /* Oversampled streams (block_sums.c, not for the 8051 firmware). */
 
@@ -196,6 +273,10 @@ typedef struct {
     uint8_t attempt;       /* SELFTEST: attempt number (from 1, mod 256) */
     uint8_t oversample;    /* OVERSAMPLE: conversions per word of the samples that follow */
     int8_t status;         /* SELFTEST, ADC_ERROR: the failure's att_status */
+    uint8_t board;         /* CHANNELS: board type (att_block_board) */
+    uint8_t channels;      /* CHANNELS: channel set (ATT_BLOCK_CH_* bits) */
+    uint8_t acc_every;     /* CHANNELS: accelerometer record every acc_every samples (0: none) */
+    uint8_t mag_every;     /* CHANNELS: magnetometer record every mag_every samples (0: none) */
 } att_block;
 
 /* Decode the ATT_BLOCK_SIZE bytes at raw into *out, a record read alone
@@ -207,11 +288,19 @@ typedef struct {
  * version; out->kind = the report's kind). */
 int att_block_decode(const uint8_t *raw, att_block *out);
 
-/* Sequence tracker: numbers the samples of a record stream. */
+/* Sequence tracker: numbers the samples of a record stream. A tracker of
+ * all-zero bytes is an unsynced, plain, gyro-only one. */
 typedef struct {
-    uint32_t next;      /* number of the next sample expected (since the last BOOT; not wrapped) */
+    uint32_t next;      /* number of the next sample expected (since the last BOOT; not wrapped):
+                           its gyro record is the next record with part ATT_BLOCK_PART_GYR */
     uint8_t synced;     /* the numbering was fixed by a BOOT or a loss report */
     uint8_t oversample; /* conversions per sample word: 1, or the last OVERSAMPLE's n */
+    uint8_t channels;   /* channel set: ATT_BLOCK_CH_GYR until a CHANNELS report (BOOT: again) */
+    uint8_t acc_every;  /* CHANNELS' acc_every (0: no accelerometer records) */
+    uint8_t mag_every;  /* CHANNELS' mag_every (0: no magnetometer records) */
+    uint8_t part;       /* the record the next sample record is (att_block_part): GYR, the
+                           gyro record of sample next; ACC or MAG, a record of the group of
+                           sample next - 1. GYR after a feed: that group is complete */
 } att_block_seq;
 
 /* Where one record falls in the numbering. */
@@ -224,20 +313,32 @@ typedef struct {
                        > 0 samples vanished without a report (they are included in
                        first/count), < 0 that many records were numbered twice;
                        0 otherwise */
+    uint8_t part;   /* SAMPLE: which record of the group of sample `first` it is
+                       (att_block_part; always GYR in a gyro-only stream); a report
+                       that cut a group short (ATT_BLOCK_E_SEQ): the record that was
+                       due (ACC or MAG); other reports: GYR */
 } att_block_span;
 
-/* Start unsynced, plain (oversample 1): samples are numbered from 0 until
- * a BOOT (numbering restarts at 0, the stream is plain again) or a loss
- * report (its first and count are adopted as they are, no slip) fixes the
- * numbering; an OVERSAMPLE report sets the stream's n. */
+/* Start unsynced, plain (oversample 1), gyro-only: samples are numbered
+ * from 0 until a BOOT (numbering restarts at 0, the stream is plain and
+ * gyro-only again) or a loss report (its first and count are adopted as
+ * they are, no slip) fixes the numbering; an OVERSAMPLE report sets the
+ * stream's n, a CHANNELS report its channel set and decimations (for the
+ * samples after it, numbered as always from BOOT). */
 void att_block_seq_init(att_block_seq *s);
 
 /* Place the decoded record b (also a SAMPLE that failed with
- * ATT_BLOCK_E_CODE: it still took a number) and advance. Returns ATT_OK,
- * ATT_E_NULL, ATT_BLOCK_E_KIND (b->kind unknown: nothing changes),
- * ATT_BLOCK_E_FIELD (a loss report with count 0: nothing changes) or
- * ATT_BLOCK_E_SEQ (synced, and a loss report disagrees with the count:
- * *span says how; the numbering follows the report from now on). */
+ * ATT_BLOCK_E_CODE: it still took its place) and advance. A sample record
+ * is the gyro record of sample s->next (which it takes), or the
+ * accelerometer or magnetometer record of the group of sample s->next - 1,
+ * as s->part says (span->part: which). Returns ATT_OK, ATT_E_NULL,
+ * ATT_BLOCK_E_KIND (b->kind unknown: nothing changes), ATT_BLOCK_E_FIELD
+ * (a loss report with count 0, an OVERSAMPLE or CHANNELS report with a
+ * field out of range: nothing changes) or ATT_BLOCK_E_SEQ (synced, and a
+ * loss report disagrees with the count: *span says how; the numbering
+ * follows the report from now on; or a report other than BOOT cut a group
+ * short: span->part is the record that was due, the group is closed and
+ * the report placed as usual). */
 int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *span);
 
 /* What a receiver calls for each record: decode the ATT_BLOCK_SIZE bytes
