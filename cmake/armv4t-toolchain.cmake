@@ -13,10 +13,16 @@ set(CMAKE_SYSTEM_PROCESSOR arm)
 set(ATT_CROSS_COMPILE_DEFAULT "arm-linux-gnueabi-")
 include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes
 
-# The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.
+# The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags but -static,
+# which only attitude-rx takes (below): a program that uses this file may link
+# attitude::attitude_shared.
 set(CMAKE_C_FLAGS_INIT "-O2 -march=armv4t -mtune=arm920t -marm -mfloat-abi=soft")
-set(CMAKE_EXE_LINKER_FLAGS_INIT "-static")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "")
 set(CMAKE_SHARED_LINKER_FLAGS_INIT "")
+
+# attitude-rx links statically (the Makefile's STATIC_APP): read by the library's
+# CMakeLists.txt for that one program.
+set(ATT_APP_LINK_OPTIONS "-static")
 
 # How libattitude.so is linked (toolchain/<name>.toml shared_*): read by the
 # library's CMakeLists.txt for that one target, not applied to other targets.

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Install everything the project needs on a fresh Debian machine:
 # the cross toolchains and simulators (apt, needs root or sudo) and the
-# Python package with its test dependencies (editable, so the CFFI
-# extensions are built from this tree).
+# Python package with its `dev` extra (editable, so the CFFI extensions are
+# built from this tree): everything a test, a benchmark or an invoke task
+# imports (pyproject.toml; tests/test_dependencies.py checks it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -34,6 +35,6 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 PY=${PYTHON:-python3}
-echo "setup: installing attitude_c (editable) with test dependencies"
+echo "setup: installing attitude_c (editable) with the dev extra (tests, benchmarks, tasks, linters)"
 $PY -m pip install -q --upgrade pip >/dev/null 2>&1 || true
-$PY -m pip install -q -e ".[test]"
+$PY -m pip install -q -e ".[dev]"

@@ -382,6 +382,49 @@ def test_rx_count_acknowledges_only_what_it_prints(rx_builds) -> None:
     assert len(acked) == 100
 
 
+def _wire_block(block: bytes) -> bytes:
+    """What A sends for one block after 0xBB: the data and its checksum (the C sender's)."""
+    from attitude_c.link import Result, make_sender
+
+    a = make_sender("c", block_size=len(block))
+    a.start(block, 0)
+    assert a.poll(0) == (Result.SEND, 0xAA)
+    a.sink(0xBB, 0)
+    out = bytearray()
+    while (r := a.poll(0))[0] == Result.SEND:
+        out.append(r[1])
+    return bytes(out)
+
+
+def test_rx_stop_keeps_its_last_answers_on_the_line(rx_builds) -> None:
+    """--count 1 and a sender that reads nothing until attitude-rx has ended (a slow reader,
+    as on a loaded machine): every answer it wrote is still there, the 0x00 of the block it
+    printed last. On main it closed the port with TCOFLUSH, which drops what the other end
+    has not taken in yet: A timed out on a block B had delivered (issue 27). The NAKed
+    blocks before it fill the pty's 4 KB line buffer, so the last answers wait in the
+    kernel's buffer, where a flush finds them whatever the machine's load."""
+    rx = Rx(rx_builds["host"], "--method", "rv1", "--no-header", "--count", "1", "--gap-ms", "2000")
+    codes = _unique_codes(1)
+    good = _wire_block(_block(codes[0]))
+    bad = good[:-1] + bytes([good[-1] ^ 0x01])  # a wrong checksum: B answers 0xFF
+    naks = 2100  # 2 answer bytes each (0xBB, 0xFF): more than the 4096 bytes of the line buffer
+    os.write(rx.master, (b"\xaa" + bad) * naks + b"\xaa" + good)
+    rx.proc.wait(timeout=60)  # it ends by itself (--count 1)
+    want = b"\xbb\xff" * naks + b"\xbb\x00"
+    got = _read_upto(rx.master, len(want))
+    rc, out, err = rx.finish(sig=None)
+    assert rc == 0 and _rows(out) == codes, err
+    assert got == want, f"{len(got)} of {len(want)} answer bytes, ending {got[-4:].hex()}"
+
+
+def _read_upto(fd: int, n: int, quiet: float = 20.0) -> bytes:
+    """n bytes from fd, or fewer if none comes for `quiet` s (never hang)."""
+    got = bytearray()
+    while len(got) < n and select.select([fd], [], [], quiet)[0]:
+        got += os.read(fd, n - len(got))
+    return bytes(got)
+
+
 @pytest.mark.parametrize(("method", "count", "samples", "every", "first"),
                          [("rv3", 20, 60, 3, 2),   # an update per 3 samples
                           ("rk4", 20, 41, 2, 2)])  # start sample, then (midpoint, end) pairs

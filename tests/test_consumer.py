@@ -143,17 +143,26 @@ def test_cmake_host_float_build_package_and_pkg_config(tmp_path: Path) -> None:
 @pytest.mark.qemu
 def test_cmake_armv4t_package_find_package_and_pkg_config(tmp_path: Path) -> None:
     """armv4t with cmake/armv4t-toolchain.cmake: the installed libattitude.a
-    and libattitude.so are ARMv4T clean; the consumer, cross-built through
-    find_package (with the same toolchain file) and through pkg-config,
-    static and against the .so, runs under qemu-arm."""
+    and libattitude.so are ARMv4T clean, attitude-rx is linked statically; the
+    consumer, cross-built through find_package (with the same toolchain file)
+    against attitude::attitude and attitude::attitude_shared (issue 27: the file
+    linked every program -static, so the .so could not be linked), and through
+    pkg-config, static and against the .so, runs under qemu-arm."""
     t = require_target("armv4t")
     root = _cmake_install(tmp_path, "armv4t-toolchain.cmake")
     _check_pc(root, f32=False)
-    assert (root / "usr/bin/attitude-rx").exists()
+    assert "no dynamic section" in _run([t.tool("readelf"), "-d", root / "usr/bin/attitude-rx"])
     _check_armv4t_install(t, root, tmp_path)
-    exe, _ = _cmake_consumer(tmp_path, root, f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake/armv4t-toolchain.cmake'}",
-                             f"-DCMAKE_FIND_ROOT_PATH={root}", "-DCMAKE_PREFIX_PATH=/usr")
-    assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
+    loader = ["-L", str(_armel_prefix(t))]  # the consumer links libc dynamically (module docstring)
+    for target, lib in (("attitude::attitude", None), ("attitude::attitude_shared", "libattitude.so.0")):
+        exe, _ = _cmake_consumer(tmp_path / target.replace(":", "_"), root,
+                                 f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake/armv4t-toolchain.cmake'}",
+                                 f"-DCMAKE_FIND_ROOT_PATH={root}", "-DCMAKE_PREFIX_PATH=/usr",
+                                 f"-DATT_CONSUMER_LINK={target}")
+        needed = _run([t.tool("readelf"), "-dW", exe])
+        assert (lib in needed) if lib else ("libattitude" not in needed), needed
+        res = t.run([exe], timeout=60, extra_run_args=loader)
+        assert res.stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}", target
     exe = _pkg_config_consumer(tmp_path, root, t.cc, t.target_cflags, t.ldflags)
     assert t.run([exe], timeout=60).stdout.decode().strip() == f"att_real=8 ok=ok {Q_TEXT}"
 

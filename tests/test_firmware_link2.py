@@ -8,8 +8,8 @@ in s51 with a v2 receiver on the other end of the pty:
   must sit exactly in the place of the samples it announces), the stack
   high-water mark, and the
   rate the link carries with a sampling period shorter than it can sustain;
-* attitude-rx --link v2 (the host build of the C app): no duplicate, no
-  sequence error, every acknowledged sample integrated.
+* attitude-rx --link v2 (the host build of the C app): no record delivered
+  twice, no sequence error, every acknowledged sample integrated.
 
 s51 runs in simulated time, the host in wall time: a host descheduled on a
 loaded machine shows up as latency, which the firmware survives by reporting
@@ -59,10 +59,28 @@ def test_both_link_builds_fit_the_at89s51(out: Path) -> None:
         tool.Config(link="v2", v2_ring=3)
 
 
-def _run_v2(img: tool.Image, timeout: float) -> tuple[tool.SimOutput, list[bytes], dict[str, int]]:
+def _run_v2(img: tool.Image, timeout: float, late: bool = False) -> tuple[tool.SimOutput, list[bytes], dict[str, int]]:
     """Run a v2 sim image against the Python receiver; (firmware output, records, receiver stats)."""
-    res = tool.run_v2(img, "python", timeout=timeout)
+    res = tool.run_v2(img, "python", timeout=timeout, late=late)
     return res, res.records, res.receiver
+
+
+def _assert_every_record_once_in_order(img: tool.Image, fw: tool.SimOutput, recs: list[bytes],
+                                       rx: dict[str, int]) -> list:
+    """What link v2 guarantees whatever the host's timing: the records delivered are the
+    firmware's, each once and in order (a frame sent again after a late ACK is recognised
+    and dropped: rx["duplicates"] counts those, and it depends on the host's latency), and
+    every record the firmware saw acknowledged was delivered. The firmware stops at its n-th
+    acknowledged sample, counting the records of that ACK up to it: the receiver may hold
+    the rest of the ring's records (sent before that ACK came), never more. Returns the stream."""
+    stream = tool.decode_stream(recs)  # raises if a loss report disagrees with the numbering
+    assert isinstance(stream[0], tool.Report) and stream[0].kind == "boot"
+    samples = [x for x in stream if isinstance(x, tool.Sample)]
+    assert [s.seq for s in samples] == sorted({s.seq for s in samples})
+    assert all(x.kind == "overrun" for x in stream[1:] if isinstance(x, tool.Report))
+    assert rx["bad_frames"] == 0 and rx["records"] == len(recs)
+    assert fw.stats["accepted"] <= len(recs) <= fw.stats["accepted"] + img.config.v2_ring - 1
+    return stream
 
 
 def test_v2_firmware_delivers_every_record_once_in_order(out: Path) -> None:
@@ -75,22 +93,30 @@ def test_v2_firmware_delivers_every_record_once_in_order(out: Path) -> None:
     fw, recs, rx = _run_v2(img, timeout=120)
     # the 8051's CRC-32C (assembly in link2_sender.c) of "123456789" = the check value (docs/link.md)
     assert "CRC E3069283" in fw.output.upper()
-    stream = tool.decode_stream(recs)  # raises if a loss report disagrees with the numbering
-    assert isinstance(stream[0], tool.Report) and stream[0].kind == "boot"
+    stream = _assert_every_record_once_in_order(img, fw, recs, rx)
     assert stream[0].link == "v2" and stream[0].period_ticks == 18  # the v2 build announces v2 in BOOT
     samples = [x for x in stream if isinstance(x, tool.Sample)]
-    assert [s.seq for s in samples] == sorted({s.seq for s in samples})
     # (no check against the gyro model here: at 5 ms the loop's link work delays scans,
     # and the model's clock is the firmware's tick; test_firmware.py checks the codes)
-    assert all(x.kind == "overrun" for x in stream[1:] if isinstance(x, tool.Report))
-    assert rx["duplicates"] == 0 and rx["bad_frames"] == 0
-    assert len(samples) >= n and fw.stats["accepted"] == len(recs)
+    assert len(samples) >= n
     assert fw.max_sp <= 0x65 + V2_STACK  # the figure test_both_link_builds_fit_the_at89s51 relies on
     rate = len(samples) / fw.sim_seconds
     taken = fw.stats["samples"] / fw.sim_seconds
     print(f"\nv2 at 9600 baud, period 18 ticks: {len(samples)} samples delivered in {fw.sim_seconds:.2f} s "
           f"simulated ({rate:.1f} samples/s; {taken:.1f}/s taken, the rest reported as OVERRUN); "
           f"{len(recs)} records, max SP 0x{fw.max_sp:02X}; receiver {rx}")
+
+
+def test_v2_firmware_late_host_still_delivers_every_record_once(out: Path) -> None:
+    """A host that answers after the firmware's retransmission timeout (issue 27: on a loaded
+    machine the host's wall time runs on while s51's simulated time does too, and main's
+    test then failed on rx["duplicates"] == 0): the firmware goes back and sends again, the
+    receiver drops what it already has, and the stream is still every record once, in order."""
+    _need()
+    img = tool.build(out, tool.Config(link="v2", period_ticks=72), kind="sim", sim_samples=30, name="fw_v2_late")
+    fw, recs, rx = _run_v2(img, timeout=120, late=True)
+    assert rx["duplicates"] > 0  # the firmware did send again (the case this test is about)
+    _assert_every_record_once_in_order(img, fw, recs, rx)
 
 
 def test_v2_firmware_to_attitude_rx(build_root: Path, tmp_path: Path) -> None:
@@ -123,7 +149,9 @@ def test_v2_firmware_to_attitude_rx(build_root: Path, tmp_path: Path) -> None:
              if ln.startswith(("attitude-rx: link2:", "attitude-rx: samples:", "attitude-rx: reports:"))
              for k, v in (kv.split("=") for kv in ln.split(":", 2)[2].split())}
     print(f"\n{fw.stats}; attitude-rx {stats}")
-    assert stats["duplicates"] == 0 and stats["bad_frames"] == 0
+    # (stats["duplicates"]: frames sent again after a late ACK and dropped; how many depends
+    # on the host's latency, the records above say that none was delivered twice)
+    assert stats["bad_frames"] == 0
     assert stats["seq_errors"] == 0 and stats["code_errors"] == 0 and stats["block_errors"] == 0
     assert stats["boot"] == 1
     # every record the firmware saw acknowledged reached attitude-rx (once: no duplicate);

@@ -180,13 +180,23 @@ def test_bench_output_lag_recovers_a_known_lag(d):
 
 @pytest.mark.system
 def test_bench_smoke():
-    """bench/broad_timing.py on a third of the BROAD trials (the full run: invoke bench --only broad_timing)."""
+    """bench/broad_timing.py's output prediction (item 5) on two BROAD trials (the full run:
+    invoke bench --only broad_timing): an output turned forward by d — VQF's by the module's
+    formula, this filter's through sensor_delay — lags the optical reference by d less, as
+    item 4's fit measures it (the benchmark's tables are its own business, not the test's)."""
     from attitude_c import broad
     from bench import broad_timing as B
+    from bench.broad import run_ours
 
     if broad.default_dir() is None:
         pytest.skip("BROAD data not found beside the checkout (../shared/data/broad)")
-    body = B.run(quick=True)
-    assert "mag_delay = " in body and "acc_delay = 5 ms" in body and "| defaults" in body
-    assert "output's lag behind the optical reference" in body
-    assert "same output prediction for both filters" in body and "VQF, output turned forward by" in body
+    d = 0.01  # s, a few times the lags measured on BROAD (1-4 ms)
+    for path in broad.find_trials()[::8][:2]:
+        t = broad.load_trial(path)
+        for name, q0, q1 in (("VQF", B.vqf_predicted(t, 0.0), B.vqf_predicted(t, d)),
+                             ("this filter", run_ours(t), run_ours(t, sensor_delay=d))):
+            shift = B.output_lag(q0, t)[0] - B.output_lag(q1, t)[0]
+            # the turn is d·(ω − b̂) in the estimate's frame, the fit projects on d·ω in the
+            # reference's: they differ by the attitude error (a few degrees, 1 − cos < 0.2 %)
+            # and the bias estimate's share of the rate (measured: 0.1-0.2 % in all); 1 %
+            assert shift == pytest.approx(d, rel=0.01), (path.name, name, shift)

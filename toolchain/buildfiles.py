@@ -16,8 +16,10 @@ What goes where: the TOML ``cflags`` (the target: architecture, ABI,
 optimization, instrumentation) go unchanged into every path; the TOML
 ``strict_cflags`` (-std, warnings, -Werror) stay with the project's own
 builds: make and CMake add their own ``-std=c99 -Wall -Wextra -Wpedantic``.
-The TOML ``ldflags`` link programs (``-static``, ``--specs=...``); the
-shared library gets them without those program-only flags, plus the TOML
+The TOML ``ldflags`` link programs (``-static``, ``--specs=...``; in CMake
+``-static`` links only ``attitude-rx``, so that a user's program can link
+``attitude::attitude_shared``); the shared library gets them without those
+program-only flags, plus the TOML
 ``shared_ldflags``, the libgcc.a that ``shared_libgcc`` prints and
 ``shared_libs`` (armv4t: an ARMv4T runtime instead of the compiler's own).
 ``tests/test_buildfiles.py`` checks that these files are current and that
@@ -39,6 +41,8 @@ CROSS_COMMON = CMAKE_DIR / "cross-common.cmake"
 
 #: Link flags only a program takes (not a shared library).
 PROGRAM_ONLY_LDFLAGS = ("-static", "--specs=")
+#: Of those, the ones only attitude-rx takes in CMake (a user's program may link the .so).
+APP_ONLY_LDFLAGS = ("-static",)
 
 
 def _generated_note(source: str, regen: str = "python -m toolchain.buildfiles") -> str:
@@ -176,11 +180,19 @@ def cmake_toolchain(t: T.Target) -> str:
                 'include("${CMAKE_CURRENT_LIST_DIR}/cross-common.cmake")  # the tools, the find modes']
     else:
         out.append(f"set(CMAKE_C_COMPILER {cc})")
-    out += ["",
-            "# The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags.",
+    app = [f for f in t.ldflags if f in APP_ONLY_LDFLAGS]
+    out += ["", "# The target's flags (toolchain/<name>.toml cflags); programs link with its ldflags"
+            + (f" but {q(app)}," if app else "."),
+            *(["# which only attitude-rx takes (below): a program that uses this file may link",
+               "# attitude::attitude_shared."] if app else []),
             f'set(CMAKE_C_FLAGS_INIT "{q(t.target_cflags)}")',
-            f'set(CMAKE_EXE_LINKER_FLAGS_INIT "{q(t.ldflags)}")',
+            f'set(CMAKE_EXE_LINKER_FLAGS_INIT "{q(f for f in t.ldflags if f not in app)}")',
             f'set(CMAKE_SHARED_LINKER_FLAGS_INIT "{q(shared_ldflags(t))}")']
+    if app:
+        out += ["",
+                "# attitude-rx links statically (the Makefile's STATIC_APP): read by the library's",
+                "# CMakeLists.txt for that one program.",
+                f'set(ATT_APP_LINK_OPTIONS "{";".join(app)}")']
     if t.shared_ldflags or t.shared_libgcc or t.shared_libs != t.libs:
         out += ["",
                 "# How libattitude.so is linked (toolchain/<name>.toml shared_*): read by the",

@@ -788,10 +788,13 @@ class V2Result(SimOutput):
 
 
 def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float = 60.0,
-           room: int = 64) -> V2Result:
+           room: int = 64, late: bool = False) -> V2Result:
     """Run a link v2 sim/bench image in s51 with libattitude's v2 receiver B on the pty:
     the C machine (``impl="c"``, through CFFI) or the Python one written from the spec.
-    The host keeps up with any rate: its room never shrinks."""
+    The host keeps up with any rate: its room never shrinks. ``late``: once records flow,
+    the host holds its answers back until the firmware has sent a frame again (its
+    retransmission timeout ran out), as a host descheduled on a loaded machine does;
+    waiting for that event, not for a time, makes it certain."""
     import serial  # pyserial
 
     from attitude_c.link.v2 import Receiver2, Result2
@@ -801,6 +804,7 @@ def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float =
         raise ValueError(f"run_v2 needs a link v2 image, got link={image.config.link!r}")
     rx: Any = CReceiver2(room=room) if impl == "c" else Receiver2(room=room)
     got: list[bytes] = []
+    reply = bytearray()
     with Session(image, timeout) as sess:
         port = serial.Serial(str(sess.port), image.config.baud, timeout=0.005)
 
@@ -809,14 +813,14 @@ def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float =
                 if rx.sink(b) == Result2.DELIVERED:
                     got.extend(rx.delivered)
                     rx.set_room(room)
-            reply = bytearray()
             while True:
                 res, byte = rx.poll()
                 if res != Result2.SEND or byte is None:
                     break
                 reply.append(byte)
-            if reply:
-                port.write(reply)
+            if reply and not (late and got and rx.stats.duplicates == 0):
+                port.write(bytes(reply))
+                reply.clear()
 
         try:
             fw = sess.run(pump=pump, describe=lambda: f"{len(got)} records, receiver {rx.stats.as_dict()}")

@@ -247,8 +247,17 @@ int rx_port_write(rx_stop *s, int fd, const uint8_t *p, size_t n);
 int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
 /* 1 if baud is one the termios layer knows. */
 int rx_serial_baud_ok(long baud);
-/* Close the port without waiting for its unsent output (a tty's close
- * would wait for it to drain, up to 30 s on a UART whose flow is stopped). */
+/* Close the port once what was written has gone out: the last answer
+ * (the 0x00 of a block the app delivered, a link v2 ACK) reaches the
+ * sender. Discarding it (TCOFLUSH; on a pty that empties what the other
+ * end has not taken in yet) made a slow sender resend a block the app had
+ * acknowledged. The port has no flow control, so its output drains at the
+ * line's rate; output that does not move for RX_DRAIN_STUCK_MS (flow
+ * stopped: tcflow TCOOFF) is dropped, as a tty's close() would wait for it
+ * up to 30 s. */
+enum {
+    RX_DRAIN_STUCK_MS = 100
+};
 void rx_serial_close(int fd);
 
 #endif /* ATTITUDE_RX_H */

@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 #include <termios.h>
 #include <unistd.h>
@@ -422,6 +423,14 @@ int rx_serial_open(const char *path, long baud, char *msg, size_t len)
 
 void rx_serial_close(int fd)
 {
-    tcflush(fd, TCOFLUSH);
+    int left = 0, before = -1, still = 0;
+    /* wait while the output queue shrinks; what stops moving for RX_DRAIN_STUCK_MS is dropped */
+    while (ioctl(fd, TIOCOUTQ, &left) == 0 && left > 0 && still < RX_DRAIN_STUCK_MS) {
+        still = left == before ? still + 10 : 0;
+        before = left;
+        (void)poll(NULL, 0, 10);
+    }
+    if (left > 0)
+        tcflush(fd, TCOFLUSH);
     close(fd);
 }
