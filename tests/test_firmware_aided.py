@@ -56,9 +56,12 @@ def test_aided_image_fits_the_at89s52(out: Path) -> None:
     print(img.size_report())
     assert img.flash <= tool.FLASH_SIZE_52 and img.ram_static <= tool.IRAM_SIZE_52
     for bad, msg in [(dict(link="legacy"), "link v2 only"), (dict(baud=9000), "baud"),
-                     (dict(acc_every=3), "acc_every"), (dict(mag_every=256), "mag_every")]:
+                     (dict(acc_every=3), "acc_every"), (dict(mag_every=256), "mag_every"),
+                     (dict(v2_batch=17), "v2_batch"), (dict(v2_hold=40000), "v2_hold")]:
         with pytest.raises(ValueError, match=msg):
             dataclasses.replace(tool.AIDED, **bad)
+    with pytest.raises(ValueError, match="aided board"):  # batching is the aided image's only
+        tool.Config(link="v2", v2_batch=2)
     with pytest.raises(ValueError, match="baud"):  # 115200 is Timer 2's, not Timer 1's
         tool.Config(baud=115200)
     assert 115200 in tool.BAUD_RATES_T2 and 57600 in tool.BAUD_RATES_T2
