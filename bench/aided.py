@@ -144,13 +144,13 @@ def run(quick: bool) -> str:
                   "figure is that of a stalled link waiting for acknowledgements, not a feasible load.",
               "", f"A group's scan (3, 6 or 9 conversions + power-down): {min(scan):.0f}..{max(scan):.0f} machine "
                   "cycles on average per plan.", "",
-              f"Where the default plan's cycles go (115200 baud; the profile image, -DFW_PROFILE): "
+              (f"Where the default plan's cycles go (115200 baud; the profile image, -DFW_PROFILE): "
               f"{busy_rec:.0f} busy machine cycles per record (load run); {prof['per_frame']:.1f} records per "
               f"frame; {prof['bytes']:.2f} bytes sent per record at {prof['poll']:.0f} cycles per poll that "
               f"sends one (with the profile's ~40 cycles of timestamps); {prof['rx_bytes']:.2f} ACK bytes "
               f"received per record at {prof['sink']:.0f} cycles per sink call (same); the scan "
               f"{prof['scan']:.0f} cycles per record; the rest is the main loop, the serial interrupt, the "
-              "records' encoding and the bench's own idle accounting.", "",
+              "records' encoding and the bench's own idle accounting."), "",
               "Accuracy on BROAD (Laidig, Caruso, Cereatti, Seel, Data 6(7), 2021; the trials in "
               "../shared/data/broad taken at the board's instants, att_ahrs defaults, the accelerometer and "
               "magnetometer in every k-th sample only; total error, RMS per trial, deg; "

@@ -83,7 +83,9 @@
 #define FW_AIN_ACC 3 /* accelerometer X, Y, Z: AIN3, AIN4, AIN5 */
 #define FW_AIN_MAG 6 /* magnetometer X, Y, Z: AIN6, AIN7, AIN8 */
 #ifndef FW_RXQ
-#define FW_RXQ 16 /* received bytes the FIFO holds (a power of two <= 128): an ACK frame is 10 bytes with its delimiters */
+/* received bytes the FIFO holds (a power of two <= 128): an ACK frame is
+ * 10 bytes with its delimiters, and one frame is answered at a time */
+#define FW_RXQ 16
 #endif
 #if !FW_LINK_V2
 #error "the aided board speaks link v2 only: build it with FW_LINK_V2=1 (toolchain/firmware.py does)"

@@ -170,10 +170,11 @@ typedef struct {
 /* ATT_LINK2_CURSOR = 1 (the default: the library, the aided AT89S52
  * image): the packed codes of a DATA frame are read through a cursor that
  * walks the ring (f_ptr, one or two bytes per frame byte, three frame
- * bytes per pair of codes: f_ph, f_nib), about 60 machine cycles per byte
- * on the 8051; 0 (the AT89S51 v2 image, which toolchain/firmware.py keeps
- * byte for byte as it was): each frame byte is recomputed from its index
- * (two nibbles, a division by 9 each), about 200. Same wire. */
+ * bytes per pair of codes: f_ph, f_nib): in s51 a poll that sends a byte
+ * costs about 220 machine cycles instead of 340; 0 (the AT89S51 v2 image,
+ * which toolchain/firmware.py keeps byte for byte as it was): each frame
+ * byte is recomputed from its index (two nibbles, a division by 9 each).
+ * Same wire. */
 #ifndef ATT_LINK2_CURSOR
 #define ATT_LINK2_CURSOR 1
 #endif
