@@ -4,7 +4,7 @@ FW_AIDED): nine TLC2543 channels, link v2 on Timer 2, BOOT + CHANNELS, sample gr
 * the image fits the AT89S52 (8 KB / 256 B) with the stack s51 measures plus a margin;
   the configuration refuses what the board cannot do;
 * in s51 (C52 core) with libattitude's link v2 receiver on the pty, the C one and the
-  Python one: BOOT (link v2, the period, the baud), CHANNELS (board, channel set,
+  Python one, for a decimated plan and for the default (aiding in every sample): BOOT (link v2, the period, the baud), CHANNELS (board, channel set,
   decimations), then groups numbered by the block format's tracker in order, every record
   in its place (gyro, accelerometer when n % acc_every == 0, magnetometer when
   n % mag_every == 0) and every code within 1 LSB of the device model's closed form
@@ -112,12 +112,15 @@ def _check_stream(records: list[bytes], cfg: tool.Config) -> int:
     return n_samples
 
 
-@pytest.mark.parametrize("impl,baud", [("c", 115200), ("python", 57600)])
-def test_aided_firmware_delivers_groups_in_order(out: Path, impl: str, baud: int) -> None:
+@pytest.mark.parametrize("impl,baud,plan", [("c", 115200, "test"), ("python", 57600, "test"),
+                                           ("c", 115200, "default")])
+def test_aided_firmware_delivers_groups_in_order(out: Path, impl: str, baud: int, plan: str) -> None:
+    """The test's plan (decimated aiding: frames mostly started by the hold's 20 ms) and the
+    shipped default (aiding in every sample: frames of a batch or more)."""
     _need()
-    cfg = dataclasses.replace(CFG, baud=baud)
+    cfg = dataclasses.replace(CFG if plan == "test" else tool.AIDED, baud=baud)
     n = 60
-    img = tool.build(out, cfg, kind="sim", sim_samples=n, name=f"aided_{impl}_{baud}")
+    img = tool.build(out, cfg, kind="sim", sim_samples=n, name=f"aided_{impl}_{baud}_{plan}")
     res = tool.run_v2(img, impl, timeout=180)  # type: ignore[arg-type]
     assert "CRC E3069283" in res.output.upper()
     assert _check_stream(res.records, cfg) >= n
