@@ -214,11 +214,11 @@ class Config:
 
 #: The aided board's default build (docs/firmware.md "The aided board"): link v2 at
 #: 115200 baud with a ring of 16 records in the upper RAM, frames of up to 16 samples held
-#: back for 6 records or 72 ticks (20 ms), and the sampling plan chosen there
+#: back for 6 records or 108 ticks (30 ms), and the sampling plan chosen there
 #: (bench/aided.py): gyros at 50 samples/s (20 ms), accelerometer and magnetometer in every
-#: sample: about 65 % CPU in s51.
+#: sample: about 63 % CPU in s51.
 AIDED = Config(board="aided9", link="v2", baud=115200, period_ticks=72, v2_ring=16, v2_samples=16, v2_batch=6,
-               v2_hold=72, acc_every=1, mag_every=1)
+               v2_hold=108, acc_every=1, mag_every=1)
 
 
 @dataclass(frozen=True)
