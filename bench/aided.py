@@ -39,11 +39,14 @@ STEPS = (6, 3)
 KS = ((1, 1), (2, 2), (2, 4), (4, 4), (8, 8))
 
 
-def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, records: int) -> dict[str, Any]:
-    """One plan's bench run: busy fraction, delivered rates, stack."""
+def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, records: int,
+             sr: bool = False) -> dict[str, Any]:
+    """One plan's bench run (``sr``: with the magnetometer's set/reset): busy fraction,
+    delivered rates, stack."""
     period, acc, mag = plan
-    cfg = dataclasses.replace(tool.AIDED, baud=baud, period_ticks=period, acc_every=acc, mag_every=mag)
-    img = tool.build(build_dir, cfg, kind="bench", sim_samples=records, name=f"aided_{baud}_{period}_{acc}_{mag}")
+    cfg = dataclasses.replace(tool.AIDED, baud=baud, period_ticks=period, acc_every=acc, mag_every=mag, mag_sr=sr)
+    img = tool.build(build_dir, cfg, kind="bench", sim_samples=records,
+                     name=f"aided_{baud}_{period}_{acc}_{mag}" + ("_sr" if sr else ""))
     res = tool.run_v2(img, "c", timeout=900)
     b = res.bench
     total = ((b["ticks"] - b["tick0"]) & 0xFFFF) * 256  # ticks since the first iteration, in cycles
@@ -114,17 +117,22 @@ def run(quick: bool) -> str:
     build_dir = ROOT / "build" / "bench_aided"
     records = 120 if quick else 400
     prod = tool.build(build_dir, tool.AIDED, kind="production", name="aided_prod")
+    prod_sr = tool.build(build_dir, dataclasses.replace(tool.AIDED, mag_sr=True), kind="production", name="aided_prod_sr")
     default = (tool.AIDED.period_ticks, tool.AIDED.acc_every, tool.AIDED.mag_every)
-    runs = [(default, 57600), *((plan, 115200) for plan in PLANS)]
-    cpu = {(plan, baud): cpu_load(tool, build_dir, plan, baud, records) for plan, baud in runs}
+    runs = [(default, 57600, False), *((plan, 115200, False) for plan in PLANS), (default, 115200, True),
+            (default, 57600, True)]
+    cpu = {(plan, baud, sr): cpu_load(tool, build_dir, plan, baud, records, sr) for plan, baud, sr in runs}
     prof = profile(tool, build_dir, records)
-    busy_rec = cpu[(default, tool.AIDED.baud)]["busy"] * tool.MACHINE_HZ / cpu[(default, tool.AIDED.baud)]["records"]
+    dflt = cpu[(default, tool.AIDED.baud, False)]
+    busy_rec = dflt["busy"] * tool.MACHINE_HZ / dflt["records"]
     acc = broad_accuracy(quick)
     lines = [
         (f"Default image (`Config(board=\"aided9\")`, `toolchain.firmware.AIDED`): flash **{prod.flash} / "
          f"8192 bytes**, internal RAM **{prod.ram_static} / 256 bytes** static, stack 0x{prod.stack_start:02X}.."
          f"0xFF = {prod.stack_free} bytes; highest SP seen in s51 over the runs below "
-         f"0x{max(c['max_sp'] for c in cpu.values()):02X}."),
+         f"0x{max(c['max_sp'] for (_, _, sr), c in cpu.items() if not sr):02X}. With the magnetometer's "
+         f"set/reset (`mag_sr=True`): flash {prod_sr.flash}, RAM {prod_sr.ram_static} static, stack from "
+         f"0x{prod_sr.stack_start:02X}, highest SP seen 0x{max(c['max_sp'] for (_, _, sr), c in cpu.items() if sr):02X}."),
         "",
         (f"Link v2 settings: a ring of {tool.AIDED.v2_ring} records in the upper RAM, up to "
          f"{tool.AIDED.v2_samples} samples per frame, a DATA frame held back for {tool.AIDED.v2_batch} records "
@@ -132,13 +140,13 @@ def run(quick: bool) -> str:
         "",
         f"CPU load in s51 (C52 core, {records} sample records acknowledged per run):",
         "",
-        "| gyros | acc every | mag every | records/s wanted | baud | busy | records/s delivered |",
-        "|---:|---:|---:|---:|---:|---:|---:|",
+        "| gyros | acc every | mag every | mag set/reset | records/s wanted | baud | busy | records/s delivered |",
+        "|---:|---:|---:|:---:|---:|---:|---:|---:|",
     ]
-    for ((p, ka, km), baud), c in cpu.items():
-        lines.append(f"| {tool.TICK_HZ / p:.0f} Hz | {ka} | {km} | {c['wanted']:.1f} | {baud} | "
-                     f"{100 * c['busy']:.1f} % | {c['records']:.1f} |")
-    scan = [c["scan"] for c in cpu.values()]
+    for ((p, ka, km), baud, sr), c in cpu.items():
+        lines.append(f"| {tool.TICK_HZ / p:.0f} Hz | {ka} | {km} | {'yes' if sr else 'no'} | {c['wanted']:.1f} | "
+                     f"{baud} | {100 * c['busy']:.1f} % | {c['records']:.1f} |")
+    scan = [c["scan"] for (_, _, sr), c in cpu.items() if not sr]
     lines += ["", "A plan whose records/s delivered fall short of those wanted saturates the 8051 (the link "
                   "v2 sender's CPU per byte): it loses samples, reported in place as OVERRUN, and its busy "
                   "figure is that of a stalled link waiting for acknowledgements, not a feasible load.",
