@@ -98,7 +98,8 @@ __sfr __at(0x97) bench_started;
 /* Profile (bench/aided.py's profile run, -DFW_PROFILE: its timestamps
  * inflate the busy figure, so the load runs go without): machine cycles
  * of the sender's polls that sent a byte / did not, of its sink calls,
- * and their counts. */
+ * and their counts. Some of these cells are the device model's in a sim
+ * image (tlc_hal_sim.h, tlc_model.c); a bench image has no model. */
 __sfr32 __at(0xC3C2C1C0) prof_send;
 __sfr32 __at(0xC7C6C5C4) prof_other;
 __sfr32 __at(0xACABAAA9) prof_rx;
