@@ -57,18 +57,23 @@ class AidedPlan:
     ``acc_every`` / ``mag_every``: an accelerometer / magnetometer record in
     sample n when n % every == 0 (1..255, the CHANNELS report); ``baud``,
     ``ring`` (records A keeps until acknowledged), ``frame_records`` (records
-    per frame), ``rto_s`` (A's go-back timeout); ``period_s`` the BOOT period
+    per frame), ``rto_s`` (A's go-back timeout; the firmware's batching of frames,
+    ATT_LINK2_ONE_BATCH/HOLD, is not modeled: the host's C sender frames at once);
+    ``mag_sr`` the magnetometer's set/reset (the firmware's ``FW_MAG_SR``: the code
+    ``(c_set + 4095 − c_reset) // 2``, offsets cancelled; off: one conversion, the
+    bridge and amplifier offsets in the code); ``period_s`` the BOOT period
     the firmware is built with (the CLI's default period for this board);
     ``accel`` / ``mag``: the front-end presets (:data:`.frontend.ACCEL_FRONTENDS`,
     :data:`.frontend.MAG_FRONTENDS`)."""
 
-    acc_every: int = 2
-    mag_every: int = 2
+    acc_every: int = 1
+    mag_every: int = 1
     period_s: float = 72 / 3600  # 72 ticks of 1/3600 s: 20 ms
     baud: int = 115200
-    ring: int = 8
-    frame_records: int = 4
+    ring: int = 16
+    frame_records: int = 16
     rto_s: float = 720 / 3600  # 720 ticks: 200 ms
+    mag_sr: bool = False
     accel: str = "adxl335"
     mag: str = "hmc1043-ad623"
 
@@ -99,8 +104,9 @@ def nominal_configs(plan: AidedPlan) -> dict[str, SensorConfig]:
     mid-scale code (ratiometric Vs/2; the set/reset code's 2047.5), scale the part's
     nominal units per code, axes as wired, no correction."""
     a, m = plan.accel_part, plan.mag_part
-    return {"accel": SensorConfig("acc", np.full(3, 2048.0), np.full(3, a.units_per_code)),
-            "mag": SensorConfig("mag", np.full(3, FLIP_ZERO), np.full(3, m.units_per_code))}
+    mid = 2048.0  # Vs/2 of a REF+ = Vs converter: code 4096/2
+    return {"accel": SensorConfig("acc", np.full(3, mid), np.full(3, a.units_per_code)),
+            "mag": SensorConfig("mag", np.full(3, FLIP_ZERO if plan.mag_sr else mid), np.full(3, m.units_per_code))}
 
 
 # ---------------------------------------------------------------------------
@@ -131,7 +137,7 @@ def frontend_words(cfg: Any, n: int, rngs: dict[str, np.random.Generator],
     out = {}
     for name, codes, truth_fn, unit in (
             ("accel", acc_codes, lambda t: traj.specific_force(t, env), "m/s^2"),
-            ("mag", flip_code(c_set, c_reset), lambda t: traj.mag_field(t, env), "uT")):
+            ("mag", flip_code(c_set, c_reset) if plan.mag_sr else c_set, lambda t: traj.mag_field(t, env), "uT")):
         words = np.asarray(codes, dtype=np.int64).reshape(n, m, 3).sum(axis=1)
         truth = traj.period_means(truth_fn, t0, h, n)
         part = plan.accel if name == "accel" else plan.mag
