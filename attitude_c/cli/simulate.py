@@ -280,6 +280,9 @@ def _aided_options(p: argparse.ArgumentParser) -> None:
                    help=f"aided9: a magnetometer record every N samples (default {plan.mag_every})")
     g.add_argument("--mag-sr", action="store_true",
                    help="aided9: magnetometer set/reset (the firmware's FW_MAG_SR: bridge offsets cancelled)")
+    g.add_argument("--host-config", default=plan.host_config, choices=("nominal", "calibrated"),
+                   help="aided9: the host's acc-*/mag-* conversion: nominal (the parts' typical figures; "
+                   "default) or calibrated (this run's part errors undone exactly: a perfect attitude calibrate)")
     g.add_argument("--accel-frontend", default=plan.accel, choices=tuple(ACCEL_FRONTENDS),
                    help=f"aided9: the analog accelerometer front end (default {plan.accel})")
     g.add_argument("--mag-frontend", default=plan.mag, choices=tuple(MAG_FRONTENDS),
@@ -289,10 +292,10 @@ def _aided_options(p: argparse.ArgumentParser) -> None:
 def _aided(args: argparse.Namespace) -> dict[str, Any]:
     """The --board options as SimConfig keywords."""
     plan = AidedPlan(acc_every=args.acc_every, mag_every=args.mag_every, mag_sr=args.mag_sr,
-                     accel=args.accel_frontend, mag=args.mag_frontend)
+                     host_config=args.host_config, accel=args.accel_frontend, mag=args.mag_frontend)
     if args.board == "gyro3":
         if plan != AidedPlan():
-            raise ValueError("--acc-every, --mag-every, --mag-sr, --accel-frontend and --mag-frontend "
+            raise ValueError("--acc-every, --mag-every, --mag-sr, --host-config, --accel-frontend and --mag-frontend "
                              "need --board aided9")
         return {}
     if args.accel not in (None, "none") or args.mag != "none":

@@ -43,9 +43,10 @@ from .frontend import (ACCEL_FRONTENDS, FLIP_ZERO, MAG_FRONTENDS, AmrErrors, Amr
                        flip_code, tlc2543_codes)
 from .host import AuxStream, Calibration, Decoded
 
-__all__ = ["AidedPlan", "BoardKind", "aided_decode", "aided_records", "carry_v2", "nominal_configs"]
+__all__ = ["AidedPlan", "BoardKind", "HostConfig", "aided_decode", "calibrated_configs", "aided_records", "carry_v2", "nominal_configs"]
 
 BoardKind = Literal["gyro3", "aided9"]
+HostConfig = Literal["nominal", "calibrated"]
 #: the block format's group parts, in their order within a sample
 PARTS = ("gyr", "acc", "mag")
 
@@ -61,7 +62,10 @@ class AidedPlan:
     ATT_LINK2_ONE_BATCH/HOLD, is not modeled: the host's C sender frames at once);
     ``mag_sr`` the magnetometer's set/reset (the firmware's ``FW_MAG_SR``: the code
     ``(c_set + 4095 − c_reset) // 2``, offsets cancelled; off: one conversion, the
-    bridge and amplifier offsets in the code); ``period_s`` the BOOT period
+    bridge and amplifier offsets in the code); ``host_config`` the host's acc-*/mag-*
+    conversion: ``"nominal"`` (the parts' typical figures, :func:`nominal_configs`) or
+    ``"calibrated"`` (the exact inverse of this run's drawn part errors: what a perfect
+    ``attitude calibrate`` would write); ``period_s`` the BOOT period
     the firmware is built with (the CLI's default period for this board);
     ``accel`` / ``mag``: the front-end presets (:data:`.frontend.ACCEL_FRONTENDS`,
     :data:`.frontend.MAG_FRONTENDS`)."""
@@ -74,6 +78,7 @@ class AidedPlan:
     frame_records: int = 16
     rto_s: float = 720 / 3600  # 720 ticks: 200 ms
     mag_sr: bool = False
+    host_config: HostConfig = "nominal"
     accel: str = "adxl335"
     mag: str = "hmc1043-ad623"
 
@@ -84,6 +89,8 @@ class AidedPlan:
                 raise InvalidArgument(f"{name} must be an integer 1..255 (the CHANNELS report), got {v!r}")
         if self.accel not in ACCEL_FRONTENDS:
             raise InvalidArgument(f"accel front end must be one of {tuple(ACCEL_FRONTENDS)}, got {self.accel!r}")
+        if self.host_config not in ("nominal", "calibrated"):
+            raise InvalidArgument(f"host_config must be 'nominal' or 'calibrated', got {self.host_config!r}")
         if self.mag not in MAG_FRONTENDS:
             raise InvalidArgument(f"mag front end must be one of {tuple(MAG_FRONTENDS)}, got {self.mag!r}")
 
@@ -109,15 +116,31 @@ def nominal_configs(plan: AidedPlan) -> dict[str, SensorConfig]:
             "mag": SensorConfig("mag", np.full(3, FLIP_ZERO if plan.mag_sr else mid), np.full(3, m.units_per_code))}
 
 
+def calibrated_configs(plan: AidedPlan, acc_err: SensorErrors, mag_err: AmrErrors) -> dict[str, SensorConfig]:
+    """The conversion that undoes the drawn errors exactly: zero the code of a zero
+    input (the zero-g error, a fraction of Vs; the bridge and amplifier offsets
+    through the gain, unless set/reset cancels them), M the inverse of the part's
+    diag(1 + s)·C, no bias."""
+    nom = nominal_configs(plan)
+    full = 4096.0
+    m = plan.mag_part
+    acc_zero = nom["accel"].zero + full * acc_err.bias
+    mag_zero = nom["mag"].zero + (0.0 if plan.mag_sr else
+                                  full * m.gain * (mag_err.bridge.bias + mag_err.amp_offset_v / m.supply_v))
+    return {"accel": SensorConfig("acc", acc_zero, nom["accel"].scale, matrix=np.linalg.inv(acc_err.matrix)),
+            "mag": SensorConfig("mag", mag_zero, nom["mag"].scale, matrix=np.linalg.inv(mag_err.bridge.matrix))}
+
+
 # ---------------------------------------------------------------------------
 # front ends → codes
 # ---------------------------------------------------------------------------
 
-def frontend_words(cfg: Any, n: int, rngs: dict[str, np.random.Generator],
-                   instants: np.ndarray, m: int) -> dict[str, AuxStream]:
+def frontend_words(cfg: Any, n: int, rngs: dict[str, np.random.Generator], instants: np.ndarray,
+                   m: int) -> tuple[dict[str, AuxStream], dict[str, SensorConfig]]:
     """The accelerometer's and the magnetometer's per-sample sums of ``m`` TLC2543
     codes (n, 3) at the board's ``instants`` (n·m,), as AuxStreams holding the
-    exact period-mean truth (values: the words, converted later)."""
+    exact period-mean truth (values: the words, converted later), and the host's
+    conversion of them (``plan.host_config``)."""
     plan: AidedPlan = cfg.aided
     traj, env, h = cfg.trajectory, cfg.environment, cfg.period
     full = cfg.sensors == "full"
@@ -143,7 +166,8 @@ def frontend_words(cfg: Any, n: int, rngs: dict[str, np.random.Generator],
         part = plan.accel if name == "accel" else plan.mag
         out[name] = AuxStream(name, part, unit, words.astype(float), truth, np.zeros((n, 3)),
                               np.zeros(n, dtype=bool))
-    return out
+    configs = nominal_configs(plan) if plan.host_config == "nominal" else calibrated_configs(plan, acc_err, mag_err)
+    return out, configs
 
 
 # ---------------------------------------------------------------------------

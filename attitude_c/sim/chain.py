@@ -584,7 +584,7 @@ def _aided(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator], progres
     m = cfg.board.oversample
     # the front ends convert at the gyros' instants (one scan of the nine inputs), unfiltered delay
     instants = cfg.board.instants(cfg.trajectory.t_start, n, cfg.period, 0.0)
-    streams = aided.frontend_words(cfg, n, rngs, instants, m)
+    streams, configs = aided.frontend_words(cfg, n, rngs, instants, m)
     head, groups = aided.aided_records(gyro, streams["accel"].values.astype(np.int64),
                                        streams["mag"].values.astype(np.int64), cfg.aided, m, cfg.period)
     sent = [r for g in groups for r in g]
@@ -593,7 +593,6 @@ def _aided(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator], progres
         got, _, stats = aided.carry_v2(head, groups, cfg.aided, cfg.period, cfg.ber, seed)
     else:
         got, stats = head + sent, {"link": "none"}
-    configs = aided.nominal_configs(cfg.aided)
     dec, count = aided.aided_decode(got, calib, configs, cfg.period)
     keep = dec.sample_index < n
     dec = Decoded(dec.increments[keep], dec.sample_index[keep], dec.words[keep], [k for k in dec.held if k < n],
