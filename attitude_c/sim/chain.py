@@ -610,15 +610,7 @@ def _aided(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator], progres
                  records_sent=groups_sent, records_received=count)
     backends = {"adc": cfg.adc.backend, "board": "aided9 (modeled AT89S52 firmware groups)",
                 "link": stats.get("backend", "none"), "sensor": "att_sensor (nominal acc-*/mag-* config)"}
-    return Acquired(dec.increments, dec.sample_index, stats, calib, backends, n, dec,
-                    {k: _present(v) for k, v in streams.items()})
-
-
-def _present(st: AuxStream) -> AuxStream:
-    """The stream's rows that carried a reading (the summary's error statistics)."""
-    ok = ~np.isnan(st.values).any(axis=1)
-    return AuxStream(st.name, st.part, st.unit, st.values[ok], st.truth[ok], st.disturbance[ok],
-                     st.saturated[ok], None, st.errors)
+    return Acquired(dec.increments, dec.sample_index, stats, calib, backends, n, dec, streams)
 
 
 def simulate(cfg: SimConfig, progress: Progress | None = None,
