@@ -207,7 +207,7 @@ class Ahrs:
         out = np.empty((n, 4), dtype=dtype)
         q = ffi.new("att_real[4]")
         for i in range(n):
-            vec = [ffi.NULL if r is None or r[i] is None else list(map(float, r[i])) for r in rows]
+            vec = [ffi.NULL if r is None or (v := r[i]) is None else [float(x) for x in v] for r in rows]
             st = self._lib.att_ahrs_update(self._s, list(map(float, g[i])), vec[0], vec[1], float(d[i]), q)
             if st != 0:
                 raise_for_status(st, "ahrs", index=i)

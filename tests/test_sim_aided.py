@@ -39,8 +39,8 @@ HEADING_BOUND = math.sqrt(2) * 0.5 / (MAG.codes_per_ut * H_UT) + TILT_BOUND * ma
 
 
 def _run(traj: object = None, **kw: object) -> object:
-    base = dict(trajectory=traj or StaticTrajectory(), duration=4.0, period=PLAN.period_s, calibration_s=1.0,
-                sensors="quantized", board_kind="aided9", estimator="ahrs")
+    base = {"trajectory": traj or StaticTrajectory(), "duration": 4.0, "period": PLAN.period_s, "calibration_s": 1.0,
+                "sensors": "quantized", "board_kind": "aided9", "estimator": "ahrs"}
     base.update(kw)
     return simulate(SimConfig(**base))  # type: ignore[arg-type]
 
@@ -129,13 +129,13 @@ def test_nominal_config_is_the_front_ends_figures() -> None:
 
 
 @pytest.mark.parametrize("kw, message", [
-    (dict(estimator="integrator"), "estimator must be 'ahrs'"),
-    (dict(sensors="ideal"), "'quantized' or 'full'"),
-    (dict(aided=AidedPlan(acc_every=0)), "acc_every must be an integer 1..255"),
-    (dict(aided=AidedPlan(host_config="perfect")), "host_config must be"),  # type: ignore[arg-type]
+    ({"estimator": "integrator"}, "estimator must be 'ahrs'"),
+    ({"sensors": "ideal"}, "'quantized' or 'full'"),
+    ({"aided": AidedPlan(acc_every=0)}, "acc_every must be an integer 1..255"),
+    ({"aided": AidedPlan(host_config="perfect")}, "host_config must be"),  # type: ignore[arg-type]
 ])
 def test_config_refusals(kw: dict[str, object], message: str) -> None:
-    base: dict[str, object] = dict(trajectory=StaticTrajectory(), duration=1.0, board_kind="aided9", estimator="ahrs")
+    base: dict[str, object] = {"trajectory": StaticTrajectory(), "duration": 1.0, "board_kind": "aided9", "estimator": "ahrs"}
     base.update(kw)
     with pytest.raises(InvalidArgument, match=message):
         SimConfig(**base).validate()  # type: ignore[arg-type]

@@ -39,16 +39,25 @@ from ..link.v2 import Result2
 from ..link.v2c import CReceiver2, CSender2
 from ..sensorcal import SensorConfig
 from .accelmag import SensorErrors, filtered
-from .frontend import (ACCEL_FRONTENDS, FLIP_ZERO, MAG_FRONTENDS, AmrErrors, AmrMagnetometer, RatiometricAccel,
-                       flip_code, tlc2543_codes)
+from .frontend import (
+    ACCEL_FRONTENDS,
+    FLIP_ZERO,
+    MAG_FRONTENDS,
+    AmrErrors,
+    AmrMagnetometer,
+    RatiometricAccel,
+    flip_code,
+    tlc2543_codes,
+)
 from .host import AuxStream, Calibration, Decoded
 
-__all__ = ["AidedPlan", "BoardKind", "HostConfig", "aided_decode", "calibrated_configs", "aided_records", "carry_v2", "nominal_configs"]
+__all__ = ["AidedPlan", "BoardKind", "HostConfig", "aided_decode", "aided_records", "calibrated_configs", "carry_v2",
+           "nominal_configs"]
 
 BoardKind = Literal["gyro3", "aided9"]
 HostConfig = Literal["nominal", "calibrated"]
 #: the block format's group parts, in their order within a sample
-PARTS = ("gyr", "acc", "mag")
+PARTS: tuple[block.Channel, ...] = ("gyr", "acc", "mag")
 
 
 @dataclass(frozen=True)

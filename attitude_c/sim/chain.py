@@ -29,8 +29,8 @@ import numpy as np
 
 from ..core import METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
-from .accelmag import MagDisturbance, SensorErrors, VectorSensor, VectorSensorModel
 from . import aided
+from .accelmag import MagDisturbance, SensorErrors, VectorSensor, VectorSensorModel
 from .adc import ADC_BACKENDS, AdcModel
 from .aided import AidedPlan, BoardKind
 from .board import Board
