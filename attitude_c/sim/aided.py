@@ -213,31 +213,50 @@ def aided_records(gyro: np.ndarray, acc: np.ndarray, mag: np.ndarray, plan: Aide
 # link v2 in simulated line time
 # ---------------------------------------------------------------------------
 
+class _Board:
+    """The firmware's producer side: pushes group k into A whole, or loses it and owes an
+    OVERRUN report that goes in first at the next room."""
+
+    def __init__(self, a: CSender2, head: list[bytes]) -> None:
+        self.a = a
+        self.pushed: list[bytes] = []
+        self.lost_first = self.lost = self.overruns = 0
+        for r in head:
+            self._push(r)
+
+    def _push(self, rec: bytes) -> None:
+        self.a.push(rec)
+        self.pushed.append(rec)
+
+    def offer(self, k: int, group: list[bytes]) -> None:
+        if self.a.room < len(group) + (1 if self.lost else 0):
+            self.lost_first = self.lost_first if self.lost else k
+            self.lost += 1
+            self.overruns += 1
+            return
+        if self.lost:
+            self._push(block.encode_loss("overrun", self.lost_first & 0xFFFF, self.lost))
+            self.lost = 0
+        for r in group:
+            self._push(r)
+
+
 def carry_v2(head: list[bytes], groups: list[list[bytes]], plan: AidedPlan, period: float, ber: float,
-             seed: int) -> tuple[list[bytes], list[int], dict[str, Any]]:
-    """The records through A → channel (``ber`` both ways) → B at ``plan.baud``; group k
-    is offered at k·period (header first). Returns (delivered records, for each
-    delivered record the group it belongs to (-1: header or a report), stats)."""
-    step = 10  # one byte time: ten bit ticks
-    bit = plan.baud
+             seed: int) -> tuple[list[bytes], dict[str, Any]]:
+    """The records through A → channel (``ber`` both ways) → B at ``plan.baud``, one
+    byte time per step; group k is offered at k·period (the header first).
+    Returns (the records B delivered, in order; stats)."""
+    step, bit = 10, plan.baud  # ticks are bit times; a byte takes ten
     a = CSender2(plan.ring, plan.frame_records, max(1, round(plan.rto_s * bit)))
     b = CReceiver2()
     b.set_room(0xFFFF)
     ch = Channel(ChannelConfig(ber=ber, seed=seed), bit)
-    pushed: list[bytes] = []
-    owner: list[int] = []
-    for r in head:
-        a.push(r)
-        pushed.append(r)
-        owner.append(-1)
+    board = _Board(a, head)
     got: list[bytes] = []
     to_a: list[int] = []
     to_b: list[int] = []
     per = period * bit
-    k = 0
-    lost_first, lost = 0, 0
-    overruns = 0
-    t = 0
+    k = t = 0
     t_end = (len(groups) * period + 30.0) * bit  # the link drains within 30 s or gives up
     while t < t_end:
         for x in to_b:
@@ -245,46 +264,26 @@ def carry_v2(head: list[bytes], groups: list[list[bytes]], plan: AidedPlan, peri
                 got.extend(b.delivered)
         for x in to_a:
             a.sink(x, t)
-        to_a, to_b = [], []
         while k < len(groups) and t >= k * per:
-            room = a.room
-            need = len(groups[k]) + (1 if lost else 0)
-            if room >= need:
-                if lost:
-                    rep = block.encode_loss("overrun", lost_first & 0xFFFF, lost)
-                    a.push(rep)
-                    pushed.append(rep)
-                    owner.append(-1)
-                    lost = 0
-                for r in groups[k]:
-                    a.push(r)
-                    pushed.append(r)
-                    owner.append(k)
-            else:
-                lost_first = k if not lost else lost_first
-                lost += 1
-                overruns += 1
+            board.offer(k, groups[k])
             k += 1
-        r1, byte = a.poll(t)
-        if r1 == Result2.SEND and byte is not None:
-            to_b.extend(ch.transmit(0, byte, t))
+        r1, byte1 = a.poll(t)
         r2, byte2 = b.poll(t)
-        if r2 == Result2.SEND and byte2 is not None:
-            to_a.extend(ch.transmit(1, byte2, t))
-        idle = r1 != Result2.SEND and r2 != Result2.SEND and not to_a and not to_b
-        if k >= len(groups) and a.pending == 0 and idle:
+        to_b = list(ch.transmit(0, byte1, t)) if r1 == Result2.SEND and byte1 is not None else []
+        to_a = list(ch.transmit(1, byte2, t)) if r2 == Result2.SEND and byte2 is not None else []
+        idle = a.pending == 0 and not to_a and not to_b and r1 != Result2.SEND and r2 != Result2.SEND
+        if idle and k >= len(groups):
             break
-        if idle and a.pending == 0 and k < len(groups):  # nothing on the line until the next group
-            t = max(t + step, min(math.ceil(k * per / step) * step, t + 60000))
-        else:
-            t += step
-    delivered_ok = sum(1 for j, r in enumerate(got) if j < len(pushed) and r == pushed[j])
+        # nothing on the line: on to the next group (at most 60000 ticks: A's 16-bit clock)
+        t = max(t + step, min(math.ceil(k * per / step) * step, t + 60000)) if idle else t + step
+    pushed = board.pushed
     stats = {"link": "v2", "ber": ber, "baud": bit, "seed": seed, "records_pushed": len(pushed),
-             "records_delivered": len(got), "records_in_order": delivered_ok,
-             "records_unacked_at_end": a.pending, "overrun_samples": overruns,
+             "records_delivered": len(got),
+             "records_in_order": sum(1 for j, r in enumerate(got) if j < len(pushed) and r == pushed[j]),
+             "records_unacked_at_end": a.pending, "overrun_samples": board.overruns,
              "link_time_s": t / bit, "sender": a.stats.as_dict(), "receiver": b.stats.as_dict(),
              "channel": ch.stats(), "backend": "c (att_link2 sender and receiver, att_link channel)"}
-    return got, owner[:len(got)], stats
+    return got, stats
 
 
 # ---------------------------------------------------------------------------
@@ -330,14 +329,20 @@ def aided_decode(records: list[bytes], calib: Calibration, configs: dict[str, Se
     sensor = calib.sensor()
     for n in np.unique(n_of):
         inc[n_of == n] = sensor.increments(words[n_of == n], int(n), period)
-    aux = {}
-    for name, part in (("accel", "acc"), ("mag", "mag")):
-        vals = np.full((len(idx), 3), np.nan)
-        js = [j for j, k in enumerate(idx) if int(k) in aid[part] and int(k) in gyro]
-        for n in {aid[part][int(idx[j])][0] for j in js}:  # one conversion per oversample factor
-            sel = [j for j in js if aid[part][int(idx[j])][0] == n]
-            w = np.array([aid[part][int(idx[j])][1] for j in sel], dtype=np.int64).reshape(-1, 3)
-            vals[sel] = configs[name].convert(w, n)
-        aux[name] = vals
+    aux = {name: _convert(aid[part], idx, set(gyro), configs[name])
+           for name, part in (("accel", "acc"), ("mag", "mag"))}
     held_set = [k for k in held if k in set(keep)]
     return Decoded(inc, idx, words, held_set, reports, aux), count
+
+
+def _convert(got: dict[int, tuple[int, tuple[int, int, int]]], idx: np.ndarray, good: set[int],
+             config: SensorConfig) -> np.ndarray:
+    """One sensor's records ``got`` (sample → (n, words)) on the rows ``idx``: values
+    (len(idx), 3), NaN where the sample has no record or was held (no good gyro record)."""
+    vals = np.full((len(idx), 3), np.nan)
+    js = [j for j, k in enumerate(idx) if int(k) in got and int(k) in good]
+    for n in {got[int(idx[j])][0] for j in js}:  # one conversion per oversample factor
+        sel = [j for j in js if got[int(idx[j])][0] == n]
+        w = np.array([got[int(idx[j])][1] for j in sel], dtype=np.int64).reshape(-1, 3)
+        vals[sel] = config.convert(w, n)
+    return vals

@@ -590,7 +590,7 @@ def _aided(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator], progres
     sent = [r for g in groups for r in g]
     if cfg.link == "c":
         seed = int(rngs["link"].integers(1, 2**31 - 1))
-        got, _, stats = aided.carry_v2(head, groups, cfg.aided, cfg.period, cfg.ber, seed)
+        got, stats = aided.carry_v2(head, groups, cfg.aided, cfg.period, cfg.ber, seed)
     else:
         got, stats = head + sent, {"link": "none"}
     dec, count = aided.aided_decode(got, calib, configs, cfg.period)
