@@ -175,3 +175,18 @@ def test_cli_aided_run(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
 def test_cli_refusals(argv: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["simulate", *argv, "--no-progress"]) == 2
     assert message in capsys.readouterr().err
+
+
+def test_update_sparse_is_update_when_every_sample_has_aiding() -> None:
+    """Ahrs.update_sparse (one att_ahrs_update per sample) against the batch call on the same
+    samples: the same C update in the same order, so equal to the last bit."""
+    from attitude_c.ahrs_filter import Ahrs
+
+    rng = np.random.default_rng(5)
+    gyr = rng.normal(0, 0.1, (50, 3))
+    acc = np.array([0.0, 0.0, 9.81]) + rng.normal(0, 0.05, (50, 3))
+    mag = np.array([20.0, 0.0, -40.0]) + rng.normal(0, 0.2, (50, 3))
+    a, b = Ahrs(q0=[1, 0, 0, 0]), Ahrs(q0=[1, 0, 0, 0])
+    np.testing.assert_array_equal(a.update_sparse(gyr, acc, mag, dt=0.02), b.update(gyr, acc, mag, dt=0.02))
+    with pytest.raises(InvalidArgument, match="same number of samples"):
+        a.update_sparse(gyr, acc[:3], dt=0.02)
