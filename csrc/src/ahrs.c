@@ -236,21 +236,6 @@ static att_real wrap_pi(att_real a)
     return a;
 }
 
-/* Initial attitude from one sample: att_align_accmag (aiding.h), six-axis
- * (heading 0) when there is no field or it gives no heading. */
-static att_status align(const att_ahrs_settings *set, const att_real acc[3], const att_real mag[3],
-                        att_real q[4])
-{
-    att_status st = ATT_AID_E_ZERO_M;
-    if (mag != NULL) {
-        st = att_align_accmag(acc, mag, set->declination, q);
-    }
-    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
-        st = att_align_accmag(acc, NULL, set->declination, q);
-    }
-    return st;
-}
-
 /* Scalar updates of the error state x with a measurement y of x[j]
  * (H = e_j), variance R. The gain K = P e_j / S, S = P[j][j] + R, is kept
  * only on the states the measurement may move (its mask) and P follows
@@ -521,294 +506,351 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
     return c;
 }
 
-att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
-                           att_real dt, att_real q_out[4])
+/* ---- The stages of one update, in the order of docs/ahrs.md ("Code map") ---- */
+
+/* Inputs: dt, finiteness and the units check of the specific force (nothing is
+ * written). *norm_lp is what acc_norm_lp becomes with this sample: |f| itself
+ * at the first one, then its slow (10 s) average. */
+static att_status check_inputs(const att_ahrs *s, const att_real gyr[3], const att_real acc[3],
+                               const att_real mag[3], att_real dt, att_real *norm_lp)
 {
-    const att_ahrs_settings *set;
-    const att_ahrs_step *k;
-    att_ahrs save;
-    att_real C[9], dth[3], x[NX], an, an_lp, v[3], acc_c[3], mag_c[3];
-    const att_real *fa, *fm; /* the aiding samples used: raw, or turned by acc/mag_delay */
-    int i, rest, flags = 0, r;
-    if (s == NULL || gyr == NULL) {
-        return ATT_E_NULL;
-    }
-    set = &s->set;
+    const att_ahrs_settings *set = &s->set;
+    att_real an, kn;
     if (!(fin(dt) && dt > 0)) {
         return ATT_E_AHRS_DT;
     }
     if (!att__finite3(gyr) || (acc != NULL && !att__finite3(acc)) || (mag != NULL && !att__finite3(mag))) {
         return ATT_E_NONFINITE;
     }
-    an = 0;
-    an_lp = 0;
-    if (acc != NULL) {
-        an = norm3(acc);
-        if (!s->acc_init && !(an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity)) {
-            return ATT_E_AHRS_UNITS;
-        }
-        if (s->acc_init) {
-            /* the cached constant when dt is unchanged (the state is not touched before the checks) */
-            att_real kn = (s->step.dt == dt) ? s->step.k_norm : dt / (ATT_R(10.0) + dt);
-            an_lp = s->acc_norm_lp + kn * (an - s->acc_norm_lp);
-            if (!(an_lp >= ATT_R(0.5) * set->gravity && an_lp <= ATT_R(8.0) * set->gravity)) {
-                return ATT_E_AHRS_UNITS;
-            }
-        }
+    *norm_lp = 0;
+    if (acc == NULL) {
+        return ATT_OK;
     }
-    if (!s->aligned) {
-        att_real q0[4];
-        att_status st;
-        if (acc == NULL) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        st = align(set, acc, mag, q0);
-        if (st != ATT_OK) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        st = att_integ_reset(&s->integ, q0);
-        if (st != ATT_OK) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        s->aligned = 1;
+    an = norm3(acc);
+    if (!s->acc_init) {
+        *norm_lp = an;
+        return (an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity) ? ATT_OK
+                                                                                     : ATT_E_AHRS_UNITS;
     }
-    copy_mutable(&save, s);
-    k = step_constants(s, dt);
+    /* the cached constant when dt is unchanged (the state is not touched before the checks) */
+    kn = (s->step.dt == dt) ? s->step.k_norm : dt / (ATT_R(10.0) + dt);
+    *norm_lp = s->acc_norm_lp + kn * (an - s->acc_norm_lp);
+    return (*norm_lp >= ATT_R(0.5) * set->gravity && *norm_lp <= ATT_R(8.0) * set->gravity)
+               ? ATT_OK
+               : ATT_E_AHRS_UNITS;
+}
 
-    /* gyro over-range */
-    if (set->gyro_range > 0
-        && (att_fabs(gyr[0]) >= set->gyro_range || att_fabs(gyr[1]) >= set->gyro_range
-            || att_fabs(gyr[2]) >= set->gyro_range)) {
-        flags |= ATT_AHRS_F_OVERRANGE;
+/* Alignment: an unaligned filter takes its attitude from this sample
+ * (att_align_accmag; six-axis, heading 0, without a usable field). */
+static att_status align_once(att_ahrs *s, const att_real acc[3], const att_real mag[3])
+{
+    att_real q0[4];
+    att_status st = ATT_AID_E_ZERO_M;
+    if (s->aligned) {
+        return ATT_OK;
     }
+    if (acc == NULL) {
+        return ATT_E_AHRS_ALIGN;
+    }
+    if (mag != NULL) {
+        st = att_align_accmag(acc, mag, s->set.declination, q0);
+    }
+    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
+        st = att_align_accmag(acc, NULL, s->set.declination, q0);
+    }
+    if (st != ATT_OK || att_integ_reset(&s->integ, q0) != ATT_OK) {
+        return ATT_E_AHRS_ALIGN;
+    }
+    s->aligned = 1;
+    return ATT_OK;
+}
 
-    /* rest detector (first-order low-passes of ω and a) */
-    rest = 0;
-    if (set->rest_time > 0 && acc != NULL) {
-        if (!s->rest_init) {
-            for (i = 0; i < 3; i++) {
-                s->rest_gyr[i] = gyr[i];
-                s->rest_acc[i] = acc[i];
-            }
-            s->rest_init = 1;
-            s->rest_t = 0;
-        } else {
-            att_real dg = 0, da = 0, dw = 0, e;
-            for (i = 0; i < 3; i++) {
-                s->rest_gyr[i] += k->k_rest * (gyr[i] - s->rest_gyr[i]);
-                s->rest_acc[i] += k->k_rest * (acc[i] - s->rest_acc[i]);
-                e = gyr[i] - s->rest_gyr[i];
-                dg += e * e;
-                e = acc[i] - s->rest_acc[i];
-                da += e * e;
-                e = s->rest_gyr[i] - s->bias[i];
-                dw += e * e;
-            }
-            if (dg < set->rest_gyr_th * set->rest_gyr_th && dw < set->rest_gyr_th * set->rest_gyr_th
-                && da < set->rest_acc_th * set->rest_acc_th) {
-                s->rest_t += dt;
-            } else {
-                s->rest_t = 0;
-            }
-            rest = s->rest_t >= set->rest_time;
+/* Gyro over-range: an axis at or above gyro_range (0 = none). */
+static int overrange(const att_ahrs_settings *set, const att_real gyr[3])
+{
+    return set->gyro_range > 0
+           && (att_fabs(gyr[0]) >= set->gyro_range || att_fabs(gyr[1]) >= set->gyro_range
+               || att_fabs(gyr[2]) >= set->gyro_range);
+}
+
+/* Rest detection: first-order low-passes (rest_tau) of ω and f; 1 once
+ * |ω − ω_lp|, |ω_lp − b| < rest_gyr_th and |f − f_lp| < rest_acc_th have held
+ * for rest_time (raw samples: before any delay compensation). */
+static int detect_rest(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], const att_real acc[3],
+                       att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    att_real dg = 0, da = 0, dw = 0, e, th2;
+    int i;
+    if (!(set->rest_time > 0 && acc != NULL)) {
+        return 0;
+    }
+    if (!s->rest_init) {
+        for (i = 0; i < 3; i++) {
+            s->rest_gyr[i] = gyr[i];
+            s->rest_acc[i] = acc[i];
         }
+        s->rest_init = 1;
+        s->rest_t = 0;
+        return 0;
     }
+    for (i = 0; i < 3; i++) {
+        s->rest_gyr[i] += k->k_rest * (gyr[i] - s->rest_gyr[i]);
+        s->rest_acc[i] += k->k_rest * (acc[i] - s->rest_acc[i]);
+        e = gyr[i] - s->rest_gyr[i];
+        dg += e * e;
+        e = acc[i] - s->rest_acc[i];
+        da += e * e;
+        e = s->rest_gyr[i] - s->bias[i];
+        dw += e * e;
+    }
+    th2 = set->rest_gyr_th * set->rest_gyr_th;
+    if (dg < th2 && dw < th2 && da < set->rest_acc_th * set->rest_acc_th) {
+        s->rest_t += dt;
+    } else {
+        s->rest_t = 0;
+    }
+    return s->rest_t >= set->rest_time;
+}
 
-    /* propagation: bias-corrected increment through the integrator */
+/* Propagation: the bias-corrected increment through the integrator, then
+ * P ← F P Fᵀ + Q (at rest with the gyro's own noise), plus overrange_sigma² on
+ * the attitude when over range. C = C_b^n of the propagated attitude. 0, or
+ * the integrator's error. */
+static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real dt, int rest,
+                     int over, att_real C[9])
+{
+    att_real dth[3];
+    int i;
     for (i = 0; i < 3; i++) {
         dth[i] = (gyr[i] - s->bias[i]) * dt;
     }
-    r = att_integ_update(&s->integ, dth, NULL);
-    if (r < 0) {
-        copy_mutable(s, &save);
-        return ATT_E_AHRS_DIVERGED;
+    if (att_integ_update(&s->integ, dth, NULL) < 0) {
+        return -1;
     }
     q2C(s->integ.q, C);
-    /* process noise: at rest the gyro's own (no motion, no model error) */
     propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
-    if (flags & ATT_AHRS_F_OVERRANGE) {
-        att_real o = set->overrange_sigma * set->overrange_sigma;
+    if (over) {
+        att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
         s->P[0][0] += o;
         s->P[1][1] += o;
         s->P[2][2] += o;
     }
-    for (i = 0; i < NX; i++) {
-        x[i] = 0;
-    }
+    return 0;
+}
 
-    /* aiding samples that lag the gyro: turned to the gyro's time (one integer test
-     * when both delays are 0) */
-    fa = acc;
-    fm = mag;
-    if (k->delays) {
-        if (acc != NULL && (k->delays & 1)) {
-            delay_comp(gyr, s->bias, set->acc_delay, acc, acc_c);
-            fa = acc_c;
-        }
-        if (mag != NULL && (k->delays & 2)) {
-            delay_comp(gyr, s->bias, set->mag_delay, mag, mag_c);
-            fm = mag_c;
-        }
+/* Sensor timing: an aiding sample x (may be NULL) that lags the gyro by d,
+ * turned to the gyro's time into out when its delay is on; else x itself. */
+static const att_real *at_gyro_time(const att_ahrs *s, const att_real gyr[3], const att_real x[3], int on,
+                                    att_real d, att_real out[3])
+{
+    if (x == NULL || !on) {
+        return x;
     }
+    delay_comp(gyr, s->bias, d, x, out);
+    return out;
+}
 
-    /* accelerometer: low-pass in the navigation frame, inclination update */
-    if (acc != NULL) {
-        att_real an_n[3], nv, hs, ang, y0, y1;
-        mat_vec(C, fa, an_n);
-        if (!s->acc_init) {
-            for (i = 0; i < 3; i++) {
-                s->acc_lp[i] = an_n[i];
-            }
-            s->acc_norm_lp = an;
-            s->acc_init = 1;
-        } else {
-            for (i = 0; i < 3; i++) {
-                s->acc_lp[i] += k->k_acc * (an_n[i] - s->acc_lp[i]);
-            }
-            s->acc_norm_lp = an_lp;
-        }
-        nv = norm3(s->acc_lp);
-        if (nv > 0) {
-            for (i = 0; i < 3; i++) {
-                v[i] = s->acc_lp[i] / nv;
-            }
-            /* correction δθ = angle · (v × e_z)/|v × e_z|, v × e_z = (v_y, −v_x, 0) */
-            hs = att_sqrt(v[0] * v[0] + v[1] * v[1]);
-            ang = att_atan2(hs, v[2]);
-            if (hs > 0) {
-                y0 = ang * v[1] / hs;
-                y1 = -ang * v[0] / hs;
-            } else {
-                y0 = 0;
-                y1 = 0;
-            }
-            if (set->acc_gate > 0 && ang > set->acc_gate) {
-                s->acc_rej_time += dt;
-                if (s->acc_rej_time < set->acc_reject_max) {
-                    flags |= ATT_AHRS_F_ACC_REJECTED;
-                } else {
-                    s->acc_rej_time = 0;
-                }
-            } else {
-                s->acc_rej_time = 0;
-            }
-            if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
-                update_acc(s->P, x, 0, y0, k->r_acc);
-                update_acc(s->P, x, 1, y1, k->r_acc);
-                if (k->tilt) {
-                    /* the reported inclination's low-pass, implicit Euler of
-                     * f'' + 2ζω0 f' + ω0² f = ω0² a_n:
-                     * f' ← (f' + dt ω0² (a_n − f))/(1 + 2ζω0 dt + ω0² dt²), f ← f + dt f' */
-                    if (s->tilt_mean) {
-                        /* start: the mean of the samples so far, until it spans the
-                         * low-pass's own τ (as VQF starts its filter) */
-                        att_real wgt;
-                        s->tilt_t += dt;
-                        wgt = dt / s->tilt_t;
-                        for (i = 0; i < 3; i++) {
-                            s->tilt_f[i] += wgt * (an_n[i] - s->tilt_f[i]);
-                        }
-                        if (s->tilt_t >= (rest ? k->tilt_tau_rest : set->tilt_tau)) {
-                            s->tilt_mean = 0;
-                        }
-                    } else {
-                        att_real kv = rest ? k->k_tilt_v_rest : k->k_tilt_v;
-                        att_real kx = rest ? k->k_tilt_x_rest : k->k_tilt_x;
-                        for (i = 0; i < 3; i++) {
-                            s->tilt_fd[i] = kv * s->tilt_fd[i] + kx * (an_n[i] - s->tilt_f[i]);
-                            s->tilt_f[i] += dt * s->tilt_fd[i];
-                        }
-                    }
-                }
-            }
-        }
+/* The accelerometer's gate with recovery: 1 when the inclination innovation
+ * ang is rejected (above acc_gate, for less than acc_reject_max so far). */
+static int acc_gated(att_ahrs *s, att_real ang, att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    if (!(set->acc_gate > 0 && ang > set->acc_gate)) {
+        s->acc_rej_time = 0;
+        return 0;
     }
-
-    /* magnetometer: heading only, disturbance rejection on norm and dip */
-    if (mag != NULL) {
-        att_real m[3], h, nm, dip, rm;
-        int use = 0;
-        mat_vec(C, fm, m);
-        h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
-        nm = norm3(m);
-        if (h > 0) {
-            dip = att_atan2(-m[2], h);
-            if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
-                /* the inclination is not known well enough to learn the dip */
-                s->mag_ref_valid = 0;
-            }
-            if (!s->mag_ref_valid) {
-                s->mag_ref[0] = nm;
-                s->mag_ref[1] = dip;
-                s->mag_cand[0] = nm;
-                s->mag_cand[1] = dip;
-                s->mag_ref_valid = 1;
-                s->mag_undist_t = set->mag_min_undisturbed;
-            }
-            /* candidate reference: the field while it stays consistent with
-             * itself; its time runs only while turning (a field fixed to the
-             * body would change with the attitude and fail the test) */
-            if (att_fabs(nm - s->mag_cand[0]) <= set->mag_norm_tol * s->mag_cand[0]
-                && att_fabs(dip - s->mag_cand[1]) <= set->mag_dip_tol) {
-                s->mag_cand[0] += k->k_mag * (nm - s->mag_cand[0]);
-                s->mag_cand[1] += k->k_mag * (dip - s->mag_cand[1]);
-                if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2]
-                    >= set->mag_new_gyr * set->mag_new_gyr) {
-                    s->mag_cand_t += dt;
-                }
-            } else {
-                s->mag_cand[0] = nm;
-                s->mag_cand[1] = dip;
-                s->mag_cand_t = 0;
-            }
-            rm = k->r_mag;
-            if (att_fabs(nm - s->mag_ref[0]) <= set->mag_norm_tol * s->mag_ref[0]
-                && att_fabs(dip - s->mag_ref[1]) <= set->mag_dip_tol) {
-                s->mag_ref[0] += k->k_mag * (nm - s->mag_ref[0]);
-                s->mag_ref[1] += k->k_mag * (dip - s->mag_ref[1]);
-                s->mag_undist_t += dt;
-                if (s->mag_undist_t >= set->mag_min_undisturbed) {
-                    s->mag_rej_time = 0;
-                    use = 1;
-                } else {
-                    flags |= ATT_AHRS_F_MAG_DISTURBED;
-                    s->mag_rej_time += dt;
-                }
-            } else if (s->mag_cand_t >= set->mag_new_time) {
-                /* a new homogeneous field: it becomes the reference */
-                s->mag_ref[0] = s->mag_cand[0];
-                s->mag_ref[1] = s->mag_cand[1];
-                s->mag_rej_time = 0;
-                s->mag_undist_t = set->mag_min_undisturbed;
-                flags |= ATT_AHRS_F_MAG_RELEARNED;
-                use = 1;
-            } else {
-                s->mag_undist_t = 0;
-                flags |= ATT_AHRS_F_MAG_DISTURBED;
-                s->mag_rej_time += dt;
-                if (s->mag_rej_time >= set->mag_reject_max) {
-                    /* bounded rejection: weak updates again */
-                    rm *= set->mag_reject_factor * set->mag_reject_factor;
-                    use = 1;
-                }
-            }
-            if (use) {
-                att_real y = wrap_pi(att_atan2(m[0], m[1]) - set->declination);
-                update_mag(s->P, x, 2, y, rm);
-            }
-        }
+    s->acc_rej_time += dt;
+    if (s->acc_rej_time < set->acc_reject_max) {
+        return 1;
     }
+    s->acc_rej_time = 0;
+    return 0;
+}
 
-    /* rest: zero-rate update of the bias */
-    if (rest) {
-        flags |= ATT_AHRS_F_REST;
+/* Accelerometer: f_n = C f (written), its first-order low-pass (acc_tau) in
+ * the navigation frame, whose inclination measures δθx, δθy (gated). 1 when
+ * the update was made. */
+static int acc_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real f[3],
+                      att_real norm_lp, att_real dt, att_real x[NX], int *flags, att_real f_n[3])
+{
+    att_real v[3], nv, hs, ang, y0 = 0, y1 = 0;
+    int i;
+    mat_vec(C, f, f_n);
+    if (!s->acc_init) {
         for (i = 0; i < 3; i++) {
-            update_bias(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], k->r_rest);
+            s->acc_lp[i] = f_n[i];
+        }
+        s->acc_init = 1;
+    } else {
+        for (i = 0; i < 3; i++) {
+            s->acc_lp[i] += k->k_acc * (f_n[i] - s->acc_lp[i]);
         }
     }
+    s->acc_norm_lp = norm_lp;
+    nv = norm3(s->acc_lp);
+    if (!(nv > 0)) {
+        return 0;
+    }
+    for (i = 0; i < 3; i++) {
+        v[i] = s->acc_lp[i] / nv;
+    }
+    /* correction δθ = angle · (v × e_z)/|v × e_z|, v × e_z = (v_y, −v_x, 0) */
+    hs = att_sqrt(v[0] * v[0] + v[1] * v[1]);
+    ang = att_atan2(hs, v[2]);
+    if (hs > 0) {
+        y0 = ang * v[1] / hs;
+        y1 = -ang * v[0] / hs;
+    }
+    if (acc_gated(s, ang, dt)) {
+        *flags |= ATT_AHRS_F_ACC_REJECTED;
+        return 0;
+    }
+    update_acc(s->P, x, 0, y0, k->r_acc);
+    update_acc(s->P, x, 1, y1, k->r_acc);
+    return 1;
+}
 
-    /* inject the error state: q ← exp(δθ) ⊗ q, b ← b + δb, acc_lp (and tilt_f, tilt_fd) ←
-     * (I + [δθ×]) acc_lp */
+/* Reported inclination: the second-order low-pass (tilt_tau, τ longer at rest)
+ * of an accepted f_n, implicit Euler of f'' + 2ζω0 f' + ω0² f = ω0² f_n:
+ * f' ← (f' + dt ω0² (f_n − f))/(1 + 2ζω0 dt + ω0² dt²), f ← f + dt f'; it starts
+ * as the mean of the samples so far until they span τ (as VQF starts its filter). */
+static void tilt_lowpass(att_ahrs *s, const att_ahrs_step *k, const att_real f_n[3], att_real dt, int rest)
+{
+    int i;
+    if (s->tilt_mean) {
+        att_real w;
+        s->tilt_t += dt;
+        w = dt / s->tilt_t;
+        for (i = 0; i < 3; i++) {
+            s->tilt_f[i] += w * (f_n[i] - s->tilt_f[i]);
+        }
+        if (s->tilt_t >= (rest ? k->tilt_tau_rest : s->set.tilt_tau)) {
+            s->tilt_mean = 0;
+        }
+    } else {
+        att_real kv = rest ? k->k_tilt_v_rest : k->k_tilt_v;
+        att_real kx = rest ? k->k_tilt_x_rest : k->k_tilt_x;
+        for (i = 0; i < 3; i++) {
+            s->tilt_fd[i] = kv * s->tilt_fd[i] + kx * (f_n[i] - s->tilt_f[i]);
+            s->tilt_f[i] += dt * s->tilt_fd[i];
+        }
+    }
+}
+
+/* 1 when a field of norm nm and dip agrees with ref (norm, dip) within
+ * mag_norm_tol (relative) and mag_dip_tol. */
+static int field_agrees(const att_ahrs_settings *set, const att_real ref[2], att_real nm, att_real dip)
+{
+    return att_fabs(nm - ref[0]) <= set->mag_norm_tol * ref[0] && att_fabs(dip - ref[1]) <= set->mag_dip_tol;
+}
+
+static void field_lowpass(att_real ref[2], att_real k, att_real nm, att_real dip)
+{
+    ref[0] += k * (nm - ref[0]);
+    ref[1] += k * (dip - ref[1]);
+}
+
+/* Magnetic reference, start and candidate: the reference is (re)set to the
+ * sample until the inclination's 1σ is below half of mag_dip_tol; the
+ * candidate tracks a field consistent with itself, its time running only
+ * while turning (a field fixed to the body changes with the attitude). */
+static void mag_candidate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real nm,
+                          att_real dip, att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
+        s->mag_ref_valid = 0; /* the inclination is not known well enough to learn the dip */
+    }
+    if (!s->mag_ref_valid) {
+        s->mag_ref[0] = s->mag_cand[0] = nm;
+        s->mag_ref[1] = s->mag_cand[1] = dip;
+        s->mag_ref_valid = 1;
+        s->mag_undist_t = set->mag_min_undisturbed;
+    }
+    if (field_agrees(set, s->mag_cand, nm, dip)) {
+        field_lowpass(s->mag_cand, k->k_mag, nm, dip);
+        if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2] >= set->mag_new_gyr * set->mag_new_gyr) {
+            s->mag_cand_t += dt;
+        }
+    } else {
+        s->mag_cand[0] = nm;
+        s->mag_cand[1] = dip;
+        s->mag_cand_t = 0;
+    }
+}
+
+/* Magnetic disturbance: the sample against the reference. Undisturbed (for
+ * mag_min_undisturbed), it is used and adapts the reference; disturbed, a
+ * candidate held for mag_new_time becomes the reference, else it is rejected
+ * until mag_reject_max, then used with the noise ×mag_reject_factor². 1 when
+ * used, with its noise *r. */
+static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real dip, att_real dt, int *flags,
+                      att_real *r)
+{
+    const att_ahrs_settings *set = &s->set;
+    *r = k->r_mag;
+    if (field_agrees(set, s->mag_ref, nm, dip)) {
+        field_lowpass(s->mag_ref, k->k_mag, nm, dip);
+        s->mag_undist_t += dt;
+        if (s->mag_undist_t >= set->mag_min_undisturbed) {
+            s->mag_rej_time = 0;
+            return 1;
+        }
+        *flags |= ATT_AHRS_F_MAG_DISTURBED;
+        s->mag_rej_time += dt;
+        return 0;
+    }
+    if (s->mag_cand_t >= set->mag_new_time) { /* a new homogeneous field: it becomes the reference */
+        s->mag_ref[0] = s->mag_cand[0];
+        s->mag_ref[1] = s->mag_cand[1];
+        s->mag_rej_time = 0;
+        s->mag_undist_t = set->mag_min_undisturbed;
+        *flags |= ATT_AHRS_F_MAG_RELEARNED;
+        return 1;
+    }
+    s->mag_undist_t = 0;
+    *flags |= ATT_AHRS_F_MAG_DISTURBED;
+    s->mag_rej_time += dt;
+    if (s->mag_rej_time >= set->mag_reject_max) { /* bounded rejection: weak updates again */
+        *r *= set->mag_reject_factor * set->mag_reject_factor;
+        return 1;
+    }
+    return 0;
+}
+
+/* Magnetometer: m_n = C m; its norm and dip against the reference, its
+ * horizontal heading minus the declination measures δθz. */
+static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real gyr[3],
+                       const att_real mag[3], att_real dt, att_real x[NX], int *flags)
+{
+    att_real m[3], h, nm, dip, r;
+    mat_vec(C, mag, m);
+    h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
+    if (!(h > 0)) {
+        return;
+    }
+    nm = norm3(m);
+    dip = att_atan2(-m[2], h);
+    mag_candidate(s, k, gyr, nm, dip, dt);
+    if (mag_accept(s, k, nm, dip, dt, flags, &r)) {
+        update_mag(s->P, x, 2, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r);
+    }
+}
+
+/* Rest: the low-passed rate measures the bias (three zero-rate scalars). */
+static void zero_rate_update(att_ahrs *s, const att_ahrs_step *k, att_real x[NX])
+{
+    int i;
+    for (i = 0; i < 3; i++) {
+        update_bias(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], k->r_rest);
+    }
+}
+
+/* Injection: q ← exp(δθ) ⊗ q, b ← b + δb; the navigation-frame vectors (acc_lp,
+ * and tilt_f, tilt_fd) ← (I + [δθ×]) v. */
+static void inject(att_ahrs *s, const att_ahrs_step *k, const att_real x[NX])
+{
     if (x[0] != 0 || x[1] != 0 || x[2] != 0) {
         att_real d[4], q0 = s->integ.q[0], q1 = s->integ.q[1], q2 = s->integ.q[2], q3 = s->integ.q[3];
         att__rotvec_delta(x, d);
@@ -818,7 +860,6 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         s->integ.q[3] = q3 + (d[0] * q3 + d[1] * q2 - d[2] * q1 + d[3] * q0);
         rotate_small(x, s->acc_lp);
         if (k->tilt) {
-            /* the reported inclination's filter lives in the same frame */
             rotate_small(x, s->tilt_f);
             rotate_small(x, s->tilt_fd);
         }
@@ -826,26 +867,75 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     s->bias[0] += x[3];
     s->bias[1] += x[4];
     s->bias[2] += x[5];
+}
+
+/* Output: the reported attitude, predicted over sensor_delay (when set) with
+ * the corrected rate, q ⊗ exp((ω − b)·d). */
+static att_status write_output(const att_ahrs *s, const att_real gyr[3], att_real q_out[4])
+{
+    att_real ph[3], d[4];
+    int i;
+    if (q_out == NULL) {
+        return ATT_OK;
+    }
+    report_q(s, q_out);
+    if (s->set.sensor_delay != 0) {
+        for (i = 0; i < 3; i++) {
+            ph[i] = (gyr[i] - s->bias[i]) * s->set.sensor_delay;
+        }
+        att__rotvec_delta(ph, d);
+        att__quat_add_mul(q_out, d);
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
+                           att_real dt, att_real q_out[4])
+{
+    att_ahrs save;
+    const att_ahrs_step *k;
+    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3];
+    att_status st;
+    int rest, flags;
+    if (s == NULL || gyr == NULL) {
+        return ATT_E_NULL;
+    }
+    st = check_inputs(s, gyr, acc, mag, dt, &norm_lp);
+    if (st == ATT_OK) {
+        st = align_once(s, acc, mag);
+    }
+    if (st != ATT_OK) {
+        return st;
+    }
+    copy_mutable(&save, s);
+    k = step_constants(s, dt);
+    flags = overrange(&s->set, gyr) ? ATT_AHRS_F_OVERRANGE : 0;
+    rest = detect_rest(s, k, gyr, acc, dt);
+    if (propagate(s, k, gyr, dt, rest, flags & ATT_AHRS_F_OVERRANGE, C) != 0) {
+        copy_mutable(s, &save);
+        return ATT_E_AHRS_DIVERGED;
+    }
+    if (k->delays) { /* one integer test when both delays are 0 */
+        acc = at_gyro_time(s, gyr, acc, k->delays & 1, s->set.acc_delay, acc_c);
+        mag = at_gyro_time(s, gyr, mag, k->delays & 2, s->set.mag_delay, mag_c);
+    }
+    if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, x, &flags, f_n) && k->tilt) {
+        tilt_lowpass(s, k, f_n, dt, rest);
+    }
+    if (mag != NULL) {
+        mag_update(s, k, C, gyr, mag, dt, x, &flags);
+    }
+    if (rest) {
+        flags |= ATT_AHRS_F_REST;
+        zero_rate_update(s, k, x);
+    }
+    inject(s, k, x);
     s->flags = flags;
     if (!finite_state(s)) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
-    if (q_out != NULL && set->sensor_delay != 0) {
-        /* output predicted over the sensor delay with the corrected rate */
-        att_real ph[3], d[4], q[4];
-        report_q(s, q);
-        for (i = 0; i < 3; i++) {
-            ph[i] = (gyr[i] - s->bias[i]) * set->sensor_delay;
-        }
-        att__rotvec_delta(ph, d);
-        q_out[0] = q[0] + (q[0] * d[0] - q[1] * d[1] - q[2] * d[2] - q[3] * d[3]);
-        q_out[1] = q[1] + (q[0] * d[1] + q[1] * d[0] + q[2] * d[3] - q[3] * d[2]);
-        q_out[2] = q[2] + (q[0] * d[2] - q[1] * d[3] + q[2] * d[0] + q[3] * d[1]);
-        q_out[3] = q[3] + (q[0] * d[3] + q[1] * d[2] - q[2] * d[1] + q[3] * d[0]);
-        return ATT_OK;
-    }
-    return write_q(s, q_out);
+    return write_output(s, gyr, q_out);
 }
 
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
