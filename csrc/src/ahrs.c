@@ -236,133 +236,77 @@ static att_real wrap_pi(att_real a)
     return a;
 }
 
-/* Scalar updates of the error state x with a measurement y of x[j]
- * (H = e_j), variance R. The gain K = P e_j / S, S = P[j][j] + R, is kept
- * only on the states the measurement may move (its mask) and P follows
- * the Joseph form for that gain,
- *     P ← P − K Pjᵀ − Pj Kᵀ + K Kᵀ S,   Pj = column j,
- * which is valid for any gain. P is symmetric: the upper triangle is
- * computed and mirrored. The three masks are written out (no runtime mask,
- * no work on zero gains): an entry with both states in the mask takes the
- * full expression; one with state i in the mask and o outside (K_o = 0)
- * reduces exactly to P_io − K_i Pj_o; one with neither is unchanged. */
-#define GAIN(i)               \
-    do {                      \
-        K[i] = pj[i] / S;     \
-        x[i] += K[i] * innov; \
-    } while (0)
-#define JOSEPH2(r, c)                                                          \
-    do {                                                                       \
-        att_real v_ = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S; \
-        P[r][c] = v_;                                                          \
-        P[c][r] = v_;                                                          \
-    } while (0)
-#define JOSEPH1(i, o)                         \
-    do {                                      \
-        att_real v_ = P[i][o] - K[i] * pj[o]; \
-        P[i][o] = v_;                         \
-        P[o][i] = v_;                         \
-    } while (0)
-#define COLUMN_J()                    \
-    do {                              \
-        int r_;                       \
-        S = P[j][j] + R;              \
-        innov = y - x[j];             \
-        for (r_ = 0; r_ < NX; r_++) { \
-            pj[r_] = P[r_][j];        \
-        }                             \
-    } while (0)
+/* A scalar measurement y of the error state x[j] (H = e_j) with variance R,
+ * moving only the states in mask (bit i: state i):
+ *     S = P_jj + R,   K_i = P_ij / S (i in the mask, else 0),   x ← x + K (y − x_j),
+ *     P ← P − K P_jᵀ − P_j Kᵀ + K Kᵀ S   (P_j = column j; Joseph form, valid for any K).
+ * Where one of the two states is outside the mask its gain is 0 and the entry
+ * reduces exactly to P_rc − K_r P_jc (or − P_jr K_c); where both are, it is
+ * unchanged. P is symmetric: the upper triangle is computed and mirrored.
+ * gcc and clang unroll the loops and inline the function into each mask's
+ * wrapper below, where the constant mask folds the tests away: straight-line
+ * code, no more instructions than the entries written out (docs/ahrs.md, "Code
+ * map"). Another compiler runs the loops: the same results, more instructions. */
+#if defined(__GNUC__)
+#define UNROLLED_INLINE inline __attribute__((always_inline))
+#else
+#define UNROLLED_INLINE inline
+#endif
 
-/* Accelerometer (j = 0 or 1): mask δθx, δθy, δb (not δθz = state 2). */
+static UNROLLED_INLINE void scalar_update(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R,
+                                          unsigned mask)
+{
+    att_real pj[NX], K[NX], S = P[j][j] + R, innov = y - x[j], v;
+    int r, c;
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+        pj[r] = P[r][j];
+        K[r] = 0;
+        if (mask & (1u << r)) {
+            K[r] = pj[r] / S;
+            x[r] += K[r] * innov;
+        }
+    }
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+#pragma GCC unroll 6
+        for (c = r; c < NX; c++) {
+            int in_r = (mask >> r) & 1u, in_c = (mask >> c) & 1u;
+            if (in_r && in_c) {
+                v = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S;
+            } else if (in_r) {
+                v = P[r][c] - K[r] * pj[c];
+            } else if (in_c) {
+                v = P[r][c] - pj[r] * K[c];
+            } else {
+                continue;
+            }
+            P[r][c] = v;
+            P[c][r] = v;
+        }
+    }
+}
+
+/* The masks: the accelerometer never moves the heading (state 2), the
+ * magnetometer never roll and pitch (0, 1), a zero-rate update only the bias. */
+#define MASK_ACC  0x3Bu /* δθx, δθy, δb */
+#define MASK_MAG  0x3Cu /* δθz, δb */
+#define MASK_BIAS 0x38u /* δb */
+
 static void update_acc(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(0);
-    GAIN(1);
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(0, 0);
-    JOSEPH2(0, 1);
-    JOSEPH2(0, 3);
-    JOSEPH2(0, 4);
-    JOSEPH2(0, 5);
-    JOSEPH2(1, 1);
-    JOSEPH2(1, 3);
-    JOSEPH2(1, 4);
-    JOSEPH2(1, 5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(0, 2);
-    JOSEPH1(1, 2);
-    JOSEPH1(3, 2);
-    JOSEPH1(4, 2);
-    JOSEPH1(5, 2);
+    scalar_update(P, x, j, y, R, MASK_ACC);
 }
 
-/* Magnetometer (j = 2): mask δθz, δb (not δθx, δθy). */
 static void update_mag(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(2);
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(2, 2);
-    JOSEPH2(2, 3);
-    JOSEPH2(2, 4);
-    JOSEPH2(2, 5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(2, 0);
-    JOSEPH1(2, 1);
-    JOSEPH1(3, 0);
-    JOSEPH1(3, 1);
-    JOSEPH1(4, 0);
-    JOSEPH1(4, 1);
-    JOSEPH1(5, 0);
-    JOSEPH1(5, 1);
+    scalar_update(P, x, j, y, R, MASK_MAG);
 }
 
-/* Zero-rate update (j = 3, 4 or 5): mask δb only. */
 static void update_bias(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(3, 0);
-    JOSEPH1(3, 1);
-    JOSEPH1(3, 2);
-    JOSEPH1(4, 0);
-    JOSEPH1(4, 1);
-    JOSEPH1(4, 2);
-    JOSEPH1(5, 0);
-    JOSEPH1(5, 1);
-    JOSEPH1(5, 2);
+    scalar_update(P, x, j, y, R, MASK_BIAS);
 }
-
-#undef GAIN
-#undef JOSEPH2
-#undef JOSEPH1
-#undef COLUMN_J
 
 /* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
  * D = Pbb): A ← A − dt (C B' + B C') + dt² C D C' + qa I,
