@@ -57,45 +57,77 @@ static int fin(att_real x)
     return isfinite(x);
 }
 
-att_status att_ahrs_check_settings(const att_ahrs_settings *set)
+/* The domain of each real setting (ahrs.h), in the struct's order: finite and, by rule, */
+enum {
+    GT, /* above the bound */
+    GE, /* at least the bound */
+    ABS /* within ±bound */
+};
+
+typedef struct {
+    const char *name;
+    size_t offset;
+    int rule;
+    att_real bound;
+} setting_domain;
+
+/* clang-format off */
+#define DOMAIN(field, rule, bound) { #field, offsetof(att_ahrs_settings, field), rule, ATT_R(bound) }
+/* clang-format on */
+
+static const setting_domain DOMAINS[] = {
+    DOMAIN(gravity, GT, 0),           DOMAIN(gyr_noise, GT, 0),         DOMAIN(gyr_noise_rest, GT, 0),
+    DOMAIN(bias_noise, GE, 0),        DOMAIN(init_att_sigma, GT, 0),    DOMAIN(init_bias_sigma, GE, 0),
+    DOMAIN(acc_tau, GE, 0),           DOMAIN(acc_noise, GT, 0),         DOMAIN(acc_gate, GE, 0),
+    DOMAIN(acc_reject_max, GT, 0),    DOMAIN(mag_noise, GT, 0),         DOMAIN(mag_norm_tol, GT, 0),
+    DOMAIN(mag_dip_tol, GT, 0),       DOMAIN(mag_ref_tau, GT, 0),       DOMAIN(mag_reject_max, GT, 0),
+    DOMAIN(mag_reject_factor, GE, 1), DOMAIN(mag_new_time, GT, 0),      DOMAIN(mag_min_undisturbed, GE, 0),
+    DOMAIN(mag_new_gyr, GE, 0),       DOMAIN(declination, ABS, ATT_PI), DOMAIN(rest_time, GE, 0),
+    DOMAIN(rest_tau, GT, 0),          DOMAIN(rest_gyr_th, GT, 0),       DOMAIN(rest_acc_th, GT, 0),
+    DOMAIN(rest_noise, GT, 0),        DOMAIN(gyro_range, GE, 0),        DOMAIN(overrange_sigma, GE, 0),
+    DOMAIN(sensor_delay, ABS, 1.0),   DOMAIN(acc_delay, ABS, 0.05),     DOMAIN(mag_delay, ABS, 0.05),
+    DOMAIN(tilt_tau, GE, 0),
+};
+
+static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
 {
-    const att_ahrs_settings *t = set;
-    if (t == NULL) {
+    att_real v = *(const att_real *)(const void *)((const unsigned char *)set + d->offset);
+    if (!fin(v)) {
+        return 0;
+    }
+    return d->rule == GT ? v > d->bound : d->rule == GE ? v >= d->bound : att_fabs(v) <= d->bound;
+}
+
+att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
+{
+    const char *bad = NULL;
+    size_t i;
+    if (field != NULL) {
+        *field = NULL;
+    }
+    if (set == NULL) {
         return ATT_E_NULL;
     }
-    if (t->method < 0 || t->method >= ATT_METHOD_COUNT || t->method == ATT_METHOD_RK4) {
-        return ATT_E_AHRS_SETTINGS;
+    if (set->method < 0 || set->method >= ATT_METHOD_COUNT || set->method == ATT_METHOD_RK4) {
+        bad = "method";
     }
-    /* strictly positive */
-    if (!(fin(t->gravity) && t->gravity > 0 && fin(t->gyr_noise) && t->gyr_noise > 0 && fin(t->bias_noise)
-          && t->bias_noise >= 0 && fin(t->init_att_sigma) && t->init_att_sigma > 0 && fin(t->init_bias_sigma)
-          && t->init_bias_sigma >= 0 && fin(t->acc_noise) && t->acc_noise > 0 && fin(t->mag_noise)
-          && t->mag_noise > 0 && fin(t->mag_norm_tol) && t->mag_norm_tol > 0 && fin(t->mag_dip_tol)
-          && t->mag_dip_tol > 0 && fin(t->mag_ref_tau) && t->mag_ref_tau > 0 && fin(t->mag_reject_max)
-          && t->mag_reject_max > 0 && fin(t->mag_reject_factor) && t->mag_reject_factor >= 1
-          && fin(t->mag_new_time) && t->mag_new_time > 0 && fin(t->mag_new_gyr) && t->mag_new_gyr >= 0
-          && fin(t->mag_min_undisturbed) && t->mag_min_undisturbed >= 0 && fin(t->acc_reject_max)
-          && t->acc_reject_max > 0 && fin(t->rest_tau) && t->rest_tau > 0 && fin(t->rest_gyr_th)
-          && t->rest_gyr_th > 0 && fin(t->rest_acc_th) && t->rest_acc_th > 0 && fin(t->rest_noise)
-          && t->rest_noise > 0 && fin(t->overrange_sigma) && t->overrange_sigma >= 0)) {
-        return ATT_E_AHRS_SETTINGS;
+    for (i = 0; i < sizeof DOMAINS / sizeof DOMAINS[0] && bad == NULL; i++) {
+        if (!in_domain(set, &DOMAINS[i])) {
+            bad = DOMAINS[i].name;
+        }
     }
-    if (!(fin(t->gyr_noise_rest) && t->gyr_noise_rest > 0)) {
-        return ATT_E_AHRS_SETTINGS;
+    if (bad == NULL) {
+        return ATT_OK;
     }
-    /* zero = off */
-    if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
-          && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
-          && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0) && fin(t->tilt_tau)
-          && t->tilt_tau >= 0 && att_fabs(t->declination) <= ATT_PI)) {
-        return ATT_E_AHRS_SETTINGS;
+    if (field != NULL) {
+        *field = bad;
     }
-    /* aiding-sensor time skew */
-    if (!(fin(t->acc_delay) && att_fabs(t->acc_delay) <= ATT_R(0.05) && fin(t->mag_delay)
-          && att_fabs(t->mag_delay) <= ATT_R(0.05))) {
-        return ATT_E_AHRS_SETTINGS;
-    }
-    return ATT_OK;
+    return ATT_E_AHRS_SETTINGS;
+}
+
+att_status att_ahrs_check_settings(const att_ahrs_settings *set)
+{
+    return att_ahrs_check_settings_field(set, NULL);
 }
 
 static void set_initial_cov(att_ahrs *s)
