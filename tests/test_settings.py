@@ -81,6 +81,12 @@ def test_the_domain_error_names_the_bad_setting() -> None:
     assert thesis_ekf.run(g, a, m, rate=100.0, gn_max_iter=1000).q.shape == (5, 4)
 
 
+def test_importing_the_filters_loads_no_extension() -> None:
+    code = ("import sys, attitude_c.ahrs_filter, attitude_c.thesis_ekf\n"
+            "assert not [m for m in sys.modules if m.startswith('attitude_c._att_')], sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
 def test_the_library_names_each_field_outside_its_domain() -> None:
     """att_ahrs_check_settings_field covers every field of att_ahrs_settings (a NaN is
     outside every domain) and names it as the struct spells it, the first in the struct's
@@ -106,9 +112,3 @@ def test_the_library_names_each_field_outside_its_domain() -> None:
     with pytest.raises(InvalidArgument, match=r"settings: acc_noise=-1.0 outside its domain \(ahrs.h") as e:
         ahrs_filter.Ahrs(mag_delay=0.06, acc_noise=-1.0)
     assert "mag_delay=" not in str(e.value)
-
-
-def test_importing_the_filters_loads_no_extension() -> None:
-    code = ("import sys, attitude_c.ahrs_filter, attitude_c.thesis_ekf\n"
-            "assert not [m for m in sys.modules if m.startswith('attitude_c._att_')], sys.modules")
-    subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
