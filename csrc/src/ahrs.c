@@ -2,6 +2,8 @@
  * libattitude — the attitude filter (ahrs.h): an error-state Kalman
  * filter on top of the rotation-vector integrator. docs/ahrs.md derives
  * every step; attitude_c/ahrs_reference.py is the independent NumPy model.
+ * att_ahrs_update runs the stage functions below in the order of a sample's
+ * path, each named in docs/ahrs.md's "Code map" beside its section.
  */
 #include <stddef.h>
 #include <string.h>
@@ -891,7 +893,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
-    if (k->delays) { /* one integer test when both delays are 0 */
+    if (k->delays) { /* from here on the aiding samples at the gyro's time (one integer test when both are 0) */
         acc = at_gyro_time(s, gyr, acc, k->delays & 1, s->set.acc_delay, acc_c);
         mag = at_gyro_time(s, gyr, mag, k->delays & 2, s->set.mag_delay, mag_c);
     }
