@@ -192,6 +192,45 @@ class Ahrs:
             raise_for_status(st, "ahrs", index=i)
         return out[0] if single else out  # float64 for f64 (no copy), float32 for f32
 
+    def update_sparse(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
+                      dt: ArrayLike | None = None) -> FloatArray:
+        """:meth:`update` for a stream whose aiding comes on some samples only (the aided
+        board's plan): a row of ``acc`` or ``mag`` that is all NaN means "not in this
+        sample" and is passed to ``att_ahrs_update`` as NULL, as attitude-rx does; one C
+        call per sample. Blocks (N, 3) → (N, 4)."""
+        g = _vectors(gyr, "gyr")
+        assert g is not None
+        n = g.shape[0]
+        rows = [self._sparse(x, name, n) for x, name in ((acc, "acc"), (mag, "mag"))]
+        d = np.broadcast_to(self._dt(dt, n), (n,))
+        dtype = _DTYPES[self.precision]
+        ffi = self._ffi
+        out = np.empty((n, 4), dtype=dtype)
+        q = ffi.new("att_real[4]")
+        for i in range(n):
+            vec = [ffi.NULL if r is None or (v := r[i]) is None else [float(x) for x in v] for r in rows]
+            st = self._lib.att_ahrs_update(self._s, list(map(float, g[i])), vec[0], vec[1], float(d[i]), q)
+            if st != 0:
+                raise_for_status(st, "ahrs", index=i)
+            out[i] = list(q)
+        return out
+
+    @staticmethod
+    def _sparse(x: ArrayLike | None, name: str, n: int) -> list[NDArray[np.float64] | None] | None:
+        """Rows of ``x`` (N, 3), None where a row is all NaN (absent); None for no ``x``."""
+        if x is None:
+            return None
+        a = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+        if a.shape[0] != n:
+            raise InvalidArgument(f"gyr and {name} must have the same number of samples, got {n}, {a.shape[0]}")
+        absent = np.isnan(a).all(axis=1)
+        present = _vectors(a[~absent], name)
+        assert present is not None
+        rows: list[NDArray[np.float64] | None] = [None] * n
+        for i, row in zip(np.flatnonzero(~absent), present):
+            rows[int(i)] = row
+        return rows
+
     def __repr__(self) -> str:
         return f"Ahrs(rate={self.rate}, precision={self.precision!r})"
 

@@ -215,4 +215,7 @@ def test_view_simulate_runs_the_filter() -> None:
     assert "static trajectory" in src.description and "ahrs (f64)" in src.description
     res = simulate(parse_simulate_options(opts))
     items = list(src.items(res))
-    assert len(items) == len(res.t) == 25  # one attitude per 0.08 s sample
+    samples = [i for i in items if i[1] == "sample"]
+    assert len(samples) == len(res.t) == 25  # one attitude per 0.08 s sample
+    # and the filter's gyro-bias estimate as counters, each time the run recorded it
+    assert sum(1 for i in items if i[1] == "counters") == len(res.bias_t)

@@ -14,12 +14,16 @@ from typing import Any, Callable
 
 from ..core import METHODS as _METHODS
 from ..sim.accelmag import ACCEL_PRESETS, MAG_PRESETS
+from ..sim.aided import AidedPlan
+from ..sim.frontend import ACCEL_FRONTENDS, MAG_FRONTENDS
 from ..sim.sensors import GYRO_PRESETS
 from ..sim.trajectory import TRAJECTORIES
 from . import options
 
 #: Simulated time when --duration is not given (and the trajectory is not a file).
 DEFAULT_DURATION_S = 60.0
+#: The paper's sample period (s): the default --period of the gyro board.
+PAPER_PERIOD_S = 0.08
 
 
 # numeric options: the shared validator (attitude_c/cli/options.py)
@@ -118,8 +122,9 @@ def register(subparsers: Any) -> None:
     g.add_argument("--duration", type=_positive("--duration"), default=argparse.SUPPRESS, metavar="S",
                    help=f"simulated time (s) (default: {DEFAULT_DURATION_S:g}, or the span of the "
                    "--trajectory-file, which it may not exceed)")
-    g.add_argument("--period", type=_positive("--period"), default=0.08, metavar="S",
-                   help="gyro sample period: one angle increment per period (s); the paper: 0.08")
+    g.add_argument("--period", type=_positive("--period"), default=None, metavar="S",
+                   help=f"gyro sample period: one angle increment per period (s) (default: the paper's "
+                   f"{PAPER_PERIOD_S:g}; with --board aided9 the aided firmware's {AidedPlan().period_s:g})")
     g.add_argument("--amplitude", type=_triple("--amplitude"), default="30,20,25",
                    metavar="Y,P,R", help="paper trajectory: sinusoid amplitudes (deg)")
     g.add_argument("--frequency", type=_triple("--frequency"), default="0.20,0.25,0.30",
@@ -188,6 +193,7 @@ def register(subparsers: Any) -> None:
     g.add_argument("--ber", type=_ber, default=0.0, help="bit error rate of the channel simulator")
     g.add_argument("--attempts", type=_int_range("--attempts", 1, 255), default=5,
                    help="link sender attempts per block before giving up")
+    _aided_options(p)
     g = p.add_argument_group("accelerometer and magnetometer (read by the host beside the gyros; "
                              "docs/simulation.md)")
     g.add_argument("--accel", default=None, choices=("none", *ACCEL_PRESETS),
@@ -259,6 +265,48 @@ class _Progress:
     def close(self) -> None:
         for b in self.bars.values():
             b.close()
+
+
+def _aided_options(p: argparse.ArgumentParser) -> None:
+    plan = AidedPlan()
+    g = p.add_argument_group("the aided board (nine channels over link v2 into the filter; docs/simulation.md)")
+    g.add_argument("--board", default="gyro3", choices=("gyro3", "aided9"),
+                   help="gyro3: the paper's AT89S51 gyro board (default); aided9: the AT89S52 board with "
+                   "the accelerometer and magnetometer front ends on the same TLC2543, its records over "
+                   "link v2 (--link c, --ber) into the filter (sets --estimator ahrs)")
+    g.add_argument("--acc-every", type=_int_range("--acc-every", 1, 255), default=plan.acc_every, metavar="N",
+                   help=f"aided9: an accelerometer record every N samples (default {plan.acc_every}: the firmware's)")
+    g.add_argument("--mag-every", type=_int_range("--mag-every", 1, 255), default=plan.mag_every, metavar="N",
+                   help=f"aided9: a magnetometer record every N samples (default {plan.mag_every})")
+    g.add_argument("--mag-sr", action="store_true",
+                   help="aided9: magnetometer set/reset (the firmware's FW_MAG_SR: bridge offsets cancelled)")
+    g.add_argument("--host-config", default=plan.host_config, choices=("nominal", "calibrated"),
+                   help="aided9: the host's acc-*/mag-* conversion: nominal (the parts' typical figures; "
+                   "default) or calibrated (this run's part errors undone exactly: a perfect attitude calibrate)")
+    g.add_argument("--accel-frontend", default=plan.accel, choices=tuple(ACCEL_FRONTENDS),
+                   help=f"aided9: the analog accelerometer front end (default {plan.accel})")
+    g.add_argument("--mag-frontend", default=plan.mag, choices=tuple(MAG_FRONTENDS),
+                   help=f"aided9: the AMR magnetometer front end (default {plan.mag})")
+
+
+def _aided(args: argparse.Namespace) -> dict[str, Any]:
+    """The --board options as SimConfig keywords."""
+    plan = AidedPlan(acc_every=args.acc_every, mag_every=args.mag_every, mag_sr=args.mag_sr,
+                     host_config=args.host_config, accel=args.accel_frontend, mag=args.mag_frontend)
+    if args.board == "gyro3":
+        if plan != AidedPlan():
+            raise ValueError("--acc-every, --mag-every, --mag-sr, --host-config, --accel-frontend and --mag-frontend "
+                             "need --board aided9")
+        return {}
+    if args.accel not in (None, "none") or args.mag != "none":
+        raise ValueError("--board aided9 carries its own front ends (--accel-frontend, --mag-frontend): "
+                         "drop --accel and --mag")
+    if args.firmware != "none" or args.adc == "ad7927" or args.budget:
+        raise ValueError("--board aided9 runs the modeled TLC2543 board: drop --firmware, --adc ad7927, --budget")
+    if args.precision == "fixed":
+        raise ValueError("--board aided9 ends in the filter: --precision f64 or f32, not fixed")
+    return {"board_kind": "aided9", "aided": plan, "estimator": "ahrs",
+            "ahrs_settings": dict(args.ahrs_setting or ()), "ahrs_init": args.ahrs_init}
 
 
 def _denoise(args: argparse.Namespace) -> Any:
@@ -341,6 +389,9 @@ def build_config(args: argparse.Namespace) -> Any:
     duration: float | None = getattr(args, "duration", None)
     thesis_board = args.adc == "ad7927"
     gyro_name = args.gyro or ("adxrs150" if thesis_board else "cg-l53")
+    aided = _aided(args)
+    if args.period is None:
+        args.period = aided["aided"].period_s if aided else PAPER_PERIOD_S
     if args.firmware != "none":
         from ..sim import source
 
@@ -387,7 +438,7 @@ def build_config(args: argparse.Namespace) -> Any:
     extra: dict[str, Any] = _magnetometer(args)
     if accel_name != "none":
         extra["accel"] = accel_preset(accel_name)
-    extra.update(_estimator(args, has_accel=accel_name != "none"))
+    extra.update(aided or _estimator(args, has_accel=accel_name != "none"))
     return SimConfig(trajectory=traj, duration=duration, period=args.period,
                      method=args.method, precision=args.precision, sensors=args.sensors,
                      gyro=gyro_preset(gyro_name), adc=AdcModel(backend=adc),

@@ -29,8 +29,10 @@ import numpy as np
 
 from ..core import METHODS, PRECISIONS, Method, Precision
 from ..errors import InvalidArgument
+from . import aided
 from .accelmag import MagDisturbance, SensorErrors, VectorSensor, VectorSensorModel
 from .adc import ADC_BACKENDS, AdcModel
+from .aided import AidedPlan, BoardKind
 from .board import Board
 from .conditioning import Conditioning
 from .denoising import Denoise
@@ -153,6 +155,8 @@ class SimConfig:
     estimator: EstimatorName = "integrator"
     ahrs_settings: dict[str, Any] = field(default_factory=dict)
     ahrs_init: Literal["truth", "align"] = "truth"
+    board_kind: BoardKind = "gyro3"
+    aided: AidedPlan = field(default_factory=AidedPlan)
 
     def validate(self) -> None:
         if self.method not in METHODS:
@@ -204,8 +208,10 @@ class SimConfig:
             raise InvalidArgument(f"estimator must be one of {ESTIMATORS}, got {self.estimator!r}")
         if self.estimator == "integrator" and (self.ahrs_settings or self.ahrs_init != "truth"):
             raise InvalidArgument("ahrs settings need the ahrs estimator (estimator='ahrs')")
+        if self.board_kind != "gyro3":
+            self._check_aided()
         if self.estimator == "ahrs":
-            if self.accel is None:
+            if self.accel is None and self.board_kind == "gyro3":
                 raise InvalidArgument("the ahrs estimator needs an accelerometer: give accel (--accel PART)")
             if self.precision == "fixed":
                 raise InvalidArgument("the ahrs estimator runs in f64 or f32, not fixed")
@@ -217,6 +223,22 @@ class SimConfig:
             if self.accel is not None or self.mag is not None:
                 raise InvalidArgument(f"the {self.firmware} source carries only the gyros: drop the "
                                       "accelerometer and magnetometer")
+
+    def _check_aided(self) -> None:
+        """The aided board's run: its own front ends, link v2 or none, the filter."""
+        if self.board_kind != "aided9":
+            raise InvalidArgument(f"board_kind must be 'gyro3' or 'aided9', got {self.board_kind!r}")
+        self.aided.check()
+        if self.accel is not None or self.mag is not None:
+            raise InvalidArgument("the aided board carries its own front ends (aided.accel, aided.mag; "
+                                  "--accel-frontend, --mag-frontend): drop accel and mag")
+        if self.estimator != "ahrs":
+            raise InvalidArgument("the aided board's chain ends in the filter: estimator must be 'ahrs'")
+        if self.sensors == "ideal" or self.firmware is not None:
+            raise InvalidArgument("the aided board runs the modeled sensors ('quantized' or 'full'), "
+                                  "no firmware source")
+        if self.adc.backend == "ad7927":
+            raise InvalidArgument("the aided board converts with the TLC2543 (adc 'tlc2543' or 'ideal')")
 
     def estimator_stage(self) -> Integrate | AhrsFilter:
         """The estimator stage of the run (stage 8)."""
@@ -259,6 +281,9 @@ class SimConfig:
             "link_attempts": self.link_attempts,
             "seed": self.seed,
             "firmware": self.firmware,
+            **({} if self.board_kind == "gyro3" else
+               {"board_kind": self.board_kind, "aided": self.aided.to_dict(),
+                "link_protocol": "v2" if self.link == "c" else "none"}),
             **self._extra_params(),
         })
 
@@ -387,7 +412,8 @@ def _spawn(seed: int) -> dict[str, np.random.Generator]:
     # (the first four streams are those of the gyro-only chain: adding streams
     # after them leaves its draws, and so the default run, unchanged)
     ss = np.random.SeedSequence(seed)
-    names = ("bias", "noise_cal", "noise_run", "link", "accel_errors", "accel_noise", "mag_errors", "mag_noise")
+    names = ("bias", "noise_cal", "noise_run", "link", "accel_errors", "accel_noise", "mag_errors", "mag_noise",
+             "afe_errors", "afe_noise")
     return {n: np.random.default_rng(s) for n, s in zip(names, ss.spawn(len(names)))}
 
 
@@ -478,8 +504,9 @@ def _aux(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
     return out
 
 
-def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
-           progress: Progress | None) -> SourceOutput:
+def _gyro_words(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
+                progress: Progress | None) -> tuple[Calibration, np.ndarray]:
+    """The host's gyro calibration and the board's gyro words (n, 3) of the run."""
     model = cfg.gyro if cfg.sensors == "full" else cfg.gyro.without(
         noise=True, bias=True, bandwidth=True, scale=True)
     gyro = Gyro(model, rngs["bias"].standard_normal(3) * model.bias_dps * DEG)
@@ -493,7 +520,12 @@ def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
                                                progress, "calibration"), m, k)
     else:  # nominal zero: the conditioned null's code
         calib = Calibration(np.full(3, cfg.adc.nominal_code(cfg.conditioning.null_at_adc(cfg.gyro))), k, m)
-    words = _words(cfg, gyro, t0, n, rngs["noise_run"], False, progress, "adc")
+    return calib, _words(cfg, gyro, t0, n, rngs["noise_run"], False, progress, "adc")
+
+
+def _model(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator],
+           progress: Progress | None) -> SourceOutput:
+    calib, words = _gyro_words(cfg, n, rngs, progress)
     stream = cfg.board.stream(words, cfg.period)
     delivered = Link(cfg.link, cfg.ber, cfg.link_attempts).carry(stream, rngs["link"], cfg.period)
     backends: dict[str, Any] = {"adc": cfg.adc.backend}
@@ -528,6 +560,8 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
         return Acquired(inc, idx, {"link": "none"}, None, {"sensors": "exact increments"}, n,
                         Decoded(inc, idx, np.zeros((n, 3), dtype=np.int64),
                                 aux={k: v.values[idx] for k, v in aux.items()}), aux)
+    if cfg.board_kind == "aided9":
+        return _aided(cfg, n, _spawn(cfg.seed), progress)
     if cfg.firmware is not None:
         out = source(cfg.firmware).acquire(cfg, n, progress)
     else:
@@ -542,6 +576,41 @@ def acquire(cfg: SimConfig, progress: Progress | None = None) -> Acquired:
         good = len(dec.sample_index) - len(dec.held)
         stats.update(delivered=good, delivered_ok=good, lost=n - good, held=dec.held, reports=dec.reports)
     return Acquired(dec.increments, dec.sample_index, stats, out.calibration, out.backends, n, dec, out.aux)
+
+
+def _aided(cfg: SimConfig, n: int, rngs: dict[str, np.random.Generator], progress: Progress | None) -> Acquired:
+    """The aided board's acquisition (:mod:`.aided`): nine channels, its groups, link v2, the host."""
+    calib, gyro = _gyro_words(cfg, n, rngs, progress)
+    m = cfg.board.oversample
+    # the front ends convert at the gyros' instants (one scan of the nine inputs), unfiltered delay
+    instants = cfg.board.instants(cfg.trajectory.t_start, n, cfg.period, 0.0)
+    streams, configs = aided.frontend_words(cfg, n, rngs, instants, m)
+    head, groups = aided.aided_records(gyro, streams["accel"].values.astype(np.int64),
+                                       streams["mag"].values.astype(np.int64), cfg.aided, m, cfg.period)
+    sent = [r for g in groups for r in g]
+    if cfg.link == "c":
+        seed = int(rngs["link"].integers(1, 2**31 - 1))
+        got, stats = aided.carry_v2(head, groups, cfg.aided, cfg.period, cfg.ber, seed)
+    else:
+        got, stats = head + sent, {"link": "none"}
+    dec, count = aided.aided_decode(got, calib, configs, cfg.period)
+    keep = dec.sample_index < n
+    dec = Decoded(dec.increments[keep], dec.sample_index[keep], dec.words[keep], [k for k in dec.held if k < n],
+                  dec.reports, {k: v[keep] for k, v in dec.aux.items()})
+    for name, part in (("accel", "acc"), ("mag", "mag")):  # the truth beside the host's readings
+        st = streams[name]
+        st.values = np.full((n, 3), np.nan)
+        st.values[dec.sample_index] = dec.aux[name]
+        st.calibration = None
+        st.errors = {"config": configs[name].lines()}
+    good = len(dec.sample_index) - len(dec.held)
+    groups_sent = {"gyr": n, "acc": len(range(0, n, cfg.aided.acc_every)),
+                   "mag": len(range(0, n, cfg.aided.mag_every))}
+    stats.update(sent=n, delivered=good, delivered_ok=good, lost=n - good, held=dec.held, reports=dec.reports,
+                 records_sent=groups_sent, records_received=count)
+    backends = {"adc": cfg.adc.backend, "board": "aided9 (modeled AT89S52 firmware groups)",
+                "link": stats.get("backend", "none"), "sensor": "att_sensor (nominal acc-*/mag-* config)"}
+    return Acquired(dec.increments, dec.sample_index, stats, calib, backends, n, dec, streams)
 
 
 def simulate(cfg: SimConfig, progress: Progress | None = None,

@@ -186,6 +186,9 @@ class AhrsFilter:
             mag = None if mag is None else to_period_end(inc, mag)
         q0 = q0_at(t0 + int(idx[0]) * h) if self.init == "truth" else None
         f = Ahrs(q0=q0, precision=self.precision, **self.filter_settings())
+        # the aided board's stream: NaN rows are samples without that sensor's record
+        sparse = bool(np.isnan(acc).any() or (mag is not None and np.isnan(mag).any()))
+        update = f.update_sparse if sparse else f.update
         step = max(1, round(self.bias_every / h))
         q = np.empty((n, 4))
         bias = []
@@ -193,7 +196,7 @@ class AhrsFilter:
         mag_rejected = 0
         for a in range(0, n, step):
             b = min(n, a + step)
-            q[a:b] = f.update(gyr[a:b], acc[a:b], None if mag is None else mag[a:b], dt=h)
+            q[a:b] = update(gyr[a:b], acc[a:b], None if mag is None else mag[a:b], dt=h)
             bias.append(f.bias)
             fl = f.flags
             rest += bool(fl & C["ATT_AHRS_F_REST"])

@@ -107,8 +107,10 @@ class AuxStream:
     errors: dict[str, Any] = field(default_factory=dict)
 
     def summary(self) -> dict[str, Any]:
-        """Error statistics of the readings against the truth (+ disturbance), per axis."""
+        """Error statistics of the readings against the truth (+ disturbance), per axis,
+        over the rows holding a reading (NaN rows: the aided board's samples without one)."""
         e = self.values - self.truth - self.disturbance
+        e = e[~np.isnan(e).any(axis=1)]
         return {"part": self.part, "unit": self.unit, "samples": len(e),
                 "mean_error": e.mean(axis=0).tolist() if len(e) else [0.0] * 3,
                 "rms_error": np.sqrt((e * e).mean(axis=0)).tolist() if len(e) else [0.0] * 3,

@@ -221,6 +221,16 @@ def format_ratio(ratio: float) -> str:
     return format(q.normalize(), "f") if q >= Decimal("0.001") else f"{float(q):.1e}"
 
 
+def _aided_link_line(lk: dict[str, Any]) -> str:
+    """The aided board's accounting: samples (groups) and records per part, link v2's figures."""
+    sent, got = lk.get("records_sent", {}), lk.get("records_received", {})
+    parts = ", ".join(f"{p} {got.get(p, 0)}/{sent.get(p, 0)}" for p in ("gyr", "acc", "mag"))
+    via = (f"link v2 at {lk.get('baud')} baud, BER {lk.get('ber', 0):g}, {lk.get('overrun_samples', 0)} samples "
+           f"lost to a full ring" if lk.get("link") == "v2" else "no link")
+    return (f"aided board ({via}): samples sent {lk.get('sent')}, delivered {lk.get('delivered')}, "
+            f"lost {lk.get('lost')}; records received/sent {parts}")
+
+
 def format_table(summary: dict[str, Any]) -> str:
     e = summary["errors_rad"]
     p = summary["parameters"]
@@ -252,6 +262,8 @@ def format_table(summary: dict[str, Any]) -> str:
                        f"delivered {lk.get('delivered')} (ok {lk.get('delivered_ok')}, duplicated "
                        f"{lk.get('duplicated')}, corrupted undetected "
                        f"{lk.get('corrupted_undetected')}), lost {lk.get('lost')}")]
+    elif lk.get("link") == "v2" or "records_sent" in lk:
+        lines += ["", _aided_link_line(lk)]
     for name, st in summary.get("sensors", {}).items():
         rms = ", ".join(f"{v:.3g}" for v in st["rms_error"])
         mean = ", ".join(f"{v:.3g}" for v in st["mean_error"])

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidArgument
-from .sources import Item, Source, pace
+from .sources import Item, Source, _filter_counters, pace
 from .stream import Hub, row
 
 __all__ = ["SimulatorSource", "parse_simulate_options"]
@@ -71,7 +71,9 @@ class SimulatorSource(Source):
         self.description = (f"simulator: {cfg.trajectory.name} trajectory, {cfg.duration:g} s, period "
                             f"{cfg.period:g} s, {cfg.method if cfg.estimator == 'integrator' else cfg.estimator} "
                             f"({cfg.precision}), sensors {cfg.sensors}, "
-                            f"link {cfg.link}, at {speed:g}x")
+                            f"link {cfg.link}"
+                            + (f", board {cfg.board_kind}" if cfg.board_kind != "gyro3" else "")
+                            + f", at {speed:g}x")
 
     def run(self, hub: Hub) -> None:
         from ..sim import simulate
@@ -89,7 +91,7 @@ class SimulatorSource(Source):
         hub.event(t_first, "note", {"note": f"simulated {self.cfg.duration:g} s in {time.monotonic() - t0:.1f} s: "
                                             f"{len(res.t)} attitude updates"})
         hub.status("running", f"playing the simulation at {self.speed:g}x")
-        n = pace(hub, self.items(res), self.speed, self._stop)
+        n = pace(hub, self.items(res), self.speed, self._stop, on_counters=self.set_counts)
         if not self._stop.is_set():
             hub.status("ended", f"simulation finished ({n} attitude updates, {self.cfg.duration:g} s)")
 
@@ -101,8 +103,13 @@ class SimulatorSource(Source):
         ns = np.round((res.t - t0) / h - 0.75).astype(np.int64)
         j = np.clip(np.searchsorted(res.sample_index, ns), 0, max(len(res.sample_index) - 1, 0))
         rates = res.increments[j] / h if len(res.increments) else np.full((len(ns), 3), np.nan)
+        bias_t = res.bias_t if res.bias_t is not None else np.zeros(0)
+        b = 0
         for k in range(len(res.t)):
             t = float(res.t[k])
+            while b < len(bias_t) and bias_t[b] <= t:  # the filter's gyro-bias estimate, as attitude-rx's
+                yield (float(bias_t[b]), "counters", _filter_counters(np.degrees(res.bias[b]).tolist(), None))
+                b += 1
             yield (t, "sample", row(t, res.q_est[k], n=int(ns[k]), rate=rates[k], q_true=res.q_true[k],
                                     euler=res.euler_est[k]))
 
