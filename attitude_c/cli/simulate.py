@@ -281,8 +281,9 @@ def _aided_options(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mag-sr", action="store_true",
                    help="aided9: magnetometer set/reset (the firmware's FW_MAG_SR: bridge offsets cancelled)")
     g.add_argument("--host-config", default=plan.host_config, choices=("nominal", "calibrated"),
-                   help="aided9: the host's acc-*/mag-* conversion: nominal (the parts' typical figures; "
-                   "default) or calibrated (this run's part errors undone exactly: a perfect attitude calibrate)")
+                   help="aided9: the host's acc-*/mag-* conversion: calibrated (default: this run's part errors "
+                   "undone exactly, a perfect attitude calibrate) or nominal (the parts' typical figures: an "
+                   "uncalibrated board)")
     g.add_argument("--accel-frontend", default=plan.accel, choices=tuple(ACCEL_FRONTENDS),
                    help=f"aided9: the analog accelerometer front end (default {plan.accel})")
     g.add_argument("--mag-frontend", default=plan.mag, choices=tuple(MAG_FRONTENDS),
