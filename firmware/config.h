@@ -56,6 +56,47 @@
 #error "the link v2 build needs -DATT_LINK2_ONE=1 on every source (toolchain/firmware.py passes it)"
 #endif
 
+/* The aided board (FW_AIDED = 1; docs/firmware.md "The aided board"): an
+ * AT89S52 (8 KB flash, 256 bytes of RAM, Timer 2) that samples nine TLC2543
+ * inputs: the gyros on AIN0-AIN2 as on the paper's board, the
+ * accelerometer's X, Y, Z on AIN3-AIN5 (FW_AIN_ACC) and the magnetometer's
+ * on AIN6-AIN8 (FW_AIN_MAG); AIN9 and AIN10 stay free. It speaks link v2
+ * only, announces itself with a CHANNELS report after BOOT
+ * (attitude/block.h), and sends sample n's accelerometer record when
+ * n % FW_ACC_EVERY == 0 and its magnetometer record when n % FW_MAG_EVERY
+ * == 0: powers of two 1..128 (a mask, no division), or 0 for a sensor it
+ * does not send. Its UART runs on Timer 2: baud = XTAL / (32 x (65536 -
+ * RCAP2)), exact at 11.0592 MHz for 115200 (RCAP2 = 0xFFFD), 57600
+ * (0xFFFA), 38400, 28800, 19200, 14400, 9600 (0xFFDC) and below; received
+ * bytes go through a small interrupt-driven FIFO (at 115200 baud a byte
+ * comes every 80 machine cycles, less than one poll of the sender). */
+#ifndef FW_AIDED
+#define FW_AIDED 0
+#endif
+#if FW_AIDED
+#ifndef FW_ACC_EVERY
+#define FW_ACC_EVERY 1
+#endif
+#ifndef FW_MAG_EVERY
+#define FW_MAG_EVERY 1
+#endif
+#define FW_AIN_ACC 3 /* accelerometer X, Y, Z: AIN3, AIN4, AIN5 */
+#define FW_AIN_MAG 6 /* magnetometer X, Y, Z: AIN6, AIN7, AIN8 */
+#ifndef FW_RXQ
+#define FW_RXQ 32 /* received bytes the FIFO holds (a power of two <= 128) */
+#endif
+#if !FW_LINK_V2
+#error "the aided board speaks link v2 only: build it with FW_LINK_V2=1 (toolchain/firmware.py does)"
+#endif
+#if FW_ACC_EVERY < 0 || FW_ACC_EVERY > 128 || (FW_ACC_EVERY & (FW_ACC_EVERY - 1)) != 0 || FW_MAG_EVERY < 0 \
+    || FW_MAG_EVERY > 128 || (FW_MAG_EVERY & (FW_MAG_EVERY - 1)) != 0
+#error "FW_ACC_EVERY and FW_MAG_EVERY must be 0 (not sent) or a power of two 1..128"
+#endif
+#if FW_RXQ < 2 || FW_RXQ > 128 || (FW_RXQ & (FW_RXQ - 1)) != 0
+#error "FW_RXQ must be a power of two 2..128"
+#endif
+#endif
+
 /* Retry interval of a failed ADC self-test (ticks; 3600 = 1 s). */
 #ifndef FW_SELFTEST_RETRY_TICKS
 #define FW_SELFTEST_RETRY_TICKS 3600
@@ -68,8 +109,14 @@
 #error "FW_XTAL_HZ must be a multiple of 3072 Hz for an exact tick"
 #endif
 
+#if FW_AIDED
+/* Timer 2 as baud generator (RCLK = TCLK = 1): baud = XTAL / (32 * (65536 - RCAP2)). */
+#if ((FW_XTAL_HZ / 32L) % FW_BAUD) != 0 || (FW_XTAL_HZ / 32L / FW_BAUD) > 65535L
+#error "FW_BAUD cannot be made exactly from FW_XTAL_HZ with Timer 2"
+#endif
+#define FW_RCAP2 (65536L - FW_XTAL_HZ / 32L / FW_BAUD)
 /* Timer 1 mode 2: baud = 2^SMOD * XTAL / (384 * (256 - TH1)). */
-#if ((FW_XTAL_HZ / 384L) % FW_BAUD) == 0 && (FW_XTAL_HZ / 384L / FW_BAUD) <= 255
+#elif ((FW_XTAL_HZ / 384L) % FW_BAUD) == 0 && (FW_XTAL_HZ / 384L / FW_BAUD) <= 255
 #define FW_SMOD 0
 #define FW_TH1  (256 - (FW_XTAL_HZ / 384L / FW_BAUD))
 #elif ((FW_XTAL_HZ / 192L) % FW_BAUD) == 0 && (FW_XTAL_HZ / 192L / FW_BAUD) <= 255

@@ -9,6 +9,10 @@
  * csrc/src/block.c (the block format's encoders, attitude/block.h). With
  * FW_LINK_V2 (config.h) the link is v2 instead: csrc/src/link2_sender.c in
  * its single-instance build (ATT_LINK2_ONE), the queue is its ring.
+ * With FW_AIDED (config.h: the aided AT89S52 board, link v2) each sample is
+ * a group of up to nine channels (gyros, accelerometer, magnetometer: one
+ * TLC2543 scan, three records; csrc/src/block_channels.c adds the CHANNELS
+ * report), the UART runs on Timer 2 and received bytes on an interrupt.
  * See docs/firmware.md for the wiring, the block formats and the build.
  *
  *   Timer 0  mode 1, free-running: TH0 advances every 256 machine cycles
@@ -32,9 +36,13 @@
  *
  * Integer arithmetic only, no dynamic memory, no __xdata.
  */
+#include "config.h" /* FW_LINK_V2, FW_AIDED */
+#if FW_AIDED
+#include <8052.h> /* Timer 2 */
+#else
 #include <8051.h>
+#endif
 
-#include "config.h" /* FW_LINK_V2 */
 #include "attitude/block.h"
 #if FW_LINK_V2
 #include "attitude/link2.h"
@@ -68,6 +76,46 @@ static uint16_t tick_now(void)
 
 /* ---- UART: mode 1, Timer 1 mode 2 ----------------------------------- */
 
+#if FW_AIDED
+/* The aided board: Timer 2 clocks the UART (RCLK = TCLK = 1, auto-reload
+ * from RCAP2: config.h), and the serial interrupt moves each received byte
+ * into a FIFO (at 115200 baud a byte comes every 80 machine cycles, less
+ * than one poll of the sender or a scan) and turns TI into tx_free, which
+ * the main loop polls instead of TI. */
+static uint8_t __idata rxq[FW_RXQ];
+static volatile uint8_t __idata rxq_in; /* written by the interrupt only */
+static uint8_t __idata rxq_out;
+static volatile __bit tx_free; /* the transmitter can take a byte */
+#define TX_FREE tx_free
+
+void uart_isr(void) __interrupt(4)
+{
+    if (RI) {
+        RI = 0;
+        rxq[rxq_in & (uint8_t)(FW_RXQ - 1)] = SBUF; /* a full FIFO loses the oldest byte: an ACK */
+        rxq_in++;                                   /* frame fails its CRC, the next one frees the records */
+    }
+    if (TI) {
+        TI = 0;
+        tx_free = 1;
+    }
+}
+
+static void uart_init(void)
+{
+    SCON = 0x50; /* mode 1 (8-bit UART, variable baud), REN = 1 */
+    RCAP2H = (unsigned char)((uint16_t)FW_RCAP2 >> 8);
+    RCAP2L = (unsigned char)FW_RCAP2;
+    TH2 = (unsigned char)((uint16_t)FW_RCAP2 >> 8);
+    TL2 = (unsigned char)FW_RCAP2;
+    T2CON = 0x34; /* RCLK = TCLK = 1 (Timer 2 is the baud generator both ways), TR2 = 1 */
+    tx_free = 1;
+    ES = 1;
+    EA = 1;
+}
+#else
+#define TX_FREE TI
+
 static void uart_init(void)
 {
     SCON = 0x50;                                    /* mode 1 (8-bit UART, variable baud), REN = 1 */
@@ -82,6 +130,7 @@ static void uart_init(void)
     TR1 = 1;
     TI = 1; /* "transmitter free": the main loop polls TI before writing SBUF */
 }
+#endif /* FW_AIDED */
 
 static void timer0_init(void)
 {
@@ -292,7 +341,20 @@ static const att_link_sender_config link_cfg = { FW_SYN_TIMEOUT_TICKS, FW_ANSWER
                                                  ATT_BLOCK_SIZE, FW_MAX_ATTEMPTS };
 #endif /* !FW_LINK_V2 */
 
-#if FW_LINK_V2
+#if FW_AIDED
+/* The bytes from the receiver the interrupt put in the FIFO. */
+static void link_rx(void)
+{
+    uint8_t b;
+    while (rxq_out != rxq_in) {
+        b = rxq[rxq_out & (uint8_t)(FW_RXQ - 1)];
+        rxq_out++;
+        FW_HOOK_RX(b);
+        FW_HOOK_V2_SINK(att_link2_sender_sink(&tx, b, fw_ticks));
+    }
+}
+#define LINK_RX() link_rx()
+#elif FW_LINK_V2
 /* A byte from the receiver, if one came. The UART holds one received byte
  * (SBUF, RI): one that completes while RI is still set is lost, and so is
  * the ACK it belongs to (its records are then freed only by the next ACK).
@@ -313,6 +375,74 @@ static void link_rx(void)
 #else
 #define LINK_RX() ((void)0)
 #endif
+
+#if FW_AIDED
+/* ---- the aided board's samples: groups ---------------------------------- */
+
+#define FW_CHANNELS                                                \
+    (ATT_BLOCK_CH_GYR | (FW_ACC_EVERY != 0 ? ATT_BLOCK_CH_ACC : 0) \
+     | (FW_MAG_EVERY != 0 ? ATT_BLOCK_CH_MAG : 0))
+
+/* The inputs of one scan: the gyros, then the accelerometer and the
+ * magnetometer when due (the first 3, 6 or 9 of all[], or mag[]). */
+static const uint8_t all[9] = { TLC2543_CH_X,   TLC2543_CH_Y, TLC2543_CH_Z,   FW_AIN_ACC,    FW_AIN_ACC + 1,
+                                FW_AIN_ACC + 2, FW_AIN_MAG,   FW_AIN_MAG + 1, FW_AIN_MAG + 2 };
+static const uint8_t mag[6] = { TLC2543_CH_X, TLC2543_CH_Y,   TLC2543_CH_Z,
+                                FW_AIN_MAG,   FW_AIN_MAG + 1, FW_AIN_MAG + 2 };
+static const uint8_t *const lists[2] = { all, mag }; /* [1]: a group without the accelerometer */
+/* A group's codes (native words), encoded into its records in place. */
+static uint16_t __idata group[9];
+static uint8_t __idata group_n; /* records in the group being taken: 1..3 */
+
+/* Whether sample seq carries the accelerometer's / magnetometer's record (1 or 0). */
+#if FW_ACC_EVERY != 0
+#define ACC_DUE() (uint8_t)(((uint8_t)seq & (uint8_t)(FW_ACC_EVERY - 1)) == 0u)
+#else
+#define ACC_DUE() 0u
+#endif
+#if FW_MAG_EVERY != 0
+#define MAG_DUE() (uint8_t)(((uint8_t)seq & (uint8_t)(FW_MAG_EVERY - 1)) == 0u)
+#else
+#define MAG_DUE() 0u
+#endif
+
+/* Scan the group of sample seq and queue its records in order (gyro,
+ * accelerometer, magnetometer), or one ADC_ERROR report in their place
+ * when the scan (or the encoding of a code) failed: the group goes into
+ * the ring whole or not at all. A ring without room for the whole group
+ * loses the sample (OVERRUN later, as for a gyro sample). */
+static void aided_sample(void)
+{
+    int st;
+    uint8_t i;
+    uint8_t acc = ACC_DUE();
+    group_n = (uint8_t)(1u + acc + MAG_DUE());
+    if (ovr_count != 0u) {
+        flush_overrun();
+    }
+    if (ovr_count != 0u || att_link2_sender_room(&tx) < group_n) {
+        ovr_count++;
+        return;
+    }
+    LINK_RX();
+    FW_HOOK_SCAN_BEGIN();
+    st = tlc2543_scan(&adc, lists[acc ^ 1u], (uint8_t)(3u * group_n), (uint16_t __data *)group,
+                      TLC2543_POWER_DOWN);
+    FW_HOOK_SCAN_END();
+    LINK_RX();
+    for (i = 0; i < group_n && st == ATT_OK; i++) {
+        st = att_block_encode_sample((uint8_t __data *)(group + 3u * i),
+                                     (const uint16_t __data *)(group + 3u * i));
+    }
+    if (st != ATT_OK) {
+        (void)att_block_encode_adc_error((uint8_t __data *)group, seq, (int8_t)st);
+        group_n = 1;
+    }
+    for (i = 0; i < group_n; i++) {
+        (void)att_link2_sender_push(&tx, (const uint8_t __data *)(group + 3u * i));
+    }
+}
+#endif /* FW_AIDED */
 
 /* main's state is static: no local lives across a call, so main pushes
  * nothing on the stack around the deep calls (the scan). */
@@ -338,6 +468,12 @@ void main(void)
         wp, (uint16_t)(FW_PERIOD_TICKS | (FW_LINK_V2 ? ATT_BLOCK_BOOT_LINK2 : 0)),
         (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT)); /* the protocol in the period word */
     q_commit();
+#if FW_AIDED
+    (void)q_push(); /* CHANNELS right after BOOT: the board and its stream */
+    (void)att_block_encode_channels(wp, (uint8_t)ATT_BLOCK_BOARD_AIDED9, (uint8_t)FW_CHANNELS,
+                                    (uint8_t)FW_ACC_EVERY, (uint8_t)FW_MAG_EVERY);
+    q_commit();
+#endif
     sampling = 0;
     next_sample = tick_now();
 
@@ -350,12 +486,12 @@ void main(void)
         LINK_RX();
 
         /* 2. the transmitter is free: the sender's next byte, if any */
-        if (TI) {
+        if (TX_FREE) {
             FW_HOOK_POLL_BEGIN();
             st = att_link2_sender_poll(&tx, fw_ticks, &txb);
             FW_HOOK_POLL(st);
             if (st == ATT_LINK2_SEND) {
-                TI = 0;
+                TX_FREE = 0;
                 SBUF = txb;
                 FW_HOOK_TX();
             } else if (st < 0) {
@@ -401,6 +537,9 @@ void main(void)
         if ((int16_t)(fw_ticks - next_sample) >= 0) {
             if (sampling) {
                 next_sample += (uint16_t)FW_PERIOD_TICKS;
+#if FW_AIDED
+                aided_sample();
+#else
                 if (sample_slot()) {
                     LINK_RX(); /* v2: the byte that came during the poll, before the scan's 0.9 ms */
                     FW_HOOK_SCAN_BEGIN();
@@ -409,6 +548,7 @@ void main(void)
                     LINK_RX(); /* v2: the byte that came during the scan */
                     sample_store(st);
                 }
+#endif
                 seq++;
             } else {
                 if (q_push()) { /* the report slot, also where the codes land */

@@ -59,33 +59,8 @@ def test_both_link_builds_fit_the_at89s51(out: Path) -> None:
 
 def _run_v2(img: tool.Image, timeout: float) -> tuple[tool.SimOutput, list[bytes], dict[str, int]]:
     """Run a v2 sim image against the Python receiver; (firmware output, records, receiver stats)."""
-    import serial  # pyserial
-
-    from attitude_c.link.v2 import Receiver2, Result2
-
-    room = 64
-    rx = Receiver2(room=room)
-    got: list[bytes] = []
-    with tool.Session(img, timeout) as sess:
-        port = serial.Serial(str(sess.port), img.config.baud, timeout=0.005)
-
-        def pump() -> None:
-            for b in port.read(max(1, port.in_waiting)):
-                if rx.sink(b) == Result2.DELIVERED:
-                    got.extend(rx.delivered)
-                    rx.set_room(room)  # the test keeps up with any rate: the room never shrinks
-            reply = bytearray()
-            while True:
-                res, byte = rx.poll()
-                if res != Result2.SEND or byte is None:
-                    break
-                reply.append(byte)
-            if reply:
-                port.write(reply)
-
-        fw = sess.run(pump=pump)
-        port.close()
-    return fw, got, rx.stats.as_dict()
+    res = tool.run_v2(img, "python", timeout=timeout)
+    return res, res.records, res.receiver
 
 
 def test_v2_firmware_delivers_every_record_once_in_order(out: Path) -> None:

@@ -77,10 +77,17 @@ MACHINE_HZ = XTAL_HZ // 12          #: machine cycles per second (12-clock core)
 TICK_HZ = MACHINE_HZ // 256         #: Timer 0 ticks per second (3600)
 FLASH_SIZE = 4096
 IRAM_SIZE = 128
+#: The aided board's AT89S52 (toolchain/mcs52.toml): 8 KB of flash, 256 bytes of RAM.
+FLASH_SIZE_52 = 8192
+IRAM_SIZE_52 = 256
 #: Link block size N the firmware sends: one record of the block format (attitude/block.h).
 BLOCK_SIZE = block.fmt().size
 #: UART rates Timer 1 in mode 2 makes exactly from 11.0592 MHz (SMOD 0 or 1).
 BAUD_RATES = (1200, 2400, 4800, 9600, 14400, 19200, 28800, 57600)
+#: ... and Timer 2 (the aided AT89S52): XTAL / (32 (65536 - RCAP2)), up to BOOT's 255 x 1200.
+BAUD_RATES_T2 = tuple(b for b in range(1200, 255 * 1200 + 1, 1200) if (XTAL_HZ // 32) % b == 0)
+#: Board types of the firmware (Config.board): the block format's CHANNELS names.
+BOARDS = ("gyro3", "aided9")
 #: Bytes on the wire per delivered block: 0xAA, 0xBB, N data, checksum, answer.
 WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
 
@@ -91,6 +98,8 @@ SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c
            CSRC / "src" / "block.c"]
 #: The link v2 build: link2_sender.c (single instance) instead of link_sender.c.
 SOURCES_V2 = [CSRC / "src" / "link2_sender.c" if s.name == "link_sender.c" else s for s in SOURCES]
+#: The aided board (link v2 only): the CHANNELS report's encoder too.
+SOURCES_AIDED = [*SOURCES_V2, CSRC / "src" / "block_channels.c"]
 #: Link protocols of the firmware (Config.link).
 LINKS = ("legacy", "v2")
 SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
@@ -124,11 +133,24 @@ class Config:
     v2_rto: int = 720                 #: v2: ticks without progress before a go-back / probe (200 ms)
     v2_samples: int = 4               #: v2: samples per DATA frame (1..24)
     v2_ring: int = 4                  #: v2: records the sender keeps until acknowledged (power of two)
+    board: Literal["gyro3", "aided9"] = "gyro3"  #: the AT89S51 gyro board or the aided AT89S52 (FW_AIDED)
+    acc_every: int = 1                #: aided: accelerometer record every acc_every samples (0: none)
+    mag_every: int = 1                #: aided: magnetometer record every mag_every samples (0: none)
 
     def __post_init__(self) -> None:
-        if self.baud not in BAUD_RATES:
-            raise ValueError(f"baud must be one of {BAUD_RATES} (exact with an 11.0592 MHz crystal), "
-                             f"got {self.baud}")
+        if self.board not in BOARDS:
+            raise ValueError(f"board must be one of {BOARDS}, got {self.board!r}")
+        rates = BAUD_RATES_T2 if self.aided else BAUD_RATES
+        if self.baud not in rates:
+            raise ValueError(f"baud must be one of {rates} (exact with an 11.0592 MHz crystal, "
+                             f"{'Timer 2' if self.aided else 'Timer 1'}), got {self.baud}")
+        if self.aided:
+            if self.link != "v2":
+                raise ValueError(f"the aided board speaks link v2 only, got link={self.link!r}")
+            for name in ("acc_every", "mag_every"):
+                v = getattr(self, name)
+                if v not in (0, 1, 2, 4, 8, 16, 32, 64, 128):
+                    raise ValueError(f"{name} must be 0 (not sent) or a power of two 1..128, got {v}")
         for name in ("period_ticks", "syn_timeout", "answer_timeout", "selftest_retry"):
             v = getattr(self, name)
             if not 1 <= v <= 32767:
@@ -145,8 +167,25 @@ class Config:
             raise ValueError(f"max_attempts must be 1..255, got {self.max_attempts}")
 
     @property
+    def aided(self) -> bool:
+        return self.board == "aided9"
+
+    @property
     def period_s(self) -> float:
         return self.period_ticks / TICK_HZ
+
+    @property
+    def target(self) -> str:
+        """The toolchain target (toolchain/*.toml): the AT89S51 or the aided AT89S52."""
+        return "mcs52" if self.aided else "mcs51"
+
+    @property
+    def flash_size(self) -> int:
+        return FLASH_SIZE_52 if self.aided else FLASH_SIZE
+
+    @property
+    def iram_size(self) -> int:
+        return IRAM_SIZE_52 if self.aided else IRAM_SIZE
 
     def defines(self) -> list[str]:
         return [f"FW_BAUD={self.baud}L", f"FW_PERIOD_TICKS={self.period_ticks}",
@@ -156,7 +195,17 @@ class Config:
                 f"FW_SELFTEST_RETRY_TICKS={self.selftest_retry}",
                 *([] if self.link == "legacy" else
                   ["FW_LINK_V2=1", "ATT_LINK2_ONE=1", f"ATT_LINK2_ONE_RTO={self.v2_rto}",
-                   f"ATT_LINK2_ONE_SAMPLES={self.v2_samples}", f"ATT_LINK2_ONE_RING={self.v2_ring}"])]
+                   f"ATT_LINK2_ONE_SAMPLES={self.v2_samples}", f"ATT_LINK2_ONE_RING={self.v2_ring}"]),
+                *([] if not self.aided else
+                  ["FW_AIDED=1", f"FW_ACC_EVERY={self.acc_every}", f"FW_MAG_EVERY={self.mag_every}",
+                   "ATT_LINK2_CRC_TABLE=1"])]
+
+
+#: The aided board's default build (docs/firmware.md "The aided board"): link v2 at
+#: 115200 baud with a ring of 8 records (all the direct RAM allows) and the sampling plan
+#: chosen there (bench/aided.py): gyros at 50 samples/s (20 ms), accelerometer and
+#: magnetometer with every 2nd sample (25/s): 69 % CPU in s51.
+AIDED = Config(board="aided9", link="v2", baud=115200, period_ticks=72, v2_ring=8, acc_every=2, mag_every=2)
 
 
 @dataclass(frozen=True)
@@ -191,15 +240,53 @@ class Gyro:
 GYROS = (Gyro(32768, 1, 0, 3), Gyro(24576, 2, 64, 5), Gyro(40960, 3, 128, 7))
 
 
-def _gyro_defines(gyros: Sequence[Gyro]) -> list[str]:
+#: The aided board's accelerometer X, Y, Z (AIN3-AIN5) and magnetometer X, Y, Z (AIN6-AIN8)
+#: in the device model: the same form as the gyros, each with its own offset, amplitude
+#: (256, 128, 256; 512, 256, 512 LSB), phase and frequency.
+AUX = (Gyro(32768, 3, 32, 1), Gyro(30000, 4, 96, 2), Gyro(45000, 3, 160, 1),
+       Gyro(20000, 2, 16, 2), Gyro(36000, 3, 200, 3), Gyro(28000, 2, 80, 1))
+
+
+def _gyro_defines(gyros: Sequence[Gyro], aux: Sequence[Gyro] = ()) -> list[str]:
     out = []
     for name, g in zip("XYZ", gyros):
         out += [f"FW_SIM_{name}_OFF={g.offset}u", f"FW_SIM_{name}_SH={g.shift}",
                 f"FW_SIM_{name}_PH={g.phase}", f"FW_SIM_{name}_STEP={g.step}"]
+    if aux:  # the aided model's six more inputs, as comma lists (firmware/sim/tlc_model.c)
+        for field, macro in (("offset", "OFF"), ("shift", "SH"), ("phase", "PH"), ("step", "STEP")):
+            out.append(f"FW_SIM_AUX_{macro}=" + ",".join(str(getattr(g, field)) for g in aux))
     return out
 
 
 # -- build ----------------------------------------------------------------
+
+#: CRC-32C (Castagnoli), reflected: the polynomial 0x1EDC6F41 with its bits reversed.
+CRC32C_REFLECTED = 0x82F63B78
+
+
+def crc32c_table() -> list[int]:
+    """The 256 remainders of the byte-at-a-time reflected CRC-32C: entry i is i shifted
+    right through 8 steps of the polynomial division (link v2's CRC, docs/link.md)."""
+    out = []
+    for i in range(256):
+        r = i
+        for _ in range(8):
+            r = (r >> 1) ^ (CRC32C_REFLECTED if r & 1 else 0)
+        out.append(r)
+    return out
+
+
+def _crc_table_source(path: Path) -> Path:
+    """The aided image's CRC table (ATT_LINK2_CRC_TABLE, csrc/src/link2_sender.c): four
+    byte planes att_link2_crc_t0..t3 in code memory, written from :func:`crc32c_table`."""
+    t = crc32c_table()
+    lines = ["/* generated by toolchain/firmware.py (crc32c_table): do not edit */", "#include <stdint.h>"]
+    for plane in range(4):
+        vals = ", ".join(f"0x{(v >> (8 * plane)) & 0xFF:02X}" for v in t)
+        lines.append(f"__code const uint8_t att_link2_crc_t{plane}[256] = {{ {vals} }};")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
 
 @dataclass
 class Image:
@@ -214,17 +301,23 @@ class Image:
     stack_free: int     #: bytes from stack_start to the end of RAM (0x7F)
 
     def size_report(self) -> str:
-        flash = (f"flash {self.flash} / {FLASH_SIZE} bytes ({FLASH_SIZE - self.flash} free)"
+        size, iram = self.config.flash_size, self.config.iram_size
+        flash = (f"flash {self.flash} / {size} bytes ({size - self.flash} free)"
                  if self.kind == "production" else
                  f"code {self.flash} bytes ({self.kind} image: model/counters, not for the chip)")
-        return (f"{self.ihx.name}: {flash}, RAM {self.ram_static} / {IRAM_SIZE} bytes static, "
-                f"stack 0x{self.stack_start:02X}..0x7F = {self.stack_free} bytes free")
+        return (f"{self.ihx.name}: {flash}, RAM {self.ram_static} / {iram} bytes static, "
+                f"stack 0x{self.stack_start:02X}..0x{iram - 1:02X} = {self.stack_free} bytes free")
 
 
-def _sdcc_flags() -> list[str]:
-    t = targets.load("mcs51")
+def _sdcc_flags(target: str = "mcs51") -> list[str]:
+    t = targets.load(target)
     t.require()
     return list(t.cflags)
+
+
+def _without_code_size(flags: list[str]) -> list[str]:
+    i = flags.index("--code-size")
+    return flags[:i] + flags[i + 2:]
 
 
 def _run(cmd: list[str]) -> None:
@@ -246,7 +339,7 @@ def parse_mem(mem: Path) -> tuple[int, int, int]:
 def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
           sim_blocks: int = 0, sim_samples: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
           extra_defines: Iterable[str] = (), name: str | None = None,
-          code_size: int = FLASH_SIZE) -> Image:
+          code_size: int | None = None, aux: Sequence[Gyro] = AUX) -> Image:
     """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
 
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
@@ -256,19 +349,24 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     ``faults`` (sim only): ``dout_stuck_high``, ``dout_stuck_low``, ``eoc_stuck`` (every
     conversion), ``adc_error_at=K`` (EOC stuck in the scan of sample K only, 0 <= K < 256: one
     ADC_ERROR report in that sample's place, then sampling goes on).
+    ``config.board = "aided9"`` builds the aided AT89S52 image (toolchain/mcs52.toml: 8 KB,
+    256 B; ``code_size`` defaults to the chip's flash); its device model serves ``aux`` on
+    AIN3-AIN8 (accelerometer, magnetometer).
     """
     if kind not in ("production", "sim", "bench"):
         raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
     out_dir = Path(out_dir)
-    name = name or f"fw_{kind}_{config.baud}" + ("" if config.link == "legacy" else "_v2")
+    name = name or f"fw_{kind}_{config.baud}" + ("" if config.link == "legacy" else "_v2") + (
+        "_aided" if config.aided else "")
+    code_size = config.flash_size if code_size is None else code_size
     objdir = out_dir / (name + ".objs")
     shutil.rmtree(objdir, ignore_errors=True)
     objdir.mkdir(parents=True, exist_ok=True)
-    flags = _sdcc_flags()
+    flags = _sdcc_flags(config.target)
     incs = [f"-I{CSRC / 'include'}", f"-I{FW_DIR}"]
     defines = ["ATT_REAL_F32", *config.defines(), *extra_defines]
     extra: list[str] = []
-    sources = list(SOURCES if config.link == "legacy" else SOURCES_V2)
+    sources = list(SOURCES_AIDED if config.aided else SOURCES if config.link == "legacy" else SOURCES_V2)
     fault_defs = {"dout_stuck_high": "FW_SIM_DOUT_STUCK=1", "dout_stuck_low": "FW_SIM_DOUT_STUCK=0",
                   "eoc_stuck": "FW_SIM_EOC_STUCK=1"}
     faults = list(faults)
@@ -276,9 +374,11 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         raise ValueError("faults need kind='sim'")
     if kind in ("sim", "bench"):
         defines += ["FW_SIM", f"FW_SIM_BLOCKS={int(sim_blocks)}", f"FW_SIM_SAMPLES={int(sim_samples)}"]
+        if config.aided:
+            defines.append("FW_SIM_C52")  # the C52 core's Timer 2 SFRs: the instrumentation moves aside
         sources.append(FW_DIR / "sim" / "sim_io.c")
     if kind == "sim":
-        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros)]
+        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros, aux if config.aided else ())]
         for f in faults:
             name, _, arg = f.partition("=")
             if name == "adc_error_at" and arg.isdigit() and int(arg) < 256:
@@ -292,12 +392,14 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         sources.insert(1, FW_DIR / "sim" / "tlc_model.c")
     if kind == "bench":
         defines += ["FW_BENCH"]
-    link_flags = [f for f in flags if f not in ("--code-size", "4096")] + ["--code-size", str(code_size)]
+    link_flags = _without_code_size(flags) + ["--code-size", str(code_size)]
     if kind != "production":
         # The simulation images carry the device model / counters and the
-        # simulator-interface output: they may exceed 4 KB (s51's code
-        # memory is 64 KB); RAM stays the chip's 128 bytes.
-        link_flags = [f for f in flags if f not in ("--code-size", "4096")] + ["--code-size", "65536"]
+        # simulator-interface output: they may exceed the flash (s51's code
+        # memory is 64 KB); RAM stays the chip's.
+        link_flags = _without_code_size(flags) + ["--code-size", "65536"]
+    if config.aided:
+        sources.append(_crc_table_source(objdir / "crc32c_table.c"))
     rels = []
     for src in sources:
         rel = objdir / (src.stem + ".rel")
@@ -311,12 +413,15 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if proc.returncode != 0:
         msg = proc.stdout + proc.stderr
         if "Insufficient" in msg or "Could not get" in msg:
-            raise FirmwareTooBig(f"{name} does not fit the AT89S51 ({code_size} B flash, 128 B RAM):\n{msg}")
+            chip = "AT89S52" if config.aided else "AT89S51"
+            raise FirmwareTooBig(f"{name} does not fit the {chip} ({code_size} B flash, "
+                                 f"{config.iram_size} B RAM):\n{msg}")
         raise FirmwareError(f"link failed for {name}:\n{msg}")
     flash, stack_start, stack_free = parse_mem(mem)
     img = Image(ihx=ihx, kind=kind, config=config, flash=flash, ram_static=stack_start,
                 stack_start=stack_start, stack_free=stack_free)
-    if (kind == "production" and flash > code_size) or stack_start + stack_free > IRAM_SIZE or stack_free <= 0:
+    if ((kind == "production" and flash > code_size) or stack_start + stack_free > config.iram_size
+            or stack_free <= 0):
         raise FirmwareTooBig(img.size_report())
     return img
 
@@ -591,7 +696,8 @@ class Session:
         # yields the CPU to the host whenever both are ready: the simulation slows down with the
         # machine instead of running away from its host.
         self._s51 = s51 = subprocess.Popen(
-            ["nice", "-n", str(S51_NICE), "s51", "-t", "C51", "-R", "1", "-I", f"if=sfr[0xff],out={sif_out}",
+            ["nice", "-n", str(S51_NICE), "s51", "-t", "C52" if self.image.config.aided else "C51", "-R", "1",
+             "-I", f"if=sfr[0xff],out={sif_out}",
              "-S", f"in={self._fw_in},out={self._fw_out}", "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
         assert s51.stdout is not None
@@ -670,6 +776,53 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
         finally:
             port.close()
     return SimResult(**vars(out), host=host)
+
+
+@dataclass
+class V2Result(SimOutput):
+    """A link v2 image's run: the firmware's output, the records the receiver delivered
+    in order, and the receiver's statistics."""
+
+    records: list[bytes] = None  # type: ignore[assignment]
+    receiver: dict[str, int] = None  # type: ignore[assignment]
+
+
+def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float = 60.0,
+           room: int = 64) -> V2Result:
+    """Run a link v2 sim/bench image in s51 with libattitude's v2 receiver B on the pty:
+    the C machine (``impl="c"``, through CFFI) or the Python one written from the spec.
+    The host keeps up with any rate: its room never shrinks."""
+    import serial  # pyserial
+
+    from attitude_c.link.v2 import Receiver2, Result2
+    from attitude_c.link.v2c import CReceiver2
+
+    if image.config.link != "v2":
+        raise ValueError(f"run_v2 needs a link v2 image, got link={image.config.link!r}")
+    rx: Any = CReceiver2(room=room) if impl == "c" else Receiver2(room=room)
+    got: list[bytes] = []
+    with Session(image, timeout) as sess:
+        port = serial.Serial(str(sess.port), image.config.baud, timeout=0.005)
+
+        def pump() -> None:
+            for b in port.read(max(1, port.in_waiting)):
+                if rx.sink(b) == Result2.DELIVERED:
+                    got.extend(rx.delivered)
+                    rx.set_room(room)
+            reply = bytearray()
+            while True:
+                res, byte = rx.poll()
+                if res != Result2.SEND or byte is None:
+                    break
+                reply.append(byte)
+            if reply:
+                port.write(reply)
+
+        try:
+            fw = sess.run(pump=pump, describe=lambda: f"{len(got)} records, receiver {rx.stats.as_dict()}")
+        finally:
+            port.close()
+    return V2Result(**vars(fw), records=got, receiver=dict(rx.stats.as_dict()))
 
 
 # -- the simulator's acquisition source "s51" ---------------------------------------

@@ -1,7 +1,7 @@
 # GENERATED from toolchain/*.toml by `python -m toolchain.buildfiles`: do not edit.
 # Target presets of the Makefile: make TARGET=<name> (see the Makefile's header).
 
-ATT_TARGETS := aarch64 armv4t armv4t-bare armv7hf host host-asan host-clang mcs51
+ATT_TARGETS := aarch64 armv4t armv4t-bare armv7hf host host-asan host-clang mcs51 mcs52
 
 # 64-bit ARM Linux.
 ATT_TARGET_KIND_aarch64 := gcc
@@ -150,3 +150,24 @@ ATT_TARGET_SOURCES_mcs51 := csrc/src/common.c csrc/src/tlc2543.c csrc/src/link_s
 ATT_TARGET_SHARED_LDFLAGS_mcs51 :=
 ATT_TARGET_SHARED_LIBGCC_mcs51 :=
 ATT_TARGET_SHARED_LIBS_mcs51 :=
+
+# AT89S52: the aided board's MCU. Pin-compatible with the AT89S51 (8051 core),
+# 8 KB flash, 256 bytes of RAM (the upper 128 reached indirectly: SDCC puts the
+# stack there), Timer 2 (the UART's baud generator: 57600 and 115200 baud exact
+# from 11.0592 MHz). s51 simulates it as the C52 core (T2 included).
+ATT_TARGET_KIND_mcs52 := sdcc
+ATT_TARGET_OS_mcs52 := none
+ATT_TARGET_CROSS_COMPILE_mcs52 :=
+ATT_TARGET_CC_mcs52 := sdcc
+ATT_TARGET_AR_mcs52 := sdar
+ATT_TARGET_CFLAGS_mcs52 := -mmcs51 --model-small --iram-size 256 --xram-size 0 --code-size 8192
+ATT_TARGET_LDFLAGS_mcs52 :=
+ATT_TARGET_LIBS_mcs52 :=
+ATT_TARGET_STATIC_APP_mcs52 := 0
+ATT_TARGET_SHARED_mcs52 := 0
+ATT_TARGET_APP_mcs52 := 0
+ATT_TARGET_APP_LIBS_mcs52 :=
+ATT_TARGET_SOURCES_mcs52 := csrc/src/common.c csrc/src/tlc2543.c csrc/src/link_sender*.c csrc/src/block*.c csrc/src/fixed*.c
+ATT_TARGET_SHARED_LDFLAGS_mcs52 :=
+ATT_TARGET_SHARED_LIBGCC_mcs52 :=
+ATT_TARGET_SHARED_LIBS_mcs52 :=

@@ -35,7 +35,7 @@
 #define FW_SIM_SAMPLES 0 /* 0: the sample count does not stop the run */
 #endif
 
-#if defined(FW_BENCH)
+#if defined(FW_BENCH) || FW_AIDED
 /* Machine-cycle timestamp (16 bits, wraps every 65536 cycles = 71 ms):
  * TH0:TL0, read high-low-high so a carry between the reads is seen. */
 static uint16_t cycles_now(void)
@@ -47,6 +47,9 @@ static uint16_t cycles_now(void)
     } while (h != TH0);
     return (uint16_t)(((uint16_t)h << 8) | l);
 }
+#endif
+
+#if defined(FW_BENCH)
 
 /* Bench counters (machine cycles from cycles_now()). They live in SFR cells
  * the C51 core does not implement (uCsim keeps them as memory), so the
@@ -75,6 +78,20 @@ __sfr16 __at(0xA2A1) bench_poll_max;
 __sfr16 __at(0xA4A3) bench_polls;
 __sfr16 __at(0xA6A5) bench_poll_sum16; /* sum of cycles / 16 (wraps after ~3000 polls) */
 __sfr16 __at(0xB3B2) bench_t_poll;
+#if FW_AIDED
+/* The aided board's CPU load. The iterations of the main loop that did
+ * nothing (no byte received or sent, no poll result but NONE or IDLE, no
+ * scan) add their machine cycles, from their start to the next one's, to
+ * bench_idle; the firmware's ticks from the first iteration (bench_tick0)
+ * to the end give the total: busy = 1 - idle / total. A busy iteration
+ * pays for one timestamp only (the poll and block counters of the other
+ * bench images are off), so the figure is the production loop's. More
+ * cells the C52 core leaves free. */
+__sfr32 __at(0xCFCE9F9E) bench_idle;
+__sfr16 __at(0xB7B1) bench_t_prev;
+__sfr16 __at(0x9B9A) bench_tick0;
+__sfr __at(0x97) bench_started;
+#endif
 
 static void bench_init(void)
 {
@@ -90,6 +107,10 @@ static void bench_init(void)
     bench_exch_sum = 0;
     bench_syn_wait_sum = 0;
     bench_ans_wait_sum = 0;
+#if FW_AIDED
+    bench_idle = 0;
+    bench_started = 0;
+#endif
 #if FW_LINK_V2
     bench_poll_max = 0;
     bench_polls = 0;
@@ -100,6 +121,15 @@ static void bench_init(void)
 static void bench_loop_start(void)
 {
     bench_t_loop = cycles_now();
+#if FW_AIDED
+    if (!bench_started) {
+        bench_started = 1;
+        bench_tick0 = fw_ticks;
+    } else if (!bench_busy) {
+        bench_idle += (uint16_t)(bench_t_loop - bench_t_prev);
+    }
+    bench_t_prev = bench_t_loop;
+#endif
     bench_busy = 0;
 }
 
@@ -168,6 +198,7 @@ static void bench_block_start(void)
 
 static void bench_scan_begin(void)
 {
+    bench_busy = 1;
     bench_t_scan = cycles_now();
 }
 
@@ -200,8 +231,12 @@ static void bench_scan_end(void)
 
 /* Instrumentation lives in SFR cells the C51 core does not implement
  * (uCsim keeps them as memory), so it takes none of the 128 bytes of RAM. */
+#if defined(FW_SIM_C52)
+__sfr16 __at(0x9291) sim_accepted; /* (0xC8-0xCD are Timer 2's on the C52 core) */
+#else
 __sfr16 __at(0xCECD) sim_accepted; /* blocks the receiver accepted (FW_SIM_BLOCKS) */
-__sfr16 __at(0xB5B4) sim_samples;  /* ... of them sample records (FW_SIM_SAMPLES) */
+#endif
+__sfr16 __at(0xB5B4) sim_samples; /* ... of them sample records (FW_SIM_SAMPLES) */
 
 static void put_stat(const char *name)
 {
@@ -268,10 +303,41 @@ static void sim_finish(void)
     STAT("polls", bench_polls);
     STAT("poll_sum16", bench_poll_sum16);
 #endif
+#if FW_AIDED
+    STAT("tick0", bench_tick0);
+    STAT("ticks", fw_ticks);
+    STAT32("idle", bench_idle);
+#endif
     fw_sim_putc('\n');
 #endif
     fw_sim_stop(0);
 }
+
+#if FW_AIDED
+/* "UART <cycles>": the machine cycles one byte takes on the line (Timer 2's
+ * bit time x 10, 8N1): from one byte's end (the interrupt's tx_free) to the
+ * end of the next, written at once; both are 0x00, link v2's frame
+ * delimiter, which a receiver skips. */
+static void sim_uart_zero(void)
+{
+    tx_free = 0;
+    SBUF = 0;
+    while (!tx_free) {
+    }
+}
+
+static void sim_uart_time(void)
+{
+    uint16_t t;
+    sim_uart_zero();
+    t = cycles_now();
+    sim_uart_zero();
+    t = (uint16_t)(cycles_now() - t);
+    fw_sim_puts("UART ");
+    fw_sim_puthex(t);
+    fw_sim_putc('\n');
+}
+#endif
 
 static void sim_init(void)
 {
@@ -285,6 +351,9 @@ static void sim_init(void)
 #endif
 #if defined(FW_SIM_MODEL)
     fw_sim_model_init();
+#endif
+#if FW_AIDED
+    sim_uart_time();
 #endif
 #if FW_LINK_V2
     /* "CRC <hex>": the 8051's CRC-32C (link2_sender.c, in assembly there) of
@@ -409,7 +478,15 @@ static void sim_acked(void)
         SIM_COUNT_BLOCK();  \
         SIM_COUNT_SAMPLE(); \
     } while (0)
-#if defined(FW_BENCH) && FW_LINK_V2
+#if defined(FW_BENCH) && FW_AIDED
+#define FW_HOOK_POLL_BEGIN()
+#define FW_HOOK_POLL(st)                                        \
+    do {                                                        \
+        if ((st) != ATT_LINK2_NONE && (st) != ATT_LINK2_IDLE) { \
+            bench_busy = 1; /* the sender did something */      \
+        }                                                       \
+    } while (0)
+#elif defined(FW_BENCH) && FW_LINK_V2
 #define FW_HOOK_POLL_BEGIN() (bench_t_poll = cycles_now())
 #define FW_HOOK_POLL(st)    \
     do {                    \
@@ -422,7 +499,11 @@ static void sim_acked(void)
 #endif
 #if defined(FW_BENCH)
 #define FW_HOOK_LOOP_START() bench_loop_start()
-#define FW_HOOK_LOOP_END()   bench_loop_end()
+#if FW_AIDED
+#define FW_HOOK_LOOP_END()
+#else
+#define FW_HOOK_LOOP_END() bench_loop_end()
+#endif
 #define FW_HOOK_RX(b)    \
     do {                 \
         bench_rx(b);     \

@@ -37,11 +37,18 @@ __sbit __at(0xC6) fwm_bad_cs;     /* CS rose with the clock high */
 __sbit __at(0xC7) fwm_bad_abort;  /* a cycle ended before its conversion did */
 __sfr __at(0xC1) fwm_nclk;        /* clocks (DATA OUT reads) in this cycle */
 __sfr __at(0xC2) fwm_in;          /* input byte shifted in */
-__sfr16 __at(0xC8C3) fwm_word;    /* result being shifted out, code << 4 */
-__sbit __at(0xCF) fwm_msb;        /* its bit 15 (SFR 0xC8 is bit-addressable) */
-__sfr __at(0xC5) fwm_eoc_wait;    /* EOC reads that still return low */
-__sfr __at(0xC6) fwm_a;           /* address of the cycle being ended */
-__sfr16 __at(0xAAA9) fwm_vx;      /* inputs AIN0..AIN2 now, code << 4 */
+#if defined(FW_SIM_C52)
+/* the C52 core (the aided AT89S52) has Timer 2 at 0xC8-0xCD: the word's high
+ * byte moves to 0xD8, another bit-addressable cell that core leaves free */
+__sfr16 __at(0xD8C3) fwm_word; /* result being shifted out, code << 4 */
+__sbit __at(0xDF) fwm_msb;     /* its bit 15 */
+#else
+__sfr16 __at(0xC8C3) fwm_word; /* result being shifted out, code << 4 */
+__sbit __at(0xCF) fwm_msb;     /* its bit 15 (SFR 0xC8 is bit-addressable) */
+#endif
+__sfr __at(0xC5) fwm_eoc_wait; /* EOC reads that still return low */
+__sfr __at(0xC6) fwm_a;        /* address of the cycle being ended */
+__sfr16 __at(0xAAA9) fwm_vx;   /* inputs AIN0..AIN2 now, code << 4 */
 __sfr16 __at(0xACAB) fwm_vy;
 __sfr16 __at(0xAEAD) fwm_vz;
 

@@ -17,8 +17,11 @@
  * really happen (Timer 0 time): a sample taken at the wrong time, a stale
  * pipeline result or a mislabelled channel shows up as a wrong value.
  * The 12-bit code is v >> 4 (ideal quantizer, no offset or gain error).
- * AIN3..AIN10 are grounded (code 0); the test inputs give 0x800, 0x000,
- * 0xFFF. FW_SIM_DOUT_STUCK=0/1 ties DATA OUT low/high, FW_SIM_EOC_STUCK
+ * AIN3..AIN10 are grounded (code 0) on the gyro board; on the aided board
+ * (FW_AIDED) AIN3..AIN8 are its accelerometer and magnetometer, the same
+ * form with the parameters FW_SIM_AUX_OFF, _SH, _PH, _STEP (comma lists of
+ * six: toolchain/firmware.py AUX), evaluated when converted (the time k is
+ * the one the scan's step set). The test inputs give 0x800, 0x000, 0xFFF. FW_SIM_DOUT_STUCK=0/1 ties DATA OUT low/high, FW_SIM_EOC_STUCK
  * keeps EOC low: the faults of the self-test and EOC-timeout tests.
  * FW_SIM_EOC_STUCK_AT=K keeps EOC low in one scan only, that of sample K
  * (or of the first sample scanned after it; K < 256): the driver times
@@ -61,17 +64,33 @@ static const int16_t quarter_sine[65] = {
     31356, 31580, 31785, 31971, 32137, 32285, 32412, 32521, 32609, 32678, 32728, 32757, 32767,
 };
 
-static const uint16_t gyro_off[3] = { FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF };
-static const uint8_t gyro_sh[3] = { FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH };
-static const uint8_t gyro_step[3] = { FW_SIM_X_STEP, FW_SIM_Y_STEP, FW_SIM_Z_STEP };
-static const uint8_t gyro_phase[3] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH };
+#if FW_AIDED
+#define FW_SIM_NCH 9 /* gyros, accelerometer, magnetometer: AIN0..AIN8 */
+#else
+#define FW_SIM_NCH 3
+#endif
+#if FW_AIDED
+#define AUX(list) , list /* the six more inputs' parameters after the gyros' */
+#else
+#define AUX(list)
+#endif
+static const uint16_t gyro_off[FW_SIM_NCH] = { FW_SIM_X_OFF, FW_SIM_Y_OFF, FW_SIM_Z_OFF AUX(FW_SIM_AUX_OFF) };
+static const uint8_t gyro_sh[FW_SIM_NCH] = { FW_SIM_X_SH, FW_SIM_Y_SH, FW_SIM_Z_SH AUX(FW_SIM_AUX_SH) };
+static const uint8_t gyro_step[FW_SIM_NCH] = { FW_SIM_X_STEP, FW_SIM_Y_STEP,
+                                               FW_SIM_Z_STEP AUX(FW_SIM_AUX_STEP) };
+static const uint8_t gyro_phase[FW_SIM_NCH] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM_Z_PH AUX(FW_SIM_AUX_PH) };
 
 /* Model state beyond tlc_hal_sim.h's cells: SFR cells too, no RAM. */
-__sfr __at(0xBD) m_started;         /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
-__sfr __at(0xC7) m_k;               /* sampling periods since the first step (mod 256) */
-__sfr16 __at(0xCAC9) m_bound;       /* fw_ticks at which m_k next increments */
-__sfr16 __at(0xCCCB) m_conversions; /* gyro input evaluations so far */
-__sfr __at(0xAF) m_fault_done;      /* FW_SIM_EOC_STUCK_AT: the one failed scan happened */
+__sfr __at(0xBD) m_started; /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
+__sfr __at(0xC7) m_k;       /* sampling periods since the first step (mod 256) */
+#if defined(FW_SIM_C52)     /* 0xC8-0xCD are Timer 2's on the C52 core */
+__sfr16 __at(0x9493) m_bound;
+__sfr16 __at(0x9695) m_conversions;
+#else
+__sfr16 __at(0xCAC9) m_bound;             /* fw_ticks at which m_k next increments */
+__sfr16 __at(0xCCCB) m_conversions;       /* gyro input evaluations so far */
+#endif
+__sfr __at(0xAF) m_fault_done; /* FW_SIM_EOC_STUCK_AT: the one failed scan happened */
 
 void fw_sim_model_init(void)
 {
@@ -141,6 +160,10 @@ unsigned char fwm_end_cycle(void)
         fwm_word = fwm_vy;
     } else if (a == TLC2543_CH_Z) {
         fwm_word = fwm_vz;
+#if FW_AIDED
+    } else if (a < FW_SIM_NCH) {
+        fwm_word = gyro(a); /* accelerometer, magnetometer: at the scan's time k */
+#endif
     } else if (a == TLC2543_TEST_MID) {
         fwm_word = 0x8000u;
     } else if (a == TLC2543_TEST_REFP) {

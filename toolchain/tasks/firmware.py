@@ -16,21 +16,41 @@ def _tool() -> ModuleType:
 
 
 @task(help={
-    "baud": "UART rate (1200 ... 57600; exact rates of the 11.0592 MHz crystal only)",
+    "baud": "UART rate (exact rates of the 11.0592 MHz crystal only: up to 57600 on the AT89S51's Timer 1, "
+            "115200 on the aided AT89S52's Timer 2; default 9600, aided 115200)",
     "period_ticks": "sampling period in Timer 0 ticks of 1/3600 s (72 = 20 ms)",
     "max_attempts": "link attempts per block before giving up",
     "out": "output directory (default build/firmware)",
     "link": "link protocol: legacy (AA/BB handshake, default) or v2 (link v2, single-instance sender)",
+    "board": "gyro3 (the paper's AT89S51, default) or aided9 (the AT89S52 with accelerometer and "
+             "magnetometer: link v2, docs/firmware.md)",
+    "acc_every": "aided9: accelerometer record every N samples (0 or a power of two up to 128; default 2)",
+    "mag_every": "aided9: magnetometer record every N samples (likewise; default 2)",
 })
-def build(c, baud=9600, period_ticks=72, max_attempts=5, out="", link="legacy"):
-    """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM) and print flash, RAM and free stack."""
+def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", board="gyro3", acc_every=2,
+          mag_every=2):
+    """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM), or the aided AT89S52 one
+    (8 KB, 256 B), and print flash, RAM and free stack."""
+    import dataclasses
+
     tool = _tool()
     if link not in tool.LINKS:
         print(f"--link must be one of {', '.join(tool.LINKS)}, got {link!r}", file=sys.stderr)
         raise SystemExit(2)
-    cfg = tool.Config(baud=int(baud), period_ticks=int(period_ticks), max_attempts=int(max_attempts), link=link)
     try:
-        img = tool.build(Path(out) if out else tool.BUILD, cfg, kind="production", name="attitude_fw" if link == "legacy" else "attitude_fw_v2")
+        if board == "aided9":
+            cfg = dataclasses.replace(tool.AIDED, baud=int(baud) or tool.AIDED.baud, period_ticks=int(period_ticks),
+                                      max_attempts=int(max_attempts), acc_every=int(acc_every),
+                                      mag_every=int(mag_every))
+        else:
+            cfg = tool.Config(baud=int(baud) or 9600, period_ticks=int(period_ticks), max_attempts=int(max_attempts),
+                              link=link, board=board)
+    except ValueError as exc:
+        print(f"invoke firmware.build: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    name = "attitude_fw_aided" if cfg.aided else "attitude_fw" if link == "legacy" else "attitude_fw_v2"
+    try:
+        img = tool.build(Path(out) if out else tool.BUILD, cfg, kind="production", name=name)
     except tool.FirmwareTooBig as exc:
         print(f"firmware does not fit: {exc}", file=sys.stderr)
         raise SystemExit(1) from None
