@@ -16,6 +16,7 @@ import math
 import os
 import signal
 import subprocess
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -63,7 +64,15 @@ class _PtyMaster:
         return os.read(self.fd, 4096) if r else b""
 
     def write(self, data: bytes) -> None:
-        os.write(self.fd, data)
+        """Write what the line takes within 1 s: once attitude-rx has ended (--count), nobody
+        reads its side and the sender's retries would fill the pty and block forever."""
+        import select
+
+        while data:
+            _, w, _ = select.select([], [self.fd], [], 1.0)
+            if not w:
+                return  # the receiver is gone: the rest is lost on the line
+            data = data[os.write(self.fd, data):]
 
     def flush(self) -> None:
         pass
@@ -98,12 +107,16 @@ def _run(cmd: list[str], records: list[bytes], count: int, *args: str) -> tuple[
     from attitude_c.link.transport2 import run_sender2
 
     master, slave = os.openpty()
+    os.set_blocking(master, False)  # _PtyMaster.write waits in select, never in write
     # --queue: room for the whole stream. With a full queue, link v2 between attitude-rx and sender
     # A stalls (a bug of main's link v2 flow control, gyro-only streams too: reported, not this test's)
     proc = subprocess.Popen([*cmd, "--port", os.ttyname(slave), "--format", "jsonl", "--count", str(count),
                              "--queue", "4096", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    ended = threading.Event()  # the sender stops when attitude-rx has ended (--count)
+    watcher = threading.Thread(target=lambda: (proc.wait(), ended.set()), daemon=True)
+    watcher.start()
     try:
-        run_sender2(_PtyMaster(master), records, impl="python", timeout=120)
+        run_sender2(_PtyMaster(master), records, impl="python", timeout=120, stop=ended)
         out, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
