@@ -7,6 +7,7 @@ samples/s and at the aided board's sampling plan (toolchain.firmware.AIDED)."""
 
 from __future__ import annotations
 
+import functools
 import math
 import tempfile
 from pathlib import Path
@@ -36,8 +37,13 @@ def _counts(quick: bool, tmp: Path) -> dict[tuple[str, str, int], float]:
     for prec in ("f64", "f32"):
         exe = t.build_program([SRC], tmp / f"rx_filter_{prec}", defines=["ATT_REAL_F32"] if prec == "f32" else [])
         for mode, every in (("path", 1), ("path", AIDED.acc_every), ("line", 1)):
-            out[(prec, mode, every)] = per_iteration(exe, lambda k, m=mode, e=every: [m, str(e), str(k)], n1, n2)
+            out[(prec, mode, every)] = per_iteration(exe, functools.partial(_args, mode, every), n1, n2)
     return out
+
+
+def _args(mode: str, every: int, n: int) -> list[str]:
+    """rx_filter_armv4t's arguments for n samples."""
+    return [mode, str(every), str(n)]
 
 
 def _us(instr: float) -> float:
