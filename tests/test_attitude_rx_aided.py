@@ -363,3 +363,20 @@ def test_filter_settings_by_field_name_and_errors(rx_builds, tmp_path: Path) -> 
     assert rc == 78 and "f.conf:1: unknown setting 'gyr_nosie'" in err
     assert run("--port", nope, "--estimator", "integrator", "--method", "rk4")[0] == 66
     assert run("--port", nope, "--method", "rk4")[0] == 66  # auto: the filter keeps its default method
+
+
+@pytest.mark.qemu
+def test_cost_harness_runs_on_armv4t(tmp_path: Path) -> None:
+    """The smoke version of `invoke bench --only rx_filter`: its harness (bench/rx_filter_armv4t.c)
+    runs the filter path on the bare ARMv4T core, every library call succeeding (exit 0), in the
+    double and the float build, each mode."""
+    from conftest import ROOT
+
+    t = require_target("armv4t-bare")
+    for prec in ("f64", "f32"):
+        exe = t.build_program([ROOT / "bench" / "rx_filter_armv4t.c"], tmp_path / f"rx_filter_{prec}",
+                              defines=["ATT_REAL_F32"] if prec == "f32" else [])
+        for args in (["path", "1", "40"], ["path", "2", "40"], ["line", "1", "40"]):
+            proc = t.run([exe, *args], timeout=120, check=False)
+            assert proc.returncode == 0, (prec, args, proc.returncode)
+    assert t.run([exe, "path", "0", "5"], timeout=60, check=False).returncode == 2  # EVERY 1..255
