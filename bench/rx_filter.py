@@ -30,15 +30,20 @@ def _counts(quick: bool, tmp: Path) -> dict[tuple[str, str, int], float]:
 
     t = T.load("armv4t-bare")
     # both runs end past the reported inclination's running-mean start (tilt_tau at 200 Hz), their
-    # difference one turn of the field table (the quick run: a quarter turn)
+    # difference one turn of the field table (the quick run: an eighth of a turn)
     n1 = math.ceil(default_settings()["tilt_tau"] * RATE) + 100
-    n2 = n1 + (TABLE // 4 if quick else TABLE)
+    n2 = n1 + (TABLE // 8 if quick else TABLE)
     out = {}
-    for prec in ("f64", "f32"):
+    for prec in _precisions(quick):
         exe = t.build_program([SRC], tmp / f"rx_filter_{prec}", defines=["ATT_REAL_F32"] if prec == "f32" else [])
         for mode, every in (("path", 1), ("path", AIDED.acc_every), ("line", 1)):
             out[(prec, mode, every)] = per_iteration(exe, functools.partial(_args, mode, every), n1, n2)
     return out
+
+
+def _precisions(quick: bool) -> tuple[str, ...]:
+    """The builds measured: attitude-rx's (double; --quick: that one alone) and the float build."""
+    return ("f64",) if quick else ("f64", "f32")
 
 
 def _args(mode: str, every: int, n: int) -> list[str]:
@@ -62,14 +67,14 @@ def run(quick: bool) -> str:
     with tempfile.TemporaryDirectory() as d:
         c = _counts(quick, Path(d))
     rows = []
-    for prec in ("f64", "f32"):
+    for prec in _precisions(quick):
         full, plan, line = c[(prec, "path", 1)], c[(prec, "path", every)], c[(prec, "line", 1)]
         gyro_only = (every * plan - full) / (every - 1) if every > 1 else float("nan")
         rows.append((prec, full, gyro_only, plan, line - full))
     out = [
         "Instructions per sample on the emulated ARMv4T core (`qemu-arm -cpu ti925t`, exact counts with "
         "`-singlestep -d nochain,exec`, `toolchain/qemu_count.py`; difference of two runs of "
-        f"`bench/rx_filter_armv4t.c` past the filter's start, {TABLE // 4 if quick else TABLE} samples apart; "
+        f"`bench/rx_filter_armv4t.c` past the filter's start, {TABLE // 8 if quick else TABLE} samples apart; "
         "soft-float newlib libm, `-O2`). The path is what attitude-rx's attitude thread does per sample of an "
         "aided stream (`csrc/app/attitude_rx.c`): the sample's records decoded and numbered "
         "(`att_block_seq_decode`), converted (`att_sensor_convert`, accelerometer and magnetometer with a "
