@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import json
 import math
-import os
 import signal
 import subprocess
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -48,29 +48,6 @@ def rx_builds(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[str]]:
             "host": [str(cross_build_target("host", out=base / "host")["app"])]}
 
 
-class _PtyMaster:
-    """The master side of attitude-rx's pty as a port for run_sender2."""
-
-    timeout = 0.01
-    baudrate = None
-    in_waiting = 0
-
-    def __init__(self, fd: int) -> None:
-        self.fd = fd
-
-    def read(self, n: int) -> bytes:
-        import select
-
-        r, _, _ = select.select([self.fd], [], [], self.timeout)
-        return os.read(self.fd, 4096) if r else b""
-
-    def write(self, data: bytes) -> None:
-        os.write(self.fd, data)
-
-    def flush(self) -> None:
-        pass
-
-
 def _codes(values: np.ndarray, scale: float, zero: float = 2048.0) -> np.ndarray:
     """Nearest 12-bit codes of values (N, 3) at `scale` units per code."""
     c = np.rint(zero + np.asarray(values) / scale).astype(np.int64)
@@ -95,24 +72,28 @@ def _records(gyr: np.ndarray, acc: np.ndarray, mag: np.ndarray, acc_every: int =
 
 
 def _run(cmd: list[str], records: list[bytes], count: int, *args: str) -> tuple[list[dict[str, Any]], str]:
-    """attitude-rx --format jsonl --count on a pty fed `records` by link v2's sender A;
-    its JSON records and stderr."""
+    """attitude-rx --format jsonl --count on one end of a pty pair (attitude_c.link.transport),
+    link v2's sender A with `records` on the other; its JSON records and stderr."""
+    import serial
+
+    from attitude_c.link.transport import PtyPair
     from attitude_c.link.transport2 import run_sender2
 
-    master, slave = os.openpty()
-    # --queue: room for the whole stream. With a full queue, link v2 between attitude-rx and sender
-    # A stalls (a bug of main's link v2 flow control, gyro-only streams too: reported, not this test's)
-    proc = subprocess.Popen([*cmd, "--port", os.ttyname(slave), "--format", "jsonl", "--count", str(count),
-                             "--queue", "4096", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    try:
-        run_sender2(_PtyMaster(master), records, impl="python", timeout=120)
-        out, err = proc.communicate(timeout=60)
-    finally:
-        if proc.poll() is None:
-            proc.send_signal(signal.SIGKILL)
-            proc.wait()
-        os.close(master)
-        os.close(slave)
+    with PtyPair() as (rx_port, board_port):
+        # --queue: room for the whole stream. With a full queue, link v2 between attitude-rx and sender
+        # A stalls (a bug of main's link v2 flow control, gyro-only streams too: reported, not this test's)
+        proc = subprocess.Popen([*cmd, "--port", rx_port, "--format", "jsonl", "--count", str(count),
+                                 "--queue", "4096", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+        ended = threading.Event()  # the sender stops once attitude-rx has ended (--count)
+        threading.Thread(target=lambda: (proc.wait(), ended.set()), daemon=True).start()
+        try:
+            with serial.Serial(board_port, 115200, timeout=0.01, write_timeout=10) as port:
+                run_sender2(port, records, impl="python", timeout=120, stop=ended)
+            out, err = proc.communicate(timeout=60)
+        finally:
+            if proc.poll() is None:
+                proc.send_signal(signal.SIGKILL)
+                proc.wait()
     text = err.decode()
     assert proc.returncode == 0, text
     # every record was delivered (the sender may miss the last ACK: --count ends attitude-rx first)
@@ -384,3 +365,20 @@ def test_filter_settings_by_field_name_and_errors(rx_builds, tmp_path: Path) -> 
     assert rc == 78 and "f.conf:1: unknown setting 'gyr_nosie'" in err
     assert run("--port", nope, "--estimator", "integrator", "--method", "rk4")[0] == 66
     assert run("--port", nope, "--method", "rk4")[0] == 66  # auto: the filter keeps its default method
+
+
+@pytest.mark.qemu
+def test_cost_harness_runs_on_armv4t(tmp_path: Path) -> None:
+    """The smoke version of `invoke bench --only rx_filter`: its harness (bench/rx_filter_armv4t.c)
+    runs the filter path on the bare ARMv4T core, every library call succeeding (exit 0), in the
+    double and the float build, each mode."""
+    from conftest import ROOT
+
+    t = require_target("armv4t-bare")
+    for prec in ("f64", "f32"):
+        exe = t.build_program([ROOT / "bench" / "rx_filter_armv4t.c"], tmp_path / f"rx_filter_{prec}",
+                              defines=["ATT_REAL_F32"] if prec == "f32" else [])
+        for args in (["path", "1", "40"], ["path", "2", "40"], ["line", "1", "40"]):
+            proc = t.run([exe, *args], timeout=120, check=False)
+            assert proc.returncode == 0, (prec, args, proc.returncode)
+    assert t.run([exe, "path", "0", "5"], timeout=60, check=False).returncode == 2  # EVERY 1..255

@@ -565,33 +565,57 @@ static void print_header(rx_app *app, rx_estimator e)
              0);
 }
 
+#define RX_R2D (180.0 / 3.14159265358979323846) /* degrees per radian (as computed before: bit for bit) */
+
+/* The fields every attitude line starts with, CSV or JSON (no line end, JSON not closed):
+ * t, n, codes, q, Euler angles and heading in degrees (held: JSON). */
+static int line_head(const rx_app *app, char *line, size_t size, uint32_t n, const uint16_t code[3],
+                     const att_real q[4])
+{
+    const int digits = att_real_size() == 4 ? 9 : 17; /* round-trip precision */
+    att_real e[3], h = 0;
+    if (att_quat_to_euler(q, e) != ATT_OK || att_quat_heading(q, &h) != ATT_OK)
+        e[0] = e[1] = e[2] = h = (att_real)0;
+    if (app->cfg.format == RX_FORMAT_CSV)
+        return snprintf(line, size, "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g", app->t,
+                        (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
+                        (double)q[1], digits, (double)q[2], digits, (double)q[3], digits,
+                        (double)e[0] * RX_R2D, digits, (double)e[1] * RX_R2D, digits, (double)e[2] * RX_R2D,
+                        digits, (double)h * RX_R2D);
+    return snprintf(line, size,
+                    "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],\"yaw_deg\":%.*g,"
+                    "\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu",
+                    app->t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
+                    (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * RX_R2D,
+                    digits, (double)e[1] * RX_R2D, digits, (double)e[2] * RX_R2D, digits, (double)h * RX_R2D,
+                    app->held);
+}
+
+/* ,"key":[x,y,z] scaled by k (CSV: ,x,y,z); nothing when v is NULL */
+static int vec3(const rx_app *app, char *p, size_t len, const char *key, const att_real *v, double k)
+{
+    const int digits = att_real_size() == 4 ? 9 : 17;
+    if (v == NULL)
+        return 0;
+    if (app->cfg.format == RX_FORMAT_CSV)
+        return snprintf(p, len, ",%.*g,%.*g,%.*g", digits, (double)v[0] * k, digits, (double)v[1] * k, digits,
+                        (double)v[2] * k);
+    return snprintf(p, len, ",\"%s\":[%.*g,%.*g,%.*g]", key, digits, (double)v[0] * k, digits,
+                    (double)v[1] * k, digits, (double)v[2] * k);
+}
+
+/* An integrator line: the head, then (JSON) the body rate of the newest sample. */
 static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
                          const att_real q[4])
 {
-    att_real e[3], h = 0;
-    const double r2d = 180.0 / 3.14159265358979323846;
-    const int digits = att_real_size() == 4 ? 9 : 17; /* round-trip precision */
-    double t = app->t;
     char line[RX_LINE_MAX];
     int len;
-    if (att_quat_to_euler(q, e) != ATT_OK || att_quat_heading(q, &h) != ATT_OK)
-        e[0] = e[1] = e[2] = h = (att_real)0;
     print_header(app, RX_EST_INTEGRATOR);
-    if (app->cfg.format == RX_FORMAT_CSV)
-        len = snprintf(line, sizeof line, "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g\n", t,
-                       (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
-                       (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d,
-                       digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
-    else
-        len = snprintf(
-            line, sizeof line,
-            "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
-            "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu,"
-            "\"rate_dps\":[%.*g,%.*g,%.*g]}\n",
-            t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits, (double)q[1],
-            digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
-            (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held, digits,
-            (double)v[0] * r2d, digits, (double)v[1] * r2d, digits, (double)v[2] * r2d);
+    len = line_head(app, line, sizeof line, n, code, q);
+    if (app->cfg.format != RX_FORMAT_CSV)
+        len += vec3(app, line + len, sizeof line - (size_t)len, "rate_dps", v, RX_R2D);
+    len +=
+        snprintf(line + len, sizeof line - (size_t)len, "%s\n", app->cfg.format == RX_FORMAT_CSV ? "" : "}");
     out_line(app, line, len, 1);
 }
 
@@ -618,16 +642,6 @@ static int json_flags(char *p, size_t len, int flags)
     return n;
 }
 
-/* ,"key":[x,y,z] scaled by k (nothing when v is NULL) */
-static int json_vec(char *p, size_t len, const char *key, const att_real *v, double k)
-{
-    const int digits = att_real_size() == 4 ? 9 : 17;
-    if (v == NULL)
-        return 0;
-    return snprintf(p, len, ",\"%s\":[%.*g,%.*g,%.*g]", key, digits, (double)v[0] * k, digits,
-                    (double)v[1] * k, digits, (double)v[2] * k);
-}
-
 /* What the filter adds to a line: its gyro-bias estimate and flags, the sample's aiding vectors. */
 typedef struct {
     att_real bias[3];          /* rad/s */
@@ -635,42 +649,26 @@ typedef struct {
     const att_real *acc, *mag; /* m/s², µT, or NULL: not in this sample */
 } rx_filter_out;
 
-/* One filter line: the attitude line's fields, then bias, flags, acc, mag. */
+/* A filter line: the head, then the rate, bias (°/s), flags, acc (m/s²) and mag (µT) in JSON;
+ * the bias (°/s) and the flag bits in CSV. */
 static void print_filter(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
                          const att_real q[4], const rx_filter_out *f)
 {
-    const double r2d = 180.0 / 3.14159265358979323846;
-    const int digits = att_real_size() == 4 ? 9 : 17;
-    att_real e[3], h = 0;
     char line[RX_LINE_MAX];
-    int len, w;
-    if (att_quat_to_euler(q, e) != ATT_OK || att_quat_heading(q, &h) != ATT_OK)
-        e[0] = e[1] = e[2] = h = (att_real)0;
+    int w;
     print_header(app, RX_EST_AHRS);
-    len =
-        snprintf(line, sizeof line,
-                 "%s\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],\"yaw_deg\":%.*g,"
-                 "\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu",
-                 "{", app->t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
-                 (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
-                 (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held);
+    w = line_head(app, line, sizeof line, n, code, q);
     if (app->cfg.format == RX_FORMAT_CSV) {
-        len = snprintf(line, sizeof line,
-                       "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%d\n",
-                       app->t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
-                       (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d,
-                       digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d,
-                       digits, (double)f->bias[0] * r2d, digits, (double)f->bias[1] * r2d, digits,
-                       (double)f->bias[2] * r2d, f->flags);
-        out_line(app, line, len, 1);
+        w += vec3(app, line + w, sizeof line - (size_t)w, "bias_dps", f->bias, RX_R2D);
+        w += snprintf(line + w, sizeof line - (size_t)w, ",%d\n", f->flags);
+        out_line(app, line, w, 1);
         return;
     }
-    w = len;
-    w += json_vec(line + w, sizeof line - (size_t)w, "rate_dps", v, r2d);
-    w += json_vec(line + w, sizeof line - (size_t)w, "bias_dps", f->bias, r2d);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "rate_dps", v, RX_R2D);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "bias_dps", f->bias, RX_R2D);
     w += json_flags(line + w, sizeof line - (size_t)w, f->flags);
-    w += json_vec(line + w, sizeof line - (size_t)w, "acc_ms2", f->acc, 1.0);
-    w += json_vec(line + w, sizeof line - (size_t)w, "mag_ut", f->mag, 1.0);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "acc_ms2", f->acc, 1.0);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "mag_ut", f->mag, 1.0);
     w += snprintf(line + w, sizeof line - (size_t)w, "}\n");
     out_line(app, line, w, 1);
 }
