@@ -31,14 +31,13 @@ pytestmark = pytest.mark.system  # builds the firmware and runs it in s51
 STACK_MARGIN = 4
 
 #: Sampling period of the long runs: 216 ticks = 60 ms. One exchange is 10
-#: byte times = 10.4 ms at 9600 baud, plus the host's latency, which s51
-#: (slower than real time with a pty) stretches to ~20 ms of simulated time
-#: and to 40-80 ms when the machine is loaded (measured with a load average
-#: of 7 on 2 cores); 60 ms and the two-slot queue keep the samples.
+#: byte times = 10.4 ms at 9600 baud, plus the host's latency: up to one
+#: lockstep step per wait (two waits, each <= tool.LOCKSTEP_BOUND_S = 43 ms,
+#: ~16 ms measured); 60 ms and the two-slot queue keep the samples.
 PERIOD = 216
 #: Link timeouts of the test images: 720 ticks = 200 ms of simulated time,
-#: so a host descheduled for a while on a loaded machine is not mistaken
-#: for a silent one (the silence test counts timeouts exactly).
+#: well above a lockstep step, so a host is never mistaken for a silent one
+#: (the silence test counts timeouts exactly).
 TIMEOUT = 720
 
 
