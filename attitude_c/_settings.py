@@ -12,7 +12,9 @@ settings as keywords named as the fields; each is checked by name:
   real number, an integer field an integer; ``bool`` is neither);
 * not finite, or outside the C type's range → ``InvalidArgument``;
 * outside the documented domain (the library's ``*_check_settings``) →
-  ``InvalidArgument`` naming the setting(s) that fail on their own.
+  ``InvalidArgument`` naming the setting: the one the library names when it can
+  (``SettingsSpec.field_fn``, e.g. ``att_ahrs_check_settings_field``: the first
+  field outside its domain), else those that fail on their own.
 
 A struct may expose an integer field by name (``Choice``: the filter's
 ``method`` as ``"rv3-reuse"``) and fields of a nested struct under
@@ -60,6 +62,9 @@ class SettingsSpec:
     choices: Mapping[str, Choice] = field(default_factory=dict)
     #: nested struct field -> its fields exposed as "<outer>_<inner>" (others stay at their defaults)
     nested: Mapping[str, tuple[str, ...]] = field(default_factory=dict)
+    #: "att_ahrs_check_settings_field": the check that also names the failing field (None: the
+    #: settings are re-checked one by one to name it)
+    field_fn: str | None = None
 
 
 def _kind_of(ctype: Any) -> str | None:
@@ -204,12 +209,23 @@ def fill(ffi: Any, lib: Any, spec: SettingsSpec, settings: Mapping[str, Any]) ->
             raise InvalidArgument(f"unknown {spec.label} setting {k!r} (known: {', '.join(fields)})")
         values[k] = _value(spec, k, fields[k][1], v)
     s = _new(ffi, lib, spec, values)
-    check = getattr(lib, spec.check_fn)
-    if check(s) != 0:
-        # name the settings that are outside the domain on their own (the others at their defaults)
-        bad = [k for k in values if check(_new(ffi, lib, spec, {k: values[k]})) != 0]
-        given = ", ".join(f"{k}={settings[k]!r}" for k in (bad or values))
-        what = "outside its domain" if len(bad) == 1 else "outside their domains" if bad else \
-            "together outside the domain"
-        raise InvalidArgument(f"settings: {given} {what} ({spec.domain})")
+    if getattr(lib, spec.check_fn)(s) != 0:
+        raise InvalidArgument(f"settings: {_outside(ffi, lib, spec, s, settings, values)} ({spec.domain})")
     return s
+
+
+def _outside(ffi: Any, lib: Any, spec: SettingsSpec, s: Any, settings: Mapping[str, Any],
+             values: Mapping[str, Any]) -> str:
+    """What of the filled struct ``s`` is outside the domain, as the message says it."""
+    if spec.field_fn is not None:
+        out = ffi.new("const char **")
+        getattr(lib, spec.field_fn)(s, out)
+        name = ffi.string(out[0]).decode().replace(".", "_")  # a nested field as exposed
+        return f"{name}={settings[name] if name in settings else read(spec, s)[name]!r} outside its domain"
+    # name the settings that are outside the domain on their own (the others at their defaults)
+    check = getattr(lib, spec.check_fn)
+    bad = [k for k in values if check(_new(ffi, lib, spec, {k: values[k]})) != 0]
+    given = ", ".join(f"{k}={settings[k]!r}" for k in (bad or values))
+    what = "outside its domain" if len(bad) == 1 else "outside their domains" if bad else \
+        "together outside the domain"
+    return f"{given} {what}"

@@ -47,7 +47,8 @@ _SPEC = _settings.SettingsSpec(
     "att_ahrs_settings", "att_ahrs_default_settings", "att_ahrs_check_settings", label="filter",
     domain="ahrs.h: noises and times > 0, '0 = off' fields ≥ 0, |sensor_delay| ≤ 1 s, "
     "|acc_delay|, |mag_delay| ≤ 0.05 s",
-    choices={"method": _settings.Choice(_method, lambda code: names.method_names()[code])})
+    choices={"method": _settings.Choice(_method, lambda code: names.method_names()[code])},
+    field_fn="att_ahrs_check_settings_field")
 
 #: The real-valued settings (field names of ``att_ahrs_settings``, read from the
 #: library on first use), besides ``method``.

@@ -31,18 +31,22 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 TITLE = "Aided AT89S52 board: CPU load per sampling plan (s51) and the filter's accuracy with decimated aiding (BROAD)"
 
-#: (gyro period in ticks of 1/3600 s, acc every, mag every) of the plans measured
-PLANS = ((72, 1, 1), (72, 2, 2), (72, 2, 4), (72, 4, 4), (36, 1, 1), (36, 4, 4))
+#: (gyro period in ticks of 1/3600 s, acc every, mag every) of the plans measured (at 115200
+#: baud; the default plan at 57600 too)
+PLANS = ((72, 1, 1), (72, 2, 2), (72, 4, 4), (36, 1, 1), (36, 2, 2), (36, 2, 4), (36, 4, 4))
 #: BROAD sample steps (285.7 Hz / step: about the board's gyro rates) and (acc, mag) decimations
 STEPS = (6, 3)
 KS = ((1, 1), (2, 2), (2, 4), (4, 4), (8, 8))
 
 
-def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, records: int) -> dict[str, Any]:
-    """One plan's bench run: busy fraction, delivered rates, stack."""
+def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, records: int,
+             sr: bool = False) -> dict[str, Any]:
+    """One plan's bench run (``sr``: with the magnetometer's set/reset): busy fraction,
+    delivered rates, stack."""
     period, acc, mag = plan
-    cfg = dataclasses.replace(tool.AIDED, baud=baud, period_ticks=period, acc_every=acc, mag_every=mag)
-    img = tool.build(build_dir, cfg, kind="bench", sim_samples=records, name=f"aided_{baud}_{period}_{acc}_{mag}")
+    cfg = dataclasses.replace(tool.AIDED, baud=baud, period_ticks=period, acc_every=acc, mag_every=mag, mag_sr=sr)
+    img = tool.build(build_dir, cfg, kind="bench", sim_samples=records,
+                     name=f"aided_{baud}_{period}_{acc}_{mag}" + ("_sr" if sr else ""))
     res = tool.run_v2(img, "c", timeout=900)
     b = res.bench
     total = ((b["ticks"] - b["tick0"]) & 0xFFFF) * 256  # ticks since the first iteration, in cycles
@@ -52,6 +56,19 @@ def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, 
             "records": res.stats["accepted"] / seconds, "wanted": tool.TICK_HZ / period * per_sample,
             "overrun": res.stats["overrun_pending"], "scan": b["scan_sum"] / b["scans"], "scan_max": b["scan_max"],
             "max_sp": res.max_sp, "stack_start": img.stack_start, "bad_frames": res.receiver["bad_frames"]}
+
+
+def profile(tool: Any, build_dir: Path, records: int) -> dict[str, float]:
+    """Where the default plan's cycles go: the profile image (-DFW_PROFILE, firmware/sim/hooks.h)
+    times every poll of the sender and every sink call (its timestamps inflate the load, so
+    the busy figure comes from the plain bench image)."""
+    img = tool.build(build_dir, tool.AIDED, kind="bench", sim_samples=records, name="aided_profile",
+                     extra_defines=["FW_PROFILE"])
+    res = tool.run_v2(img, "c", timeout=900)
+    b, n = res.bench, res.stats["accepted"]
+    return {"per_frame": n / max(1, b["nframe"]), "bytes": b["nsend"] / n, "poll": b["psend"] / b["nsend"],
+            "rx_bytes": b["nrx"] / n, "sink": b["prx"] / max(1, b["nrx"]), "scan": b["scan_sum"] / n,
+            "idle_polls": b["pother"] / n}
 
 
 def run_decimated(tr: Any, step: int, k: tuple[int, int]) -> np.ndarray:
@@ -100,28 +117,48 @@ def run(quick: bool) -> str:
     build_dir = ROOT / "build" / "bench_aided"
     records = 120 if quick else 400
     prod = tool.build(build_dir, tool.AIDED, kind="production", name="aided_prod")
-    cpu = {(plan, baud): cpu_load(tool, build_dir, plan, baud, records) for plan in PLANS for baud in (57600, 115200)}
+    prod_sr = tool.build(build_dir, dataclasses.replace(tool.AIDED, mag_sr=True), kind="production", name="aided_prod_sr")
+    default = (tool.AIDED.period_ticks, tool.AIDED.acc_every, tool.AIDED.mag_every)
+    runs = [(default, 57600, False), *((plan, 115200, False) for plan in PLANS), (default, 115200, True),
+            (default, 57600, True)]
+    cpu = {(plan, baud, sr): cpu_load(tool, build_dir, plan, baud, records, sr) for plan, baud, sr in runs}
+    prof = profile(tool, build_dir, records)
+    dflt = cpu[(default, tool.AIDED.baud, False)]
+    busy_rec = dflt["busy"] * tool.MACHINE_HZ / dflt["records"]
     acc = broad_accuracy(quick)
     lines = [
         (f"Default image (`Config(board=\"aided9\")`, `toolchain.firmware.AIDED`): flash **{prod.flash} / "
          f"8192 bytes**, internal RAM **{prod.ram_static} / 256 bytes** static, stack 0x{prod.stack_start:02X}.."
          f"0xFF = {prod.stack_free} bytes; highest SP seen in s51 over the runs below "
-         f"0x{max(c['max_sp'] for c in cpu.values()):02X}."),
+         f"0x{max(c['max_sp'] for (_, _, sr), c in cpu.items() if not sr):02X}. With the magnetometer's "
+         f"set/reset (`mag_sr=True`): flash {prod_sr.flash}, RAM {prod_sr.ram_static} static, stack from "
+         f"0x{prod_sr.stack_start:02X}, highest SP seen 0x{max(c['max_sp'] for (_, _, sr), c in cpu.items() if sr):02X}."),
+        "",
+        (f"Link v2 settings: a ring of {tool.AIDED.v2_ring} records in the upper RAM, up to "
+         f"{tool.AIDED.v2_samples} samples per frame, a DATA frame held back for {tool.AIDED.v2_batch} records "
+         f"or {tool.AIDED.v2_hold} ticks ({1000 * tool.AIDED.v2_hold / tool.TICK_HZ:.0f} ms)."),
         "",
         f"CPU load in s51 (C52 core, {records} sample records acknowledged per run):",
         "",
-        "| gyros | acc every | mag every | records/s wanted | baud | busy | records/s delivered |",
-        "|---:|---:|---:|---:|---:|---:|---:|",
+        "| gyros | acc every | mag every | mag set/reset | records/s wanted | baud | busy | records/s delivered |",
+        "|---:|---:|---:|:---:|---:|---:|---:|---:|",
     ]
-    for ((p, ka, km), baud), c in cpu.items():
-        lines.append(f"| {tool.TICK_HZ / p:.0f} Hz | {ka} | {km} | {c['wanted']:.1f} | {baud} | "
-                     f"{100 * c['busy']:.1f} % | {c['records']:.1f} |")
-    scan = [c["scan"] for c in cpu.values()]
+    for ((p, ka, km), baud, sr), c in cpu.items():
+        lines.append(f"| {tool.TICK_HZ / p:.0f} Hz | {ka} | {km} | {'yes' if sr else 'no'} | {c['wanted']:.1f} | "
+                     f"{baud} | {100 * c['busy']:.1f} % | {c['records']:.1f} |")
+    scan = [c["scan"] for (_, _, sr), c in cpu.items() if not sr]
     lines += ["", "A plan whose records/s delivered fall short of those wanted saturates the 8051 (the link "
                   "v2 sender's CPU per byte): it loses samples, reported in place as OVERRUN, and its busy "
                   "figure is that of a stalled link waiting for acknowledgements, not a feasible load.",
               "", f"A group's scan (3, 6 or 9 conversions + power-down): {min(scan):.0f}..{max(scan):.0f} machine "
                   "cycles on average per plan.", "",
+              (f"Where the default plan's cycles go (115200 baud; the profile image, -DFW_PROFILE): "
+              f"{busy_rec:.0f} busy machine cycles per record (load run); {prof['per_frame']:.1f} records per "
+              f"frame; {prof['bytes']:.2f} bytes sent per record at {prof['poll']:.0f} cycles per poll that "
+              f"sends one (with the profile's ~40 cycles of timestamps); {prof['rx_bytes']:.2f} ACK bytes "
+              f"received per record at {prof['sink']:.0f} cycles per sink call (same); the scan "
+              f"{prof['scan']:.0f} cycles per record; the rest is the main loop, the serial interrupt, the "
+              "records' encoding and the bench's own idle accounting."), "",
               "Accuracy on BROAD (Laidig, Caruso, Cereatti, Seel, Data 6(7), 2021; the trials in "
               "../shared/data/broad taken at the board's instants, att_ahrs defaults, the accelerometer and "
               "magnetometer in every k-th sample only; total error, RMS per trial, deg; "

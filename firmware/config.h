@@ -82,8 +82,19 @@
 #endif
 #define FW_AIN_ACC 3 /* accelerometer X, Y, Z: AIN3, AIN4, AIN5 */
 #define FW_AIN_MAG 6 /* magnetometer X, Y, Z: AIN6, AIN7, AIN8 */
+/* FW_MAG_SR = 1: each magnetometer sample is converted after a set pulse
+ * and again after a reset pulse of its straps (P3.4, main.c SR_PIN), and
+ * the combination (c_set + 4095 - c_reset) / 2 is sent: the bridge offset
+ * cancels. Three more conversions per magnetometer sample (about 5.7 points
+ * of CPU at the default plan: docs/firmware.md); 0 (default): one
+ * conversion, P3.4 untouched, the offset left to `attitude calibrate`. */
+#ifndef FW_MAG_SR
+#define FW_MAG_SR 0
+#endif
 #ifndef FW_RXQ
-#define FW_RXQ 32 /* received bytes the FIFO holds (a power of two <= 128) */
+/* received bytes the FIFO holds (a power of two <= 128): an ACK frame is
+ * 10 bytes with its delimiters, and one frame is answered at a time */
+#define FW_RXQ 16
 #endif
 #if !FW_LINK_V2
 #error "the aided board speaks link v2 only: build it with FW_LINK_V2=1 (toolchain/firmware.py does)"

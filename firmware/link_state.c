@@ -13,6 +13,9 @@
 #include "attitude/link2.h"
 
 att_link2_sender ATT_LINK_MEM att_link2_one;
+#if ATT_LINK2_ONE_RING_IDATA
+uint8_t __idata att_link2_one_ring[ATT_LINK2_ONE_RING * ATT_LINK2_RECORD]; /* the aided AT89S52: upper RAM */
+#endif
 #else
 #include "attitude/link.h"
 

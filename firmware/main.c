@@ -406,6 +406,40 @@ static uint8_t __idata group_n; /* records in the group being taken: 1..3 */
 #define MAG_DUE() 0u
 #endif
 
+/* FW_MAG_SR (config.h): the magnetometer's set/reset strap driver (docs/firmware.md, wiring):
+ * P3.4's rising edge fires a set pulse, its falling edge a reset pulse
+ * (free here: Timer 0 counts machine cycles, not its T0 input). A
+ * magnetometer sample is converted once after each: the bridge's offset is
+ * the same in both states, the field's sign flips, so
+ * (c_set + 4095 - c_reset) / 2 keeps the field and drops the offset. */
+#if FW_MAG_SR
+#define SR_PIN P3_4
+#if FW_MAG_EVERY == 1
+#define IF_MAG(due) /* every sample carries the magnetometer */
+#else
+#define IF_MAG(due) if (due)
+#endif
+#if FW_MAG_EVERY != 0
+static const uint8_t mag_in[3] = { FW_AIN_MAG, FW_AIN_MAG + 1, FW_AIN_MAG + 2 };
+static uint16_t __idata mag_reset[3]; /* the reset state's codes */
+
+/* The group's magnetometer codes (its last three words, converted in the
+ * set state) combined with the reset state's; the scan's status. */
+static int mag_flip(void)
+{
+    uint8_t i;
+    int st;
+    uint16_t __data *w = (uint16_t __data *)(group + 3u * (uint8_t)(group_n - 1u));
+    SR_PIN = 0; /* reset pulse */
+    st = tlc2543_scan(&adc, mag_in, 3, (uint16_t __data *)mag_reset, TLC2543_POWER_DOWN);
+    for (i = 0; i < 3u; i++) {
+        w[i] = (uint16_t)((uint16_t)(w[i] + 4095u - mag_reset[i]) >> 1);
+    }
+    return st;
+}
+#endif
+#endif /* FW_MAG_SR */
+
 /* Scan the group of sample seq and queue its records in order (gyro,
  * accelerometer, magnetometer), or one ADC_ERROR report in their place
  * when the scan (or the encoding of a code) failed: the group goes into
@@ -416,7 +450,8 @@ static void aided_sample(void)
     int st;
     uint8_t i;
     uint8_t acc = ACC_DUE();
-    group_n = (uint8_t)(1u + acc + MAG_DUE());
+    uint8_t mag = MAG_DUE();
+    group_n = (uint8_t)(1u + acc + mag);
     if (ovr_count != 0u) {
         flush_overrun();
     }
@@ -425,9 +460,23 @@ static void aided_sample(void)
         return;
     }
     LINK_RX();
+#if FW_MAG_SR && FW_MAG_EVERY != 0
+    IF_MAG(mag)
+    {
+        SR_PIN = 1; /* set pulse: the magnetometer is converted last in the scan */
+    }
+#endif
     FW_HOOK_SCAN_BEGIN();
     st = tlc2543_scan(&adc, lists[acc ^ 1u], (uint8_t)(3u * group_n), (uint16_t __data *)group,
                       TLC2543_POWER_DOWN);
+#if FW_MAG_SR && FW_MAG_EVERY != 0
+    IF_MAG(mag)
+    {
+        if (st == ATT_OK) {
+            st = mag_flip();
+        }
+    }
+#endif
     FW_HOOK_SCAN_END();
     LINK_RX();
     for (i = 0; i < group_n && st == ATT_OK; i++) {
@@ -454,6 +503,9 @@ void main(void)
     int st;
 
     P1 = 0xFD; /* P1.1 (I/O CLOCK) low; CS high; EOC, DATA OUT released */
+#if FW_MAG_SR
+    SR_PIN = 0; /* a reset pulse (the latch comes up high): the first sample's set pulse is an edge */
+#endif
     timer0_init();
     uart_init();
     FW_HOOK_INIT();

@@ -23,6 +23,8 @@ import numpy as np
 import pytest
 from conftest import require_target
 
+pytestmark = pytest.mark.system  # builds and runs attitude-rx (host and ARMv4T) on aided streams
+
 G0 = 9.80665
 ACC_SCALE = G0 / 400.0  # m/s² per code in these tests: 1 g = 400 codes exactly
 MAG_SCALE = 0.05  # µT per code

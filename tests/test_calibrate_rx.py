@@ -26,6 +26,8 @@ from attitude_c.link import block
 from attitude_c.sim.accelmag import G0, SensorErrors
 from attitude_c.sim.frontend import ACCEL_FRONTENDS, MAG_FRONTENDS, AmrErrors, flip_code, tlc2543_codes
 
+pytestmark = pytest.mark.system  # builds and runs attitude-rx with the calibration
+
 ACC, MAG = ACCEL_FRONTENDS["adxl335"], MAG_FRONTENDS["hmc1043-ad623"]
 HARD = np.array([9.0, -12.0, 5.0])  # µT
 SOFT = np.diag([1.04, 0.97, 1.01])

@@ -4,7 +4,7 @@ FW_AIDED): nine TLC2543 channels, link v2 on Timer 2, BOOT + CHANNELS, sample gr
 * the image fits the AT89S52 (8 KB / 256 B) with the stack s51 measures plus a margin;
   the configuration refuses what the board cannot do;
 * in s51 (C52 core) with libattitude's link v2 receiver on the pty, the C one and the
-  Python one: BOOT (link v2, the period, the baud), CHANNELS (board, channel set,
+  Python one, for a decimated plan and for the default (aiding in every sample): BOOT (link v2, the period, the baud), CHANNELS (board, channel set,
   decimations), then groups numbered by the block format's tracker in order, every record
   in its place (gyro, accelerometer when n % acc_every == 0, magnetometer when
   n % mag_every == 0) and every code within 1 LSB of the device model's closed form
@@ -58,9 +58,15 @@ def test_aided_image_fits_the_at89s52(out: Path) -> None:
     print(img.size_report())
     assert img.flash <= tool.FLASH_SIZE_52 and img.ram_static <= tool.IRAM_SIZE_52
     for bad, msg in [(dict(link="legacy"), "link v2 only"), (dict(baud=9000), "baud"),
-                     (dict(acc_every=3), "acc_every"), (dict(mag_every=256), "mag_every")]:
+                     (dict(acc_every=3), "acc_every"), (dict(mag_every=256), "mag_every"),
+                     (dict(v2_batch=17), "v2_batch"), (dict(v2_hold=40000), "v2_hold"),
+                     (dict(mag_sr=True, mag_every=0), "mag_sr")]:
         with pytest.raises(ValueError, match=msg):
             dataclasses.replace(tool.AIDED, **bad)
+    with pytest.raises(ValueError, match="aided board"):  # batching is the aided image's only
+        tool.Config(link="v2", v2_batch=2)
+    with pytest.raises(ValueError, match="mag_sr"):
+        tool.Config(link="v2", mag_sr=True)
     with pytest.raises(ValueError, match="baud"):  # 115200 is Timer 2's, not Timer 1's
         tool.Config(baud=115200)
     assert 115200 in tool.BAUD_RATES_T2 and 57600 in tool.BAUD_RATES_T2
@@ -105,18 +111,28 @@ def _check_stream(records: list[bytes], cfg: tool.Config) -> int:
         # sine table adds < 0.02 LSB: within 1 LSB (docs/firmware.md)
         for axis, code in enumerate(rec.codes):
             lsb = CHANNELS[PART_AIN[span.part] + axis].lsb(span.first)
+            if span.part == "mag" and not cfg.mag_sr:
+                lsb += tool.BRIDGE / 16  # the model's bridge offset, which set/reset cancels
             assert abs(code - math.floor(lsb)) <= 1, (span, axis, code, lsb)
         n_samples += 1
     assert got == want[:len(got)] and len(want) - len(got) <= 2  # the last group may still be under way
     return n_samples
 
 
-@pytest.mark.parametrize("impl,baud", [("c", 115200), ("python", 57600)])
-def test_aided_firmware_delivers_groups_in_order(out: Path, impl: str, baud: int) -> None:
+PLANS = {"test": CFG, "default": tool.AIDED, "sr": dataclasses.replace(tool.AIDED, mag_sr=True)}
+
+
+@pytest.mark.parametrize("impl,baud,plan", [("c", 115200, "test"), ("python", 57600, "test"),
+                                           ("c", 115200, "default"), ("c", 115200, "sr")])
+def test_aided_firmware_delivers_groups_in_order(out: Path, impl: str, baud: int, plan: str) -> None:
+    """The test's plan (decimated aiding: frames mostly started by the hold's 30 ms), the
+    shipped default (aiding in every sample: frames of a batch or more; the magnetometer's
+    codes carry the model's bridge offset) and the default with set/reset (the offset
+    cancelled: the codes the model's field gives)."""
     _need()
-    cfg = dataclasses.replace(CFG, baud=baud)
+    cfg = dataclasses.replace(PLANS[plan], baud=baud)
     n = 60
-    img = tool.build(out, cfg, kind="sim", sim_samples=n, name=f"aided_{impl}_{baud}")
+    img = tool.build(out, cfg, kind="sim", sim_samples=n, name=f"aided_{impl}_{baud}_{plan}")
     res = tool.run_v2(img, impl, timeout=180)  # type: ignore[arg-type]
     assert "CRC E3069283" in res.output.upper()
     assert _check_stream(res.records, cfg) >= n

@@ -86,3 +86,30 @@ def test_importing_the_filters_loads_no_extension() -> None:
     code = ("import sys, attitude_c.ahrs_filter, attitude_c.thesis_ekf\n"
             "assert not [m for m in sys.modules if m.startswith('attitude_c._att_')], sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=ROOT)
+
+
+def test_the_library_names_each_field_outside_its_domain() -> None:
+    """att_ahrs_check_settings_field covers every field of att_ahrs_settings (a NaN is
+    outside every domain) and names it as the struct spells it, the first in the struct's
+    order when several are out."""
+    from attitude_c._lib import ffi_lib
+
+    for precision in ("f64", "f32"):
+        ffi, lib = ffi_lib(precision)
+        name = ffi.new("const char **")
+        for field in ahrs_filter.SETTINGS:
+            s = ffi.new("att_ahrs_settings *")
+            lib.att_ahrs_default_settings(s)
+            setattr(s, field, float("nan"))
+            assert lib.att_ahrs_check_settings_field(s, name) == lib.ATT_E_AHRS_SETTINGS
+            assert ffi.string(name[0]).decode() == field
+        lib.att_ahrs_default_settings(s)
+        s.method = lib.ATT_METHOD_RK4
+        assert lib.att_ahrs_check_settings_field(s, name) == lib.ATT_E_AHRS_SETTINGS
+        assert ffi.string(name[0]) == b"method"
+        lib.att_ahrs_default_settings(s)
+        assert lib.att_ahrs_check_settings_field(s, name) == 0 and name[0] == ffi.NULL
+    # two outside: the message names the first in the struct's order (acc_noise before mag_delay)
+    with pytest.raises(InvalidArgument, match=r"settings: acc_noise=-1.0 outside its domain \(ahrs.h") as e:
+        ahrs_filter.Ahrs(mag_delay=0.06, acc_noise=-1.0)
+    assert "mag_delay=" not in str(e.value)

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -203,6 +205,11 @@ def test_budget_cli(tmp_path, capsys) -> None:
     assert b["methods"] == ["rv1", "rv3"]
     assert b["dominant_source"]["rv1"] == "algorithm"
     assert (out / "budget.md").read_text().startswith("| stage |")
+    # every cell in rad and in degrees: the degrees are the rad value x 180/pi to the 3 digits shown
+    cells = re.findall(r"(\d\.\d\de[-+]\d+) rad = (\d\.\d\de[-+]\d+)°", text)
+    assert len(cells) >= 2 * 2  # at least two stages for each of the two methods
+    for rad, deg in cells:
+        assert float(deg) == pytest.approx(math.degrees(float(rad)), rel=0.01)  # both rounded to 3 digits
     import matplotlib.image as mpimg
 
     assert mpimg.imread(out / "budget.png").shape[0] > 200

@@ -142,9 +142,12 @@ class Config:
     v2_rto: int = 720                 #: v2: ticks without progress before a go-back / probe (200 ms)
     v2_samples: int = 4               #: v2: samples per DATA frame (1..24)
     v2_ring: int = 4                  #: v2: records the sender keeps until acknowledged (power of two)
+    v2_batch: int = 0                 #: v2, aided: records a DATA frame waits for (0: none; ATT_LINK2_ONE_BATCH)
+    v2_hold: int = 0                  #: v2, aided: ... for at most this many ticks (ATT_LINK2_ONE_HOLD)
     board: Literal["gyro3", "aided9"] = "gyro3"  #: the AT89S51 gyro board or the aided AT89S52 (FW_AIDED)
     acc_every: int = 1                #: aided: accelerometer record every acc_every samples (0: none)
     mag_every: int = 1                #: aided: magnetometer record every mag_every samples (0: none)
+    mag_sr: bool = False              #: aided: magnetometer set/reset on P3.4 (FW_MAG_SR; docs/firmware.md)
 
     def __post_init__(self) -> None:
         if self.board not in BOARDS:
@@ -172,6 +175,14 @@ class Config:
             raise ValueError(f"v2_samples must be 1..24, got {self.v2_samples}")
         if self.v2_ring not in (1, 2, 4, 8, 16, 32, 64):
             raise ValueError(f"v2_ring must be a power of two 1..64, got {self.v2_ring}")
+        if not 0 <= self.v2_batch <= self.v2_ring:
+            raise ValueError(f"v2_batch must be 0..v2_ring ({self.v2_ring}), got {self.v2_batch}")
+        if not 0 <= self.v2_hold <= 32767:
+            raise ValueError(f"v2_hold must be 0..32767 ticks, got {self.v2_hold}")
+        if self.mag_sr and not (self.aided and self.mag_every):
+            raise ValueError("mag_sr needs the aided board with its magnetometer (board='aided9', mag_every > 0)")
+        if (self.v2_batch or self.v2_hold) and not self.aided:
+            raise ValueError("v2_batch and v2_hold are the aided board's (board='aided9')")
         if not 1 <= self.max_attempts <= 255:
             raise ValueError(f"max_attempts must be 1..255, got {self.max_attempts}")
 
@@ -205,16 +216,21 @@ class Config:
                 *([] if self.link == "legacy" else
                   ["FW_LINK_V2=1", "ATT_LINK2_ONE=1", f"ATT_LINK2_ONE_RTO={self.v2_rto}",
                    f"ATT_LINK2_ONE_SAMPLES={self.v2_samples}", f"ATT_LINK2_ONE_RING={self.v2_ring}"]),
+                *([] if self.link == "legacy" or self.aided else
+                  ["ATT_LINK2_CURSOR=0"]),  # the AT89S51 v2 image as it was (attitude/link2.h)
                 *([] if not self.aided else
                   ["FW_AIDED=1", f"FW_ACC_EVERY={self.acc_every}", f"FW_MAG_EVERY={self.mag_every}",
-                   "ATT_LINK2_CRC_TABLE=1"])]
+                   "ATT_LINK2_CRC_TABLE=1", "ATT_LINK2_ONE_RING_IDATA=1", f"ATT_LINK2_ONE_BATCH={self.v2_batch}",
+                   f"ATT_LINK2_ONE_HOLD={self.v2_hold}", f"FW_MAG_SR={int(self.mag_sr)}"])]
 
 
 #: The aided board's default build (docs/firmware.md "The aided board"): link v2 at
-#: 115200 baud with a ring of 8 records (all the direct RAM allows) and the sampling plan
-#: chosen there (bench/aided.py): gyros at 50 samples/s (20 ms), accelerometer and
-#: magnetometer with every 2nd sample (25/s): 69 % CPU in s51.
-AIDED = Config(board="aided9", link="v2", baud=115200, period_ticks=72, v2_ring=8, acc_every=2, mag_every=2)
+#: 115200 baud with a ring of 16 records in the upper RAM, frames of up to 16 samples held
+#: back for 6 records or 108 ticks (30 ms), and the sampling plan chosen there
+#: (bench/aided.py): gyros at 50 samples/s (20 ms), accelerometer and magnetometer in every
+#: sample: about 63 % CPU in s51.
+AIDED = Config(board="aided9", link="v2", baud=115200, period_ticks=72, v2_ring=16, v2_samples=16, v2_batch=6,
+               v2_hold=108, acc_every=1, mag_every=1)
 
 
 @dataclass(frozen=True)
@@ -256,6 +272,12 @@ AUX = (Gyro(32768, 3, 32, 1), Gyro(30000, 4, 96, 2), Gyro(45000, 3, 160, 1),
        Gyro(20000, 2, 16, 2), Gyro(36000, 3, 200, 3), Gyro(28000, 2, 80, 1))
 
 
+#: The device model's magnetometer bridge offset (firmware/sim/tlc_model.c FW_SIM_BRIDGE), in
+#: 16-bit fractions of Vref: 256 LSB, the same in the set and the reset state; a code read
+#: without set/reset carries it, the set/reset combination cancels it.
+BRIDGE = 4096
+
+
 def _gyro_defines(gyros: Sequence[Gyro], aux: Sequence[Gyro] = ()) -> list[str]:
     out = []
     for name, g in zip("XYZ", gyros):
@@ -264,6 +286,7 @@ def _gyro_defines(gyros: Sequence[Gyro], aux: Sequence[Gyro] = ()) -> list[str]:
     if aux:  # the aided model's six more inputs, as comma lists (firmware/sim/tlc_model.c)
         for field, macro in (("offset", "OFF"), ("shift", "SH"), ("phase", "PH"), ("step", "STEP")):
             out.append(f"FW_SIM_AUX_{macro}=" + ",".join(str(getattr(g, field)) for g in aux))
+        out.append(f"FW_SIM_BRIDGE={BRIDGE}u")
     return out
 
 

@@ -141,13 +141,15 @@ def run_budget(base: SimConfig, methods: tuple[Method, ...] = METHODS, ber: floa
 
 
 def format_budget(b: BudgetResult, markdown: bool = False) -> str:
-    """Table: rows = stages, columns = methods; cells = RMS error (contribution)."""
+    """Table: rows = stages, columns = methods; cells = RMS error in rad and in degrees
+    (the stage's contribution in rad)."""
     def cell(i: int, j: int) -> str:
         if np.isnan(b.rms[i, j]):
             return "n/a"
+        both = f"{b.rms[i, j]:.2e} rad = {np.degrees(b.rms[i, j]):.2e}°"
         if i == 0:
-            return f"{b.rms[i, j]:.2e}"
-        return f"{b.rms[i, j]:.2e} ({b.contribution[i, j]:+.1e})"
+            return both
+        return f"{both} ({b.contribution[i, j]:+.1e})"
 
     head = ["stage"] + b.methods
     rows = [[s] + [cell(i, j) for j in range(len(b.methods))] for i, s in enumerate(b.stages)]
@@ -198,6 +200,7 @@ def plot_budget(b: BudgetResult, path: Any, dpi: int = 100) -> None:
     ax.set_xticks(x)
     ax.set_xticklabels(b.methods)
     ax.set_ylabel("contribution to RMS attitude error / rad")
+    ax.secondary_yaxis("right", functions=(np.degrees, np.radians)).set_ylabel("/ °")
     p = b.params
     ax.set_title(f"Error budget — {p['trajectory']['trajectory']} trajectory, h = {p['period_s']:g} s, "
                  f"{p['duration_s']:g} s, gyro {p['gyro']['name']}, link BER {p['budget_ber']:g}",

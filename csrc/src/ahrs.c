@@ -2,6 +2,8 @@
  * libattitude — the attitude filter (ahrs.h): an error-state Kalman
  * filter on top of the rotation-vector integrator. docs/ahrs.md derives
  * every step; attitude_c/ahrs_reference.py is the independent NumPy model.
+ * att_ahrs_update runs the stage functions below in the order of a sample's
+ * path, each named in docs/ahrs.md's "Code map" beside its section.
  */
 #include <stddef.h>
 #include <string.h>
@@ -57,45 +59,77 @@ static int fin(att_real x)
     return isfinite(x);
 }
 
-att_status att_ahrs_check_settings(const att_ahrs_settings *set)
+/* The domain of each real setting (ahrs.h), in the struct's order: finite and, by rule, */
+enum {
+    GT, /* above the bound */
+    GE, /* at least the bound */
+    ABS /* within ±bound */
+};
+
+typedef struct {
+    const char *name;
+    size_t offset;
+    int rule;
+    att_real bound;
+} setting_domain;
+
+/* clang-format off */
+#define DOMAIN(field, rule, bound) { #field, offsetof(att_ahrs_settings, field), rule, ATT_R(bound) }
+/* clang-format on */
+
+static const setting_domain DOMAINS[] = {
+    DOMAIN(gravity, GT, 0),           DOMAIN(gyr_noise, GT, 0),         DOMAIN(gyr_noise_rest, GT, 0),
+    DOMAIN(bias_noise, GE, 0),        DOMAIN(init_att_sigma, GT, 0),    DOMAIN(init_bias_sigma, GE, 0),
+    DOMAIN(acc_tau, GE, 0),           DOMAIN(acc_noise, GT, 0),         DOMAIN(acc_gate, GE, 0),
+    DOMAIN(acc_reject_max, GT, 0),    DOMAIN(mag_noise, GT, 0),         DOMAIN(mag_norm_tol, GT, 0),
+    DOMAIN(mag_dip_tol, GT, 0),       DOMAIN(mag_ref_tau, GT, 0),       DOMAIN(mag_reject_max, GT, 0),
+    DOMAIN(mag_reject_factor, GE, 1), DOMAIN(mag_new_time, GT, 0),      DOMAIN(mag_min_undisturbed, GE, 0),
+    DOMAIN(mag_new_gyr, GE, 0),       DOMAIN(declination, ABS, ATT_PI), DOMAIN(rest_time, GE, 0),
+    DOMAIN(rest_tau, GT, 0),          DOMAIN(rest_gyr_th, GT, 0),       DOMAIN(rest_acc_th, GT, 0),
+    DOMAIN(rest_noise, GT, 0),        DOMAIN(gyro_range, GE, 0),        DOMAIN(overrange_sigma, GE, 0),
+    DOMAIN(sensor_delay, ABS, 1.0),   DOMAIN(acc_delay, ABS, 0.05),     DOMAIN(mag_delay, ABS, 0.05),
+    DOMAIN(tilt_tau, GE, 0),
+};
+
+static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
 {
-    const att_ahrs_settings *t = set;
-    if (t == NULL) {
+    att_real v = *(const att_real *)(const void *)((const unsigned char *)set + d->offset);
+    if (!fin(v)) {
+        return 0;
+    }
+    return d->rule == GT ? v > d->bound : d->rule == GE ? v >= d->bound : att_fabs(v) <= d->bound;
+}
+
+att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
+{
+    const char *bad = NULL;
+    size_t i;
+    if (field != NULL) {
+        *field = NULL;
+    }
+    if (set == NULL) {
         return ATT_E_NULL;
     }
-    if (t->method < 0 || t->method >= ATT_METHOD_COUNT || t->method == ATT_METHOD_RK4) {
-        return ATT_E_AHRS_SETTINGS;
+    if (set->method < 0 || set->method >= ATT_METHOD_COUNT || set->method == ATT_METHOD_RK4) {
+        bad = "method";
     }
-    /* strictly positive */
-    if (!(fin(t->gravity) && t->gravity > 0 && fin(t->gyr_noise) && t->gyr_noise > 0 && fin(t->bias_noise)
-          && t->bias_noise >= 0 && fin(t->init_att_sigma) && t->init_att_sigma > 0 && fin(t->init_bias_sigma)
-          && t->init_bias_sigma >= 0 && fin(t->acc_noise) && t->acc_noise > 0 && fin(t->mag_noise)
-          && t->mag_noise > 0 && fin(t->mag_norm_tol) && t->mag_norm_tol > 0 && fin(t->mag_dip_tol)
-          && t->mag_dip_tol > 0 && fin(t->mag_ref_tau) && t->mag_ref_tau > 0 && fin(t->mag_reject_max)
-          && t->mag_reject_max > 0 && fin(t->mag_reject_factor) && t->mag_reject_factor >= 1
-          && fin(t->mag_new_time) && t->mag_new_time > 0 && fin(t->mag_new_gyr) && t->mag_new_gyr >= 0
-          && fin(t->mag_min_undisturbed) && t->mag_min_undisturbed >= 0 && fin(t->acc_reject_max)
-          && t->acc_reject_max > 0 && fin(t->rest_tau) && t->rest_tau > 0 && fin(t->rest_gyr_th)
-          && t->rest_gyr_th > 0 && fin(t->rest_acc_th) && t->rest_acc_th > 0 && fin(t->rest_noise)
-          && t->rest_noise > 0 && fin(t->overrange_sigma) && t->overrange_sigma >= 0)) {
-        return ATT_E_AHRS_SETTINGS;
+    for (i = 0; i < sizeof DOMAINS / sizeof DOMAINS[0] && bad == NULL; i++) {
+        if (!in_domain(set, &DOMAINS[i])) {
+            bad = DOMAINS[i].name;
+        }
     }
-    if (!(fin(t->gyr_noise_rest) && t->gyr_noise_rest > 0)) {
-        return ATT_E_AHRS_SETTINGS;
+    if (bad == NULL) {
+        return ATT_OK;
     }
-    /* zero = off */
-    if (!(fin(t->acc_tau) && t->acc_tau >= 0 && fin(t->acc_gate) && t->acc_gate >= 0 && fin(t->rest_time)
-          && t->rest_time >= 0 && fin(t->gyro_range) && t->gyro_range >= 0 && fin(t->declination)
-          && fin(t->sensor_delay) && att_fabs(t->sensor_delay) <= ATT_R(1.0) && fin(t->tilt_tau)
-          && t->tilt_tau >= 0 && att_fabs(t->declination) <= ATT_PI)) {
-        return ATT_E_AHRS_SETTINGS;
+    if (field != NULL) {
+        *field = bad;
     }
-    /* aiding-sensor time skew */
-    if (!(fin(t->acc_delay) && att_fabs(t->acc_delay) <= ATT_R(0.05) && fin(t->mag_delay)
-          && att_fabs(t->mag_delay) <= ATT_R(0.05))) {
-        return ATT_E_AHRS_SETTINGS;
-    }
-    return ATT_OK;
+    return ATT_E_AHRS_SETTINGS;
+}
+
+att_status att_ahrs_check_settings(const att_ahrs_settings *set)
+{
+    return att_ahrs_check_settings_field(set, NULL);
 }
 
 static void set_initial_cov(att_ahrs *s)
@@ -236,148 +270,77 @@ static att_real wrap_pi(att_real a)
     return a;
 }
 
-/* Initial attitude from one sample: att_align_accmag (aiding.h), six-axis
- * (heading 0) when there is no field or it gives no heading. */
-static att_status align(const att_ahrs_settings *set, const att_real acc[3], const att_real mag[3],
-                        att_real q[4])
+/* A scalar measurement y of the error state x[j] (H = e_j) with variance R,
+ * moving only the states in mask (bit i: state i):
+ *     S = P_jj + R,   K_i = P_ij / S (i in the mask, else 0),   x ← x + K (y − x_j),
+ *     P ← P − K P_jᵀ − P_j Kᵀ + K Kᵀ S   (P_j = column j; Joseph form, valid for any K).
+ * Where one of the two states is outside the mask its gain is 0 and the entry
+ * reduces exactly to P_rc − K_r P_jc (or − P_jr K_c); where both are, it is
+ * unchanged. P is symmetric: the upper triangle is computed and mirrored.
+ * gcc and clang unroll the loops and inline the function into each mask's
+ * wrapper below, where the constant mask folds the tests away: straight-line
+ * code, no more instructions than the entries written out (docs/ahrs.md, "Code
+ * map"). Another compiler runs the loops: the same results, more instructions. */
+#if defined(__GNUC__)
+#define UNROLLED_INLINE inline __attribute__((always_inline))
+#else
+#define UNROLLED_INLINE inline
+#endif
+
+static UNROLLED_INLINE void scalar_update(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R,
+                                          unsigned mask)
 {
-    att_status st = ATT_AID_E_ZERO_M;
-    if (mag != NULL) {
-        st = att_align_accmag(acc, mag, set->declination, q);
+    att_real pj[NX], K[NX], S = P[j][j] + R, innov = y - x[j], v;
+    int r, c;
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+        pj[r] = P[r][j];
+        K[r] = 0;
+        if (mask & (1u << r)) {
+            K[r] = pj[r] / S;
+            x[r] += K[r] * innov;
+        }
     }
-    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
-        st = att_align_accmag(acc, NULL, set->declination, q);
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+#pragma GCC unroll 6
+        for (c = r; c < NX; c++) {
+            int in_r = (mask >> r) & 1u, in_c = (mask >> c) & 1u;
+            if (in_r && in_c) {
+                v = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S;
+            } else if (in_r) {
+                v = P[r][c] - K[r] * pj[c];
+            } else if (in_c) {
+                v = P[r][c] - pj[r] * K[c];
+            } else {
+                continue;
+            }
+            P[r][c] = v;
+            P[c][r] = v;
+        }
     }
-    return st;
 }
 
-/* Scalar updates of the error state x with a measurement y of x[j]
- * (H = e_j), variance R. The gain K = P e_j / S, S = P[j][j] + R, is kept
- * only on the states the measurement may move (its mask) and P follows
- * the Joseph form for that gain,
- *     P ← P − K Pjᵀ − Pj Kᵀ + K Kᵀ S,   Pj = column j,
- * which is valid for any gain. P is symmetric: the upper triangle is
- * computed and mirrored. The three masks are written out (no runtime mask,
- * no work on zero gains): an entry with both states in the mask takes the
- * full expression; one with state i in the mask and o outside (K_o = 0)
- * reduces exactly to P_io − K_i Pj_o; one with neither is unchanged. */
-#define GAIN(i)               \
-    do {                      \
-        K[i] = pj[i] / S;     \
-        x[i] += K[i] * innov; \
-    } while (0)
-#define JOSEPH2(r, c)                                                          \
-    do {                                                                       \
-        att_real v_ = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S; \
-        P[r][c] = v_;                                                          \
-        P[c][r] = v_;                                                          \
-    } while (0)
-#define JOSEPH1(i, o)                         \
-    do {                                      \
-        att_real v_ = P[i][o] - K[i] * pj[o]; \
-        P[i][o] = v_;                         \
-        P[o][i] = v_;                         \
-    } while (0)
-#define COLUMN_J()                    \
-    do {                              \
-        int r_;                       \
-        S = P[j][j] + R;              \
-        innov = y - x[j];             \
-        for (r_ = 0; r_ < NX; r_++) { \
-            pj[r_] = P[r_][j];        \
-        }                             \
-    } while (0)
+/* The masks: the accelerometer never moves the heading (state 2), the
+ * magnetometer never roll and pitch (0, 1), a zero-rate update only the bias. */
+#define MASK_ACC  0x3Bu /* δθx, δθy, δb */
+#define MASK_MAG  0x3Cu /* δθz, δb */
+#define MASK_BIAS 0x38u /* δb */
 
-/* Accelerometer (j = 0 or 1): mask δθx, δθy, δb (not δθz = state 2). */
 static void update_acc(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(0);
-    GAIN(1);
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(0, 0);
-    JOSEPH2(0, 1);
-    JOSEPH2(0, 3);
-    JOSEPH2(0, 4);
-    JOSEPH2(0, 5);
-    JOSEPH2(1, 1);
-    JOSEPH2(1, 3);
-    JOSEPH2(1, 4);
-    JOSEPH2(1, 5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(0, 2);
-    JOSEPH1(1, 2);
-    JOSEPH1(3, 2);
-    JOSEPH1(4, 2);
-    JOSEPH1(5, 2);
+    scalar_update(P, x, j, y, R, MASK_ACC);
 }
 
-/* Magnetometer (j = 2): mask δθz, δb (not δθx, δθy). */
 static void update_mag(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(2);
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(2, 2);
-    JOSEPH2(2, 3);
-    JOSEPH2(2, 4);
-    JOSEPH2(2, 5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(2, 0);
-    JOSEPH1(2, 1);
-    JOSEPH1(3, 0);
-    JOSEPH1(3, 1);
-    JOSEPH1(4, 0);
-    JOSEPH1(4, 1);
-    JOSEPH1(5, 0);
-    JOSEPH1(5, 1);
+    scalar_update(P, x, j, y, R, MASK_MAG);
 }
 
-/* Zero-rate update (j = 3, 4 or 5): mask δb only. */
 static void update_bias(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
-    att_real pj[NX], K[NX], S, innov;
-    COLUMN_J();
-    GAIN(3);
-    GAIN(4);
-    GAIN(5);
-    JOSEPH2(3, 3);
-    JOSEPH2(3, 4);
-    JOSEPH2(3, 5);
-    JOSEPH2(4, 4);
-    JOSEPH2(4, 5);
-    JOSEPH2(5, 5);
-    JOSEPH1(3, 0);
-    JOSEPH1(3, 1);
-    JOSEPH1(3, 2);
-    JOSEPH1(4, 0);
-    JOSEPH1(4, 1);
-    JOSEPH1(4, 2);
-    JOSEPH1(5, 0);
-    JOSEPH1(5, 1);
-    JOSEPH1(5, 2);
+    scalar_update(P, x, j, y, R, MASK_BIAS);
 }
-
-#undef GAIN
-#undef JOSEPH2
-#undef JOSEPH1
-#undef COLUMN_J
 
 /* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
  * D = Pbb): A ← A − dt (C B' + B C') + dt² C D C' + qa I,
@@ -521,294 +484,351 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
     return c;
 }
 
-att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
-                           att_real dt, att_real q_out[4])
+/* ---- The stages of one update, in the order of docs/ahrs.md ("Code map") ---- */
+
+/* Inputs: dt, finiteness and the units check of the specific force (nothing is
+ * written). *norm_lp is what acc_norm_lp becomes with this sample: |f| itself
+ * at the first one, then its slow (10 s) average. */
+static att_status check_inputs(const att_ahrs *s, const att_real gyr[3], const att_real acc[3],
+                               const att_real mag[3], att_real dt, att_real *norm_lp)
 {
-    const att_ahrs_settings *set;
-    const att_ahrs_step *k;
-    att_ahrs save;
-    att_real C[9], dth[3], x[NX], an, an_lp, v[3], acc_c[3], mag_c[3];
-    const att_real *fa, *fm; /* the aiding samples used: raw, or turned by acc/mag_delay */
-    int i, rest, flags = 0, r;
-    if (s == NULL || gyr == NULL) {
-        return ATT_E_NULL;
-    }
-    set = &s->set;
+    const att_ahrs_settings *set = &s->set;
+    att_real an, kn;
     if (!(fin(dt) && dt > 0)) {
         return ATT_E_AHRS_DT;
     }
     if (!att__finite3(gyr) || (acc != NULL && !att__finite3(acc)) || (mag != NULL && !att__finite3(mag))) {
         return ATT_E_NONFINITE;
     }
-    an = 0;
-    an_lp = 0;
-    if (acc != NULL) {
-        an = norm3(acc);
-        if (!s->acc_init && !(an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity)) {
-            return ATT_E_AHRS_UNITS;
-        }
-        if (s->acc_init) {
-            /* the cached constant when dt is unchanged (the state is not touched before the checks) */
-            att_real kn = (s->step.dt == dt) ? s->step.k_norm : dt / (ATT_R(10.0) + dt);
-            an_lp = s->acc_norm_lp + kn * (an - s->acc_norm_lp);
-            if (!(an_lp >= ATT_R(0.5) * set->gravity && an_lp <= ATT_R(8.0) * set->gravity)) {
-                return ATT_E_AHRS_UNITS;
-            }
-        }
+    *norm_lp = 0;
+    if (acc == NULL) {
+        return ATT_OK;
     }
-    if (!s->aligned) {
-        att_real q0[4];
-        att_status st;
-        if (acc == NULL) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        st = align(set, acc, mag, q0);
-        if (st != ATT_OK) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        st = att_integ_reset(&s->integ, q0);
-        if (st != ATT_OK) {
-            return ATT_E_AHRS_ALIGN;
-        }
-        s->aligned = 1;
+    an = norm3(acc);
+    if (!s->acc_init) {
+        *norm_lp = an;
+        return (an >= ATT_R(0.25) * set->gravity && an <= ATT_R(4.0) * set->gravity) ? ATT_OK
+                                                                                     : ATT_E_AHRS_UNITS;
     }
-    copy_mutable(&save, s);
-    k = step_constants(s, dt);
+    /* the cached constant when dt is unchanged (the state is not touched before the checks) */
+    kn = (s->step.dt == dt) ? s->step.k_norm : dt / (ATT_R(10.0) + dt);
+    *norm_lp = s->acc_norm_lp + kn * (an - s->acc_norm_lp);
+    return (*norm_lp >= ATT_R(0.5) * set->gravity && *norm_lp <= ATT_R(8.0) * set->gravity)
+               ? ATT_OK
+               : ATT_E_AHRS_UNITS;
+}
 
-    /* gyro over-range */
-    if (set->gyro_range > 0
-        && (att_fabs(gyr[0]) >= set->gyro_range || att_fabs(gyr[1]) >= set->gyro_range
-            || att_fabs(gyr[2]) >= set->gyro_range)) {
-        flags |= ATT_AHRS_F_OVERRANGE;
+/* Alignment: an unaligned filter takes its attitude from this sample
+ * (att_align_accmag; six-axis, heading 0, without a usable field). */
+static att_status align_once(att_ahrs *s, const att_real acc[3], const att_real mag[3])
+{
+    att_real q0[4];
+    att_status st = ATT_AID_E_ZERO_M;
+    if (s->aligned) {
+        return ATT_OK;
     }
+    if (acc == NULL) {
+        return ATT_E_AHRS_ALIGN;
+    }
+    if (mag != NULL) {
+        st = att_align_accmag(acc, mag, s->set.declination, q0);
+    }
+    if (st == ATT_AID_E_ZERO_M || st == ATT_AID_E_PARALLEL) {
+        st = att_align_accmag(acc, NULL, s->set.declination, q0);
+    }
+    if (st != ATT_OK || att_integ_reset(&s->integ, q0) != ATT_OK) {
+        return ATT_E_AHRS_ALIGN;
+    }
+    s->aligned = 1;
+    return ATT_OK;
+}
 
-    /* rest detector (first-order low-passes of ω and a) */
-    rest = 0;
-    if (set->rest_time > 0 && acc != NULL) {
-        if (!s->rest_init) {
-            for (i = 0; i < 3; i++) {
-                s->rest_gyr[i] = gyr[i];
-                s->rest_acc[i] = acc[i];
-            }
-            s->rest_init = 1;
-            s->rest_t = 0;
-        } else {
-            att_real dg = 0, da = 0, dw = 0, e;
-            for (i = 0; i < 3; i++) {
-                s->rest_gyr[i] += k->k_rest * (gyr[i] - s->rest_gyr[i]);
-                s->rest_acc[i] += k->k_rest * (acc[i] - s->rest_acc[i]);
-                e = gyr[i] - s->rest_gyr[i];
-                dg += e * e;
-                e = acc[i] - s->rest_acc[i];
-                da += e * e;
-                e = s->rest_gyr[i] - s->bias[i];
-                dw += e * e;
-            }
-            if (dg < set->rest_gyr_th * set->rest_gyr_th && dw < set->rest_gyr_th * set->rest_gyr_th
-                && da < set->rest_acc_th * set->rest_acc_th) {
-                s->rest_t += dt;
-            } else {
-                s->rest_t = 0;
-            }
-            rest = s->rest_t >= set->rest_time;
+/* Gyro over-range: an axis at or above gyro_range (0 = none). */
+static int overrange(const att_ahrs_settings *set, const att_real gyr[3])
+{
+    return set->gyro_range > 0
+           && (att_fabs(gyr[0]) >= set->gyro_range || att_fabs(gyr[1]) >= set->gyro_range
+               || att_fabs(gyr[2]) >= set->gyro_range);
+}
+
+/* Rest detection: first-order low-passes (rest_tau) of ω and f; 1 once
+ * |ω − ω_lp|, |ω_lp − b| < rest_gyr_th and |f − f_lp| < rest_acc_th have held
+ * for rest_time (raw samples: before any delay compensation). */
+static int detect_rest(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], const att_real acc[3],
+                       att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    att_real dg = 0, da = 0, dw = 0, e, th2;
+    int i;
+    if (!(set->rest_time > 0 && acc != NULL)) {
+        return 0;
+    }
+    if (!s->rest_init) {
+        for (i = 0; i < 3; i++) {
+            s->rest_gyr[i] = gyr[i];
+            s->rest_acc[i] = acc[i];
         }
+        s->rest_init = 1;
+        s->rest_t = 0;
+        return 0;
     }
+    for (i = 0; i < 3; i++) {
+        s->rest_gyr[i] += k->k_rest * (gyr[i] - s->rest_gyr[i]);
+        s->rest_acc[i] += k->k_rest * (acc[i] - s->rest_acc[i]);
+        e = gyr[i] - s->rest_gyr[i];
+        dg += e * e;
+        e = acc[i] - s->rest_acc[i];
+        da += e * e;
+        e = s->rest_gyr[i] - s->bias[i];
+        dw += e * e;
+    }
+    th2 = set->rest_gyr_th * set->rest_gyr_th;
+    if (dg < th2 && dw < th2 && da < set->rest_acc_th * set->rest_acc_th) {
+        s->rest_t += dt;
+    } else {
+        s->rest_t = 0;
+    }
+    return s->rest_t >= set->rest_time;
+}
 
-    /* propagation: bias-corrected increment through the integrator */
+/* Propagation: the bias-corrected increment through the integrator, then
+ * P ← F P Fᵀ + Q (at rest with the gyro's own noise), plus overrange_sigma² on
+ * the attitude when over range. C = C_b^n of the propagated attitude. 0, or
+ * the integrator's error. */
+static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real dt, int rest,
+                     int over, att_real C[9])
+{
+    att_real dth[3];
+    int i;
     for (i = 0; i < 3; i++) {
         dth[i] = (gyr[i] - s->bias[i]) * dt;
     }
-    r = att_integ_update(&s->integ, dth, NULL);
-    if (r < 0) {
-        copy_mutable(s, &save);
-        return ATT_E_AHRS_DIVERGED;
+    if (att_integ_update(&s->integ, dth, NULL) < 0) {
+        return -1;
     }
     q2C(s->integ.q, C);
-    /* process noise: at rest the gyro's own (no motion, no model error) */
     propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
-    if (flags & ATT_AHRS_F_OVERRANGE) {
-        att_real o = set->overrange_sigma * set->overrange_sigma;
+    if (over) {
+        att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
         s->P[0][0] += o;
         s->P[1][1] += o;
         s->P[2][2] += o;
     }
-    for (i = 0; i < NX; i++) {
-        x[i] = 0;
-    }
+    return 0;
+}
 
-    /* aiding samples that lag the gyro: turned to the gyro's time (one integer test
-     * when both delays are 0) */
-    fa = acc;
-    fm = mag;
-    if (k->delays) {
-        if (acc != NULL && (k->delays & 1)) {
-            delay_comp(gyr, s->bias, set->acc_delay, acc, acc_c);
-            fa = acc_c;
-        }
-        if (mag != NULL && (k->delays & 2)) {
-            delay_comp(gyr, s->bias, set->mag_delay, mag, mag_c);
-            fm = mag_c;
-        }
+/* Sensor timing: an aiding sample x (may be NULL) that lags the gyro by d,
+ * turned to the gyro's time into out when its delay is on; else x itself. */
+static const att_real *at_gyro_time(const att_ahrs *s, const att_real gyr[3], const att_real x[3], int on,
+                                    att_real d, att_real out[3])
+{
+    if (x == NULL || !on) {
+        return x;
     }
+    delay_comp(gyr, s->bias, d, x, out);
+    return out;
+}
 
-    /* accelerometer: low-pass in the navigation frame, inclination update */
-    if (acc != NULL) {
-        att_real an_n[3], nv, hs, ang, y0, y1;
-        mat_vec(C, fa, an_n);
-        if (!s->acc_init) {
-            for (i = 0; i < 3; i++) {
-                s->acc_lp[i] = an_n[i];
-            }
-            s->acc_norm_lp = an;
-            s->acc_init = 1;
-        } else {
-            for (i = 0; i < 3; i++) {
-                s->acc_lp[i] += k->k_acc * (an_n[i] - s->acc_lp[i]);
-            }
-            s->acc_norm_lp = an_lp;
-        }
-        nv = norm3(s->acc_lp);
-        if (nv > 0) {
-            for (i = 0; i < 3; i++) {
-                v[i] = s->acc_lp[i] / nv;
-            }
-            /* correction δθ = angle · (v × e_z)/|v × e_z|, v × e_z = (v_y, −v_x, 0) */
-            hs = att_sqrt(v[0] * v[0] + v[1] * v[1]);
-            ang = att_atan2(hs, v[2]);
-            if (hs > 0) {
-                y0 = ang * v[1] / hs;
-                y1 = -ang * v[0] / hs;
-            } else {
-                y0 = 0;
-                y1 = 0;
-            }
-            if (set->acc_gate > 0 && ang > set->acc_gate) {
-                s->acc_rej_time += dt;
-                if (s->acc_rej_time < set->acc_reject_max) {
-                    flags |= ATT_AHRS_F_ACC_REJECTED;
-                } else {
-                    s->acc_rej_time = 0;
-                }
-            } else {
-                s->acc_rej_time = 0;
-            }
-            if (!(flags & ATT_AHRS_F_ACC_REJECTED)) {
-                update_acc(s->P, x, 0, y0, k->r_acc);
-                update_acc(s->P, x, 1, y1, k->r_acc);
-                if (k->tilt) {
-                    /* the reported inclination's low-pass, implicit Euler of
-                     * f'' + 2ζω0 f' + ω0² f = ω0² a_n:
-                     * f' ← (f' + dt ω0² (a_n − f))/(1 + 2ζω0 dt + ω0² dt²), f ← f + dt f' */
-                    if (s->tilt_mean) {
-                        /* start: the mean of the samples so far, until it spans the
-                         * low-pass's own τ (as VQF starts its filter) */
-                        att_real wgt;
-                        s->tilt_t += dt;
-                        wgt = dt / s->tilt_t;
-                        for (i = 0; i < 3; i++) {
-                            s->tilt_f[i] += wgt * (an_n[i] - s->tilt_f[i]);
-                        }
-                        if (s->tilt_t >= (rest ? k->tilt_tau_rest : set->tilt_tau)) {
-                            s->tilt_mean = 0;
-                        }
-                    } else {
-                        att_real kv = rest ? k->k_tilt_v_rest : k->k_tilt_v;
-                        att_real kx = rest ? k->k_tilt_x_rest : k->k_tilt_x;
-                        for (i = 0; i < 3; i++) {
-                            s->tilt_fd[i] = kv * s->tilt_fd[i] + kx * (an_n[i] - s->tilt_f[i]);
-                            s->tilt_f[i] += dt * s->tilt_fd[i];
-                        }
-                    }
-                }
-            }
-        }
+/* The accelerometer's gate with recovery: 1 when the inclination innovation
+ * ang is rejected (above acc_gate, for less than acc_reject_max so far). */
+static int acc_gated(att_ahrs *s, att_real ang, att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    if (!(set->acc_gate > 0 && ang > set->acc_gate)) {
+        s->acc_rej_time = 0;
+        return 0;
     }
-
-    /* magnetometer: heading only, disturbance rejection on norm and dip */
-    if (mag != NULL) {
-        att_real m[3], h, nm, dip, rm;
-        int use = 0;
-        mat_vec(C, fm, m);
-        h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
-        nm = norm3(m);
-        if (h > 0) {
-            dip = att_atan2(-m[2], h);
-            if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
-                /* the inclination is not known well enough to learn the dip */
-                s->mag_ref_valid = 0;
-            }
-            if (!s->mag_ref_valid) {
-                s->mag_ref[0] = nm;
-                s->mag_ref[1] = dip;
-                s->mag_cand[0] = nm;
-                s->mag_cand[1] = dip;
-                s->mag_ref_valid = 1;
-                s->mag_undist_t = set->mag_min_undisturbed;
-            }
-            /* candidate reference: the field while it stays consistent with
-             * itself; its time runs only while turning (a field fixed to the
-             * body would change with the attitude and fail the test) */
-            if (att_fabs(nm - s->mag_cand[0]) <= set->mag_norm_tol * s->mag_cand[0]
-                && att_fabs(dip - s->mag_cand[1]) <= set->mag_dip_tol) {
-                s->mag_cand[0] += k->k_mag * (nm - s->mag_cand[0]);
-                s->mag_cand[1] += k->k_mag * (dip - s->mag_cand[1]);
-                if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2]
-                    >= set->mag_new_gyr * set->mag_new_gyr) {
-                    s->mag_cand_t += dt;
-                }
-            } else {
-                s->mag_cand[0] = nm;
-                s->mag_cand[1] = dip;
-                s->mag_cand_t = 0;
-            }
-            rm = k->r_mag;
-            if (att_fabs(nm - s->mag_ref[0]) <= set->mag_norm_tol * s->mag_ref[0]
-                && att_fabs(dip - s->mag_ref[1]) <= set->mag_dip_tol) {
-                s->mag_ref[0] += k->k_mag * (nm - s->mag_ref[0]);
-                s->mag_ref[1] += k->k_mag * (dip - s->mag_ref[1]);
-                s->mag_undist_t += dt;
-                if (s->mag_undist_t >= set->mag_min_undisturbed) {
-                    s->mag_rej_time = 0;
-                    use = 1;
-                } else {
-                    flags |= ATT_AHRS_F_MAG_DISTURBED;
-                    s->mag_rej_time += dt;
-                }
-            } else if (s->mag_cand_t >= set->mag_new_time) {
-                /* a new homogeneous field: it becomes the reference */
-                s->mag_ref[0] = s->mag_cand[0];
-                s->mag_ref[1] = s->mag_cand[1];
-                s->mag_rej_time = 0;
-                s->mag_undist_t = set->mag_min_undisturbed;
-                flags |= ATT_AHRS_F_MAG_RELEARNED;
-                use = 1;
-            } else {
-                s->mag_undist_t = 0;
-                flags |= ATT_AHRS_F_MAG_DISTURBED;
-                s->mag_rej_time += dt;
-                if (s->mag_rej_time >= set->mag_reject_max) {
-                    /* bounded rejection: weak updates again */
-                    rm *= set->mag_reject_factor * set->mag_reject_factor;
-                    use = 1;
-                }
-            }
-            if (use) {
-                att_real y = wrap_pi(att_atan2(m[0], m[1]) - set->declination);
-                update_mag(s->P, x, 2, y, rm);
-            }
-        }
+    s->acc_rej_time += dt;
+    if (s->acc_rej_time < set->acc_reject_max) {
+        return 1;
     }
+    s->acc_rej_time = 0;
+    return 0;
+}
 
-    /* rest: zero-rate update of the bias */
-    if (rest) {
-        flags |= ATT_AHRS_F_REST;
+/* Accelerometer: f_n = C f (written), its first-order low-pass (acc_tau) in
+ * the navigation frame, whose inclination measures δθx, δθy (gated). 1 when
+ * the update was made. */
+static int acc_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real f[3],
+                      att_real norm_lp, att_real dt, att_real x[NX], int *flags, att_real f_n[3])
+{
+    att_real v[3], nv, hs, ang, y0 = 0, y1 = 0;
+    int i;
+    mat_vec(C, f, f_n);
+    if (!s->acc_init) {
         for (i = 0; i < 3; i++) {
-            update_bias(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], k->r_rest);
+            s->acc_lp[i] = f_n[i];
+        }
+        s->acc_init = 1;
+    } else {
+        for (i = 0; i < 3; i++) {
+            s->acc_lp[i] += k->k_acc * (f_n[i] - s->acc_lp[i]);
         }
     }
+    s->acc_norm_lp = norm_lp;
+    nv = norm3(s->acc_lp);
+    if (!(nv > 0)) {
+        return 0;
+    }
+    for (i = 0; i < 3; i++) {
+        v[i] = s->acc_lp[i] / nv;
+    }
+    /* correction δθ = angle · (v × e_z)/|v × e_z|, v × e_z = (v_y, −v_x, 0) */
+    hs = att_sqrt(v[0] * v[0] + v[1] * v[1]);
+    ang = att_atan2(hs, v[2]);
+    if (hs > 0) {
+        y0 = ang * v[1] / hs;
+        y1 = -ang * v[0] / hs;
+    }
+    if (acc_gated(s, ang, dt)) {
+        *flags |= ATT_AHRS_F_ACC_REJECTED;
+        return 0;
+    }
+    update_acc(s->P, x, 0, y0, k->r_acc);
+    update_acc(s->P, x, 1, y1, k->r_acc);
+    return 1;
+}
 
-    /* inject the error state: q ← exp(δθ) ⊗ q, b ← b + δb, acc_lp (and tilt_f, tilt_fd) ←
-     * (I + [δθ×]) acc_lp */
+/* Reported inclination: the second-order low-pass (tilt_tau, τ longer at rest)
+ * of an accepted f_n, implicit Euler of f'' + 2ζω0 f' + ω0² f = ω0² f_n:
+ * f' ← (f' + dt ω0² (f_n − f))/(1 + 2ζω0 dt + ω0² dt²), f ← f + dt f'; it starts
+ * as the mean of the samples so far until they span τ (as VQF starts its filter). */
+static void tilt_lowpass(att_ahrs *s, const att_ahrs_step *k, const att_real f_n[3], att_real dt, int rest)
+{
+    int i;
+    if (s->tilt_mean) {
+        att_real w;
+        s->tilt_t += dt;
+        w = dt / s->tilt_t;
+        for (i = 0; i < 3; i++) {
+            s->tilt_f[i] += w * (f_n[i] - s->tilt_f[i]);
+        }
+        if (s->tilt_t >= (rest ? k->tilt_tau_rest : s->set.tilt_tau)) {
+            s->tilt_mean = 0;
+        }
+    } else {
+        att_real kv = rest ? k->k_tilt_v_rest : k->k_tilt_v;
+        att_real kx = rest ? k->k_tilt_x_rest : k->k_tilt_x;
+        for (i = 0; i < 3; i++) {
+            s->tilt_fd[i] = kv * s->tilt_fd[i] + kx * (f_n[i] - s->tilt_f[i]);
+            s->tilt_f[i] += dt * s->tilt_fd[i];
+        }
+    }
+}
+
+/* 1 when a field of norm nm and dip agrees with ref (norm, dip) within
+ * mag_norm_tol (relative) and mag_dip_tol. */
+static int field_agrees(const att_ahrs_settings *set, const att_real ref[2], att_real nm, att_real dip)
+{
+    return att_fabs(nm - ref[0]) <= set->mag_norm_tol * ref[0] && att_fabs(dip - ref[1]) <= set->mag_dip_tol;
+}
+
+static void field_lowpass(att_real ref[2], att_real k, att_real nm, att_real dip)
+{
+    ref[0] += k * (nm - ref[0]);
+    ref[1] += k * (dip - ref[1]);
+}
+
+/* Magnetic reference, start and candidate: the reference is (re)set to the
+ * sample until the inclination's 1σ is below half of mag_dip_tol; the
+ * candidate tracks a field consistent with itself, its time running only
+ * while turning (a field fixed to the body changes with the attitude). */
+static void mag_candidate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real nm,
+                          att_real dip, att_real dt)
+{
+    const att_ahrs_settings *set = &s->set;
+    if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
+        s->mag_ref_valid = 0; /* the inclination is not known well enough to learn the dip */
+    }
+    if (!s->mag_ref_valid) {
+        s->mag_ref[0] = s->mag_cand[0] = nm;
+        s->mag_ref[1] = s->mag_cand[1] = dip;
+        s->mag_ref_valid = 1;
+        s->mag_undist_t = set->mag_min_undisturbed;
+    }
+    if (field_agrees(set, s->mag_cand, nm, dip)) {
+        field_lowpass(s->mag_cand, k->k_mag, nm, dip);
+        if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2] >= set->mag_new_gyr * set->mag_new_gyr) {
+            s->mag_cand_t += dt;
+        }
+    } else {
+        s->mag_cand[0] = nm;
+        s->mag_cand[1] = dip;
+        s->mag_cand_t = 0;
+    }
+}
+
+/* Magnetic disturbance: the sample against the reference. Undisturbed (for
+ * mag_min_undisturbed), it is used and adapts the reference; disturbed, a
+ * candidate held for mag_new_time becomes the reference, else it is rejected
+ * until mag_reject_max, then used with the noise ×mag_reject_factor². 1 when
+ * used, with its noise *r. */
+static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real dip, att_real dt, int *flags,
+                      att_real *r)
+{
+    const att_ahrs_settings *set = &s->set;
+    *r = k->r_mag;
+    if (field_agrees(set, s->mag_ref, nm, dip)) {
+        field_lowpass(s->mag_ref, k->k_mag, nm, dip);
+        s->mag_undist_t += dt;
+        if (s->mag_undist_t >= set->mag_min_undisturbed) {
+            s->mag_rej_time = 0;
+            return 1;
+        }
+        *flags |= ATT_AHRS_F_MAG_DISTURBED;
+        s->mag_rej_time += dt;
+        return 0;
+    }
+    if (s->mag_cand_t >= set->mag_new_time) { /* a new homogeneous field: it becomes the reference */
+        s->mag_ref[0] = s->mag_cand[0];
+        s->mag_ref[1] = s->mag_cand[1];
+        s->mag_rej_time = 0;
+        s->mag_undist_t = set->mag_min_undisturbed;
+        *flags |= ATT_AHRS_F_MAG_RELEARNED;
+        return 1;
+    }
+    s->mag_undist_t = 0;
+    *flags |= ATT_AHRS_F_MAG_DISTURBED;
+    s->mag_rej_time += dt;
+    if (s->mag_rej_time >= set->mag_reject_max) { /* bounded rejection: weak updates again */
+        *r *= set->mag_reject_factor * set->mag_reject_factor;
+        return 1;
+    }
+    return 0;
+}
+
+/* Magnetometer: m_n = C m; its norm and dip against the reference, its
+ * horizontal heading minus the declination measures δθz. */
+static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real gyr[3],
+                       const att_real mag[3], att_real dt, att_real x[NX], int *flags)
+{
+    att_real m[3], h, nm, dip, r;
+    mat_vec(C, mag, m);
+    h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
+    if (!(h > 0)) {
+        return;
+    }
+    nm = norm3(m);
+    dip = att_atan2(-m[2], h);
+    mag_candidate(s, k, gyr, nm, dip, dt);
+    if (mag_accept(s, k, nm, dip, dt, flags, &r)) {
+        update_mag(s->P, x, 2, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r);
+    }
+}
+
+/* Rest: the low-passed rate measures the bias (three zero-rate scalars). */
+static void zero_rate_update(att_ahrs *s, const att_ahrs_step *k, att_real x[NX])
+{
+    int i;
+    for (i = 0; i < 3; i++) {
+        update_bias(s->P, x, 3 + i, s->rest_gyr[i] - s->bias[i], k->r_rest);
+    }
+}
+
+/* Injection: q ← exp(δθ) ⊗ q, b ← b + δb; the navigation-frame vectors (acc_lp,
+ * and tilt_f, tilt_fd) ← (I + [δθ×]) v. */
+static void inject(att_ahrs *s, const att_ahrs_step *k, const att_real x[NX])
+{
     if (x[0] != 0 || x[1] != 0 || x[2] != 0) {
         att_real d[4], q0 = s->integ.q[0], q1 = s->integ.q[1], q2 = s->integ.q[2], q3 = s->integ.q[3];
         att__rotvec_delta(x, d);
@@ -818,7 +838,6 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         s->integ.q[3] = q3 + (d[0] * q3 + d[1] * q2 - d[2] * q1 + d[3] * q0);
         rotate_small(x, s->acc_lp);
         if (k->tilt) {
-            /* the reported inclination's filter lives in the same frame */
             rotate_small(x, s->tilt_f);
             rotate_small(x, s->tilt_fd);
         }
@@ -826,26 +845,75 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     s->bias[0] += x[3];
     s->bias[1] += x[4];
     s->bias[2] += x[5];
+}
+
+/* Output: the reported attitude, predicted over sensor_delay (when set) with
+ * the corrected rate, q ⊗ exp((ω − b)·d). */
+static att_status write_output(const att_ahrs *s, const att_real gyr[3], att_real q_out[4])
+{
+    att_real ph[3], d[4];
+    int i;
+    if (q_out == NULL) {
+        return ATT_OK;
+    }
+    report_q(s, q_out);
+    if (s->set.sensor_delay != 0) {
+        for (i = 0; i < 3; i++) {
+            ph[i] = (gyr[i] - s->bias[i]) * s->set.sensor_delay;
+        }
+        att__rotvec_delta(ph, d);
+        att__quat_add_mul(q_out, d);
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real acc[3], const att_real mag[3],
+                           att_real dt, att_real q_out[4])
+{
+    att_ahrs save;
+    const att_ahrs_step *k;
+    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3];
+    att_status st;
+    int rest, flags;
+    if (s == NULL || gyr == NULL) {
+        return ATT_E_NULL;
+    }
+    st = check_inputs(s, gyr, acc, mag, dt, &norm_lp);
+    if (st == ATT_OK) {
+        st = align_once(s, acc, mag);
+    }
+    if (st != ATT_OK) {
+        return st;
+    }
+    copy_mutable(&save, s);
+    k = step_constants(s, dt);
+    flags = overrange(&s->set, gyr) ? ATT_AHRS_F_OVERRANGE : 0;
+    rest = detect_rest(s, k, gyr, acc, dt);
+    if (propagate(s, k, gyr, dt, rest, flags & ATT_AHRS_F_OVERRANGE, C) != 0) {
+        copy_mutable(s, &save);
+        return ATT_E_AHRS_DIVERGED;
+    }
+    if (k->delays) { /* from here on the aiding samples at the gyro's time (one integer test when both are 0) */
+        acc = at_gyro_time(s, gyr, acc, k->delays & 1, s->set.acc_delay, acc_c);
+        mag = at_gyro_time(s, gyr, mag, k->delays & 2, s->set.mag_delay, mag_c);
+    }
+    if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, x, &flags, f_n) && k->tilt) {
+        tilt_lowpass(s, k, f_n, dt, rest);
+    }
+    if (mag != NULL) {
+        mag_update(s, k, C, gyr, mag, dt, x, &flags);
+    }
+    if (rest) {
+        flags |= ATT_AHRS_F_REST;
+        zero_rate_update(s, k, x);
+    }
+    inject(s, k, x);
     s->flags = flags;
     if (!finite_state(s)) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
-    if (q_out != NULL && set->sensor_delay != 0) {
-        /* output predicted over the sensor delay with the corrected rate */
-        att_real ph[3], d[4], q[4];
-        report_q(s, q);
-        for (i = 0; i < 3; i++) {
-            ph[i] = (gyr[i] - s->bias[i]) * set->sensor_delay;
-        }
-        att__rotvec_delta(ph, d);
-        q_out[0] = q[0] + (q[0] * d[0] - q[1] * d[1] - q[2] * d[2] - q[3] * d[3]);
-        q_out[1] = q[1] + (q[0] * d[1] + q[1] * d[0] + q[2] * d[3] - q[3] * d[2]);
-        q_out[2] = q[2] + (q[0] * d[2] - q[1] * d[3] + q[2] * d[0] + q[3] * d[1]);
-        q_out[3] = q[3] + (q[0] * d[3] + q[1] * d[2] - q[2] * d[1] + q[3] * d[0]);
-        return ATT_OK;
-    }
-    return write_q(s, q_out);
+    return write_output(s, gyr, q_out);
 }
 
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,

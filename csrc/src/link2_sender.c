@@ -38,6 +38,18 @@
 #define CUR_RESET()
 #define CUR_GROW()
 #define CUR_HALVE()
+#if ATT_LINK2_ONE_RING_IDATA
+#define RING ((uint8_t ATT_LINK_MEM *)att_link2_one_ring) /* reached through @R0/@R1 only */
+#else
+#define RING (S->ring)
+#endif
+#if ATT_LINK2_ONE_BATCH /* hold a DATA frame back for more records (attitude/link2.h) */
+#define AND_READY(tick)                                             \
+    &&((uint8_t)(S->head - S->next) >= (uint8_t)ATT_LINK2_ONE_BATCH \
+       || (uint16_t)((tick)-S->t0) > (uint16_t)ATT_LINK2_ONE_HOLD)
+#else
+#define AND_READY(tick)
+#endif
 #else
 #define S                 s
 #define SELF              att_link2_sender ATT_LINK_MEM *s
@@ -65,7 +77,9 @@
     if (s->cur < MAX_SAMPLES) { \
         s->cur++;               \
     }
-#define CUR_HALVE() (s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1))
+#define CUR_HALVE()     (s->cur = (uint8_t)((uint8_t)(s->cur + 1u) >> 1))
+#define RING            (s->ring)
+#define AND_READY(tick) /* the library's sender frames at once */
 #endif
 
 #if defined(__SDCC_mcs51) && ATT_LINK2_CRC_TABLE
@@ -190,7 +204,7 @@ uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte)
 static uint8_t ATT_LINK_MEM *slot(SELF_ uint8_t seq)
 {
     uint16_t i = (uint8_t)(seq & (uint8_t)(RING_SIZE - 1u));
-    return S->ring + (uint16_t)((uint16_t)(i << 2) + (uint16_t)(i << 1)); /* 6 i: no multiply on the 8051 */
+    return RING + (uint16_t)((uint16_t)(i << 2) + (uint16_t)(i << 1)); /* 6 i: no multiply on the 8051 */
 }
 
 /* A sample record whose three codes fit 12 bits travels packed. */
@@ -425,6 +439,51 @@ bad:
 
 /* -- poll: the emitter ----------------------------------------------- */
 
+#if ATT_LINK2_CURSOR
+/* Decoded byte i of the frame being sent, i < f_len - 4 (the bytes the CRC
+ * covers), asked for in order. Its data bytes come through the cursor f_ptr:
+ * a RAW frame's record byte by byte; a DATA frame's codes (big-endian 16-bit
+ * words, record after record, so the frame's codes are consecutive words of
+ * the ring, wrapping at its end) two by two in three bytes: hi0 lo0 -> byte 0
+ * = code 0 >> 4; byte 1 = (code 0 & 15) << 4 | hi1 (0: the padding of an odd
+ * number of codes, its last byte); byte 2 = lo1. A word never straddles the
+ * ring's end, so the cursor wraps only after a low byte. */
+static uint8_t frame_byte(SELF_ uint8_t i)
+{
+    uint8_t ATT_LINK_MEM *p = S->f_ptr;
+    uint8_t b;
+    if (i < 2u) {
+        return i == 0u ? S->f_head : S->f_seq;
+    }
+    if (S->f_head & (uint8_t)ATT_LINK2_T_RAW) {
+        S->f_ptr = p + 1;
+        return *p;
+    }
+    if (S->f_ph == 1u) {
+        S->f_ph = 2;
+        if ((uint8_t)(i + 5u) == S->f_len) {
+            return S->f_nib; /* the odd last code: its low nibble and 4 bits of padding */
+        }
+        S->f_ptr = p + 1;
+        return (uint8_t)(S->f_nib | *p);
+    }
+    if (S->f_ph == 0u) {
+        b = p[1];
+        S->f_nib = (uint8_t)(b << 4);
+        b = (uint8_t)((uint8_t)(*p << 4) | (uint8_t)(b >> 4));
+        p += 2;
+        S->f_ph = 1;
+    } else {
+        b = *p++;
+        S->f_ph = 0;
+    }
+    if (p == RING + (uint16_t)((uint16_t)((uint16_t)RING_SIZE << 2) + (uint16_t)((uint16_t)RING_SIZE << 1))) {
+        p = RING;
+    }
+    S->f_ptr = p;
+    return b;
+}
+#else
 /* Nibble k of the packed codes of the DATA frame being sent (0 past the
  * last code): sample k / 9, nibble k % 9 of its three 12-bit codes, which
  * is the low (0) or high (0x80) nibble of byte nib_at[k % 9] & 7 of the record. */
@@ -459,6 +518,8 @@ static uint8_t frame_byte(SELF_ uint8_t i)
     i = (uint8_t)(i << 1);
     return (uint8_t)((uint8_t)(nibble(ARG_ i) << 4) | nibble(ARG_(uint8_t)(i + 1u)));
 }
+
+#endif
 
 /* The next encoded byte of the frame being sent (tx = TX_BODY). */
 static uint8_t body_byte(SELF)
@@ -529,6 +590,10 @@ static void start_data(SELF)
         S->f_len = (uint8_t)(6u + (uint8_t)((uint8_t)(9u * n + 1u) >> 1));
     }
     S->f_seq = seq;
+#if ATT_LINK2_CURSOR
+    S->f_ptr = slot(ARG_ seq);
+    S->f_ph = 0;
+#endif
     /* records below hi were sent before: they count as resent */
     old = (uint8_t)(seq - S->base) < (uint8_t)(S->hi - S->base) ? (uint8_t)(S->hi - seq) : 0u;
     if (old >= n) {
@@ -572,7 +637,7 @@ static att_link2_result poll_idle(SELF_ uint16_t tick)
         S->f_head = (uint8_t)(ATT_LINK2_T_DATA | (S->flags & FL_EPOCH)); /* probe at next */
         goto empty_frame;
     }
-    if (S->session == (uint8_t)SES_RUN && S->next != S->head && window_open(ARG_ S->next)) {
+    if (S->session == (uint8_t)SES_RUN && S->next != S->head && window_open(ARG_ S->next) AND_READY(tick)) {
         start_data(ARG);
         return ATT_LINK2_SEND;
     }

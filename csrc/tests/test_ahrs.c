@@ -81,6 +81,47 @@ static void test_settings(void)
     CHECK_EQ_INT(att_ahrs_init(NULL, NULL, NULL), ATT_E_NULL);
 }
 
+/* att_ahrs_check_settings_field names the first field outside its domain, in
+ * the struct's order (ahrs.h), as the struct spells it. */
+static void test_settings_field_names(void)
+{
+    att_ahrs_settings set;
+    const char *field = "unset";
+    att_ahrs_default_settings(&set);
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_OK);
+    CHECK(field == NULL);
+    field = "unset";
+    CHECK_EQ_INT(att_ahrs_check_settings_field(NULL, &field), ATT_E_NULL);
+    CHECK(field == NULL);
+    set.acc_noise = 0; /* a density: > 0 */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "acc_noise") == 0);
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, NULL), ATT_E_AHRS_SETTINGS); /* field may be NULL */
+    set.mag_delay = (att_real)0.06;                                               /* after acc_noise */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "acc_noise") == 0);
+    set.gyr_noise_rest = (att_real)NAN; /* before acc_noise */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "gyr_noise_rest") == 0);
+    set.method = ATT_METHOD_RK4; /* the first field */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "method") == 0);
+    att_ahrs_default_settings(&set);
+    set.mag_reject_factor = (att_real)0.99; /* ≥ 1 */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "mag_reject_factor") == 0);
+    set.mag_reject_factor = 1;
+    set.declination = -(att_real)3.14159265358979323846; /* |D| ≤ π (the library's), ends included */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_OK);
+    set.declination = (att_real)-3.15;
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "declination") == 0);
+    att_ahrs_default_settings(&set);
+    set.tilt_tau = (att_real)-1; /* the last field */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "tilt_tau") == 0);
+}
+
 static void test_statuses(void)
 {
     att_ahrs s, before;
@@ -349,6 +390,7 @@ static void test_tilt_not_below_the_horizon(void)
 int main(void)
 {
     test_settings();
+    test_settings_field_names();
     test_statuses();
     test_static_convergence();
     test_rest_bias();

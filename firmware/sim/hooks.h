@@ -91,6 +91,24 @@ __sfr32 __at(0xCFCE9F9E) bench_idle;
 __sfr16 __at(0xB7B1) bench_t_prev;
 __sfr16 __at(0x9B9A) bench_tick0;
 __sfr __at(0x97) bench_started;
+#if defined(FW_PROFILE) && !(defined(FW_BENCH) && FW_AIDED)
+#error "FW_PROFILE is a variant of the aided board's bench image"
+#endif
+#if defined(FW_PROFILE)
+/* Profile (bench/aided.py's profile run, -DFW_PROFILE: its timestamps
+ * inflate the busy figure, so the load runs go without): machine cycles
+ * of the sender's polls that sent a byte / did not, of its sink calls,
+ * and their counts. Some of these cells are the device model's in a sim
+ * image (tlc_hal_sim.h, tlc_model.c); a bench image has no model. */
+__sfr32 __at(0xC3C2C1C0) prof_send;
+__sfr32 __at(0xC7C6C5C4) prof_other;
+__sfr32 __at(0xACABAAA9) prof_rx;
+__sfr16 __at(0x9493) prof_nsend;
+__sfr16 __at(0xAEAD) prof_nframe;
+__sfr16 __at(0x9695) prof_nrx;
+__sfr16 __at(0x9D9C) prof_t;
+__sfr __at(0xBF) prof_r;
+#endif
 #endif
 
 static void bench_init(void)
@@ -110,6 +128,14 @@ static void bench_init(void)
 #if FW_AIDED
     bench_idle = 0;
     bench_started = 0;
+#if defined(FW_PROFILE)
+    prof_send = 0;
+    prof_other = 0;
+    prof_rx = 0;
+    prof_nsend = 0;
+    prof_nframe = 0;
+    prof_nrx = 0;
+#endif
 #endif
 #if FW_LINK_V2
     bench_poll_max = 0;
@@ -307,6 +333,14 @@ static void sim_finish(void)
     STAT("tick0", bench_tick0);
     STAT("ticks", fw_ticks);
     STAT32("idle", bench_idle);
+#if defined(FW_PROFILE)
+    STAT32("psend", prof_send);
+    STAT32("pother", prof_other);
+    STAT32("prx", prof_rx);
+    STAT("nsend", prof_nsend);
+    STAT("nframe", prof_nframe);
+    STAT("nrx", prof_nrx);
+#endif
 #endif
     fw_sim_putc('\n');
 #endif
@@ -445,8 +479,12 @@ static void sim_init(void)
  * comes back); each counts as one accepted block. sim_base0 and sim_rec
  * live in SFR cells, like the counters. */
 __sfr __at(0xB6) sim_base0;
-#define sim_rec \
-    (att_link2_one.ring + (uint8_t)(6u * (uint8_t)(sim_base0 & (uint8_t)(ATT_LINK2_ONE_RING - 1))))
+#if ATT_LINK2_ONE_RING_IDATA
+#define sim_ring att_link2_one_ring
+#else
+#define sim_ring att_link2_one.ring
+#endif
+#define sim_rec (sim_ring + (uint8_t)(6u * (uint8_t)(sim_base0 & (uint8_t)(ATT_LINK2_ONE_RING - 1))))
 static void sim_acked(void)
 {
     while (sim_base0 != att_link2_one.base) {
@@ -460,6 +498,23 @@ static void sim_acked(void)
         sim_base0++;
     }
 }
+#if defined(FW_PROFILE)
+#define FW_HOOK_V2_SINK(call)                         \
+    do {                                              \
+        sim_base0 = att_link2_one.base;               \
+        prof_t = cycles_now();                        \
+        prof_r = (call);                              \
+        prof_rx += (uint16_t)(cycles_now() - prof_t); \
+        prof_nrx++;                                   \
+        if (prof_r == ATT_LINK2_FRAME) {              \
+            prof_nframe++; /* a valid ACK */          \
+        }                                             \
+        if (prof_r == ATT_LINK2_BAD_FRAME) {          \
+            sim_bad_acks++; /* e.g. a byte lost */    \
+        }                                             \
+        sim_acked();                                  \
+    } while (0)
+#else
 #define FW_HOOK_V2_SINK(call)                      \
     do {                                           \
         sim_base0 = att_link2_one.base;            \
@@ -468,6 +523,7 @@ static void sim_acked(void)
         }                                          \
         sim_acked();                               \
     } while (0)
+#endif
 #endif
 
 /* ---- the hooks (firmware/hooks.h lists them) ---- */
@@ -478,7 +534,22 @@ static void sim_acked(void)
         SIM_COUNT_BLOCK();  \
         SIM_COUNT_SAMPLE(); \
     } while (0)
-#if defined(FW_BENCH) && FW_AIDED
+#if defined(FW_PROFILE)
+#define FW_HOOK_POLL_BEGIN() (bench_t_poll = cycles_now())
+#define FW_HOOK_POLL(st)                                        \
+    do {                                                        \
+        bench_t_poll = (uint16_t)(cycles_now() - bench_t_poll); \
+        if ((st) == ATT_LINK2_SEND) {                           \
+            prof_send += bench_t_poll;                          \
+            prof_nsend++;                                       \
+        } else {                                                \
+            prof_other += bench_t_poll;                         \
+        }                                                       \
+        if ((st) != ATT_LINK2_NONE && (st) != ATT_LINK2_IDLE) { \
+            bench_busy = 1; /* the sender did something */      \
+        }                                                       \
+    } while (0)
+#elif defined(FW_BENCH) && FW_AIDED
 #define FW_HOOK_POLL_BEGIN()
 #define FW_HOOK_POLL(st)                                        \
     do {                                                        \

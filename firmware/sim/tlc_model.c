@@ -115,8 +115,19 @@ void fw_sim_model_init(void)
 #endif
 }
 
-/* Gyro c's input now, as a 12-bit code << 4. */
-static uint16_t gyro(uint8_t c)
+/* Input c now: on the aided board analog() gives the 16-bit fraction of
+ * Vref before the quantizer (mag() below adds the bridge offset first);
+ * on the gyro board gyro() gives the 12-bit code << 4 directly (that
+ * image's code as it was). */
+#if FW_AIDED
+#define INPUT_FN analog
+#define QUANT(v) (v)
+#define gyro(c)  ((uint16_t)(analog(c) & 0xFFF0u))
+#else
+#define INPUT_FN gyro
+#define QUANT(v) ((v)&0xFFF0u)
+#endif
+static uint16_t INPUT_FN(uint8_t c)
 {
     uint8_t p = (uint8_t)(gyro_phase[c] + (uint8_t)(m_k * gyro_step[c]));
     uint8_t i = (uint8_t)(p & 63u);
@@ -129,8 +140,26 @@ static uint16_t gyro(uint8_t c)
     if (q & 2u) {
         v = (uint16_t)-v;
     }
-    return (uint16_t)((uint16_t)(gyro_off[c] + v) & 0xFFF0u);
+    return (uint16_t)QUANT((uint16_t)(gyro_off[c] + v));
 }
+
+#if FW_AIDED
+/* The magnetometer's bridges (AIN6-AIN8): the field's sign follows the
+ * set/reset straps' last pulse (P3.4, as the firmware drives it: high =
+ * set, low = reset), the bridge offset FW_SIM_BRIDGE (toolchain/firmware.py
+ * BRIDGE: 256 LSB) does not, as
+ * in attitude_c's hmc1043-ad623 front end; (c_set + 4095 - c_reset) / 2 is
+ * then within 1 LSB of the field's code (docs/firmware.md). */
+__sbit __at(0xB4) m_sr_pin; /* P3.4 reads its latch in s51: 1 until driven low */
+static uint16_t mag(uint8_t c)
+{
+    uint16_t v = analog(c);
+    if (!m_sr_pin) {
+        v = (uint16_t)(0u - v);
+    }
+    return (uint16_t)((uint16_t)(v + FW_SIM_BRIDGE) & 0xFFF0u);
+}
+#endif
 
 #ifndef FW_SIM_CONV_POLLS
 #define FW_SIM_CONV_POLLS 2 /* EOC reads low after a conversion starts */
@@ -162,7 +191,7 @@ unsigned char fwm_end_cycle(void)
         fwm_word = fwm_vz;
 #if FW_AIDED
     } else if (a < FW_SIM_NCH) {
-        fwm_word = gyro(a); /* accelerometer, magnetometer: at the scan's time k */
+        fwm_word = a >= (uint8_t)FW_AIN_MAG ? mag(a) : gyro(a); /* at the scan's time k */
 #endif
     } else if (a == TLC2543_TEST_MID) {
         fwm_word = 0x8000u;

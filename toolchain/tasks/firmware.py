@@ -24,11 +24,14 @@ def _tool() -> ModuleType:
     "link": "link protocol: legacy (AA/BB handshake, default) or v2 (link v2, single-instance sender)",
     "board": "gyro3 (the paper's AT89S51, default) or aided9 (the AT89S52 with accelerometer and "
              "magnetometer: link v2, docs/firmware.md)",
-    "acc_every": "aided9: accelerometer record every N samples (0 or a power of two up to 128; default 2)",
-    "mag_every": "aided9: magnetometer record every N samples (likewise; default 2)",
+    "acc_every": "aided9: accelerometer record every N samples (0 or a power of two up to 128; default: "
+                 "toolchain.firmware.AIDED's, every sample)",
+    "mag_every": "aided9: magnetometer record every N samples (likewise)",
+    "mag_sr": "aided9: magnetometer set/reset on P3.4, the combined code sent (about 5.5 points of CPU more; "
+              "docs/firmware.md)",
 })
-def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", board="gyro3", acc_every=2,
-          mag_every=2):
+def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", board="gyro3", acc_every=-1,
+          mag_every=-1, mag_sr=False):
     """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM), or the aided AT89S52 one
     (8 KB, 256 B), and print flash, RAM and free stack."""
     import dataclasses
@@ -40,8 +43,10 @@ def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", boa
     try:
         if board == "aided9":
             cfg = dataclasses.replace(tool.AIDED, baud=int(baud) or tool.AIDED.baud, period_ticks=int(period_ticks),
-                                      max_attempts=int(max_attempts), acc_every=int(acc_every),
-                                      mag_every=int(mag_every))
+                                      max_attempts=int(max_attempts),
+                                      acc_every=tool.AIDED.acc_every if int(acc_every) < 0 else int(acc_every),
+                                      mag_every=tool.AIDED.mag_every if int(mag_every) < 0 else int(mag_every),
+                                      mag_sr=bool(mag_sr))
         else:
             cfg = tool.Config(baud=int(baud) or 9600, period_ticks=int(period_ticks), max_attempts=int(max_attempts),
                               link=link, board=board)

@@ -225,6 +225,13 @@ void att_ahrs_default_settings(att_ahrs_settings *set);
  * ATT_E_AHRS_SETTINGS (ATT_E_NULL for NULL). */
 att_status att_ahrs_check_settings(const att_ahrs_settings *set);
 
+/* The same check, naming what fails: *field (may be NULL) is set to the name
+ * of the first field, in the struct's order, outside its domain, spelled as
+ * in att_ahrs_settings ("acc_noise", "method"), or to NULL when the status is
+ * not ATT_E_AHRS_SETTINGS. The string is the library's (static, not to be
+ * freed). */
+att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field);
+
 /* Initialize. set == NULL uses the defaults. q0 (body → ENU, normalized
  * here) gives the initial attitude; q0 == NULL leaves the filter
  * unaligned: the first update aligns it from that sample's specific

@@ -167,6 +167,17 @@ typedef struct {
 #ifndef ATT_LINK2_CRC_TABLE
 #define ATT_LINK2_CRC_TABLE 0
 #endif
+/* ATT_LINK2_CURSOR = 1 (the default: the library, the aided AT89S52
+ * image): the packed codes of a DATA frame are read through a cursor that
+ * walks the ring (f_ptr, one or two bytes per frame byte, three frame
+ * bytes per pair of codes: f_ph, f_nib): in s51 a poll that sends a byte
+ * costs about 220 machine cycles instead of 340; 0 (the AT89S51 v2 image,
+ * which toolchain/firmware.py keeps byte for byte as it was): each frame
+ * byte is recomputed from its index (two nibbles, a division by 9 each).
+ * Same wire. */
+#ifndef ATT_LINK2_CURSOR
+#define ATT_LINK2_CURSOR 1
+#endif
 #if ATT_LINK2_ONE
 #ifndef ATT_LINK2_ONE_RTO
 #define ATT_LINK2_ONE_RTO 720 /* ticks: 200 ms of the firmware's 1/3600 s ticks */
@@ -176,6 +187,33 @@ typedef struct {
 #endif
 #ifndef ATT_LINK2_ONE_RING
 #define ATT_LINK2_ONE_RING 4 /* records: 1, 2, 4, .., 64 */
+#endif
+/* ATT_LINK2_ONE_RING_IDATA = 1 (an 8052: 256 bytes of RAM): the ring is
+ * not inside att_link2_one but the firmware's own array
+ * `uint8_t __idata att_link2_one_ring[ATT_LINK2_ONE_RING * 6]`, which the
+ * linker may place in the upper 128 bytes (reached only through @R0/@R1,
+ * as the sender reaches the ring anyway): a longer ring than direct RAM
+ * holds, hence longer frames and fewer ACKs per record. */
+#ifndef ATT_LINK2_ONE_RING_IDATA
+#define ATT_LINK2_ONE_RING_IDATA 0
+#endif
+/* Batching (0 = off: a DATA frame starts as soon as a record is ready):
+ * between frames the sender holds back a DATA frame while fewer than
+ * ATT_LINK2_ONE_BATCH records are ready to send and at most
+ * ATT_LINK2_ONE_HOLD ticks have passed since its last progress (frame end,
+ * ACK): a board that pushes records faster than its CPU can frame them one
+ * sample at a time sends fewer, longer frames (the per-frame cost: 8 bytes
+ * of header, CRC and delimiters, an ACK of 9 bytes to receive and check),
+ * for a latency of at most ATT_LINK2_ONE_HOLD ticks. */
+#ifndef ATT_LINK2_ONE_BATCH
+#define ATT_LINK2_ONE_BATCH 0
+#endif
+#ifndef ATT_LINK2_ONE_HOLD
+#define ATT_LINK2_ONE_HOLD 0
+#endif
+#if ATT_LINK2_ONE_BATCH < 0 || ATT_LINK2_ONE_BATCH > ATT_LINK2_ONE_RING || ATT_LINK2_ONE_HOLD < 0 \
+    || ATT_LINK2_ONE_HOLD > 32767
+#error "ATT_LINK2_ONE_BATCH must be 0..ATT_LINK2_ONE_RING, ATT_LINK2_ONE_HOLD 0..32767 ticks"
 #endif
 #if ATT_LINK2_ONE_RTO < 1 || ATT_LINK2_ONE_RTO > 32767 || ATT_LINK2_ONE_SAMPLES < 1    \
     || ATT_LINK2_ONE_SAMPLES > 24 || ATT_LINK2_ONE_RING < 1 || ATT_LINK2_ONE_RING > 64 \
@@ -207,17 +245,25 @@ typedef struct {
     uint8_t f_pos;   /*   next decoded byte */
     uint8_t run;     /*   rCOBS: bytes since the last code */
     uint8_t rx_len;  /* ACK bytes received so far (0xFF: skipping an over-long frame) */
+#if ATT_LINK2_CURSOR
+    uint8_t ATT_LINK_MEM *f_ptr; /* frame being sent: the ring byte its next data byte reads */
+    uint8_t f_ph;                /*   packed codes: byte 0, 1 or 2 of a pair of codes */
+    uint8_t f_nib;               /*   the pair's first code's low nibble (<< 4) for byte 1 */
+#endif
 #if !ATT_LINK2_ONE
     uint8_t cur; /* samples per frame now: halved on a loss, +1 per progress */
 #endif
     uint8_t rx[8]; /* encoded ACK frame being received */
-#if ATT_LINK2_ONE
+#if ATT_LINK2_ONE && !ATT_LINK2_ONE_RING_IDATA
     uint8_t ring[ATT_LINK2_ONE_RING * ATT_LINK2_RECORD]; /* the ring (single-instance build) */
 #endif
 } att_link2_sender;
 
 #if ATT_LINK2_ONE
 extern att_link2_sender ATT_LINK_MEM att_link2_one; /* defined by the firmware */
+#if ATT_LINK2_ONE_RING_IDATA
+extern uint8_t __idata att_link2_one_ring[ATT_LINK2_ONE_RING * ATT_LINK2_RECORD]; /* ... and its ring */
+#endif
 void att_link2_sender1_init(void);
 void att_link2_sender1_reset(void);
 uint8_t att_link2_sender1_room(void);
