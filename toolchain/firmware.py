@@ -1116,11 +1116,10 @@ def _acquire(cfg: SimConfig, n: int, progress: Callable[[str, int, int], None] |
         raise InvalidArgument(f"--firmware s51 needs a period that is a whole number of the "
                               f"firmware's 1/{TICK_HZ} s ticks, got {cfg.period} s")
     try:
-        # Link timeouts of 1 s of simulated time (the chip's default is 50 ms): s51 runs in
-        # simulated time, the host end in wall time, and a host answering late on a loaded
-        # machine must not make the firmware resend a block the host already accepted (the
-        # protocol's duplicate, docs/link.md), which would shift the numbering of the samples
-        # after it; late answers cost overruns instead, reported in place and counted as lost.
+        # Link timeouts of 1 s of simulated time (the chip's default is 50 ms): a firmware
+        # resend of a block the host already accepted (the protocol's duplicate, docs/link.md)
+        # would shift the numbering of the samples after it. run() drives s51 in lockstep, so
+        # an answer is at most LOCKSTEP_BOUND_S late; the long timeouts are the margin.
         fw_cfg = Config(period_ticks=round(ticks), max_attempts=cfg.link_attempts, syn_timeout=3600,
                         answer_timeout=3600)
         # every run builds its own image in its own directory: two runs at once (pytest -n 2)
