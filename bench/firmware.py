@@ -5,11 +5,12 @@ counters kept in unused SFR cells, Timer 0 as the cycle clock) runs in
 ``s51 -t C51`` against libattitude's C receiver on a pty pair
 (toolchain/firmware.py). In s51 nothing drives P1, so EOC reads "done" at once:
 the scan figure is the driver's own cost (on hardware each of the 4 I/O
-cycles also waits up to 10 us for the conversion). The host answers in wall
-time while s51 runs slower than real time, so the measured exchange includes
-the host's latency; the zero-latency exchange is the measured one minus the
-two waits' excess over their wire time (0xAA + 0xBB, checksum + answer: two
-byte times each).
+cycles also waits up to 10 us for the conversion). s51 runs in lockstep with
+the host (docs/firmware.md "Lockstep"): a host answer reaches the firmware up
+to one step (10 000 instructions) after the byte it answers, so the measured
+exchange includes that latency; the zero-latency exchange is the measured one
+minus the two waits' excess over their wire time (0xAA + 0xBB, checksum +
+answer: two byte times each).
 """
 
 from __future__ import annotations

@@ -1,10 +1,11 @@
 """AT89S51 firmware (firmware/): SDCC build limits and whole-firmware runs in s51.
 
-Every run is ``s51 -t C51 -R 1`` with the UART on a ``socat`` pty pair and
-libattitude's C receiver B (through CFFI) on the other end
-(:class:`toolchain.firmware.LinkHost`); the firmware stops itself through the
-simulator interface after a given number of accepted blocks, and every
-s51/socat process is killed in a ``finally`` (wall-clock timeouts on all).
+Every run is ``s51 -t C51 -R 1`` in lockstep with libattitude's C receiver B
+(through CFFI) on its UART (:class:`toolchain.firmware.LinkHost`,
+:func:`toolchain.firmware.run`: simulated time advances only while the host is
+caught up); the firmware stops itself through the simulator interface after a
+given number of accepted blocks, and every s51 process is killed in a
+``finally`` (wall-clock timeouts on all).
 
 Images (toolchain/firmware.py): ``production`` (what goes into the chip),
 ``bench`` (production pins and RAM layout, cycle counters in unused SFR
@@ -14,6 +15,7 @@ a TLC2543 + gyro model kept in unused SFR cells: same RAM layout again).
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import pytest
@@ -29,14 +31,13 @@ pytestmark = pytest.mark.system  # builds the firmware and runs it in s51
 STACK_MARGIN = 4
 
 #: Sampling period of the long runs: 216 ticks = 60 ms. One exchange is 10
-#: byte times = 10.4 ms at 9600 baud, plus the host's latency, which s51
-#: (slower than real time with a pty) stretches to ~20 ms of simulated time
-#: and to 40-80 ms when the machine is loaded (measured with a load average
-#: of 7 on 2 cores); 60 ms and the two-slot queue keep the samples.
+#: byte times = 10.4 ms at 9600 baud, plus the host's latency: up to one
+#: lockstep step per wait (two waits, each <= tool.LOCKSTEP_BOUND_S = 43 ms,
+#: ~16 ms measured); 60 ms and the two-slot queue keep the samples.
 PERIOD = 216
 #: Link timeouts of the test images: 720 ticks = 200 ms of simulated time,
-#: so a host descheduled for a while on a loaded machine is not mistaken
-#: for a silent one (the silence test counts timeouts exactly).
+#: well above a lockstep step, so a host is never mistaken for a silent one
+#: (the silence test counts timeouts exactly).
 TIMEOUT = 720
 
 
@@ -214,6 +215,42 @@ def test_adc_error_is_reported_in_the_lost_samples_place(out: Path) -> None:
     samples = _samples(stream)
     assert lost not in {s.seq for s in samples} and max(s.seq for s in samples) > lost
     _assert_match_model(samples)
+
+
+class _StallingHost(tool.LinkHost):
+    """A host end descheduled (fault injection: a sleep standing for the OS running
+    something else) for ``stall_s`` of wall time between accepting block ``at`` and
+    answering it."""
+
+    def __init__(self, at: int, stall_s: float) -> None:
+        super().__init__()
+        self.at, self.stall_s = at, stall_s
+
+    def receive(self, data: bytes) -> bytes:
+        before = len(self.blocks)
+        reply = super().receive(data)
+        if before <= self.at < len(self.blocks):
+            time.sleep(self.stall_s)
+        return reply
+
+
+def test_a_descheduled_host_answers_in_time_in_simulated_time(out: Path) -> None:
+    """Issue 27: s51 ran on while the host was descheduled, the firmware's answer timeout
+    ran out for a block the host had accepted, and the legacy protocol delivered it
+    twice (docs/link.md). In lockstep the firmware sees the answer within one step
+    however long the host stalls: no timeout, no resend, the ADC error in its place."""
+    _need()
+    cfg = tool.Config(period_ticks=PERIOD, syn_timeout=TIMEOUT, answer_timeout=TIMEOUT)
+    img = tool.build(out, cfg, kind="sim", sim_blocks=12, faults=["adc_error_at=5"], name="fw_stalled_host")
+    # five answer timeouts of wall time: free-running s51 (>= 0.6 x real time, loaded) would time out
+    host = _StallingHost(at=6, stall_s=5 * TIMEOUT / tool.TICK_HZ)
+    res = tool.run(img, host, timeout=60)
+    assert res.stats["timeouts"] == 0 and res.stats["sent"] == res.stats["accepted"] == 12
+    assert [a.index for a in host.attempts] == list(range(12))  # one attempt per block: no resend
+    assert 0 < res.max_step_s <= tool.LOCKSTEP_BOUND_S < TIMEOUT / tool.TICK_HZ
+    errs = [x for x in res.stream if isinstance(x, tool.Report) and x.kind == "adc_error"]
+    assert len(errs) == 1 and errs[0].first >= 5  # decode_stream checked it against the count
+    _assert_match_model(_samples(res.stream))
 
 
 def test_fastest_baud_57600(out: Path) -> None:

@@ -30,9 +30,9 @@ def test_firmware_chain_delivers_every_sample_and_tracks_the_truth() -> None:
     res = simulate(SimConfig(trajectory=tr, duration=dur, period=h, firmware="s51"))
     s = res.summary["link"]
     n = 50
-    # s51 runs in simulated time but the host answers over a pty in wall time:
-    # on a loaded machine the firmware may skip samples, which it reports in the
-    # stream (overrun / gave_up); every sample is accounted for, and the lost ones
+    # s51 runs in lockstep with the host (an answer at most one step, 43 ms, late:
+    # docs/firmware.md); should the firmware skip samples anyway, it reports them in
+    # the stream (overrun / gave_up); every sample is accounted for, and the lost ones
     # after the first good sample are held (attitude-rx's policy)
     assert s["delivered"] + s["lost"] == n
     assert s["lost"] == 0 or {"overrun", "gave_up"} & set(s["reports"])

@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import select
 import shutil
 import signal
 import subprocess
@@ -93,6 +94,14 @@ WIRE_BYTES_PER_BLOCK = 1 + 1 + BLOCK_SIZE + 1 + 1
 
 #: Scheduling priority of s51 under the host end (see Session.run).
 S51_NICE = 10
+#: Instructions s51 runs per console ``step`` in lockstep (Session.run_lockstep). An 8051
+#: instruction takes at most 4 machine cycles (MUL, DIV), so a step lasts at most
+#: 4 * LOCKSTEP_INSNS machine cycles = 43.4 ms of simulated time (about 16 ms with the
+#: firmware's instruction mix): the most simulated time by which a host answer can reach
+#: the firmware late, below the chip's 50 ms link timeouts (Config's default).
+LOCKSTEP_INSNS = 10_000
+#: The hard bound above, in simulated seconds.
+LOCKSTEP_BOUND_S = 4 * LOCKSTEP_INSNS / MACHINE_HZ
 
 SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
            CSRC / "src" / "block.c"]
@@ -403,8 +412,8 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     if kind == "sim":
         defines += ["FW_SIM_MODEL", *_gyro_defines(gyros, aux if config.aided else ())]
         for f in faults:
-            name, _, arg = f.partition("=")
-            if name == "adc_error_at" and arg.isdigit() and int(arg) < 256:
+            fault, _, arg = f.partition("=")
+            if fault == "adc_error_at" and arg.isdigit() and int(arg) < 256:
                 defines.append(f"FW_SIM_EOC_STUCK_AT={int(arg)}")
                 continue
             if f not in fault_defs:
@@ -525,10 +534,11 @@ class LinkHost:
     attempt gets one data bit flipped before the receiver sees it, so the
     receiver itself answers 0xFF. ``silent``: n -> how many 0xAA to ignore
     while n blocks have been accepted (no 0xBB: the firmware times out).
-    Ticks are wall-clock milliseconds; the gap timeout is long (1 s)
-    because s51 runs slower than real time and may be descheduled on a
-    loaded machine: the firmware's own timeouts (simulated time) are what
-    the tests exercise.
+    Ticks are milliseconds of the host's clock: wall time, or s51's simulated
+    time when :func:`run` drives s51 in lockstep (:meth:`use_clock`). The gap
+    timeout is long (1 s) because on a wall clock s51 runs slower than real
+    time and may be descheduled on a loaded machine: the firmware's own
+    timeouts (simulated time) are what the tests exercise.
     """
 
     def __init__(self, impl: str = "c", *, block_size: int = BLOCK_SIZE, gap_timeout_ms: int = 1000,
@@ -543,20 +553,25 @@ class LinkHost:
         self.attempts: list[Attempt] = []
         self.ignored_syn: list[int] = []      #: accepted count at each ignored 0xAA
         self.wire: list[tuple[str, int]] = []  #: ("A"|"B", byte) in order
-        self.wire_t: list[float] = []          #: host wall time of each wire entry (s)
+        self.wire_t: list[float] = []          #: host clock time of each wire entry (s)
         self._data: bytearray | None = None
         self._corrupted: set[int] = set()
+        self._clock: Callable[[], float] = time.monotonic
         self._t0 = time.monotonic()
 
+    def use_clock(self, clock: Callable[[], float]) -> None:
+        """Take ticks and wire times from ``clock`` (seconds, from 0) instead of wall time."""
+        self._clock, self._t0 = clock, 0.0
+
     def tick(self) -> int:
-        return int((time.monotonic() - self._t0) * 1000.0)
+        return int((self._clock() - self._t0) * 1000.0)
 
     def receive(self, data: bytes) -> bytes:
         """Bytes from the firmware; returns the bytes to send back."""
         out = bytearray()
         for b in data:
             self.wire.append(("A", b))
-            self.wire_t.append(time.monotonic())
+            self.wire_t.append(self._clock())
             now = self.tick()
             k = len(self.blocks)
             if self._data is None and b == 0xAA and self.silent.get(k, 0) > 0:
@@ -586,7 +601,7 @@ class LinkHost:
             if res == "send":
                 out.append(byte)
                 self.wire.append(("B", byte))
-                self.wire_t.append(time.monotonic())
+                self.wire_t.append(self._clock())
                 if byte == 0xBB:
                     self._data = bytearray()
             elif res == "timeout":
@@ -618,6 +633,7 @@ class SimOutput:
 @dataclass
 class SimResult(SimOutput):
     host: LinkHost = None  # type: ignore[assignment]
+    max_step_s: float = 0.0  #: lockstep: the longest step's simulated time (0: not in lockstep)
 
     @property
     def stream(self) -> list[Sample | Report]:
@@ -644,6 +660,33 @@ def _parse_kv(line_tag: str, text: str) -> dict[str, int]:
     return {k: int(v, 16) for k, v in re.findall(r"(\w+)=([0-9A-F]+)", m.group(1))}
 
 
+class _Console:
+    """s51's command console on its stdin/stdout pipes (``-c -``; no prompt on a pipe)."""
+
+    def __init__(self, proc: subprocess.Popen[bytes], deadline: float, fail: Callable[[str], Exception]) -> None:
+        assert proc.stdin is not None and proc.stdout is not None
+        self.proc, self.deadline, self.fail = proc, deadline, fail
+        self.out = bytearray()  #: everything the console printed
+
+    def ask(self, command: str, until: re.Pattern[bytes]) -> re.Match[bytes]:
+        """Send ``command``; wait (up to the deadline) until its output matches ``until``."""
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        start = len(self.out)
+        self.proc.stdin.write(command.encode() + b"\n")
+        self.proc.stdin.flush()
+        while (m := until.search(self.out, start)) is None:
+            left = self.deadline - time.monotonic()
+            if left <= 0 or self.proc.poll() is not None:
+                raise self.fail(f"no answer to `{command}`")
+            if select.select([self.proc.stdout], [], [], min(left, 1.0))[0]:
+                self.out += os.read(self.proc.stdout.fileno(), 65536)
+        return m
+
+
+#: The end of a `step`'s report: the clock ticks it simulated (12 per machine cycle).
+_STEPPED = re.compile(rb"Simulated (\d+) ticks .*\nHost usage: [^\n]*\n")
+
+
 class Session:
     """A socat pty pair with s51 on one end (``with Session(image) as s:``).
 
@@ -651,9 +694,13 @@ class Session:
     Linux computer (:class:`LinkHost` through :func:`run`, or a program such
     as ``attitude-rx``) *before* ``s.run()`` starts the firmware, so that its
     BOOT report finds a listener. Every process is killed on exit.
+
+    ``lockstep=True``: no pty; the host end reads and writes s51's UART FIFOs
+    itself (:meth:`read`, :meth:`write`) and :meth:`run_lockstep` advances
+    simulated time only while the host is caught up (docs/firmware.md).
     """
 
-    def __init__(self, image: Image, timeout: float = 60.0) -> None:
+    def __init__(self, image: Image, timeout: float = 60.0, *, lockstep: bool = False) -> None:
         if image.kind == "production":
             raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
         for tool in ("s51", "socat"):
@@ -671,11 +718,18 @@ class Session:
         self._socat: subprocess.Popen[bytes] | None = None
         self._s51: subprocess.Popen[bytes] | None = None
         self._t0 = time.monotonic()
+        self.lockstep = lockstep
+        self._fds: list[int] = []  #: lockstep: the host's ends of the FIFOs (from s51, to s51)
+        self.sim_seconds = 0.0     #: lockstep: simulated time so far
+        self.max_step_s = 0.0      #: lockstep: the longest step's simulated time
 
     def __enter__(self) -> Session:  # noqa: PYI034 - typing.Self needs Python 3.11
         try:
             os.mkfifo(self._fw_in)
             os.mkfifo(self._fw_out)
+            if self.lockstep:  # both open read-write: no open() waits for s51's end
+                self._fds = [os.open(f, os.O_RDWR | os.O_NONBLOCK) for f in (self._fw_out, self._fw_in)]
+                return self
             self._socat = subprocess.Popen(
                 ["socat", f"OPEN:{self._fw_out},rdwr!!OPEN:{self._fw_in},rdwr", f"pty,raw,echo=0,link={self.port}"],
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
@@ -698,7 +752,64 @@ class Session:
     def close(self) -> None:
         _kill_group(self._s51)
         _kill_group(self._socat)
+        for fd in self._fds:
+            os.close(fd)
+        self._fds = []
         shutil.rmtree(self._tmp, ignore_errors=True)
+
+    def read(self) -> bytes:
+        """Lockstep: every byte the firmware's UART has sent and the host has not read."""
+        out = bytearray()
+        while True:
+            try:
+                chunk = os.read(self._fds[0], 4096)
+            except BlockingIOError:
+                return bytes(out)
+            out += chunk
+
+    def write(self, data: bytes) -> None:
+        """Lockstep: bytes to the firmware's UART (in the FIFO before the next step)."""
+        view = memoryview(data)
+        while view:
+            view = view[os.write(self._fds[1], view):]
+
+    def sim_time(self) -> float:
+        """Lockstep: simulated seconds since reset at the end of the last step."""
+        return self.sim_seconds
+
+    def _s51_cmd(self, *tail: str) -> list[str]:
+        return ["s51", "-t", "C52" if self.image.config.aided else "C51", "-R", "1",
+                "-I", f"if=sfr[0xff],out={self._tmp / 'sif.out'}", "-S", f"in={self._fw_in},out={self._fw_out}", *tail]
+
+    def run_lockstep(self, pump: Callable[[], None], describe: Callable[[], str] | None = None) -> SimOutput:
+        """Run s51 in steps of :data:`LOCKSTEP_INSNS` instructions from its console, calling
+        ``pump()`` (the host end: read everything, answer) between two steps, until the
+        firmware stops itself. Simulated time stands still while the host works or is
+        descheduled, so a byte the firmware sends is answered within the next step: at
+        most :data:`LOCKSTEP_BOUND_S` simulated seconds later, whatever the machine's load.
+        Errors as :meth:`run`."""
+        sif_out = self._tmp / "sif.out"
+        t_start = time.monotonic()
+
+        def fail(what: str) -> Exception:
+            return SimTimeout(f"s51 did not stop within {self.timeout} s ({what}); firmware output so far:\n"
+                              + (sif_out.read_text(errors="replace") if sif_out.exists() else "")
+                              + "\ns51 console (end):\n" + con.out.decode(errors="replace")[-3000:]
+                              + (f"\nhost: {describe()}" if describe is not None else ""))
+
+        self._s51 = subprocess.Popen(self._s51_cmd("-c", "-", str(self.image.ihx)), stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True,
+                                     cwd=self._tmp)
+        con = _Console(self._s51, t_start + self.timeout, fail)
+        con.ask("expr uart0_check_often=1", re.compile(rb"^1$", re.MULTILINE))
+        while not (sif_out.exists() and re.search(r"^EXIT \d+$", sif_out.read_text(errors="replace"), re.MULTILINE)):
+            step = int(con.ask(f"step {LOCKSTEP_INSNS}", _STEPPED).group(1)) / XTAL_HZ
+            self.sim_seconds += step
+            self.max_step_s = max(self.max_step_s, step)
+            pump()
+        con.ask("state", _STATE_SP)  # printed after the clock line
+        _kill_group(self._s51)
+        return _sim_output(sif_out.read_text(errors="replace"), bytes(con.out), time.monotonic() - t_start)
 
     def run(self, pump: Any = None, describe: Any = None) -> SimOutput:
         """Start s51 and wait until the firmware stops itself (``pump()``, if given, is
@@ -719,10 +830,8 @@ class Session:
         # yields the CPU to the host whenever both are ready: the simulation slows down with the
         # machine instead of running away from its host.
         self._s51 = s51 = subprocess.Popen(
-            ["nice", "-n", str(S51_NICE), "s51", "-t", "C52" if self.image.config.aided else "C51", "-R", "1",
-             "-I", f"if=sfr[0xff],out={sif_out}",
-             "-S", f"in={self._fw_in},out={self._fw_out}", "-C", str(cmds)], stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
+            ["nice", "-n", str(S51_NICE), *self._s51_cmd("-C", str(cmds))], stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True, cwd=self._tmp)
         assert s51.stdout is not None
         os.set_blocking(s51.stdout.fileno(), False)
         out = bytearray()
@@ -748,28 +857,58 @@ class Session:
             out += s51.stdout.read() or b""
         except (OSError, ValueError):
             pass
-        console = out.decode(errors="replace")
         output = sif_out.read_text(errors="replace") if sif_out.exists() else ""
-        wall = time.monotonic() - t_start
-        m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
-        if m is None or int(m.group(1)) != 0:
-            raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\n"
-                                f"console:\n{console[-2000:]}")
-        sp = _STATE_SP.search(out)
-        clk = _STATE_CLOCK.search(out)
-        if sp is None or clk is None:
-            raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
-        return SimOutput(output=output, console=console, stats=_parse_kv("STATS", output),
-                         bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
-                         sim_seconds=float(clk.group(1)), wall_seconds=wall)
+        return _sim_output(output, bytes(out), time.monotonic() - t_start)
+
+
+def _sim_output(output: str, out: bytes, wall: float) -> SimOutput:
+    """The run's result from the firmware's output and s51's console (``state`` printed)."""
+    console = out.decode(errors="replace")
+    m = re.search(r"^EXIT (\d+)$", output, re.MULTILINE)
+    if m is None or int(m.group(1)) != 0:
+        raise FirmwareError(f"firmware did not stop cleanly (EXIT 0); output:\n{output}\n"
+                            f"console:\n{console[-2000:]}")
+    sp = _STATE_SP.search(out)
+    clk = _STATE_CLOCK.search(out)
+    if sp is None or clk is None:
+        raise FirmwareError(f"no s51 state report in the console:\n{console[-2000:]}")
+    return SimOutput(output=output, console=console, stats=_parse_kv("STATS", output),
+                     bench=_parse_kv("BENCH", output), max_sp=int(sp.group(1), 16),
+                     sim_seconds=float(clk.group(1)), wall_seconds=wall)
 
 
 _STATE_SP = re.compile(rb"Max value of stack pointer= 0x([0-9a-fA-F]+)")
 _STATE_CLOCK = re.compile(rb"Total time since last reset= ([0-9.]+) sec")
 
 
-def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) -> SimResult:
+def _describe(host: LinkHost) -> str:
+    return f"{len(host.wire)} bytes on the wire, last {host.wire[-12:]}, receiver {host.stats()}"
+
+
+def _run_lockstep(image: Image, host: LinkHost, timeout: float) -> SimResult:
+    """:func:`run` with s51 in lockstep with ``host`` (on s51's simulated clock)."""
+    with Session(image, timeout, lockstep=True) as sess:
+        host.use_clock(sess.sim_time)
+
+        def pump() -> None:
+            data = sess.read()
+            reply = host.receive(data) if data else host._poll(host.tick())
+            if reply:
+                sess.write(reply)
+
+        out = sess.run_lockstep(pump, lambda: _describe(host))
+    return SimResult(**vars(out), host=host, max_step_s=sess.max_step_s)
+
+
+def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0, lockstep: bool = True) -> SimResult:
     """Run a sim/bench image in ``s51 -t C51`` with its UART on a pty pair and ``host`` on the other end.
+
+    ``lockstep`` (the default): s51 runs in steps from its console with ``host`` on its
+    UART's FIFOs, and simulated time advances only while the host is caught up, so the
+    firmware sees every host answer at most :data:`LOCKSTEP_BOUND_S` simulated seconds
+    late, however the OS schedules the host (docs/firmware.md "Lockstep"); the host's
+    ticks are simulated milliseconds. ``lockstep=False``: s51 runs freely (niced) and the
+    host answers over the pty in wall time, as any program on the pty does.
 
     The firmware stops itself (simulator interface) after the configured
     number of accepted blocks; s51 then prints its ``state`` (maximum stack
@@ -781,6 +920,8 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
     import serial  # pyserial
 
     host = host or LinkHost()
+    if lockstep:
+        return _run_lockstep(image, host, timeout)
     with Session(image, timeout) as sess:
         port = serial.Serial(str(sess.port), image.config.baud, timeout=0.01)
 
@@ -790,12 +931,8 @@ def run(image: Image, host: LinkHost | None = None, *, timeout: float = 60.0) ->
             if reply:
                 port.write(reply)
 
-        def describe() -> str:
-            return (f"{len(host.wire)} bytes on the wire, last {host.wire[-12:]}, "
-                    f"receiver {host.stats()}")
-
         try:
-            out = sess.run(pump, describe)
+            out = sess.run(pump, lambda: _describe(host))
         finally:
             port.close()
     return SimResult(**vars(out), host=host)
@@ -979,11 +1116,10 @@ def _acquire(cfg: SimConfig, n: int, progress: Callable[[str, int, int], None] |
         raise InvalidArgument(f"--firmware s51 needs a period that is a whole number of the "
                               f"firmware's 1/{TICK_HZ} s ticks, got {cfg.period} s")
     try:
-        # Link timeouts of 1 s of simulated time (the chip's default is 50 ms): s51 runs in
-        # simulated time, the host end in wall time, and a host answering late on a loaded
-        # machine must not make the firmware resend a block the host already accepted (the
-        # protocol's duplicate, docs/link.md), which would shift the numbering of the samples
-        # after it; late answers cost overruns instead, reported in place and counted as lost.
+        # Link timeouts of 1 s of simulated time (the chip's default is 50 ms): a firmware
+        # resend of a block the host already accepted (the protocol's duplicate, docs/link.md)
+        # would shift the numbering of the samples after it. run() drives s51 in lockstep, so
+        # an answer is at most LOCKSTEP_BOUND_S late; the long timeouts are the margin.
         fw_cfg = Config(period_ticks=round(ticks), max_attempts=cfg.link_attempts, syn_timeout=3600,
                         answer_timeout=3600)
         # every run builds its own image in its own directory: two runs at once (pytest -n 2)
