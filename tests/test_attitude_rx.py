@@ -890,24 +890,43 @@ def test_rx_warns_when_the_boot_period_cannot_fit_the_line(rx_builds) -> None:
 
 
 class _PtyMaster:
-    """The master side of attitude-rx's pty as a port for run_sender2."""
+    """The master side of attitude-rx's pty as a port for run_sender2. Writes wait for room
+    only while attitude-rx runs: once it has ended (--count), nobody reads the pty, and a
+    blocking write into its full buffer would hang the sender."""
 
     timeout = 0.01
     baudrate = None
     in_waiting = 0
 
-    def __init__(self, fd: int) -> None:
-        self.fd = fd
+    def __init__(self, fd: int, rx: Rx) -> None:
+        self.fd, self.rx = fd, rx
+        os.set_blocking(fd, False)
 
     def read(self, n: int) -> bytes:
         r, _, _ = select.select([self.fd], [], [], self.timeout)
         return os.read(self.fd, 4096) if r else b""
 
     def write(self, data: bytes) -> None:
-        os.write(self.fd, data)
+        view = memoryview(data)
+        while view and self.rx.proc.poll() is None:
+            _, w, _ = select.select([], [self.fd], [], self.timeout)
+            try:
+                view = view[os.write(self.fd, view):] if w else view
+            except BlockingIOError:  # room for less than the pty's write chunk: wait again
+                pass
 
     def flush(self) -> None:
         pass
+
+
+class _RxEnded:
+    """run_sender2's stop: set once attitude-rx has ended."""
+
+    def __init__(self, rx: Rx) -> None:
+        self.rx = rx
+
+    def is_set(self) -> bool:
+        return self.rx.proc.poll() is not None
 
 
 @pytest.mark.parametrize("link", ["v2", "auto"])
@@ -920,7 +939,8 @@ def test_rx_link_v2(rx_builds, link: str) -> None:
     codes = _gyro_codes(300)
     recs = [block.encode_boot(36, 9600)] + [_block(c) for c in codes]
     rx = Rx(rx_builds["host"], "--link", link, "--method", "rv1", "--count", "200", "--no-header")
-    rep = run_sender2(_PtyMaster(rx.master), recs, impl="python", timeout=15)
+    rep = run_sender2(_PtyMaster(rx.master, rx), recs, impl="python", timeout=15,
+                      stop=_RxEnded(rx))  # type: ignore[arg-type]
     rc, out, err = rx.finish(sig=None)
     assert rc == 0, err
     assert len(out.splitlines()) == 200
@@ -1019,7 +1039,7 @@ def test_rx_link_auto_undecodable_legacy_block_decides_nothing(rx_builds) -> Non
     rx = Rx(rx_builds["host"], "--method", "rv1", "--no-header", "--gap-ms", "2000")
     assert Feeder(rx.master, impl="c", timeout_ms=300).send(_block((0xF123, 0x4567, 0x89AB)))
     codes = [tuple(int(v) for v in c) for c in _gyro_codes(30)]
-    rep = run_sender2(_PtyMaster(rx.master), [block.encode_boot(72, 9600)] + [_block(c) for c in codes],
+    rep = run_sender2(_PtyMaster(rx.master, rx), [block.encode_boot(72, 9600)] + [_block(c) for c in codes],
                       impl="python", timeout=15)
     assert rep.acknowledged == 31
     time.sleep(0.3)
