@@ -614,13 +614,21 @@ def integrate_rates(omega: ArrayLike, dt: ArrayLike, method: Method = "rk4",
 # ---------------------------------------------------------------------------
 
 def sensor_values(words: ArrayLike, zero: ArrayLike, scale: ArrayLike, n: int = 1,
-                  axes: ArrayLike = (0, 1, 2), signs: ArrayLike = (1, 1, 1)) -> F:
+                  axes: ArrayLike = (0, 1, 2), signs: ArrayLike = (1, 1, 1),
+                  matrix: ArrayLike | None = None, bias: ArrayLike | None = None) -> F:
     """Body-frame values (M, 3) of sample words (M, 3), each the sum of ``n``
     conversions: body axis i reads channel ``axes[i]`` with sign ``signs[i]``,
     value = sign · (mean code − zero) · scale (the mean code of the channel is
-    word / n; zero in codes of one conversion, scale in units per code)."""
+    word / n; zero in codes of one conversion, scale in units per code); then
+    the correction out = matrix · (value − bias) (matrix 3 × 3, default the
+    identity; bias in the output's units, default 0)."""
     w = np.asarray(words, dtype=np.float64).reshape(-1, 3)
     mean = w / float(n)
     chan = (mean - np.asarray(zero, dtype=np.float64)) * np.asarray(scale, dtype=np.float64)
-    return chan[:, np.asarray(axes, dtype=np.intp)] * np.asarray(signs, dtype=np.float64)
+    value = chan[:, np.asarray(axes, dtype=np.intp)] * np.asarray(signs, dtype=np.float64)
+    if matrix is None and bias is None:
+        return value
+    m = np.eye(3) if matrix is None else np.asarray(matrix, dtype=np.float64).reshape(3, 3)
+    b = np.zeros(3) if bias is None else np.asarray(bias, dtype=np.float64)
+    return np.einsum("ij,kj->ki", m, value - b)
 

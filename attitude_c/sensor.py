@@ -5,10 +5,16 @@ docs/sensor.md): the one implementation of the host's codes → rates step,
 shared with ``attitude-rx``. For body axis i reading channel ``axes[i]``::
 
     value_i = signs[i] · (word / n − zero) · scale      (a gyro: rad/s)
-    Δθ_i    = value_i · period
+    out     = matrix · (value − bias)                   (default: I, 0)
+    Δθ_i    = out_i · period
 
 ``n`` is the number of conversions summed into each word (1, or the
-stream's OVERSAMPLE report, docs/block.md). The NumPy reference is
+stream's OVERSAMPLE report, docs/block.md). ``matrix`` (3 × 3,
+dimensionless: misalignment and scale-factor correction, soft iron) and
+``bias`` (output units: m/s², µT — hard iron) are the 3x3 correction; a
+magnetometer calibration ``m_cal = S (m − h)`` (:mod:`attitude_c.magcal`,
+fitted to this sensor's uncorrected values) is ``matrix=S, bias=h``
+(:meth:`Sensor.with_magcal`). The NumPy reference is
 :func:`attitude_c.reference.sensor_values`.
 """
 
@@ -19,11 +25,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import magcal, names
 from ._lib import ffi_lib
 from .core import FloatPrecision
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
 
 __all__ = ["Sensor", "adc_words"]
+
+_IDENTITY = np.eye(3)
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
@@ -63,11 +72,14 @@ class Sensor:
     (0..65535; fractional after a calibration); ``scale``: units per code per
     channel (a gyro: rad/s per code; non-zero); ``axes``: the channel each body
     axis reads (a permutation of 0, 1, 2); ``signs``: +1 or −1 per body axis;
-    ``precision``: the float build that converts.
+    ``precision``: the float build that converts; ``matrix`` (3, 3) and
+    ``bias`` (3,): the correction ``out = matrix · (value − bias)`` (``None``:
+    identity, zero), |det matrix| ≥ 1 / ``ATT_SENSOR_DET_RECIP`` (1/1000).
     """
 
     def __init__(self, zero: ArrayLike, scale: ArrayLike, axes: ArrayLike = (0, 1, 2),
-                 signs: ArrayLike = (1, 1, 1), precision: FloatPrecision = "f64") -> None:
+                 signs: ArrayLike = (1, 1, 1), precision: FloatPrecision = "f64", *,
+                 matrix: ArrayLike | None = None, bias: ArrayLike | None = None) -> None:
         if precision not in _DTYPES:
             raise InvalidArgument(f"precision must be one of {tuple(_DTYPES)}, got {precision!r}")
         self.zero = _triple(zero, "zero")
@@ -87,6 +99,22 @@ class Sensor:
             raise InvalidArgument(f"zero must be 0..65535 and scale non-zero, got zero {self.zero.tolist()}, "
                                   f"scale {self.scale.tolist()}")
         raise_for_status(st, "Sensor(zero, scale)")
+        self.matrix = _matrix(matrix)
+        self.bias = np.zeros(3) if bias is None else _triple(bias, "bias")
+        st = self._lib.att_sensor_set_correction(self._s, self.matrix.reshape(9).tolist(), self.bias.tolist())
+        if st == self._lib.ATT_E_ARG:
+            det_min = 1.0 / names.C["ATT_SENSOR_DET_RECIP"]
+            raise InvalidArgument(f"matrix must be invertible, |det| >= {det_min:g}, got det "
+                                  f"{np.linalg.det(self.matrix):.6g}: {self.matrix.tolist()}")
+        raise_for_status(st, "Sensor(matrix, bias)")
+
+    def with_magcal(self, cal: magcal.Calibration) -> Sensor:
+        """This sensor with a magnetometer calibration ``m_cal = S (m − h)`` fitted
+        to its uncorrected values as its correction: ``matrix = S``, ``bias = h``
+        (replacing any correction it had)."""
+        if not isinstance(cal, magcal.Calibration):
+            raise InvalidType(f"cal must be an attitude_c.magcal.Calibration, got {type(cal).__name__}")
+        return Sensor(self.zero, self.scale, self.axes, self.signs, self.precision, matrix=cal.S, bias=cal.h)
 
     def increments(self, words: ArrayLike, n: int = 1, period: float = 1.0) -> NDArray[Any]:
         """Words (M, 3) of ``n`` conversions each, sampled every ``period`` s → values
@@ -115,4 +143,21 @@ class Sensor:
 
     def __repr__(self) -> str:
         return (f"Sensor(zero={self.zero.tolist()}, scale={self.scale.tolist()}, axes={self.axes}, "
-                f"signs={self.signs}, precision={self.precision!r})")
+                f"signs={self.signs}, precision={self.precision!r}, matrix={self.matrix.tolist()}, "
+                f"bias={self.bias.tolist()})")
+
+
+def _matrix(x: ArrayLike | None) -> NDArray[np.float64]:
+    if x is None:
+        return _IDENTITY.copy()
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidType(f"matrix must be 3 x 3 numbers: {exc}") from None
+    if a.shape == (9,):
+        a = a.reshape(3, 3)
+    if a.shape != (3, 3):
+        raise InvalidArgument(f"matrix must have shape (3, 3) (or 9 numbers, row-major), got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise NonFiniteError(f"matrix holds NaN or Inf: {a.tolist()}")
+    return a

@@ -403,3 +403,30 @@ def test_soak_smoke(browser) -> None:
     # C extension loaded (~100-200 MiB); a leak of one copy per sample would show in the long run
     assert fig["rss_max_mb"] < 1024, fig
     assert math.isfinite(fig["rss_growth_second_half_mb"])
+
+
+def test_filter_bias_and_flags_from_attitude_rx(browser) -> None:
+    """attitude-rx's filter lines (--estimator ahrs) on stdin: the page lists the newest gyro-bias
+    estimate (°/s) and the filter's flags by name, with their labels."""
+    v = _view("--port", "0", "--stdin", "--display-rate", "20", stdin=subprocess.PIPE)
+    page = browser.new_page()
+    try:
+        page.goto(v.url)
+        page.wait_for_selector("body[data-state=waiting]", timeout=20_000)
+        for k in range(5):  # the shape of attitude_rx.c's print_filter, flags changing on the last line
+            flags = '["rest","acc_rejected"]' if k == 4 else "[]"
+            line = (f'{{"t":{0.01 * (k + 1)},"n":{k},"codes":[2048,2048,2048],"q":[1,0,0,0],"yaw_deg":0,'
+                    f'"pitch_deg":0,"roll_deg":0,"heading_deg":0,"held":0,"rate_dps":[0,0,0],'
+                    f'"bias_dps":[0.01234,-0.5,{0.25 * k}],"flags":{flags},"acc_ms2":[0,0,9.81]}}\n')
+            v.proc.stdin.write(line.encode())
+        v.proc.stdin.flush()
+        _wait_text(page, "counter-filter_flags", "rest acc_rejected")
+        assert page.text_content("#counter-bias_x_dps") == "0.0123"  # 4 decimals of °/s
+        assert page.text_content("#counter-bias_y_dps") == "-0.5"
+        assert page.text_content("#counter-bias_z_dps") == "1"
+        labels = page.eval_on_selector_all("#counters .kv-item .k", "els => els.map(e => e.textContent)")
+        assert {"gyro bias x (°/s)", "gyro bias y (°/s)", "gyro bias z (°/s)", "filter flags"} <= set(labels)
+        _shot(page, "view-filter-bias-flags")
+    finally:
+        page.close()
+        v.kill()

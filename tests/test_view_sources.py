@@ -486,3 +486,25 @@ def test_pace_stops_when_asked() -> None:
     hub.tick()
     assert hub.samples_in == 1  # the first sample is due at once, the second 1 s later
     hub.recorder.close()
+
+
+def test_line_reader_shows_the_filters_bias_and_flags() -> None:
+    """attitude-rx's filter lines (--estimator ahrs): the gyro-bias estimate (°/s) and the flags of
+    the newest sample become the counters the page lists (JSON names; CSV: the ATT_AHRS_F_* bits)."""
+    from attitude_c.names import C
+
+    r = sources.LineReader()
+    p = r.feed('{"t":0.02,"n":1,"codes":[2048,2048,2048],"q":[1,0,0,0],"held":0,"rate_dps":[0,0,0],'
+               '"bias_dps":[0.012345,-0.5,0],"flags":["rest","mag_disturbed"],"acc_ms2":[0,0,9.8]}')
+    assert p.kind == "sample"
+    assert p.counters == {"held": 0, "bias_x_dps": 0.0123, "bias_y_dps": -0.5, "bias_z_dps": 0.0,
+                          "filter_flags": "rest mag_disturbed"}
+    p = r.feed('{"t":0.04,"n":2,"q":[1,0,0,0],"held":0,"bias_dps":[0,0,0],"flags":[]}')
+    assert p.counters["filter_flags"] == "none"
+    r = sources.LineReader()
+    r.feed("t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg,"
+           "bias_x_dps,bias_y_dps,bias_z_dps,flags")
+    bits = C["ATT_AHRS_F_REST"] | C["ATT_AHRS_F_ACC_REJECTED"]
+    p = r.feed(f"0.06,2,2100,2048,2000,1,0,0,0,0,0,0,0,0.25,0,-0.125,{bits}")
+    assert p.counters == {"bias_x_dps": 0.25, "bias_y_dps": 0.0, "bias_z_dps": -0.125,
+                          "filter_flags": "rest acc_rejected"}

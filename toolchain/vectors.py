@@ -289,11 +289,14 @@ def aiding_cases(rng: np.random.Generator, n: int = 48) -> list[Case]:
 
 def sensor_cases(rng: np.random.Generator) -> list[Case]:
     """Sensor words to increments (att_sensor_increments) against reference.sensor_values:
-    plain codes and sums of 16 and of 3 conversions, permuted and signed axes, and a word
+    plain codes and sums of 16 and of 3 conversions, permuted and signed axes, a correction
+    matrix and bias (att_sensor_set_correction; the others: identity and zero), and a word
     above its limit (the error names the sample, nothing is written)."""
     ref = _ref()
     out: list[Case] = []
-    for n_conv, period in ((1, 0.02), (16, 0.08), (3, 0.005)):
+    for case, (n_conv, period) in enumerate(((1, 0.02), (16, 0.08), (3, 0.005), (1, 0.01))):
+        corrected = case == 3
+        mat = _f32(np.eye(3) + rng.uniform(-0.1, 0.1, size=(3, 3))) if corrected else np.eye(3)
         m = 40
         words = rng.integers(0, n_conv * 4095 + 1, size=(m, 3)).astype(np.float64)
         words[0] = 0
@@ -303,16 +306,22 @@ def sensor_cases(rng: np.random.Generator) -> list[Case]:
         axes = rng.permutation(3)
         signs = rng.choice([-1, 1], size=3)
         per = float(_f32(np.array([period]))[0])
+        bias = _f32(rng.uniform(-0.5, 0.5, size=3) * float(np.max(np.abs(scale))) * 4096) if corrected \
+            else np.zeros(3)
         params = [str(n_conv), repr(per), *(repr(float(v)) for v in (*zero, *scale)),
-                  *(str(int(v)) for v in (*axes, *signs))]
-        exp = ref.sensor_values(words, zero, scale, n_conv, axes, signs) * per
+                  *(str(int(v)) for v in (*axes, *signs)), *(repr(float(v)) for v in (*mat.ravel(), *bias))]
+        exp = ref.sensor_values(words, zero, scale, n_conv, axes, signs, mat, bias) * per
         # the terms before the subtraction are ~4096 codes × |scale| × period: the roundings'
-        # size (the difference itself may be much smaller)
-        big = 4096 * float(np.max(np.abs(scale))) * per
-        out.append(Case(f"sensor.n{n_conv}", "sensor", words, params=params, expected=exp, ops=8, scale=big))
+        # size (the difference itself may be much smaller); the correction: 6 more roundings of
+        # terms up to a row of |M| times (|value| + |b|)
+        big = (4096 * float(np.max(np.abs(scale))) + float(np.max(np.abs(bias)))) * per \
+            * float(np.abs(mat).sum(axis=1).max())
+        name = f"sensor.corrected.n{n_conv}" if corrected else f"sensor.n{n_conv}"
+        out.append(Case(name, "sensor", words, params=params, expected=exp, ops=14 if corrected else 8, scale=big))
         bad = words.copy()
         bad[7, 2] = n_conv * 4095 + 1
-        out.append(Case(f"sensor.bad.n{n_conv}", "sensor", bad, params=params, status_ok=False, err_index=7))
+        if not corrected:
+            out.append(Case(f"sensor.bad.n{n_conv}", "sensor", bad, params=params, status_ok=False, err_index=7))
     return out
 
 

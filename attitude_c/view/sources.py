@@ -124,6 +124,31 @@ _CSV_EULER_DEG = ("yaw_deg", "pitch_deg", "roll_deg")
 # attitude simulate's timeseries.csv (attitude_c.sim.report.TIMESERIES_COLUMNS; before issue 27, without units)
 _CSV_EULER_RAD = (("yaw_est_rad", "pitch_est_rad", "roll_est_rad"), ("yaw_est", "pitch_est", "roll_est"))
 _CSV_RATE_DPS = ("rate_x_dps", "rate_y_dps", "rate_z_dps")
+_CSV_BIAS_DPS = ("bias_x_dps", "bias_y_dps", "bias_z_dps")  # attitude-rx's filter lines (and "flags")
+
+
+def _filter_counters(bias_dps: list[float] | None, flags: Any) -> dict[str, Any]:
+    """attitude-rx's filter fields of the newest sample as counters the page shows: the gyro-bias
+    estimate (°/s, 4 decimals) and the flags by name (a list of names, or the ATT_AHRS_F_* bits;
+    "none" when no flag is set)."""
+    out: dict[str, Any] = {}
+    if bias_dps is not None:
+        out.update({k: round(float(v), 4) for k, v in zip(_CSV_BIAS_DPS, bias_dps)})
+    if isinstance(flags, int) and not isinstance(flags, bool):
+        flags = _flag_names(flags)
+    if isinstance(flags, list):
+        out["filter_flags"] = " ".join(str(f) for f in flags) or "none"
+    return out
+
+
+def _flag_names(bits: int) -> list[str]:
+    """The names of the attitude filter's flag bits (ATT_AHRS_F_*, attitude/ahrs.h), as attitude-rx's
+    JSON Lines print them."""
+    from ..names import C
+
+    pre = "ATT_AHRS_F_"
+    return [k[len(pre):].lower() for k, v in sorted(C.items(), key=lambda kv: kv[1])
+            if k.startswith(pre) and bits & v]
 
 
 def _vec(d: dict[str, Any], key: str, k: int, scale: float = 1.0) -> list[float] | None:
@@ -146,7 +171,9 @@ class LineReader:
     ``{"report": NAME, ...}`` is a report and ``{"error": ...}`` an error
     (events); ``{"link": {...}}`` or ``{"stats": {...}}`` records give
     counters (their numeric fields). attitude-rx's cumulative ``held``
-    becomes a counter. Anything else is counted and ignored.
+    becomes a counter, and so do its filter's ``bias_dps`` and ``flags`` of
+    the newest sample (``bias_x_dps`` .. ``bias_z_dps``, ``filter_flags``;
+    CSV: the bias columns and ``flags``). Anything else is counted and ignored.
     """
 
     def __init__(self) -> None:
@@ -180,8 +207,9 @@ class LineReader:
             smp = row(t, q, n=None if n is None else float(n), rate=_vec(d, "rate_dps", 3, _RAD),
                       q_true=_vec(d, "true_q", 4), euler=eul, heading=None if h is None else float(h) * _RAD)
             p = Parsed("sample", t, sample=smp)
-            if "held" in d:
-                p.counters = {"held": d["held"]}
+            counters = {"held": d["held"]} if "held" in d else {}
+            counters.update(_filter_counters(_vec(d, "bias_dps", 3), d.get("flags")))
+            p.counters = counters or None
             return p
         t = float(d.get("t", float("nan")))
         if "report" in d:
@@ -227,7 +255,11 @@ class LineReader:
         tq = [num(c) for c in r["true_q"]] if r.get("true_q") else None
         h = num(r["heading"]) * _RAD if r.get("heading") else None
         n = num(r["n"]) if r.get("n") else None
-        return Parsed("sample", t, sample=row(t, q, n=n, rate=rate, q_true=tq, euler=eul, heading=h))
+        p = Parsed("sample", t, sample=row(t, q, n=n, rate=rate, q_true=tq, euler=eul, heading=h))
+        if r.get("bias"):
+            bits = num("flags") if "flags" in cols else math.nan
+            p.counters = _filter_counters([num(c) for c in r["bias"]], int(bits) if math.isfinite(bits) else None)
+        return p
 
     def _header(self, fields: list[str]) -> None:
         names = [f.strip() for f in fields]
@@ -239,6 +271,7 @@ class LineReader:
         r["euler_deg"] = _CSV_EULER_DEG if all(c in cols for c in _CSV_EULER_DEG) else None
         r["euler_rad"] = next((g for g in _CSV_EULER_RAD if all(c in cols for c in g)), None)
         r["rate"] = _CSV_RATE_DPS if all(c in cols for c in _CSV_RATE_DPS) else None
+        r["bias"] = _CSV_BIAS_DPS if all(c in cols for c in _CSV_BIAS_DPS) else None
         r["heading"] = "heading_deg" if "heading_deg" in cols else None
         r["n"] = "n" if "n" in cols else None
         r["event"] = "event" if "event" in cols else None

@@ -85,7 +85,10 @@ typedef struct {
     unsigned long pending;     /* sample periods integrated since the last update (rv2/rv3/rk4) */
     unsigned long undelivered; /* acknowledged samples never integrated: output failed or blocked */
     unsigned long lines_lost;  /* attitude lines that could not be written */
-    unsigned long reports[ATT_BLOCK_OVERSAMPLE + 1];
+    unsigned long reports[ATT_BLOCK_CHANNELS + 1];
+    unsigned long acc_records, mag_records; /* aiding records handled (aided streams) */
+    unsigned long aid_unused;               /* ... not used: the integrator's, or their sample missing */
+    int header_est;                         /* CSV: the estimator whose header was printed (-1: none) */
     unsigned long block_errors, seq_errors;
     double period;   /* s, the sample period in use */
     double t;        /* s, time integrated so far (sample periods, held ones included) */
@@ -94,8 +97,9 @@ typedef struct {
     int out_blocked; /* stdout stayed blocked past the grace time after a stop */
 } rx_app;
 
-static const char *const report_names[ATT_BLOCK_OVERSAMPLE + 1] = { "BOOT",    "SELFTEST",  "GAVE_UP",
-                                                                    "OVERRUN", "ADC_ERROR", "OVERSAMPLE" };
+static const char *const report_names[ATT_BLOCK_CHANNELS + 1] = { "BOOT",    "SELFTEST",  "GAVE_UP",
+                                                                  "OVERRUN", "ADC_ERROR", "OVERSAMPLE",
+                                                                  "CHANNELS" };
 
 static rx_stop *g_stop = NULL; /* for the signal handler only */
 static volatile sig_atomic_t g_signal = 0;
@@ -185,6 +189,8 @@ static int is_loss(unsigned kind)
  * rules as sample(), bad_record() and hold() below). */
 static unsigned long periods_of(const rx_item *it, int *have_good)
 {
+    if (it->blk.kind == ATT_BLOCK_SAMPLE && it->span.part != ATT_BLOCK_PART_GYR)
+        return 0; /* an accelerometer or magnetometer record: part of its sample's period */
     if (it->status == ATT_OK && it->blk.kind == ATT_BLOCK_SAMPLE) {
         *have_good = 1;
         return 1;
@@ -198,15 +204,39 @@ static unsigned long periods_of(const rx_item *it, int *have_good)
     return 0;
 }
 
-/* --count: are the acknowledged samples already enough for it? */
+/* --count: are the acknowledged samples already enough for it? (The records still due
+ * in the last sample's group belong to its line: never refused.) The filter prints a
+ * line per sample, the integrator per update of its method. */
 static int count_reached(rx_app *app, const rx_acked *x)
 {
     unsigned long failed, n;
-    if (app->cfg.count == 0)
+    if (app->cfg.count == 0 || x->seq.part != ATT_BLOCK_PART_GYR)
         return 0;
     failed = rx_queue_failed(&app->queue);
     n = x->periods > failed ? x->periods - failed : 0;
+    if (rx_estimator_for(app->cfg.estimator, x->seq.channels) == RX_EST_AHRS)
+        return n >= app->cfg.count;
     return att_integ_outputs(&x->shape, (size_t)n) >= app->cfg.count;
+}
+
+/* Decode and number one record of an accepted block (or a link v2 delivery). */
+static void number(att_block_seq *seq, rx_item *it, const uint8_t *raw)
+{
+    memset(it, 0, sizeof *it);
+    memcpy(it->raw, raw, sizeof it->raw);
+    it->status =
+        att_block_seq_decode(seq, it->raw, &it->blk, &it->span); /* a bad sample still takes its place */
+    if (it->status == ATT_BLOCK_E_SEQ) {
+        it->seq_status = it->status;
+        it->status = ATT_OK;
+    }
+    it->closes = it->blk.kind == ATT_BLOCK_SAMPLE && seq->part == ATT_BLOCK_PART_GYR;
+}
+
+/* Sample records that number a sample (gyro records; in a gyro-only stream every one). */
+static unsigned numbers_a_sample(const rx_item *it)
+{
+    return it->blk.kind == ATT_BLOCK_SAMPLE && it->span.part == ATT_BLOCK_PART_GYR;
 }
 
 /* A block passed the checksum (the receiver machine queued 0x00). Decode
@@ -232,18 +262,9 @@ static int deliver(rx_app *app, rx_acked *x, const uint8_t *block)
         return ATT_LINK_NAK;
     }
     for (k = 0; k + ATT_BLOCK_SIZE <= app->cfg.block_size; k += ATT_BLOCK_SIZE, n++) {
-        rx_item *it = &items[n];
-        memset(it, 0, sizeof *it);
-        memcpy(it->raw, block + k, sizeof it->raw);
-        it->status = att_block_seq_decode(&seq, it->raw, &it->blk,
-                                          &it->span); /* a bad sample still takes its number */
-        if (it->status == ATT_BLOCK_E_SEQ) {
-            it->seq_status = it->status;
-            it->status = ATT_OK;
-        }
-        if (it->blk.kind == ATT_BLOCK_SAMPLE)
-            samples++;
-        periods += periods_of(it, &have_good);
+        number(&seq, &items[n], block + k);
+        samples += numbers_a_sample(&items[n]);
+        periods += periods_of(&items[n], &have_good);
     }
     after_ms(&deadline, app->cfg.hold_ms);
     for (;;) { /* wait for room in slices of 10 ms, watching for a stop request */
@@ -294,17 +315,9 @@ static void deliver2(rx_app *app, rx_acked *x, const uint8_t *out, unsigned n)
     unsigned long periods = 0;
     struct timespec now;
     for (k = 0; k < n; k++) {
-        rx_item *it = &items[k];
-        memset(it, 0, sizeof *it);
-        memcpy(it->raw, out + ATT_LINK2_RECORD * k, sizeof it->raw);
-        it->status = att_block_seq_decode(&x->seq, it->raw, &it->blk, &it->span);
-        if (it->status == ATT_BLOCK_E_SEQ) {
-            it->seq_status = it->status;
-            it->status = ATT_OK;
-        }
-        if (it->blk.kind == ATT_BLOCK_SAMPLE)
-            samples++;
-        periods += periods_of(it, &x->have_good);
+        number(&x->seq, &items[k], out + ATT_LINK2_RECORD * k);
+        samples += numbers_a_sample(&items[k]);
+        periods += periods_of(&items[k], &x->have_good);
     }
     clock_gettime(CLOCK_MONOTONIC, &now);
     if (rx_queue_push_all(&app->queue, items, n, &now) != 0)
@@ -529,50 +542,164 @@ static void out_line(rx_app *app, const char *line, int len, int update)
     }
 }
 
-static void print_header(rx_app *app)
+/* JSON Lines record for a report or an error (--format jsonl only); body: ,"key":value... */
+static void json_record(rx_app *app, const char *body)
 {
-    static const char h[] = "t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg\n";
-    if (app->cfg.format == RX_FORMAT_CSV && app->cfg.header)
-        out_line(app, h, (int)sizeof h - 1, 0);
+    char line[RX_LINE_MAX];
+    if (app->cfg.format == RX_FORMAT_JSONL)
+        out_line(app, line, snprintf(line, sizeof line, "{\"t\":%.9g,%s}\n", app->t, body), 0);
 }
 
-static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
-                         const att_real q[4])
+/* CSV: the header of the estimator whose lines follow, before its first line (again
+ * when a new stream changes the estimator). */
+static void print_header(rx_app *app, rx_estimator e)
 {
-    att_real e[3], h = 0;
-    const double r2d = 180.0 / 3.14159265358979323846;
-    const int digits = att_real_size() == 4 ? 9 : 17; /* round-trip precision */
-    double t = app->t;
+    static const char h[] = "t,n,code_x,code_y,code_z,q0,q1,q2,q3,yaw_deg,pitch_deg,roll_deg,heading_deg";
     char line[RX_LINE_MAX];
-    int len;
+    if (app->cfg.format != RX_FORMAT_CSV || !app->cfg.header || app->header_est == (int)e)
+        return;
+    app->header_est = (int)e;
+    out_line(app, line,
+             snprintf(line, sizeof line, "%s%s\n", h,
+                      e == RX_EST_AHRS ? ",bias_x_dps,bias_y_dps,bias_z_dps,flags" : ""),
+             0);
+}
+
+#define RX_R2D (180.0 / 3.14159265358979323846) /* degrees per radian (as computed before: bit for bit) */
+
+/* The fields every attitude line starts with, CSV or JSON (no line end, JSON not closed):
+ * t, n, codes, q, Euler angles and heading in degrees (held: JSON). */
+static int line_head(const rx_app *app, char *line, size_t size, uint32_t n, const uint16_t code[3],
+                     const att_real q[4])
+{
+    const int digits = att_real_size() == 4 ? 9 : 17; /* round-trip precision */
+    att_real e[3], h = 0;
     if (att_quat_to_euler(q, e) != ATT_OK || att_quat_heading(q, &h) != ATT_OK)
         e[0] = e[1] = e[2] = h = (att_real)0;
     if (app->cfg.format == RX_FORMAT_CSV)
-        len = snprintf(line, sizeof line, "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g\n", t,
-                       (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
-                       (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d,
-                       digits, (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d);
-    else
-        len = snprintf(
-            line, sizeof line,
-            "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],"
-            "\"yaw_deg\":%.*g,\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu,"
-            "\"rate_dps\":[%.*g,%.*g,%.*g]}\n",
-            t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits, (double)q[1],
-            digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * r2d, digits,
-            (double)e[1] * r2d, digits, (double)e[2] * r2d, digits, (double)h * r2d, app->held, digits,
-            (double)v[0] * r2d, digits, (double)v[1] * r2d, digits, (double)v[2] * r2d);
+        return snprintf(line, size, "%.9g,%lu,%u,%u,%u,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g", app->t,
+                        (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
+                        (double)q[1], digits, (double)q[2], digits, (double)q[3], digits,
+                        (double)e[0] * RX_R2D, digits, (double)e[1] * RX_R2D, digits, (double)e[2] * RX_R2D,
+                        digits, (double)h * RX_R2D);
+    return snprintf(line, size,
+                    "{\"t\":%.9g,\"n\":%lu,\"codes\":[%u,%u,%u],\"q\":[%.*g,%.*g,%.*g,%.*g],\"yaw_deg\":%.*g,"
+                    "\"pitch_deg\":%.*g,\"roll_deg\":%.*g,\"heading_deg\":%.*g,\"held\":%lu",
+                    app->t, (unsigned long)n, code[0], code[1], code[2], digits, (double)q[0], digits,
+                    (double)q[1], digits, (double)q[2], digits, (double)q[3], digits, (double)e[0] * RX_R2D,
+                    digits, (double)e[1] * RX_R2D, digits, (double)e[2] * RX_R2D, digits, (double)h * RX_R2D,
+                    app->held);
+}
+
+/* ,"key":[x,y,z] scaled by k (CSV: ,x,y,z); nothing when v is NULL */
+static int vec3(const rx_app *app, char *p, size_t len, const char *key, const att_real *v, double k)
+{
+    const int digits = att_real_size() == 4 ? 9 : 17;
+    if (v == NULL)
+        return 0;
+    if (app->cfg.format == RX_FORMAT_CSV)
+        return snprintf(p, len, ",%.*g,%.*g,%.*g", digits, (double)v[0] * k, digits, (double)v[1] * k, digits,
+                        (double)v[2] * k);
+    return snprintf(p, len, ",\"%s\":[%.*g,%.*g,%.*g]", key, digits, (double)v[0] * k, digits,
+                    (double)v[1] * k, digits, (double)v[2] * k);
+}
+
+/* An integrator line: the head, then (JSON) the body rate of the newest sample. */
+static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
+                         const att_real q[4])
+{
+    char line[RX_LINE_MAX];
+    int len;
+    print_header(app, RX_EST_INTEGRATOR);
+    len = line_head(app, line, sizeof line, n, code, q);
+    if (app->cfg.format != RX_FORMAT_CSV)
+        len += vec3(app, line + len, sizeof line - (size_t)len, "rate_dps", v, RX_R2D);
+    len +=
+        snprintf(line + len, sizeof line - (size_t)len, "%s\n", app->cfg.format == RX_FORMAT_CSV ? "" : "}");
     out_line(app, line, len, 1);
 }
 
-/* The attitude thread's integration state. */
+/* The filter's flags by name (attitude/ahrs.h, ATT_AHRS_F_*). */
+static const struct {
+    int bit;
+    const char *name;
+} flag_names[] = { { ATT_AHRS_F_OVERRANGE, "overrange" },
+                   { ATT_AHRS_F_REST, "rest" },
+                   { ATT_AHRS_F_ACC_REJECTED, "acc_rejected" },
+                   { ATT_AHRS_F_MAG_DISTURBED, "mag_disturbed" },
+                   { ATT_AHRS_F_MAG_RELEARNED, "mag_relearned" } };
+
+/* ,"flags":["rest",...] */
+static int json_flags(char *p, size_t len, int flags)
+{
+    size_t i;
+    int n = snprintf(p, len, ",\"flags\":[");
+    for (i = 0; i < sizeof flag_names / sizeof flag_names[0]; i++)
+        if ((flags & flag_names[i].bit) && n >= 0 && (size_t)n < len)
+            n += snprintf(p + n, len - (size_t)n, "%s\"%s\"", p[n - 1] == '[' ? "" : ",", flag_names[i].name);
+    if (n >= 0 && (size_t)n < len)
+        n += snprintf(p + n, len - (size_t)n, "]");
+    return n;
+}
+
+/* What the filter adds to a line: its gyro-bias estimate and flags, the sample's aiding vectors. */
+typedef struct {
+    att_real bias[3];          /* rad/s */
+    int flags;                 /* ATT_AHRS_F_* */
+    const att_real *acc, *mag; /* m/s², µT, or NULL: not in this sample */
+} rx_filter_out;
+
+/* A filter line: the head, then the rate, bias (°/s), flags, acc (m/s²) and mag (µT) in JSON;
+ * the bias (°/s) and the flag bits in CSV. */
+static void print_filter(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
+                         const att_real q[4], const rx_filter_out *f)
+{
+    char line[RX_LINE_MAX];
+    int w;
+    print_header(app, RX_EST_AHRS);
+    w = line_head(app, line, sizeof line, n, code, q);
+    if (app->cfg.format == RX_FORMAT_CSV) {
+        w += vec3(app, line + w, sizeof line - (size_t)w, "bias_dps", f->bias, RX_R2D);
+        w += snprintf(line + w, sizeof line - (size_t)w, ",%d\n", f->flags);
+        out_line(app, line, w, 1);
+        return;
+    }
+    w += vec3(app, line + w, sizeof line - (size_t)w, "rate_dps", v, RX_R2D);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "bias_dps", f->bias, RX_R2D);
+    w += json_flags(line + w, sizeof line - (size_t)w, f->flags);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "acc_ms2", f->acc, 1.0);
+    w += vec3(app, line + w, sizeof line - (size_t)w, "mag_ut", f->mag, 1.0);
+    w += snprintf(line + w, sizeof line - (size_t)w, "}\n");
+    out_line(app, line, w, 1);
+}
+
+/* The sample whose accelerometer and magnetometer records are still due (the filter). */
+typedef struct {
+    int open;         /* its gyro record came; the group is not complete */
+    uint32_t n;       /* its number */
+    att_real gyr[3];  /* rad/s */
+    uint16_t code[3]; /* its gyro codes */
+    att_real acc[3];  /* m/s² */
+    att_real mag[3];  /* µT */
+    int has_acc, has_mag;
+} rx_group;
+
+/* The attitude thread's estimator state. */
 typedef struct {
     att_integ integ;
-    att_sensor gyro;    /* codes -> body rate (--gyro-zero, --gyro-scale, --axes) */
+    att_sensor gyro; /* codes -> body rate (--gyro-zero, --gyro-scale, --axes) */
+    att_sensor acc;  /* codes -> specific force, m/s² (acc-*) */
+    att_sensor mag;  /* codes -> field, µT (mag-*) */
+    att_ahrs ahrs;   /* the filter (initialized when a stream first needs it) */
+    int ahrs_ready;
+    rx_estimator est;   /* this stream's estimator, once est_known */
+    int est_known;      /* resolved at the stream's first sample */
+    unsigned channels;  /* this stream's channel set (CHANNELS; a BOOT: gyro only) */
     uint8_t oversample; /* conversions per sample word: 1, or the stream's OVERSAMPLE */
     att_real rate[3];   /* body rate of the last good sample, rad/s */
     uint16_t code[3];   /* its codes */
     int have_rate;      /* a good sample has been integrated */
+    rx_group grp;       /* the filter's sample waiting for its group */
 } rx_att;
 
 static int finished(const rx_app *app)
@@ -613,6 +740,76 @@ static void integrate(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], c
         rx_stop_request(&app->stop);
 }
 
+/* One sample period through the filter: gyr (rad/s), acc, mag (or NULL). */
+static void filter(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], const uint16_t code[3],
+                   const att_real *acc, const att_real *mag)
+{
+    att_real q[4];
+    rx_filter_out f;
+    int rc = att_ahrs_update(&a->ahrs, v, acc, mag, (att_real)app->period, q);
+    if (rc != ATT_OK) {
+        app->integ_errors++;
+        rx_queue_count_failed(&app->queue); /* the receiver's --count accounting */
+        rx_log(&app->stop, "sample %lu rejected by the filter: %s", (unsigned long)n, att_status_str(rc));
+        return;
+    }
+    app->t += app->period;
+    if (app->cfg.count && app->updates >= app->cfg.count)
+        return; /* past --count: filtered, not printed */
+    app->updates++;
+    att_ahrs_bias(&a->ahrs, f.bias);
+    f.flags = att_ahrs_flags(&a->ahrs);
+    f.acc = acc;
+    f.mag = mag;
+    print_filter(app, n, code, v, q, &f);
+    if (app->cfg.count && app->updates == app->cfg.count)
+        rx_stop_request(&app->stop);
+}
+
+/* The estimator of this stream, chosen at its first sample (or missing period). */
+static rx_estimator estimator(rx_app *app, rx_att *a)
+{
+    rx_estimator e;
+    if (a->est_known)
+        return a->est;
+    e = rx_estimator_for(app->cfg.estimator, a->channels);
+    if (e == RX_EST_AHRS && !a->ahrs_ready) {
+        if (att_ahrs_init(&a->ahrs, &app->cfg.ahrs, NULL) == ATT_OK)
+            a->ahrs_ready = 1;
+        else
+            e = RX_EST_INTEGRATOR; /* not reached: the settings were checked when read */
+    }
+    if (app->cfg.estimator == RX_EST_AHRS && e != RX_EST_AHRS)
+        rx_log(&app->stop,
+               "warning: --estimator ahrs, but the stream has no accelerometer (%s): integrating "
+               "the gyros",
+               a->channels & ATT_BLOCK_CH_GYR ? "gyro only" : "no CHANNELS report");
+    rx_log(&app->stop, "estimator: %s", rx_estimator_name(e));
+    a->est = e;
+    a->est_known = 1;
+    return e;
+}
+
+/* One sample period through this stream's estimator (the held rate: acc, mag NULL). */
+static void step(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], const uint16_t code[3],
+                 const att_real *acc, const att_real *mag)
+{
+    if (estimator(app, a) == RX_EST_AHRS)
+        filter(app, a, n, v, code, acc, mag);
+    else
+        integrate(app, a, n, v, code);
+}
+
+/* The group of the open sample is complete (or cut short): filter it. */
+static void close_group(rx_app *app, rx_att *a)
+{
+    rx_group *g = &a->grp;
+    if (!g->open)
+        return;
+    g->open = 0;
+    filter(app, a, g->n, g->gyr, g->code, g->has_acc ? g->acc : NULL, g->has_mag ? g->mag : NULL);
+}
+
 /* Samples first .. first + n - 1 will never come (why: for the log): hold
  * the last good rate over them, or, before the first good sample, only
  * let the time pass. */
@@ -635,11 +832,12 @@ static void hold(rx_app *app, rx_att *a, uint32_t first, uint32_t n, const char 
            (unsigned long)n, n == 1u ? "" : "s");
     for (k = 0; k < n && !finished(app); k++) {
         app->held++;
-        integrate(app, a, first + k, a->rate, a->code);
+        step(app, a, first + k, a->rate, a->code, NULL, NULL);
     }
 }
 
-/* A good sample: codes -> body rate (calibration, axes: att_sensor) -> integrator. */
+/* A good sample: codes -> body rate (calibration, axes: att_sensor) -> the estimator
+ * (the filter: once its group's accelerometer and magnetometer records are in). */
 static void sample(rx_app *app, rx_att *a, const rx_item *it)
 {
     int i;
@@ -649,15 +847,50 @@ static void sample(rx_app *app, rx_att *a, const rx_item *it)
         a->code[i] = it->blk.code[i];
     a->have_rate = 1;
     app->integrated++;
-    integrate(app, a, it->span.first, a->rate, a->code);
+    if (estimator(app, a) != RX_EST_AHRS) {
+        integrate(app, a, it->span.first, a->rate, a->code);
+        return;
+    }
+    memset(&a->grp, 0, sizeof a->grp);
+    a->grp.open = 1;
+    a->grp.n = it->span.first;
+    memcpy(a->grp.gyr, a->rate, sizeof a->grp.gyr);
+    memcpy(a->grp.code, a->code, sizeof a->grp.code);
+    if (it->closes)
+        close_group(app, a);
 }
 
-/* JSON Lines record for a report or an error (--format jsonl only); body: ,"key":value... */
-static void json_record(rx_app *app, const char *body)
+/* An accelerometer or magnetometer record: into its sample's group (the filter), or counted. */
+static void aiding(rx_app *app, rx_att *a, const rx_item *it)
 {
-    char line[RX_LINE_MAX];
-    if (app->cfg.format == RX_FORMAT_JSONL)
-        out_line(app, line, snprintf(line, sizeof line, "{\"t\":%.9g,%s}\n", app->t, body), 0);
+    const int is_acc = it->span.part == ATT_BLOCK_PART_ACC;
+    rx_group *g = &a->grp;
+    att_real *v = is_acc ? g->acc : g->mag;
+    char body[RX_MSG_MAX];
+    if (is_acc)
+        app->acc_records++;
+    else
+        app->mag_records++;
+    if (it->status != ATT_OK) { /* a code above the stream's limit: this sample goes without it */
+        app->code_errors++;
+        rx_log(&app->stop, "%s record of sample %lu rejected: code out of range (%u, %u, %u)",
+               is_acc ? "accelerometer" : "magnetometer", (unsigned long)it->span.first, it->blk.code[0],
+               it->blk.code[1], it->blk.code[2]);
+        snprintf(body, sizeof body, "\"error\":\"code\",\"n\":%lu,\"part\":\"%s\",\"codes\":[%u,%u,%u]",
+                 (unsigned long)it->span.first, is_acc ? "acc" : "mag", it->blk.code[0], it->blk.code[1],
+                 it->blk.code[2]);
+        json_record(app, body);
+    } else if (g->open && g->n == it->span.first
+               && att_sensor_convert(is_acc ? &a->acc : &a->mag, it->blk.code, a->oversample, v) == ATT_OK) {
+        if (is_acc)
+            g->has_acc = 1;
+        else
+            g->has_mag = 1;
+    } else {
+        app->aid_unused++; /* the integrator's stream, or its sample's gyro record was missing */
+    }
+    if (it->closes)
+        close_group(app, a);
 }
 
 /* --format jsonl: the link's counters as a {"link":{...}} record (cumulative). */
@@ -751,15 +984,42 @@ static void boot(rx_app *app, const att_block *b)
     json_record(app, body);
 }
 
+static void channels(rx_app *app, rx_att *a, const att_block *b)
+{
+    char body[RX_MSG_MAX];
+    a->channels = b->channels;
+    a->est_known = 0;
+    rx_log(&app->stop, "CHANNELS: board %u, gyro%s%s, accelerometer every %u, magnetometer every %u sample%s",
+           b->board, b->channels & ATT_BLOCK_CH_ACC ? " + accelerometer" : "",
+           b->channels & ATT_BLOCK_CH_MAG ? " + magnetometer" : "", b->acc_every, b->mag_every,
+           b->mag_every == 1u ? "" : "s");
+    snprintf(body, sizeof body,
+             "\"report\":\"CHANNELS\",\"board\":%u,\"channels\":%u,\"acc_every\":%u,\"mag_every\":%u",
+             b->board, b->channels, b->acc_every, b->mag_every);
+    json_record(app, body);
+}
+
 static void report(rx_app *app, rx_att *a, const rx_item *it)
 {
     const att_block *b = &it->blk;
     char body[RX_MSG_MAX], scan[32] = "";
     const char *name = report_names[b->kind];
     app->reports[b->kind]++;
+    if (it->seq_status == ATT_BLOCK_E_SEQ && it->span.part != ATT_BLOCK_PART_GYR) {
+        app->seq_errors++; /* its sample went to the estimator with what had come (handle()) */
+        rx_log(&app->stop,
+               "%s inside a sample's group: its %s record never came (the sample is used without it)", name,
+               it->span.part == ATT_BLOCK_PART_ACC ? "accelerometer" : "magnetometer");
+    }
     if (b->kind == ATT_BLOCK_BOOT) {
-        a->oversample = 1; /* a new stream: plain codes until an OVERSAMPLE report */
+        a->oversample = 1;              /* a new stream: plain codes until an OVERSAMPLE report, */
+        a->channels = ATT_BLOCK_CH_GYR; /* gyro only until a CHANNELS report */
+        a->est_known = 0;               /* its estimator chosen at its first sample */
         boot(app, b);
+        return;
+    }
+    if (b->kind == ATT_BLOCK_CHANNELS) {
+        channels(app, a, b);
         return;
     }
     if (b->kind == ATT_BLOCK_OVERSAMPLE) {
@@ -778,7 +1038,7 @@ static void report(rx_app *app, rx_att *a, const rx_item *it)
         return;
     }
     /* a loss report: span = the samples missing here (an unreported gap included) */
-    if (it->seq_status == ATT_BLOCK_E_SEQ) {
+    if (it->seq_status == ATT_BLOCK_E_SEQ && it->span.slip != 0) {
         app->seq_errors++;
         rx_log(&app->stop, "%s for sample %u, but %ld sample%s %s: numbering follows the report", name,
                b->first, (long)(it->span.slip < 0 ? -it->span.slip : it->span.slip),
@@ -827,6 +1087,24 @@ static void bad_record(rx_app *app, rx_att *a, const rx_item *it)
     json_record(app, body);
 }
 
+/* One record, in stream order. A filter's sample waits for its group: a record that
+ * is not one of its aiding records (a report, the next sample) closes it first. */
+static void handle(rx_app *app, rx_att *a, const rx_item *it)
+{
+    if (it->blk.kind == ATT_BLOCK_SAMPLE && it->span.part != ATT_BLOCK_PART_GYR
+        && (it->status == ATT_OK || it->status == ATT_BLOCK_E_CODE)) {
+        aiding(app, a, it);
+        return;
+    }
+    close_group(app, a);
+    if (it->status != ATT_OK)
+        bad_record(app, a, it);
+    else if (it->blk.kind == ATT_BLOCK_SAMPLE)
+        sample(app, a, it);
+    else
+        report(app, a, it);
+}
+
 static void *attitude_thread(void *arg)
 {
     rx_app *app = arg;
@@ -836,8 +1114,10 @@ static void *attitude_thread(void *arg)
 
     memset(&a, 0, sizeof a);
     a.oversample = 1;
-    if (rx_gyro_init(c, &a.gyro) != ATT_OK) {
-        rx_log(&app->stop, "gyro calibration rejected (--gyro-zero, --gyro-scale, --axes)");
+    a.channels = ATT_BLOCK_CH_GYR;
+    if (rx_sensor_init(&c->gyro, &a.gyro) != ATT_OK || rx_sensor_init(&c->acc, &a.acc) != ATT_OK
+        || rx_sensor_init(&c->mag, &a.mag) != ATT_OK) {
+        rx_log(&app->stop, "sensor calibration rejected (gyro-*, acc-*, mag-*)"); /* checked when read */
         rx_stop_request(&app->stop);
         return NULL;
     }
@@ -846,24 +1126,19 @@ static void *attitude_thread(void *arg)
         rx_stop_request(&app->stop);
         return NULL;
     }
-    print_header(app);
     /* every record in the queue was acknowledged: each is handled, also after a stop request */
     while (rx_queue_pop(&app->queue, &it) == 0) {
         if (abandoned(app)) { /* stdout failed or stayed blocked: count what cannot be printed */
-            if (it.status == ATT_OK && it.blk.kind == ATT_BLOCK_SAMPLE)
+            if (it.status == ATT_OK && numbers_a_sample(&it))
                 app->undelivered++;
             continue;
         }
         if (c->consumer_delay > 0)
             (void)rx_stop_wait(&app->stop, c->consumer_delay); /* a diagnostic: not once stopping */
-        if (it.status != ATT_OK)
-            bad_record(app, &a, &it);
-        else if (it.blk.kind == ATT_BLOCK_SAMPLE)
-            sample(app, &a, &it);
-        else
-            report(app, &a, &it);
+        handle(app, &a, &it);
         link_record_due(app);
     }
+    close_group(app, &a); /* a group the stream ended in (a stop): its sample with what came */
     return NULL;
 }
 
@@ -910,6 +1185,9 @@ static void print_statistics(rx_app *app)
            app->reports[ATT_BLOCK_BOOT], app->reports[ATT_BLOCK_SELFTEST], app->reports[ATT_BLOCK_GAVE_UP],
            app->reports[ATT_BLOCK_OVERRUN], app->reports[ATT_BLOCK_ADC_ERROR],
            app->reports[ATT_BLOCK_OVERSAMPLE], app->block_errors, app->seq_errors);
+    if (app->reports[ATT_BLOCK_CHANNELS])
+        rx_log(&app->stop, "aiding: channels=%lu acc_records=%lu mag_records=%lu unused=%lu",
+               app->reports[ATT_BLOCK_CHANNELS], app->acc_records, app->mag_records, app->aid_unused);
     if (app->undelivered || app->lines_lost)
         rx_log(&app->stop, "%lu acknowledged sample%s not integrated and %lu attitude line%s not printed: %s",
                app->undelivered, app->undelivered == 1 ? "" : "s", app->lines_lost,
@@ -950,6 +1228,7 @@ int main(int argc, char **argv)
     rx_out_private(1);
     rx_out_private(2);
     app.period = app.cfg.period;
+    app.header_est = -1;
     app.live.mode = app.cfg.link; /* with auto: nothing heard yet */
     rate_check(&app, app.cfg.period, app.cfg.link);
     app.fd = rx_serial_open(app.cfg.port, app.cfg.baud, msg, sizeof msg);

@@ -43,6 +43,13 @@ enum {
  * default, 72 ticks of 1/3600 s (docs/firmware.md). */
 #define RX_PERIOD_DEFAULT (72.0 / 3600.0)
 
+/* Nominal conversions of the aided board's accelerometer and magnetometer (the
+ * defaults of acc-* and mag-*; `attitude calibrate` writes measured ones). */
+#define RX_ACC_ZERO  2048.0            /* ratiometric: 0 g at half the supply */
+#define RX_ACC_SCALE (9.80665 / 409.6) /* m/s² per code: 0.1 of the supply per g (ADXL335 class) */
+#define RX_MAG_ZERO  2047.5            /* set/reset code (c_set + 4095 - c_reset) / 2 at zero field */
+#define RX_MAG_SCALE (100.0 / 819.2)   /* µT per code: 1 mV/V/gauss bridge x gain 200 (HMC1043 + AD623) */
+
 /* What the command line asks for. */
 typedef enum {
     RX_RUN = 0,
@@ -55,17 +62,34 @@ typedef enum {
     RX_FORMAT_JSONL = 1
 } rx_format;
 
+/* The estimator (--estimator): auto chooses per stream from its CHANNELS report. */
+typedef enum {
+    RX_EST_AUTO = 0,      /* ahrs when the stream announces accelerometer and magnetometer */
+    RX_EST_AHRS = 1,      /* att_ahrs: gyro bias, accelerometer and magnetometer aiding */
+    RX_EST_INTEGRATOR = 2 /* att_integ: the gyros alone, open loop (the paper's) */
+} rx_estimator;
+
+/* One three-axis sensor's conversion (attitude/sensor.h): the gyro-*, acc-*, mag-* keys. */
+typedef struct {
+    double zero[3];  /* ADC code at zero input, per channel */
+    double scale[3]; /* units per code, per channel: rad/s (gyro), m/s² (acc), µT (mag) */
+    int axis_src[3]; /* body axis i = sign[i] * channel axis_src[i] */
+    int axis_sign[3];
+    double mat[9];  /* correction M, row-major (identity) */
+    double bias[3]; /* correction b, output units (0) */
+} rx_sensor_cfg;
+
 /* Everything the command line / config file sets. */
 typedef struct {
     char port[RX_PATH_MAX];
-    long baud;       /* bits per second */
-    double period;   /* s, gyro sample period (until a BOOT report announces it) */
-    int period_set;  /* --period given (command line or config file): BOOT does not override it */
-    double zero[3];  /* ADC code at zero rate, per channel */
-    double scale[3]; /* rad/s per code, per channel */
-    int axis_src[3]; /* body axis i = sign[i] * channel axis_src[i] */
-    int axis_sign[3];
+    long baud;      /* bits per second */
+    double period;  /* s, gyro sample period (until a BOOT report announces it) */
+    int period_set; /* --period given (command line or config file): BOOT does not override it */
+    rx_sensor_cfg gyro, acc, mag;
     att_method method;
+    int method_set;         /* --method given: the filter's too (else its default, rv3-reuse) */
+    rx_estimator estimator; /* --estimator */
+    att_ahrs_settings ahrs; /* the filter's settings (keys: the field names); .method from method */
     rx_format format;
     unsigned block_size;   /* link block N: a multiple of 6 (3 x 16-bit codes per sample) */
     unsigned queue_size;   /* samples the queue holds (1..RX_QUEUE_MAX) */
@@ -89,7 +113,9 @@ enum {
 
 /* Defaults: 9600 baud, period 0.02 s (RX_PERIOD_DEFAULT), zero 2048,
  * scale = 90 deg/s per 2048 codes, axes x,y,z, rv3, CSV, N = 6, queue 256,
- * gap 20 ms, hold 20 ms, link auto. */
+ * gap 20 ms, hold 20 ms, link auto, estimator auto, the filter's defaults
+ * (att_ahrs_default_settings), the accelerometer's and magnetometer's
+ * nominal conversions (RX_ACC_*, RX_MAG_*), no corrections. */
 void rx_config_defaults(rx_config *c);
 
 /* Parse argv with getopt_long (and the --config files it names, whose
@@ -115,9 +141,20 @@ const char *rx_method_name(att_method m);
  * 0 if the rate fits, 1 with the numbers in msg if it does not. */
 int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t msglen);
 
-/* The gyro converter (attitude/sensor.h) of the configuration's zero,
- * scale and axes: att_sensor_init's status. */
-int rx_gyro_init(const rx_config *c, att_sensor *gyro);
+/* A converter (attitude/sensor.h) of one sensor's zero, scale, axes and
+ * correction: att_sensor_init's or att_sensor_set_correction's status. */
+int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s);
+
+/* The filter settings a config file or the command line may set, by their
+ * att_ahrs_settings field names (every att_real field; method is the
+ * shared --method): name i (0, 1, ... until NULL) and its value in *set. */
+const char *rx_ahrs_setting(size_t i, const att_ahrs_settings *set, double *value);
+
+/* The estimator a stream runs: --estimator, or with auto the stream's
+ * channel set (ATT_BLOCK_CH_* bits; gyro only before a CHANNELS report). */
+rx_estimator rx_estimator_for(rx_estimator chosen, unsigned channels);
+
+const char *rx_estimator_name(rx_estimator e);
 
 void rx_usage(const char *prog, void *stream);
 
@@ -129,6 +166,8 @@ typedef struct {
     att_block_span span; /* its place in the numbering (sample: span.first = its number) */
     int status;          /* att_block_decode's status (ATT_BLOCK_E_CODE: bad sample) */
     int seq_status;      /* att_block_seq_feed's status (ATT_BLOCK_E_SEQ: numbering slipped) */
+    int closes;          /* a sample record that completes its sample's group (the tracker's
+                            next record is a gyro record): every gyro-only sample closes */
     uint8_t raw[ATT_BLOCK_SIZE];
 } rx_item;
 

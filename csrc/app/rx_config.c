@@ -5,6 +5,8 @@
 #include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,19 +26,75 @@ static const struct {
     { "rk4", ATT_METHOD_RK4 },
 };
 
-int rx_gyro_init(const rx_config *c, att_sensor *gyro)
+int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
 {
-    att_real zero[3], scale[3];
+    att_real zero[3], scale[3], mat[9], bias[3];
     uint8_t axis[3];
     int8_t sign[3];
-    int i;
+    att_sensor t;
+    int i, rc;
     for (i = 0; i < 3; i++) {
         zero[i] = (att_real)c->zero[i];
         scale[i] = (att_real)c->scale[i];
         axis[i] = (uint8_t)c->axis_src[i];
         sign[i] = (int8_t)c->axis_sign[i];
+        bias[i] = (att_real)c->bias[i];
     }
-    return att_sensor_init(gyro, zero, scale, axis, sign);
+    for (i = 0; i < 9; i++)
+        mat[i] = (att_real)c->mat[i];
+    if ((rc = att_sensor_init(&t, zero, scale, axis, sign)) != ATT_OK
+        || (rc = att_sensor_set_correction(&t, mat, bias)) != ATT_OK)
+        return rc;
+    *s = t;
+    return ATT_OK;
+}
+
+/* The filter's settings by field name (attitude/ahrs.h): every att_real field of
+ * att_ahrs_settings; method is the shared "method" key. A field added to the header
+ * is added here (tests/test_attitude_rx_aided.py compares this list with the header's). */
+#define RX_AHRS_REAL_FIELDS(X)                                                                               \
+    X(gravity)                                                                                               \
+    X(gyr_noise)                                                                                             \
+    X(gyr_noise_rest) X(bias_noise) X(init_att_sigma) X(init_bias_sigma) X(acc_tau) X(acc_noise) X(acc_gate) \
+        X(acc_reject_max) X(mag_noise) X(mag_norm_tol) X(mag_dip_tol) X(mag_ref_tau) X(mag_reject_max)       \
+            X(mag_reject_factor) X(mag_new_time) X(mag_min_undisturbed) X(mag_new_gyr) X(declination)        \
+                X(rest_time) X(rest_tau) X(rest_gyr_th) X(rest_acc_th) X(rest_noise) X(gyro_range)           \
+                    X(overrange_sigma) X(sensor_delay) X(acc_delay) X(mag_delay) X(tilt_tau)
+#define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
+
+static const struct {
+    const char *name;
+    size_t offset;
+} ahrs_fields[] = { RX_AHRS_REAL_FIELDS(RX_AHRS_ENTRY) };
+
+static att_real *ahrs_field(att_ahrs_settings *set, size_t i)
+{
+    return (att_real *)(void *)((char *)set + ahrs_fields[i].offset);
+}
+
+const char *rx_ahrs_setting(size_t i, const att_ahrs_settings *set, double *value)
+{
+    if (i >= sizeof ahrs_fields / sizeof ahrs_fields[0])
+        return NULL;
+    *value = (double)*ahrs_field((att_ahrs_settings *)(uintptr_t)set, i);
+    return ahrs_fields[i].name;
+}
+
+static const char *const estimator_names[] = { "auto", "ahrs", "integrator" };
+
+const char *rx_estimator_name(rx_estimator e)
+{
+    return (unsigned)e < 3u ? estimator_names[e] : "?";
+}
+
+rx_estimator rx_estimator_for(rx_estimator chosen, unsigned channels)
+{
+    const unsigned aided = ATT_BLOCK_CH_ACC | ATT_BLOCK_CH_MAG;
+    if (chosen == RX_EST_AUTO)
+        return (channels & aided) == aided ? RX_EST_AHRS : RX_EST_INTEGRATOR;
+    if (chosen == RX_EST_AHRS && !(channels & ATT_BLOCK_CH_ACC))
+        return RX_EST_INTEGRATOR; /* no accelerometer: nothing to align or aid with (a warning) */
+    return chosen;
 }
 
 const char *rx_method_name(att_method m)
@@ -48,20 +106,32 @@ const char *rx_method_name(att_method m)
     return "?";
 }
 
-void rx_config_defaults(rx_config *c)
+static void sensor_defaults(rx_sensor_cfg *s, double zero, double scale)
 {
     int i;
+    for (i = 0; i < 3; i++) {
+        s->zero[i] = zero;
+        s->scale[i] = scale;
+        s->axis_src[i] = i;
+        s->axis_sign[i] = 1;
+        s->bias[i] = 0.0;
+    }
+    for (i = 0; i < 9; i++)
+        s->mat[i] = i % 4 == 0 ? 1.0 : 0.0;
+}
+
+void rx_config_defaults(rx_config *c)
+{
     memset(c, 0, sizeof *c);
     c->baud = 9600;
     c->period = RX_PERIOD_DEFAULT;
-    for (i = 0; i < 3; i++) {
-        c->zero[i] = 2048.0;
-        /* 90 deg/s full scale over half of a 12-bit range (CG-L53 + TLC2543) */
-        c->scale[i] = (90.0 * 3.14159265358979323846 / 180.0) / 2048.0;
-        c->axis_src[i] = i;
-        c->axis_sign[i] = 1;
-    }
+    /* 90 deg/s full scale over half of a 12-bit range (CG-L53 + TLC2543) */
+    sensor_defaults(&c->gyro, 2048.0, (90.0 * 3.14159265358979323846 / 180.0) / 2048.0);
+    sensor_defaults(&c->acc, RX_ACC_ZERO, RX_ACC_SCALE);
+    sensor_defaults(&c->mag, RX_MAG_ZERO, RX_MAG_SCALE);
     c->method = ATT_METHOD_RV3;
+    att_ahrs_default_settings(&c->ahrs);
+    c->estimator = RX_EST_AUTO;
     c->format = RX_FORMAT_CSV;
     c->block_size = 6;
     c->queue_size = 256;
@@ -204,6 +274,94 @@ static int parse_axes(const char *s, int src[3], int sign[3])
     return 0;
 }
 
+/* "a,b,...": exactly n doubles */
+static int parse_list(const char *s, double *out, int n)
+{
+    char tmp[256];
+    char *p, *tok, *save = NULL;
+    int k = 0;
+    if (strlen(s) >= sizeof tmp)
+        return -1;
+    strcpy(tmp, s);
+    for (p = tmp; (tok = strtok_r(p, ",", &save)) != NULL; p = NULL) {
+        if (k == n || parse_double(tok, &out[k]) != 0)
+            return -1;
+        k++;
+    }
+    return k == n ? 0 : -1;
+}
+
+static double det3(const double m[9])
+{
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
+           + m[2] * (m[3] * m[7] - m[4] * m[6]);
+}
+
+/* gyro-*, acc-*, mag-* (and axes): key is the part after the prefix; unit names the scale's unit. */
+static int set_sensor(rx_sensor_cfg *s, const char *name, const char *key, const char *value,
+                      const char *unit, char *msg, size_t len)
+{
+    double v[9];
+    if (strcmp(key, "zero") == 0) {
+        if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > ATT_SENSOR_ZERO_MAX
+            || v[1] > ATT_SENSOR_ZERO_MAX || v[2] > ATT_SENSOR_ZERO_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG, "%s: '%s' must be CODE or CODE,CODE,CODE (0..65535)", name,
+                        value);
+        memcpy(s->zero, v, sizeof s->zero);
+    } else if (strcmp(key, "scale") == 0) {
+        if (parse_triple(value, v) != 0 || v[0] == 0 || v[1] == 0 || v[2] == 0)
+            return fail(msg, len, RX_EXIT_CONFIG, "%s: '%s' must be %s_PER_CODE or three of them, non-zero",
+                        name, value, unit);
+        memcpy(s->scale, v, sizeof s->scale);
+    } else if (strcmp(key, "axes") == 0) {
+        if (parse_axes(value, s->axis_src, s->axis_sign) != 0)
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "%s: '%s' must name each channel once with an optional sign, e.g. x,y,z or -y,+x,z",
+                        name, value);
+    } else if (strcmp(key, "matrix") == 0) {
+        if (parse_list(value, v, 9) != 0 || !(fabs(det3(v)) * ATT_SENSOR_DET_RECIP >= 1.0))
+            return fail(msg, len, RX_EXIT_CONFIG,
+                        "%s: '%s' must be 9 numbers (row-major) of an invertible matrix, |det| >= 1/%d", name,
+                        value, ATT_SENSOR_DET_RECIP);
+        memcpy(s->mat, v, sizeof s->mat);
+    } else if (strcmp(key, "bias") == 0) {
+        if (parse_triple(value, v) != 0)
+            return fail(msg, len, RX_EXIT_CONFIG, "%s: '%s' must be B or B,B,B (%s)", name, value,
+                        strcmp(unit, "UT") == 0         ? "uT"
+                        : strcmp(unit, "M_PER_S2") == 0 ? "m/s^2"
+                                                        : "rad/s");
+        memcpy(s->bias, v, sizeof s->bias);
+    } else {
+        return fail(msg, len, RX_EXIT_CONFIG, "unknown setting '%s'", name);
+    }
+    return 0;
+}
+
+/* A filter setting by its att_ahrs_settings field name. The settings so far pass
+ * att_ahrs_check_settings (the defaults do, and each change is checked): a failure
+ * is this setting's. */
+static int set_ahrs(rx_config *c, const char *name, const char *value, char *msg, size_t len)
+{
+    att_ahrs_settings t = c->ahrs;
+    double d;
+    size_t i;
+    for (i = 0; i < sizeof ahrs_fields / sizeof ahrs_fields[0]; i++)
+        if (strcmp(name, ahrs_fields[i].name) == 0)
+            break;
+    if (i == sizeof ahrs_fields / sizeof ahrs_fields[0])
+        return fail(msg, len, RX_EXIT_CONFIG, "unknown setting '%s'", name);
+    if (parse_double(value, &d) != 0)
+        return fail(msg, len, RX_EXIT_CONFIG, "%s: '%s' is not a number", name, value);
+    *ahrs_field(&t, i) = (att_real)d;
+    if (att_ahrs_check_settings(&t) != ATT_OK)
+        return fail(msg, len, RX_EXIT_CONFIG,
+                    "%s: %s is outside its domain (attitude/ahrs.h: noises and times > 0, '0 = off' fields "
+                    ">= 0, |declination| <= pi, |sensor_delay| <= 1 s, |acc_delay|, |mag_delay| <= 0.05 s)",
+                    name, value);
+    c->ahrs = t;
+    return 0;
+}
+
 int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, size_t len)
 {
     unsigned long u;
@@ -228,24 +386,13 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
                         "period: '%s' must be a sample period in seconds, 0 < T <= 10", value);
         c->period = d;
         c->period_set = 1;
-    } else if (strcmp(name, "gyro-zero") == 0) {
-        double v[3];
-        if (parse_triple(value, v) != 0 || v[0] < 0 || v[1] < 0 || v[2] < 0 || v[0] > 65535 || v[1] > 65535
-            || v[2] > 65535)
-            return fail(msg, len, RX_EXIT_CONFIG, "gyro-zero: '%s' must be CODE or CODE,CODE,CODE (0..65535)",
-                        value);
-        memcpy(c->zero, v, sizeof v);
-    } else if (strcmp(name, "gyro-scale") == 0) {
-        double v[3];
-        if (parse_triple(value, v) != 0 || v[0] == 0 || v[1] == 0 || v[2] == 0)
-            return fail(msg, len, RX_EXIT_CONFIG,
-                        "gyro-scale: '%s' must be RAD_PER_S_PER_CODE or three of them, non-zero", value);
-        memcpy(c->scale, v, sizeof v);
-    } else if (strcmp(name, "axes") == 0) {
-        if (parse_axes(value, c->axis_src, c->axis_sign) != 0)
-            return fail(msg, len, RX_EXIT_CONFIG,
-                        "axes: '%s' must name each channel once with an optional sign, e.g. x,y,z or -y,+x,z",
-                        value);
+    } else if (strncmp(name, "gyro-", 5) == 0 || strcmp(name, "axes") == 0) {
+        return set_sensor(&c->gyro, name, strcmp(name, "axes") == 0 ? "axes" : name + 5, value, "RAD_PER_S",
+                          msg, len);
+    } else if (strncmp(name, "acc-", 4) == 0) {
+        return set_sensor(&c->acc, name, name + 4, value, "M_PER_S2", msg, len);
+    } else if (strncmp(name, "mag-", 4) == 0) {
+        return set_sensor(&c->mag, name, name + 4, value, "UT", msg, len);
     } else if (strcmp(name, "method") == 0) {
         for (i = 0; i < sizeof methods / sizeof methods[0]; i++)
             if (strcmp(value, methods[i].name) == 0)
@@ -255,6 +402,13 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
                         "method: unknown '%s' (rv1, rv2, rv3, rv3-coning, rv3-reuse, rv3-reuse-poly, rk4)",
                         value);
         c->method = methods[i].method;
+        c->method_set = 1;
+    } else if (strcmp(name, "estimator") == 0) {
+        for (i = 0; i < 3 && strcmp(value, rx_estimator_name((rx_estimator)i)) != 0; i++)
+            ;
+        if (i == 3)
+            return fail(msg, len, RX_EXIT_CONFIG, "estimator: '%s' must be auto, ahrs or integrator", value);
+        c->estimator = (rx_estimator)i;
     } else if (strcmp(name, "format") == 0) {
         if (strcmp(value, "csv") == 0)
             c->format = RX_FORMAT_CSV;
@@ -310,7 +464,7 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         else
             return fail(msg, len, RX_EXIT_CONFIG, "header: '%s' must be yes or no", value);
     } else {
-        return fail(msg, len, RX_EXIT_CONFIG, "unknown setting '%s'", name);
+        return set_ahrs(c, name, value, msg, len);
     }
     return 0;
 }
@@ -401,7 +555,41 @@ static const struct option long_options[] = { { "help", no_argument, NULL, OPT_H
                                               { "consumer-delay", required_argument, NULL, OPT_SETTING },
                                               { "reopen-delay", required_argument, NULL, OPT_SETTING },
                                               { "header", required_argument, NULL, OPT_SETTING },
-                                              { NULL, 0, NULL, 0 } };
+                                              { "estimator", required_argument, NULL, OPT_SETTING },
+                                              { "acc-zero", required_argument, NULL, OPT_SETTING },
+                                              { "acc-scale", required_argument, NULL, OPT_SETTING },
+                                              { "acc-axes", required_argument, NULL, OPT_SETTING },
+                                              { "acc-matrix", required_argument, NULL, OPT_SETTING },
+                                              { "acc-bias", required_argument, NULL, OPT_SETTING },
+                                              { "mag-zero", required_argument, NULL, OPT_SETTING },
+                                              { "mag-scale", required_argument, NULL, OPT_SETTING },
+                                              { "mag-axes", required_argument, NULL, OPT_SETTING },
+                                              { "mag-matrix", required_argument, NULL, OPT_SETTING },
+                                              { "mag-bias", required_argument, NULL, OPT_SETTING },
+                                              { "gyro-matrix", required_argument, NULL, OPT_SETTING },
+                                              { "gyro-bias", required_argument, NULL, OPT_SETTING } };
+
+enum {
+    N_BASE = sizeof long_options / sizeof long_options[0],
+    N_AHRS = sizeof ahrs_fields / sizeof ahrs_fields[0]
+};
+
+/* The options getopt_long sees: the list above, then one per filter setting, then the end. */
+static const struct option *all_options(void)
+{
+    static struct option all[N_BASE + N_AHRS + 1];
+    size_t i;
+    for (i = 0; i < N_BASE; i++)
+        all[i] = long_options[i];
+    for (i = 0; i < N_AHRS; i++) {
+        all[N_BASE + i].name = ahrs_fields[i].name;
+        all[N_BASE + i].has_arg = required_argument;
+        all[N_BASE + i].flag = NULL;
+        all[N_BASE + i].val = OPT_SETTING;
+    }
+    memset(&all[N_BASE + N_AHRS], 0, sizeof all[0]);
+    return all;
+}
 
 /* The option as the user wrote it (argv[optind - 1], without "=value"). */
 static const char *opt_text(char **argv, char *buf, size_t len)
@@ -422,12 +610,13 @@ static int parse_pass(rx_config *c, int argc, char **argv, int pass, rx_action *
 {
     int ch, idx, rc;
     char opt[64];
+    const struct option *options = all_options();
     optind = 0; /* full rescan (glibc and musl) */
     opterr = 0; /* messages are ours: one line naming the option */
     for (;;) {
         idx = -1;
         optopt = 0;
-        ch = getopt_long(argc, argv, ":h", long_options, &idx);
+        ch = getopt_long(argc, argv, ":h", options, &idx);
         if (ch == -1)
             break;
         switch (ch) {
@@ -446,7 +635,7 @@ static int parse_pass(rx_config *c, int argc, char **argv, int pass, rx_action *
             c->header = 0;
             break;
         case OPT_SETTING:
-            if (pass == 2 && (rc = rx_config_set(c, long_options[idx].name, optarg, msg, len)) != 0)
+            if (pass == 2 && (rc = rx_config_set(c, options[idx].name, optarg, msg, len)) != 0)
                 return rc;
             break;
         case ':':
@@ -463,6 +652,20 @@ static int parse_pass(rx_config *c, int argc, char **argv, int pass, rx_action *
     return 0;
 }
 
+/* The filter integrates with --method when one is given (rk4 is not one it can run:
+ * refused with --estimator ahrs; with auto the filter keeps its default). */
+static int ahrs_method(rx_config *c, char *msg, size_t len)
+{
+    if (!c->method_set)
+        return 0;
+    if (c->method != ATT_METHOD_RK4)
+        c->ahrs.method = (int)c->method;
+    else if (c->estimator == RX_EST_AHRS)
+        return fail(msg, len, RX_EXIT_CONFIG,
+                    "method: rk4 cannot run in the filter (--estimator ahrs): choose rv1 .. rv3-reuse-poly");
+    return 0;
+}
+
 int rx_config_parse(rx_config *c, int argc, char **argv, rx_action *action, char *msg, size_t len)
 {
     int rc;
@@ -474,7 +677,31 @@ int rx_config_parse(rx_config *c, int argc, char **argv, rx_action *action, char
     if (c->port[0] == '\0')
         return fail(msg, len, RX_EXIT_USAGE,
                     "no serial port: give --port PATH (or port = PATH in --config FILE)");
-    return 0;
+    return ahrs_method(c, msg, len);
+}
+
+/* The filter's settings with their defaults, from the table (attitude/ahrs.h gives units and domains). */
+static void usage_ahrs(FILE *f)
+{
+    att_ahrs_settings d;
+    const char *name;
+    double v;
+    size_t i;
+    int col = 0;
+    att_ahrs_default_settings(&d);
+    fprintf(f,
+            "Filter settings (--estimator ahrs), named as the fields of att_ahrs_settings (attitude/ahrs.h:\n"
+            "units and domains; docs/ahrs.md), --NAME VALUE or NAME = VALUE; defaults:\n");
+    for (i = 0; (name = rx_ahrs_setting(i, &d, &v)) != NULL; i++) {
+        char item[64];
+        int n = snprintf(item, sizeof item, "%s %g", name, v);
+        if (col > 0 && col + n + 2 > 96) {
+            fputs(",\n", f);
+            col = 0;
+        }
+        col += fprintf(f, "%s%s", col ? ", " : "  ", item);
+    }
+    fprintf(f, "\n  method: --method (the filter's default: %s)\n", rx_method_name((att_method)d.method));
 }
 
 void rx_usage(const char *prog, void *stream)
@@ -505,6 +732,15 @@ void rx_usage(const char *prog, void *stream)
             "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
             "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
             "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
+            "  --estimator E            auto|ahrs|integrator: the attitude filter (att_ahrs: gyro bias,\n"
+            "                           accelerometer and magnetometer aiding) or the gyros alone; auto\n"
+            "                           (default): ahrs when the stream's CHANNELS report announces\n"
+            "                           accelerometer and magnetometer, else integrator\n"
+            "  --acc-zero, --acc-scale, --acc-axes, --acc-matrix, --acc-bias: the accelerometer's codes\n"
+            "                           -> m/s^2, as --gyro-zero, --gyro-scale, --axes, then M (v - b):\n"
+            "                           9 values row-major (default identity), b in m/s^2 (default 0)\n"
+            "  --mag-zero, --mag-scale, --mag-axes, --mag-matrix, --mag-bias: the magnetometer's, in uT\n"
+            "                           (matrix: soft iron, bias: hard iron); --gyro-matrix, --gyro-bias\n"
             "  --config FILE            'name = value' lines with the names above; the command line wins\n"
             "  -h, --help               this text;  --version: the version\n"
             "A block (v2: a record) is acknowledged only once its records are queued; every acknowledged\n"
@@ -515,4 +751,5 @@ void rx_usage(const char *prog, void *stream)
             "75 stopped while stdout stayed blocked (acknowledged samples unprinted), 77 permission\n"
             "denied, 78 bad configuration.\n",
             prog);
+    usage_ahrs((FILE *)stream);
 }

@@ -35,11 +35,75 @@ att_status att_sensor_init(att_sensor *s, const att_real zero[3], const att_real
         s->scale[i] = scale[i];
         s->axis[i] = axis != NULL ? axis[i] : (uint8_t)i;
         s->sign[i] = sign != NULL ? sign[i] : (int8_t)1;
+        s->bias[i] = 0;
     }
+    for (i = 0; i < 9; i++) {
+        s->mat[i] = i % 4 == 0 ? ATT_R(1.0) : ATT_R(0.0);
+    }
+    s->plain = 1u;
     return ATT_OK;
 }
 
-/* The three values of one sample into v (unchecked output). */
+static att_real det3(const att_real m[9])
+{
+    return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
+           + m[2] * (m[3] * m[7] - m[4] * m[6]);
+}
+
+att_status att_sensor_set_correction(att_sensor *s, const att_real mat[9], const att_real bias[3])
+{
+    att_real det;
+    uint8_t plain = 1u;
+    int i;
+    if (s == NULL || mat == NULL || bias == NULL) {
+        return ATT_E_NULL;
+    }
+    for (i = 0; i < 9; i++) {
+        if (!isfinite(mat[i])) {
+            return ATT_E_NONFINITE;
+        }
+        if (mat[i] != (i % 4 == 0 ? ATT_R(1.0) : ATT_R(0.0))) {
+            plain = 0u;
+        }
+    }
+    if (!att__finite3(bias)) {
+        return ATT_E_NONFINITE;
+    }
+    det = det3(mat);
+    if (!isfinite(det)) {
+        return ATT_E_ARG; /* entries so large that the determinant overflows: no correction */
+    }
+    if (att_fabs(det) * (att_real)ATT_SENSOR_DET_RECIP < ATT_R(1.0)) {
+        return ATT_E_ARG;
+    }
+    for (i = 0; i < 9; i++) {
+        s->mat[i] = mat[i];
+    }
+    for (i = 0; i < 3; i++) {
+        s->bias[i] = bias[i];
+        if (bias[i] != (att_real)0) {
+            plain = 0u;
+        }
+    }
+    s->plain = plain;
+    return ATT_OK;
+}
+
+/* out = M (v - b), in att_magcal_apply's order (attitude/sensor.h). */
+static void correct(const att_sensor *s, att_real v[3])
+{
+    att_real d[3];
+    const att_real *m = s->mat;
+    int i;
+    for (i = 0; i < 3; i++) {
+        d[i] = v[i] - s->bias[i];
+    }
+    for (i = 0; i < 3; i++) {
+        v[i] = m[3 * i] * d[0] + m[3 * i + 1] * d[1] + m[3 * i + 2] * d[2];
+    }
+}
+
+/* The three corrected values of one sample into v (unchecked output). */
 static att_status values(const att_sensor *s, const uint16_t w[3], uint8_t n, att_real v[3])
 {
     int i;
@@ -53,6 +117,9 @@ static att_status values(const att_sensor *s, const uint16_t w[3], uint8_t n, at
     for (i = 0; i < 3; i++) {
         c = s->axis[i];
         v[i] = (att_real)s->sign[i] * ((att_real)w[c] / (att_real)n - s->zero[c]) * s->scale[c];
+    }
+    if (!s->plain) {
+        correct(s, v);
     }
     return ATT_OK;
 }

@@ -21,8 +21,10 @@
  *   link_tx BLOCK SYN_TO ANS_TO ATTEMPTS BYTES... -- N events for sender A;
  *   wden_dwt WAVELET LEVELS, wden_idwt WAVELET LEVELS -- N samples (1) -> N coefficients
  *     (wavedec order) and back;
- *   sensor OVERSAMPLE PERIOD Z0 Z1 Z2 K0 K1 K2 A0 A1 A2 S0 S1 S2 -- N words (3) -> N increments (3)
- *     (att_sensor_increments; Z zero codes, K scales, A the channel of each body axis, S signs);
+ *   sensor OVERSAMPLE PERIOD Z0 Z1 Z2 K0 K1 K2 A0 A1 A2 S0 S1 S2 M0..M8 B0 B1 B2 -- N words (3) -> N
+ *     increments (3)
+ *     (att_sensor_increments; Z zero codes, K scales, A the channel of each body axis, S signs, then
+ *     M the 9 correction values row-major and B the 3 biases: att_sensor_set_correction);
  *   wden_stream WAVELET MODE LEVELS BLOCK EDGE_START EDGE_END DETREND -- N samples (1) pushed in one
  *     att_wden_push_n() call, then flushed -> N denoised samples;
  *   align DECL SIX        -- N records f, m (6; SIX = 1: f only, 3) -> N quaternions (att_align_accmag_n);
@@ -297,14 +299,14 @@ static int run_wden(const char *id, const char *fn, size_t n)
 static int run_sensor(const char *id, size_t n)
 {
     static uint16_t words[3 * MAX_REC];
-    double p[14];
-    att_real zero[3], scale[3];
+    double p[26];
+    att_real zero[3], scale[3], mat[9], bias[3];
     uint8_t axis[3];
     int8_t sign[3];
     att_sensor s;
     size_t i, err = 0;
     att_status st;
-    for (i = 0; i < 14; i++)
+    for (i = 0; i < 26; i++)
         if (number(&p[i]) != 0)
             return -1;
     for (i = 0; i < 3; i++) {
@@ -312,12 +314,17 @@ static int run_sensor(const char *id, size_t n)
         scale[i] = (att_real)p[5 + i];
         axis[i] = (uint8_t)p[8 + i];
         sign[i] = (int8_t)p[11 + i];
+        bias[i] = (att_real)p[23 + i];
     }
+    for (i = 0; i < 9; i++)
+        mat[i] = (att_real)p[14 + i];
     if (read_values(in_buf, 3 * n) != 0)
         return -1;
     for (i = 0; i < 3 * n; i++)
         words[i] = (uint16_t)in_buf[i];
     st = att_sensor_init(&s, zero, scale, axis, sign);
+    if (st == ATT_OK)
+        st = att_sensor_set_correction(&s, mat, bias);
     if (st == ATT_OK)
         st = att_sensor_increments(&s, words, n, (uint8_t)p[0], (att_real)p[1], out_buf, &err);
     result(id, st, st == ATT_OK ? -1L : (long)err, st == ATT_OK ? n : 0);

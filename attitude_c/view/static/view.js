@@ -177,6 +177,9 @@
     ["OVERRUN", "OVERRUN reports"], ["SELFTEST", "SELFTEST reports"], ["ADC_ERROR", "ADC_ERROR reports"],
     ["error", "bad records"], ["held", "samples held"], ["missing", "samples missing"],
   ];
+  // labels of counters a source may add (shown when present): attitude-rx's filter fields
+  const LABELS = { bias_x_dps: "gyro bias x (°/s)", bias_y_dps: "gyro bias y (°/s)",
+                   bias_z_dps: "gyro bias z (°/s)", filter_flags: "filter flags" };
   const HUB = [["samples", "samples received"], ["recorded", "samples recorded"],
                ["frames_dropped", "display frames dropped"], ["clients", "tabs connected"]];
 
@@ -186,7 +189,7 @@
     const seen = new Set();
     for (const [k, label] of KNOWN) { rows.push([k, label, S.counters[k]]); seen.add(k); }
     for (const k of Object.keys(S.counters).sort()) {
-      if (!seen.has(k)) rows.push([k, k.replace(/_/g, " "), S.counters[k]]);
+      if (!seen.has(k)) rows.push([k, LABELS[k] || k.replace(/_/g, " "), S.counters[k]]);
     }
     for (const [k, label] of HUB) rows.push(["hub-" + k, label, S.hub[k]]);
     rows.push(["hub-missed", "frames missed by this tab", S.missedFrames]);

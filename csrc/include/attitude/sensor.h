@@ -21,6 +21,26 @@
  *   axis     which channel each body axis reads (each channel once);
  *   sign     +1 or -1 per body axis.
  *
+ * then a 3x3 correction (att_sensor_set_correction; att_sensor_init sets
+ * M = I, b = 0):
+ *
+ *     out = M · (value − b)
+ *
+ *   M (mat)  row-major, dimensionless: misalignment and scale-factor
+ *            correction (accelerometer), soft iron (magnetometer); finite,
+ *            |det M| ≥ 1 / ATT_SENSOR_DET_RECIP, else ATT_E_ARG;
+ *   b (bias) in the output's units (m/s² for an accelerometer, µT for a
+ *            magnetometer: hard iron; rad/s for a gyro); finite.
+ *
+ * With M = I and b = 0 out is value bit for bit (the gyro path of every
+ * stream before the correction existed). A magnetometer calibration
+ * (attitude/aiding.h: m_cal = S (m − h), fitted to this sensor's values
+ * with M = I, b = 0) is M = S, b = h: out is then att_magcal_apply's
+ * m_cal, bit for bit (the same operations in the same order).
+ *
+ * Units: a gyro's out is the body rate (rad/s), an accelerometer's the
+ * specific force (m/s²), a magnetometer's the field (µT).
+ *
  * Gyros: value is the body rate (rad/s); the angle increment of one sample
  * period h (s) is value · h — the board's n conversions at the midpoints of
  * equal sub-intervals form the midpoint-rule mean rate of the period.
@@ -38,7 +58,10 @@
 #include "attitude/common.h"
 
 enum {
-    ATT_SENSOR_ZERO_MAX = 65535 /* largest zero reading (codes) */
+    ATT_SENSOR_ZERO_MAX = 65535, /* largest zero reading (codes) */
+    ATT_SENSOR_DET_RECIP = 1000  /* a correction needs |det M| ≥ 1/1000: a misalignment, scale-factor
+                                    or soft-iron correction is near a rotation (|det| ≈ 1); below it
+                                    an axis is (nearly) lost, a configuration mistake */
 };
 
 /* A three-axis sensor's calibration and axis mapping (set by att_sensor_init). */
@@ -47,6 +70,9 @@ typedef struct {
     att_real scale[3]; /* units per code per channel */
     uint8_t axis[3];   /* body axis i reads channel axis[i] */
     int8_t sign[3];    /* ... times sign[i] */
+    att_real mat[9];   /* correction M, row-major (identity) */
+    att_real bias[3];  /* b, output units (0) */
+    uint8_t plain;     /* 1 when M = I and b = 0: out = value, no correction computed */
 } att_sensor;
 
 /* Check and store a calibration. axis and sign may be NULL: body axis i
@@ -57,12 +83,18 @@ typedef struct {
 att_status att_sensor_init(att_sensor *s, const att_real zero[3], const att_real scale[3],
                            const uint8_t axis[3], const int8_t sign[3]);
 
+/* Check and store the correction M (mat, row-major) and b (bias) of a
+ * sensor set up by att_sensor_init. ATT_OK, ATT_E_NULL, ATT_E_NONFINITE,
+ * ATT_E_ARG (|det M| < 1/ATT_SENSOR_DET_RECIP); *s is untouched on an
+ * error. */
+att_status att_sensor_set_correction(att_sensor *s, const att_real mat[9], const att_real bias[3]);
+
 /* One sample: words[0..2] (channels) of n conversions each (1..ATT_BLOCK_OVERSAMPLE_MAX) to the
- * body-frame values out[0..2] (a gyro: rad/s). out may not alias words. */
+ * body-frame values out[0..2] (a gyro: rad/s), corrected. out may not alias words. */
 att_status att_sensor_convert(const att_sensor *s, const uint16_t words[3], uint8_t n, att_real out[3]);
 
 /* m samples (m × 3 words) of a gyro sampled every period seconds (> 0,
- * finite) to angle increments (m × 3 values, rad): value · period each.
+ * finite) to angle increments (m × 3 values, rad): out · period each.
  * On an error *err_index (may be NULL) is the first bad sample and no
  * increment is written. */
 att_status att_sensor_increments(const att_sensor *s, const uint16_t *words, size_t m, uint8_t n,
