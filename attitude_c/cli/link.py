@@ -166,6 +166,8 @@ def _block_printer() -> Any:
             out: dict[str, Any]
             if rec.kind == "sample":
                 out = {"n": span.first, "codes": list(rec.codes)}
+                if span.part != "gyr":  # an aided stream's accelerometer or magnetometer record
+                    out["part"] = span.part
                 if st != 0:
                     out["error"] = tracker.error(st)  # never a sample to integrate
             else:

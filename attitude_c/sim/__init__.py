@@ -11,7 +11,9 @@ one module each (:mod:`.trajectory`, :mod:`.sensors`, :mod:`.accelmag`,
 composes them (``simulate``, ``acquire``),
 :mod:`.budget` switches the error sources on one at a time, :mod:`.report`
 writes a run's plots and files, :mod:`.sweeps` runs many scenarios on Dask
-(``sweep``, docs/sweep.md).
+(``sweep``, docs/sweep.md). :mod:`.frontend` models the aided board's analog
+accelerometer and magnetometer front ends down to TLC2543 codes (issue 26; not
+in the chain yet).
 """
 
 from __future__ import annotations
