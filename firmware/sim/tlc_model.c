@@ -115,6 +115,18 @@ void fw_sim_model_init(void)
 #endif
 }
 
+#if defined(FW_SIM_DATA)
+/* The input file's next code, << 4. */
+static uint16_t next_code(void)
+{
+    uint16_t hi = fw_sim_getc();
+    return (uint16_t)(((hi << 8) | fw_sim_getc()) << 4);
+}
+#define AUX_INPUT(a) next_code()
+#else
+#define AUX_INPUT(a) gyro(a)
+#endif
+
 /* Gyro c's input now, as a 12-bit code << 4. */
 static uint16_t gyro(uint8_t c)
 {
@@ -162,7 +174,7 @@ unsigned char fwm_end_cycle(void)
         fwm_word = fwm_vz;
 #if FW_AIDED
     } else if (a < FW_SIM_NCH) {
-        fwm_word = gyro(a); /* accelerometer, magnetometer: at the scan's time k */
+        fwm_word = AUX_INPUT(a); /* accelerometer, magnetometer: at the scan's time k */
 #endif
     } else if (a == TLC2543_TEST_MID) {
         fwm_word = 0x8000u;
@@ -198,9 +210,15 @@ void fw_sim_model_step(void)
         m_k++;
         m_bound += (uint16_t)FW_PERIOD_TICKS;
     }
+#if defined(FW_SIM_DATA)
+    fwm_vx = next_code();
+    fwm_vy = next_code();
+    fwm_vz = next_code();
+#else
     fwm_vx = gyro(0);
     fwm_vy = gyro(1);
     fwm_vz = gyro(2);
+#endif
     m_conversions++;
 }
 
