@@ -77,19 +77,19 @@ def run(quick: bool) -> str:
     ch = board_channels()
     cfg = tool.AIDED
     lines = [
-        f"Firmware: `toolchain.firmware.AIDED` (gyros every {cfg.period_ticks}/{tool.TICK_HZ} s, accelerometer "
+        (f"Firmware: `toolchain.firmware.AIDED` (gyros every {cfg.period_ticks}/{tool.TICK_HZ} s, accelerometer "
         f"every {cfg.acc_every}, magnetometer every {cfg.mag_every} samples, link v2 at {cfg.baud} baud), "
         "sim image with the data-driven TLC2543 model. Codes (round to nearest about 2048): "
         + "; ".join(f"{c.name} {c.lsb:.4g} {c.unit} per code, clipped at ±{c.clip:.4g} {c.unit}" for c in ch.values())
         + ". Trials: " + (f"{QUICK_SECONDS:.0f} s of each from {QUICK_LEAD:.0f} s before its movement phase "
-                          "(`--quick`; *from + s*: the excerpt's start and length)" if quick else "whole") + ".",
+                          "(`--quick`; *from + s*: the excerpt's start and length)" if quick else "whole") + "."),
         "",
-        "BROAD total error (RMS over the movement phase, deg) of: the chain (attitude-rx's lines); the library "
+        ("BROAD total error (RMS over the movement phase, deg) of: the chain (attitude-rx's lines); the library "
         "filter run directly on the same codes (direct); on the unquantized samples at the same instants "
         "(unquantized). *max diff*: largest angle between the chain's and the direct filter's attitude over "
         "all samples (deg; ~1e-6 is arccos's resolution near 0, i.e. equal). *once*: every sample printed "
         "once in order, no loss report, no duplicate (records attitude-rx received, BOOT and CHANNELS "
-        "included). *wall*: seconds the s51 run took.",
+        "included). *wall*: seconds the s51 run took."),
         "",
         "| trial | attitude-rx | from + s | chain | direct | unquantized | max diff | once (records) | wall |",
         "|---|---|---:|---:|---:|---:|---:|---|---:|",
@@ -97,9 +97,9 @@ def run(quick: bool) -> str:
     lines += [_row(r, b) for r in rows for b in ("host", "armv4t") if b in r]
     mean = {k: float(np.mean([r[k] if k != "chain" else r["host"]["total"] for r in rows]))
             for k in ("chain", "direct", "unquantized")}
-    lines += [f"| **mean ({len(rows)} trials)** | host | | **{mean['chain']:.3f}** | {mean['direct']:.3f} | "
-              f"{mean['unquantized']:.3f} | {max(r['host']['diff'] for r in rows):.1e} | "
-              f"{'all' if all(r['host']['once'] for r in rows) else '**not all**'} | |",
+    lines += [(f"| **mean ({len(rows)} trials)** | host | | **{mean['chain']:.3f}** | {mean['direct']:.3f} | "
+               f"{mean['unquantized']:.3f} | {max(r['host']['diff'] for r in rows):.1e} | "
+               f"{'all' if all(r['host']['once'] for r in rows) else '**not all**'} | |"),
               "", f"Worst trial, chain: {max(r['host']['total'] for r in rows):.3f}°. Codes clipped (values at a "
               f"channel's limit, all trials): " + ", ".join(
                   f"{k} {sum(r['clipped'][k] for r in rows)}" for k in ("gyro", "acc", "mag")) + "."]

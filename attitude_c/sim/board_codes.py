@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -157,23 +158,23 @@ def _nlerp(q: NDArray[np.float64], rate: float, t: NDArray[np.float64]) -> NDArr
     return r / np.linalg.norm(r, axis=1, keepdims=True)
 
 
-def resample(trial: object, period: float, channels: dict[str, CodeChannel], start: float = 0.0,
+def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start: float = 0.0,
              duration: float | None = None) -> BoardRecording:
     """A :class:`attitude_c.broad.Trial` (or anything with ``rate``, ``gyr``, ``acc``,
     ``mag``, ``quat``, ``movement``) at the board's instants from ``start`` (s) for
     ``duration`` (s; None: to the end): gyro, accelerometer and field linearly
     interpolated (point samples, as the board's converter takes them), the reference by
     normalized linear interpolation, ``movement`` of the nearest sample; then coded."""
-    rate = float(getattr(trial, "rate"))
-    n_src = int(getattr(trial, "gyr").shape[0])
+    rate = float(trial.rate)
+    n_src = int(trial.gyr.shape[0])
     end = (n_src - 1) / rate if duration is None else min((n_src - 1) / rate, start + duration)
     if not (period > 0 and 0 <= start < end):
         raise InvalidArgument(f"need period > 0 and 0 <= start < end of the recording, got period={period!r}, "
                               f"start={start!r}, end={end!r}")
-    t = start + np.arange(int(math.floor((end - start) / period)) + 1) * period
-    si = {k: _interp(np.asarray(getattr(trial, a), np.float64), rate, t)
-          for k, a in (("gyro", "gyr"), ("acc", "acc"), ("mag", "mag"))}
+    t = (start + np.arange(math.floor((end - start) / period) + 1) * period).astype(np.float64)
+    si = {k: _interp(np.asarray(a, np.float64), rate, t)
+          for k, a in (("gyro", trial.gyr), ("acc", trial.acc), ("mag", trial.mag))}
     near = np.minimum(np.rint(t * rate).astype(np.int64), n_src - 1)
     return BoardRecording(period=period, t=t, si=si, codes={k: codes(v, channels[k]) for k, v in si.items()},
-                          quat=_nlerp(np.asarray(getattr(trial, "quat"), np.float64), rate, t),
-                          movement=np.asarray(getattr(trial, "movement"), bool)[near], channels=channels)
+                          quat=_nlerp(np.asarray(trial.quat, np.float64), rate, t),
+                          movement=np.asarray(trial.movement, bool)[near], channels=channels)
