@@ -43,6 +43,11 @@ class ChainRun:
     wall_seconds: float
     stderr: str
 
+    @property
+    def lost(self) -> list[int]:
+        """Samples a loss report covers (attitude-rx holds them: the last rate, no aiding)."""
+        return sorted(r["first"] + i for r in self.reports if "first" in r for i in range(r["count"]))
+
     def delivered_once(self, n: int) -> bool:
         """Every sample 0..n-1 printed once, in order, no loss report, no duplicate."""
         losses = [r for r in self.reports if "first" in r]
@@ -129,10 +134,11 @@ def _serve(sess: tool.Session, proc: subprocess.Popen[bytes], n: int) -> tuple[t
 
 
 def direct(rec: BoardRecording, config: tool.Config = tool.AIDED, *, quantized: bool = True,
-           settings: dict[str, Any] | None = None) -> np.ndarray:
+           settings: dict[str, Any] | None = None, lost: Sequence[int] = ()) -> np.ndarray:
     """The library's filter (attitude_c's att_ahrs in double), one update per sample with the
     accelerometer and magnetometer only where the board sends them (NULL elsewhere), on the
-    codes converted as attitude-rx converts them (``quantized``) or on the SI values."""
+    codes converted as attitude-rx converts them (``quantized``) or on the SI values. The
+    ``lost`` samples are held as attitude-rx holds them: the last good rate, no aiding."""
     from attitude_c import _settings
     from attitude_c._lib import ffi_lib
     from attitude_c.ahrs_filter import _SPEC
@@ -144,10 +150,12 @@ def direct(rec: BoardRecording, config: tool.Config = tool.AIDED, *, quantized: 
         raise ValueError(f"settings: att_ahrs_init refused {settings!r}")
     q, qo = np.empty((rec.n, 4)), ffi.new("att_real[4]")
     every = {"acc": config.acc_every, "mag": config.mag_every}
+    held, gyro = set(lost), list(src["gyro"][0])
     for k in range(rec.n):
-        vec = [ffi.new("att_real[3]", list(src[c][k])) if every[c] and k % every[c] == 0 else ffi.NULL
-               for c in ("acc", "mag")]
-        st = lib.att_ahrs_update(s, list(src["gyro"][k]), vec[0], vec[1], config.period_s, qo)
+        vec = [ffi.new("att_real[3]", list(src[c][k])) if every[c] and k % every[c] == 0 and k not in held
+               else ffi.NULL for c in ("acc", "mag")]
+        gyro = gyro if k in held else list(src["gyro"][k])
+        st = lib.att_ahrs_update(s, gyro, vec[0], vec[1], config.period_s, qo)
         if st != 0:
             raise RuntimeError(f"att_ahrs_update failed at sample {k} (status {st})")
         q[k] = list(qo)
