@@ -79,10 +79,18 @@ def test_broad_excerpt_through_the_chain_equals_the_library_filter(excerpt: bc.B
     t = require_target(build)
     cmd = [*t.run_cmd, str(cross_build_target(build, out=tmp_path / build)["app"])]
     run = aided_chain.run_chain(excerpt, cmd, tmp_path / "fw")
-    assert run.delivered_once(excerpt.n), (run.ns[:5], run.reports, run.stats)
-    assert [r["report"] for r in run.reports] == ["BOOT", "CHANNELS"]
-    assert run.stats["records"] == tool.data_records(tool.AIDED, excerpt.n) + 2  # + BOOT, CHANNELS
-    q = aided_chain.direct(excerpt)
+    # every sample printed once, in order; nothing duplicated or damaged on the link
+    assert run.ns == list(range(len(run.ns))) and len(run.ns) >= excerpt.n, run.ns[:5]
+    assert run.stats["duplicates"] == 0 and run.stats["bad_frames"] == 0, run.stats
+    # the only loss the chain may show: s51 runs in simulated time and attitude-rx acknowledges in
+    # wall time, so on a loaded machine the firmware's ring can fill and it loses a sample at the
+    # source, reported in place (OVERRUN) and held by attitude-rx; the direct filter holds it too
+    assert [r["report"] for r in run.reports[:2]] == ["BOOT", "CHANNELS"]
+    assert all(r["report"] == "OVERRUN" for r in run.reports[2:]), run.reports
+    if not run.lost:
+        assert run.delivered_once(excerpt.n)
+        assert run.stats["records"] >= tool.data_records(tool.AIDED, excerpt.n) + 2  # + BOOT, CHANNELS
+    q = aided_chain.direct(excerpt, lost=run.lost)
     # attitude-rx is built in double (ATT_REAL_F64) like the package's filter: the host build runs
     # the same C with the same IEEE operations and prints 17 digits (round trip), so the
     # quaternions are equal. ARMv4T: soft-float libm (sqrt, atan2, sin, cos) may differ from the
