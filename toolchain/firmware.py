@@ -371,7 +371,7 @@ def parse_mem(mem: Path) -> tuple[int, int, int]:
 def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str = "production",
           sim_blocks: int = 0, sim_samples: int = 0, gyros: Sequence[Gyro] = GYROS, faults: Iterable[str] = (),
           extra_defines: Iterable[str] = (), name: str | None = None,
-          code_size: int | None = None, aux: Sequence[Gyro] = AUX) -> Image:
+          code_size: int | None = None, aux: Sequence[Gyro] = AUX, data: bool = False) -> Image:
     """Compile and link one image; raise :class:`FirmwareTooBig` if it does not fit.
 
     ``kind``: ``production``, ``sim`` (device model + simulator stop after
@@ -383,7 +383,8 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     ADC_ERROR report in that sample's place, then sampling goes on).
     ``config.board = "aided9"`` builds the aided AT89S52 image (toolchain/mcs52.toml: 8 KB,
     256 B; ``code_size`` defaults to the chip's flash); its device model serves ``aux`` on
-    AIN3-AIN8 (accelerometer, magnetometer).
+    AIN3-AIN8 (accelerometer, magnetometer), or with ``data=True`` (aided sim images) every
+    input from a recording: the file :func:`data_file` writes, given to :class:`Session`.
     """
     if kind not in ("production", "sim", "bench"):
         raise ValueError(f"kind must be production, sim or bench, got {kind!r}")
@@ -409,8 +410,11 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
         if config.aided:
             defines.append("FW_SIM_C52")  # the C52 core's Timer 2 SFRs: the instrumentation moves aside
         sources.append(FW_DIR / "sim" / "sim_io.c")
+    if data and (kind != "sim" or not config.aided):
+        raise ValueError("data=True needs kind='sim' and the aided board (board='aided9')")
     if kind == "sim":
-        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros, aux if config.aided else ())]
+        defines += ["FW_SIM_MODEL", *_gyro_defines(gyros, aux if config.aided else ()),
+                    *(["FW_SIM_DATA"] if data else [])]
         for f in faults:
             fault, _, arg = f.partition("=")
             if fault == "adc_error_at" and arg.isdigit() and int(arg) < 256:
@@ -456,6 +460,35 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
             or stack_free <= 0):
         raise FirmwareTooBig(img.size_report())
     return img
+
+
+def data_records(config: Config, n: int) -> int:
+    """Sample records (gyro, accelerometer, magnetometer) of an aided stream's first n samples."""
+    def due(every: int) -> int:
+        return 0 if every == 0 else (n + every - 1) // every
+    return n + due(config.acc_every) + due(config.mag_every)
+
+
+def data_file(path: Path | str, config: Config, gyro: np.ndarray, acc: np.ndarray, mag: np.ndarray) -> int:
+    """Write the input of a ``data=True`` image (firmware/sim/tlc_model.c FW_SIM_DATA): per
+    sample n the three gyro codes, then the accelerometer's if n % acc_every == 0, then the
+    magnetometer's if n % mag_every == 0 (the scan's order), each code two bytes big-endian.
+    Arrays (N, 3) of 12-bit codes; returns the sample records written."""
+    arrays = [np.asarray(a, dtype=np.int64) for a in (gyro, acc, mag)]
+    if any(a.shape != arrays[0].shape or a.ndim != 2 or a.shape[1] != 3 for a in arrays):
+        raise ValueError(f"gyro, acc, mag must be code arrays of one shape (N, 3), got {[a.shape for a in arrays]}")
+    if any(a.size and (a.min() < 0 or a.max() > 4095) for a in arrays):
+        raise ValueError("gyro, acc, mag must be 12-bit codes (0..4095)")
+    g, a, m = arrays
+    recs = []
+    for k in range(g.shape[0]):
+        recs.append(g[k])
+        if config.acc_every and k % config.acc_every == 0:
+            recs.append(a[k])
+        if config.mag_every and k % config.mag_every == 0:
+            recs.append(m[k])
+    Path(path).write_bytes(np.asarray(recs, dtype=">u2").tobytes())
+    return len(recs)
 
 
 # -- the block stream -------------------------------------------------------
@@ -700,7 +733,8 @@ class Session:
     simulated time only while the host is caught up (docs/firmware.md).
     """
 
-    def __init__(self, image: Image, timeout: float = 60.0, *, lockstep: bool = False) -> None:
+    def __init__(self, image: Image, timeout: float = 60.0, data: Path | None = None, *,
+                 lockstep: bool = False) -> None:
         if image.kind == "production":
             raise ValueError("a production image never stops in the simulator; build kind='sim' or 'bench'")
         for tool in ("s51", "socat"):
@@ -708,6 +742,7 @@ class Session:
                 raise FirmwareError(f"{tool} not found (apt-get install sdcc-ucsim socat)")
         self.image = image
         self.timeout = timeout
+        self.data = data  #: the simulator interface's input file (a data image's recording)
         self._tmp = Path(tempfile.mkdtemp(prefix="fwsim_"))
         # s51's UART on two FIFOs, not on a pty: on a terminal, uCsim opens its serial
         # control menu when the byte uart0_esc_char (^X) arrives, and link v2's ACKs carry
@@ -778,8 +813,9 @@ class Session:
         return self.sim_seconds
 
     def _s51_cmd(self, *tail: str) -> list[str]:
+        sif = f"if=sfr[0xff],out={self._tmp / 'sif.out'}" + (f",in={self.data}" if self.data is not None else "")
         return ["s51", "-t", "C52" if self.image.config.aided else "C51", "-R", "1",
-                "-I", f"if=sfr[0xff],out={self._tmp / 'sif.out'}", "-S", f"in={self._fw_in},out={self._fw_out}", *tail]
+                "-I", sif, "-S", f"in={self._fw_in},out={self._fw_out}", *tail]
 
     def run_lockstep(self, pump: Callable[[], None], describe: Callable[[], str] | None = None) -> SimOutput:
         """Run s51 in steps of :data:`LOCKSTEP_INSNS` instructions from its console, calling

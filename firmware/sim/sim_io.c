@@ -9,6 +9,12 @@ void fw_sim_putc(char c)
     FW_SIM_SIF = (unsigned char)c;
 }
 
+uint8_t fw_sim_getc(void)
+{
+    FW_SIM_SIF = 'r';
+    return FW_SIM_SIF;
+}
+
 void fw_sim_puts(const char *s)
 {
     while (*s) {

@@ -27,6 +27,17 @@
  * (or of the first sample scanned after it; K < 256): the driver times
  * out, the firmware sends an ADC_ERROR report in that sample's place and
  * samples on (a deterministic loss report).
+ *
+ * FW_SIM_DATA (aided board only): the inputs come from a recording instead,
+ * the simulator interface's input file (s51 -I ...,in=FILE), read in the
+ * order the firmware converts them: per sample, the three gyro codes when
+ * the scan's step runs, then each accelerometer or magnetometer code when
+ * its conversion ends (so only the groups' due channels are in the file:
+ * n % FW_ACC_EVERY, n % FW_MAG_EVERY, as the firmware decides). A code is
+ * two bytes, big-endian, 0..4095 (toolchain/firmware.py data_file). The
+ * scan of the sample at time k gets the file's group k: the groups of
+ * samples the firmware never scanned (lost to an OVERRUN) are read and
+ * dropped first, so a loss does not shift the recording.
  */
 #include "attitude/tlc2543.h"
 #include "config.h"
@@ -83,6 +94,7 @@ static const uint8_t gyro_phase[FW_SIM_NCH] = { FW_SIM_X_PH, FW_SIM_Y_PH, FW_SIM
 /* Model state beyond tlc_hal_sim.h's cells: SFR cells too, no RAM. */
 __sfr __at(0xBD) m_started; /* fw_sim_model_step() ran once (a byte: SFR 0xC8 holds fwm_word) */
 __sfr __at(0xC7) m_k;       /* sampling periods since the first step (mod 256) */
+__sfr __at(0xF5) m_next;    /* FW_SIM_DATA: the file's next group (sample number mod 256) */
 #if defined(FW_SIM_C52)     /* 0xC8-0xCD are Timer 2's on the C52 core */
 __sfr16 __at(0x9493) m_bound;
 __sfr16 __at(0x9695) m_conversions;
@@ -110,10 +122,45 @@ void fw_sim_model_init(void)
     m_bound = 0;
     m_conversions = 0;
     m_fault_done = 0;
+#if defined(FW_SIM_DATA)
+    m_next = 0;
+#endif
 #if defined(FW_SIM_DOUT_STUCK)
     fwm_stuck_dout = FW_SIM_DOUT_STUCK;
 #endif
 }
+
+#if defined(FW_SIM_DATA)
+#if FW_MAG_SR
+#error "FW_SIM_DATA serves one code per magnetometer conversion: not with FW_MAG_SR"
+#endif
+/* The input file's next code, << 4. */
+static uint16_t next_code(void)
+{
+    uint16_t hi = fw_sim_getc();
+    return (uint16_t)(((hi << 8) | fw_sim_getc()) << 4);
+}
+
+/* Read and drop group m_next (a sample the firmware did not scan). */
+static void skip_group(void)
+{
+    uint8_t n = 3u;
+#if FW_ACC_EVERY != 0
+    if ((m_next & (uint8_t)(FW_ACC_EVERY - 1)) == 0u) {
+        n += 3u;
+    }
+#endif
+#if FW_MAG_EVERY != 0
+    if ((m_next & (uint8_t)(FW_MAG_EVERY - 1)) == 0u) {
+        n += 3u;
+    }
+#endif
+    while (n-- != 0u) {
+        (void)next_code();
+    }
+    m_next++;
+}
+#endif
 
 /* Input c now: on the aided board analog() gives the 16-bit fraction of
  * Vref before the quantizer (mag() below adds the bridge offset first);
@@ -191,7 +238,11 @@ unsigned char fwm_end_cycle(void)
         fwm_word = fwm_vz;
 #if FW_AIDED
     } else if (a < FW_SIM_NCH) {
+#if defined(FW_SIM_DATA)
+        fwm_word = next_code(); /* accelerometer, magnetometer: the recording's next code */
+#else
         fwm_word = a >= (uint8_t)FW_AIN_MAG ? mag(a) : gyro(a); /* at the scan's time k */
+#endif
 #endif
     } else if (a == TLC2543_TEST_MID) {
         fwm_word = 0x8000u;
@@ -227,9 +278,19 @@ void fw_sim_model_step(void)
         m_k++;
         m_bound += (uint16_t)FW_PERIOD_TICKS;
     }
+#if defined(FW_SIM_DATA)
+    while (m_next != m_k) {
+        skip_group();
+    }
+    m_next++; /* this group: its gyros now, its other codes as they are converted */
+    fwm_vx = next_code();
+    fwm_vy = next_code();
+    fwm_vz = next_code();
+#else
     fwm_vx = gyro(0);
     fwm_vy = gyro(1);
     fwm_vz = gyro(2);
+#endif
     m_conversions++;
 }
 

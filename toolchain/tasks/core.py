@@ -143,7 +143,7 @@ def clean(c):
 # Each module bench/<name>.py defines TITLE and run(quick: bool) -> str (a
 # Markdown section body). `invoke bench` runs them all (or --only NAME) and
 # rewrites that module's section of docs/benchmarks.md, keeping the others.
-BENCH_ORDER = ("host", "armv4t", "fixed", "tlc2543", "ad7927", "firmware", "aided", "link", "peers")
+BENCH_ORDER = ("host", "armv4t", "fixed", "tlc2543", "ad7927", "firmware", "aided", "chain", "link", "peers")
 
 
 def _bench_modules() -> list[str]:

@@ -1,0 +1,162 @@
+"""A recording through the whole aided chain (issue 26): its codes served by the TLC2543
+model to the aided firmware in s51 (``data=True`` image, toolchain/firmware.py), link v2
+over a pty, attitude-rx (any build: host, or ARMv4T under qemu-arm) running its filter
+(``--estimator auto``, the configuration written by attitude_c.sim.board_codes) and
+printing JSON lines; beside it the library's filter run directly on the same samples.
+
+Used by tests/test_aided_chain.py (a short excerpt) and bench/chain.py (the BROAD trials).
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import tempfile
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from attitude_c.sim.board_codes import BoardRecording, board_channels, resample, rx_config, values
+
+from . import firmware as tool
+
+#: Samples of the recording's last group repeated after it: the firmware scans ahead of
+#: its acknowledgements (a ring of records), so the file must not end at the last sample.
+PAD_SAMPLES = 32
+
+
+@dataclass
+class ChainRun:
+    """What attitude-rx printed for the recording's samples, and the run's counters."""
+
+    q: np.ndarray  #: (n, 4) attitude-rx's quaternion of sample 0..n-1
+    ns: list[int]  #: the sample numbers of every attitude line printed, in order
+    reports: list[dict[str, Any]]  #: every report record (BOOT, CHANNELS, losses)
+    stats: dict[str, int]  #: attitude-rx's end-of-run counters (link2:, samples:, reports:)
+    firmware: dict[str, int]  #: the firmware's STATS line
+    sim_seconds: float
+    wall_seconds: float
+    stderr: str
+
+    @property
+    def lost(self) -> list[int]:
+        """Samples a loss report covers (attitude-rx holds them: the last rate, no aiding)."""
+        return sorted(r["first"] + i for r in self.reports if "first" in r for i in range(r["count"]))
+
+    def delivered_once(self, n: int) -> bool:
+        """Every sample 0..n-1 printed once, in order, no loss report, no duplicate."""
+        losses = [r for r in self.reports if "first" in r]
+        return (self.ns[:n] == list(range(n)) and self.ns == list(range(len(self.ns))) and not losses
+                and self.stats.get("duplicates", 0) == 0 and self.stats.get("bad_frames", 0) == 0)
+
+
+def recording(trial: Any, config: tool.Config = tool.AIDED, start: float = 0.0,
+              duration: float | None = None) -> BoardRecording:
+    """The trial at the firmware's sampling instants (its period), as the board's codes."""
+    return resample(trial, config.period_s, board_channels(), start=start, duration=duration)
+
+
+def _stats(err: str) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for ln in err.splitlines():
+        if ln.startswith(("attitude-rx: link2:", "attitude-rx: samples:", "attitude-rx: reports:")):
+            out.update({k: int(v) for k, v in (kv.split("=") for kv in ln.split(":", 2)[2].split())
+                        if v.lstrip("-").isdigit()})
+    return out
+
+
+def _pad(a: np.ndarray) -> np.ndarray:
+    return np.concatenate([a, np.repeat(a[-1:], PAD_SAMPLES, axis=0)])
+
+
+def run_chain(rec: BoardRecording, rx_cmd: Sequence[str], build_dir: Path, *,
+              config: tool.Config = tool.AIDED, timeout: float | None = None) -> ChainRun:
+    """The recording through firmware (s51), link v2, pty and attitude-rx (``rx_cmd``)."""
+    n = rec.n
+    img = tool.build(build_dir, config, kind="sim", sim_samples=tool.data_records(config, n), data=True,
+                     name="fw_chain")
+    timeout = timeout if timeout is not None else 4.0 * n * config.period_s + 120.0
+    with tempfile.TemporaryDirectory(prefix="chain_") as tmp:
+        data, conf = Path(tmp) / "codes.bin", Path(tmp) / "rx.conf"
+        tool.data_file(data, config, *(_pad(rec.codes[k]) for k in ("gyro", "acc", "mag")))
+        conf.write_text(rx_config(rec.channels))
+        with tool.Session(img, timeout=timeout, data=data) as sess:
+            proc = subprocess.Popen([*rx_cmd, "--port", str(sess.port), "--format", "jsonl", "--estimator", "auto",
+                                     "--config", str(conf), "--queue", "4096"],
+                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+            try:
+                fw, lines, err = _serve(sess, proc, n)
+            finally:
+                if proc.poll() is None:
+                    proc.kill()
+                    proc.wait()
+    recs = [json.loads(x) for x in lines]
+    ups = [r for r in recs if "q" in r]
+    if len(ups) < n:
+        raise tool.FirmwareError(f"attitude-rx printed {len(ups)} of {n} samples; stderr:\n{err}")
+    return ChainRun(q=np.array([r["q"] for r in ups[:n]]), ns=[r["n"] for r in ups],
+                    reports=[r for r in recs if "report" in r], stats=_stats(err), firmware=fw.stats,
+                    sim_seconds=fw.sim_seconds, wall_seconds=fw.wall_seconds, stderr=err)
+
+
+def _serve(sess: tool.Session, proc: subprocess.Popen[bytes], n: int) -> tuple[tool.SimOutput, list[str], str]:
+    """Run the firmware until it saw every record of the n samples acknowledged; then wait
+    for attitude-rx's line of sample n-1 (acknowledged records are all printed), stop it."""
+    assert proc.stdout is not None and proc.stderr is not None
+    banner = proc.stderr.readline().decode()  # printed once the port is configured: BOOT finds a listener
+    lines: list[str] = []
+    last = threading.Event()
+
+    def read() -> None:
+        assert proc.stdout is not None
+        for raw in proc.stdout:
+            lines.append(raw.decode())
+            if f'"n":{n - 1},' in raw.decode().replace(" ", ""):
+                last.set()
+        last.set()  # attitude-rx ended
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    fw = sess.run(describe=lambda: f"attitude-rx printed {len(lines)} lines")
+    last.wait(timeout=60)  # bound only for a broken attitude-rx: acknowledged records are printed
+    proc.send_signal(signal.SIGINT)
+    err = banner + proc.stderr.read().decode()
+    proc.wait(timeout=60)
+    reader.join(timeout=60)
+    if proc.returncode != 0:
+        raise tool.FirmwareError(f"attitude-rx exited with {proc.returncode}:\n{err}")
+    return fw, lines, err
+
+
+def direct(rec: BoardRecording, config: tool.Config = tool.AIDED, *, quantized: bool = True,
+           settings: dict[str, Any] | None = None, lost: Sequence[int] = ()) -> np.ndarray:
+    """The library's filter (attitude_c's att_ahrs in double), one update per sample with the
+    accelerometer and magnetometer only where the board sends them (NULL elsewhere), on the
+    codes converted as attitude-rx converts them (``quantized``) or on the SI values. The
+    ``lost`` samples are held as attitude-rx holds them: the last good rate, no aiding."""
+    from attitude_c import _settings
+    from attitude_c._lib import ffi_lib
+    from attitude_c.ahrs_filter import _SPEC
+
+    src = {k: values(rec.codes[k], rec.channels[k]) if quantized else rec.si[k] for k in ("gyro", "acc", "mag")}
+    ffi, lib = ffi_lib("f64")
+    s = ffi.new("att_ahrs *")
+    if lib.att_ahrs_init(s, _settings.fill(ffi, lib, _SPEC, settings or {}), ffi.NULL) != 0:
+        raise ValueError(f"settings: att_ahrs_init refused {settings!r}")
+    q, qo = np.empty((rec.n, 4)), ffi.new("att_real[4]")
+    every = {"acc": config.acc_every, "mag": config.mag_every}
+    held, gyro = set(lost), list(src["gyro"][0])
+    for k in range(rec.n):
+        vec = [ffi.new("att_real[3]", list(src[c][k])) if every[c] and k % every[c] == 0 and k not in held
+               else ffi.NULL for c in ("acc", "mag")]
+        gyro = gyro if k in held else list(src["gyro"][k])
+        st = lib.att_ahrs_update(s, gyro, vec[0], vec[1], config.period_s, qo)
+        if st != 0:
+            raise RuntimeError(f"att_ahrs_update failed at sample {k} (status {st})")
+        q[k] = list(qo)
+    return q
