@@ -52,14 +52,41 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
 /* The filter's settings by field name (attitude/ahrs.h): every att_real field of
  * att_ahrs_settings; method is the shared "method" key. A field added to the header
  * is added here (tests/test_attitude_rx_aided.py compares this list with the header's). */
-#define RX_AHRS_REAL_FIELDS(X)                                                                               \
-    X(gravity)                                                                                               \
-    X(gyr_noise)                                                                                             \
-    X(gyr_noise_rest) X(bias_noise) X(init_att_sigma) X(init_bias_sigma) X(acc_tau) X(acc_noise) X(acc_gate) \
-        X(acc_reject_max) X(mag_noise) X(mag_norm_tol) X(mag_dip_tol) X(mag_ref_tau) X(mag_reject_max)       \
-            X(mag_reject_factor) X(mag_new_time) X(mag_min_undisturbed) X(mag_new_gyr) X(declination)        \
-                X(rest_time) X(rest_tau) X(rest_gyr_th) X(rest_acc_th) X(rest_noise) X(gyro_range)           \
-                    X(overrange_sigma) X(sensor_delay) X(acc_delay) X(mag_delay) X(tilt_tau)
+/* One field a line, unformatted: clang-format 14 reflows an X-macro list differently each pass. */
+// clang-format off
+#define RX_AHRS_REAL_FIELDS(X) \
+    X(gravity) \
+    X(gyr_noise) \
+    X(gyr_noise_rest) \
+    X(bias_noise) \
+    X(init_att_sigma) \
+    X(init_bias_sigma) \
+    X(acc_tau) \
+    X(acc_noise) \
+    X(acc_gate) \
+    X(acc_reject_max) \
+    X(mag_noise) \
+    X(mag_norm_tol) \
+    X(mag_dip_tol) \
+    X(mag_ref_tau) \
+    X(mag_reject_max) \
+    X(mag_reject_factor) \
+    X(mag_new_time) \
+    X(mag_min_undisturbed) \
+    X(mag_new_gyr) \
+    X(declination) \
+    X(rest_time) \
+    X(rest_tau) \
+    X(rest_gyr_th) \
+    X(rest_acc_th) \
+    X(rest_noise) \
+    X(gyro_range) \
+    X(overrange_sigma) \
+    X(sensor_delay) \
+    X(acc_delay) \
+    X(mag_delay) \
+    X(tilt_tau)
+// clang-format on
 #define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
 
 static const struct {

@@ -145,12 +145,16 @@ static uint16_t next_code(void)
 static void skip_group(void)
 {
     uint8_t n = 3u;
-#if FW_ACC_EVERY != 0
+#if FW_ACC_EVERY == 1
+    n += 3u;
+#elif FW_ACC_EVERY != 0
     if ((m_next & (uint8_t)(FW_ACC_EVERY - 1)) == 0u) {
         n += 3u;
     }
 #endif
-#if FW_MAG_EVERY != 0
+#if FW_MAG_EVERY == 1
+    n += 3u;
+#elif FW_MAG_EVERY != 0
     if ((m_next & (uint8_t)(FW_MAG_EVERY - 1)) == 0u) {
         n += 3u;
     }
