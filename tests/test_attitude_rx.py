@@ -1047,3 +1047,67 @@ def test_rx_link_auto_undecodable_legacy_block_decides_nothing(rx_builds) -> Non
     assert rc == 0, err
     assert "the board speaks link v2" in err and "legacy protocol" not in err
     assert [r for r in _rows(out) if max(r) < 4096][-30:] == codes, err
+
+
+class _ProbeWatch(_PtyMaster):
+    """_PtyMaster that sets ``probed`` when A writes a probe (an empty DATA frame): A's sign
+    that B's limit has blocked it for rto ticks."""
+
+    def __init__(self, fd: int, rx: Rx) -> None:
+        import threading
+
+        super().__init__(fd, rx)
+        self.probed = threading.Event()
+
+    def write(self, data: bytes) -> None:
+        from attitude_c.link import v2
+
+        for part in bytes(data).split(b"\0"):
+            f = v2.rcobs_decode(part) if part else None
+            if f is not None and len(f) == 6 and f[0] & 0xDF == v2.T_DATA:  # n = 0, either epoch
+                self.probed.set()
+        super().write(data)
+
+
+@pytest.mark.parametrize("impl", ["c", "python"])
+def test_rx_link_v2_full_queue_resumes(rx_builds, impl: str) -> None:
+    """Link v2 under back-pressure: attitude-rx's stdout is a pipe nobody reads at first, so its
+    attitude thread blocks, the queue fills and B's limit stops A (which probes). Once stdout is
+    read, the room grows and A must resume: every one of the 800 samples acknowledged, received
+    once and printed, and the run ends by --count. (A colleague's "v2 stall" at a full queue was
+    this state with a harness that never read stdout: correct back-pressure, not a stuck link.)"""
+    import fcntl
+    import threading
+
+    from attitude_c.link.transport2 import run_sender2
+
+    n, queue = 800, 256
+    rx = Rx(rx_builds["host"], "--link", "v2", "--method", "rv1", "--count", str(n), "--no-header",
+            "--consumer-delay", "0.003")
+    assert rx.proc.stdout is not None
+    # one page of pipe (Linux' minimum): ~38 lines of ~107 bytes, far below the 800 - 256 queued
+    # and 64 in A's ring that must be printed before the last sample can be acknowledged
+    fcntl.fcntl(rx.proc.stdout.fileno(), fcntl.F_SETPIPE_SZ, 4096)
+    port = _ProbeWatch(rx.master, rx)
+    out: list[bytes] = []
+
+    def drain() -> None:
+        port.probed.wait(60)  # bound only: the probe comes once the pipe and the queue are full
+        out.append(rx.proc.stdout.read())  # type: ignore[union-attr]
+
+    th = threading.Thread(target=drain, daemon=True)
+    th.start()
+    recs = [_block(c) for c in _gyro_codes(n)]
+    rep = run_sender2(port, recs, impl=impl, timeout=60, stop=_RxEnded(rx))  # type: ignore[arg-type]
+    if rep.ended_by != "done":  # a stuck link leaves attitude-rx waiting: stop it for its statistics
+        rx.proc.send_signal(signal.SIGINT)
+    th.join(90)  # bound only: the drain ends at attitude-rx's exit
+    rc, _, err = rx.finish(sig=None)
+    st = _stats(err)
+    assert port.probed.is_set() and rep.stats["timeouts"] >= 1, err  # B's limit did block A
+    assert rc == 0 and rep.ended_by == "done" and rep.acknowledged == n, f"{rep}\n{err}"
+    assert st["queue_high_water"] == queue, err  # the default queue did fill
+    line = next(x for x in err.splitlines() if x.startswith("attitude-rx: link2:"))
+    l2 = dict(kv.split("=") for kv in line.split(":", 2)[2].split())
+    assert int(l2["records"]) == n and st["received"] == n and st["integrated"] == n, err  # each once
+    assert len(b"".join(out).splitlines()) == n
