@@ -152,9 +152,12 @@ FIT_HORIZON_JS = """
 
 
 def _wait_text(page, el_id: str, text: str, *, equal: bool = True, timeout: float = 20_000) -> None:
-    """Wait until #el_id's text is (or, equal=False, is no longer) ``text``. A function, not a
-    string expression: the page's CSP (no eval) applies to Playwright's string predicates."""
-    page.wait_for_function("([id, t, eq]) => (document.getElementById(id).textContent === t) === eq",
+    """Wait until #el_id exists and its text is (or, equal=False, is no longer) ``text``. A
+    function, not a string expression: the page's CSP (no eval) applies to Playwright's string
+    predicates. An element the page has not drawn yet (a counter before its first sample) is
+    waited for: a predicate that throws ends the wait at once."""
+    page.wait_for_function("([id, t, eq]) => { const e = document.getElementById(id); "
+                           "return e !== null && (e.textContent === t) === eq; }",
                            arg=[el_id, text, equal], timeout=timeout)
 
 
