@@ -120,7 +120,7 @@ def _list_options() -> int:
     print("kind = \"simulate\": options (spec name, command-line option, choices)")
     for name, o in simulate_options().items():
         ch = f"  {{{', '.join(map(str, o.choices))}}}" if o.choices else ""
-        what = {"flag": " (switch: true/false)", "append": " (repeatable: a list of values)"}.get(o.kind, "")
+        what = {"switch": " (switch: true/false)", "repeat": " (repeatable: a list of values)"}.get(o.kind, "")
         print(f"  {name:16s} {o.flag}{what}{ch}")
     print("kind = \"recordings\": estimators")
     for name in sorted(ESTIMATORS):

@@ -3,11 +3,12 @@
 A *spec* (TOML) names a kind of run and the values to run it with:
 
 * ``kind = "simulate"``: one run is one ``attitude simulate`` scenario. Any
-  option of that command can be fixed, gridded or drawn at random: the
-  options are read from the command's own parser
-  (:func:`simulate_options`), so an option added there is sweepable with no
-  change here. Each run's parameters go through that parser and the
-  command's ``build_config``, exactly as on the command line.
+  option of the simulator can be fixed, gridded or drawn at random: the
+  options are the simulator's option table (:mod:`attitude_c.sim.options`,
+  :func:`simulate_options`), which the command's parser is made from, so an
+  option added there is sweepable with no change here. Each run's parameters
+  become its configuration with ``SimConfig.from_dict``, the values checked
+  by the same types as on the command line.
 * ``kind = "recordings"``: one run is one attitude estimator, with one set of
   settings, on one recording (a BROAD trial, :mod:`attitude_c.broad`),
   scored with BROAD's error metric. The estimator is a callable registered
@@ -31,7 +32,6 @@ sweep runs.
 
 from __future__ import annotations
 
-import argparse
 import hashlib
 import inspect
 import itertools
@@ -52,6 +52,7 @@ import numpy as np
 from .._io import write_with
 from ..core import Method, Precision
 from ..errors import InvalidArgument
+from .options import Option, by_name, parse, parse_value
 
 __all__ = [
     "ESTIMATORS",
@@ -116,79 +117,12 @@ def _toml_loads(text: str) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------------
-# the simulate option set, read from the command's parser
+# the simulate option set: the simulator's option table
 # ---------------------------------------------------------------------------
 
-class _ParseError(Exception):
-    pass
-
-
-class _RaisingParser(argparse.ArgumentParser):
-    """An ArgumentParser that raises instead of printing usage and exiting."""
-
-    def error(self, message: str) -> Any:  # type: ignore[override]
-        opt = message.partition(": ")[0].removeprefix("argument ")
-        raise _ParseError(message.replace(f"argument {opt}: {opt}: ", f"{opt}: ", 1))  # the validators name it
-
-
-@dataclass(frozen=True)
-class Option:
-    """One sweepable option of ``attitude simulate``."""
-
-    dest: str             #: the parameter name in a spec and in the table (``cone_angle``)
-    flag: str             #: the option on the command line (``--cone-angle``)
-    kind: Literal["value", "flag", "append"]  #: ``flag``: a switch (true/false); ``append``: repeatable
-    choices: tuple[Any, ...] | None
-    help: str
-    unit: str | None = None  #: the value's unit (plot axes), from the option's metavar or help
-
-
-#: argument groups of ``attitude simulate`` that say how a run is shown or stored, not what
-#: runs: not sweepable (the sweep sets the seed itself)
-_CONTROL_GROUPS = ("run",)
-
-
-@lru_cache(maxsize=1)
-def _simulate_parser() -> Any:
-    from ..cli import simulate as cli_simulate
-
-    top = _RaisingParser(prog="attitude")
-    sub = top.add_subparsers(dest="command", parser_class=_RaisingParser)
-    cli_simulate.register(sub)
-    return sub.choices["simulate"]
-
-
-@lru_cache(maxsize=1)
 def _options() -> dict[str, Option]:
-    p = _simulate_parser()
-    control = {id(a) for g in p._action_groups if g.title in _CONTROL_GROUPS for a in g._group_actions}
-    out: dict[str, Option] = {}
-    for a in p._actions:
-        if not a.option_strings or id(a) in control or isinstance(a, argparse._HelpAction):
-            continue
-        flag = max(a.option_strings, key=len)
-        kind: Literal["value", "flag", "append"] = (
-            "flag" if a.nargs == 0 else "append" if isinstance(a, argparse._AppendAction) else "value")
-        out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "",
-                             _option_unit(a.metavar, a.help or ""))
-    return out
-
-
-#: Units an option's metavar names (``--period S``), and those its help gives in brackets
-#: (``(deg)``, ``(Hz)``, ``(deg/s; ...)``), as a plot axis writes them.
-_METAVAR_UNITS = {"S": "s", "DEG": "°", "HZ": "Hz", "DEG_S": "°/s", "M_S2": "m/s²"}
-_HELP_UNITS = {"s": "s", "deg": "°", "Hz": "Hz", "deg/s": "°/s", "µT": "µT", "m": "m"}
-
-
-def _option_unit(metavar: Any, help_text: str) -> str | None:
-    """The unit of an option's value: its metavar's, else the one unit its help gives in
-    brackets (None for none, or for several: a triple of mixed units)."""
-    import re
-
-    if isinstance(metavar, str) and metavar in _METAVAR_UNITS:
-        return _METAVAR_UNITS[metavar]
-    found = {_HELP_UNITS[m] for m in re.findall(r"\((s|deg|Hz|deg/s|µT|m)[;,)]", help_text)}
-    return found.pop() if len(found) == 1 else None
+    """The simulator's options a spec can set (the table, :mod:`.options`; the sweep sets the seed)."""
+    return {n: o for n, o in by_name().items() if n not in RESERVED}
 
 
 #: Units of result and setting names by their ending (vectors' ``_0``.. stripped first).
@@ -214,7 +148,8 @@ def _labelled(spec: Spec, name: str) -> str:
 
 
 def simulate_options() -> dict[str, Option]:
-    """The options of ``attitude simulate`` a spec can set, by parameter name."""
+    """The simulator's options a spec can set (those of ``attitude simulate`` but the
+    seed, which the sweep sets, and how a run is kept), by parameter name."""
     return dict(_options())
 
 
@@ -223,6 +158,7 @@ def _option_name(name: str) -> str:
 
 
 def _argv_value(v: Any) -> str:
+    """A value as its command-line text (a table cell)."""
     if isinstance(v, bool):
         return str(v).lower()
     if isinstance(v, float):
@@ -230,31 +166,6 @@ def _argv_value(v: Any) -> str:
     if isinstance(v, (list, tuple)):
         return ",".join(_argv_value(x) for x in v)
     return str(v)
-
-
-def _simulate_argv(params: Mapping[str, Any]) -> list[str]:
-    opts = _options()
-    argv: list[str] = []
-    for k, v in params.items():
-        if k in RESERVED:
-            continue
-        o = opts[k]
-        if o.kind == "flag":
-            if not isinstance(v, bool):
-                raise _ParseError(f"{o.flag} is a switch: give true or false, got {v!r}")
-            if v:
-                argv.append(o.flag)
-        elif o.kind == "append":  # a string (or a list of numbers) is one occurrence; a list of them, several
-            many = isinstance(v, list) and all(isinstance(x, (str, list)) for x in v)
-            argv += [f"{o.flag}={_argv_value(x)}" for x in (v if many else [v])]
-        else:
-            argv.append(f"{o.flag}={_argv_value(v)}")
-    argv += ["--seed", str(int(params.get("seed", 0)))]
-    return argv
-
-
-def _simulate_namespace(params: Mapping[str, Any]) -> Any:
-    return _simulate_parser().parse_args(_simulate_argv(params))
 
 
 def _jsonable(v: Any) -> Any:
@@ -580,9 +491,9 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     if clash:
         raise SpecError(f"parameter(s) {sorted(clash)} both in [grid] and [random]")
     for k, v in pinned.items() if kind == "simulate" else ():
-        try:  # each value alone, through the command's parser: the error names the key
-            _simulate_namespace({k: v})
-        except _ParseError as exc:
+        try:  # each value alone, through the option table: the error names the key
+            parse_value(k, v)
+        except (ValueError, TypeError) as exc:
             raise SpecError(f"--set {k}: {exc}") from None
     if kind == "recordings" and "trial" in pinned:
         t = pinned.pop("trial")
@@ -672,20 +583,17 @@ _MISSING = object()
 def _canonical(kind: str, point: dict[str, Any], estimators: dict[str, Callable[..., Any]]) -> dict[str, Any]:
     """The run's parameters as the run will see them; SpecError if they cannot run."""
     if kind == "simulate":
-        from ..cli.simulate import build_config
-        from ..errors import AttitudeError
+        from .chain import SimConfig
+        from .configure import build
 
-        try:
-            ns = _simulate_namespace(point)
-        except _ParseError as exc:
-            raise SpecError(f"run {_show(point)}: {exc}") from None
-        try:  # the command's own checks: a combination that cannot run is a spec error
-            build_config(ns).validate()
-        except (AttitudeError, ValueError, TypeError) as exc:
+        try:  # each value alone, then the configuration's own checks: what cannot run is a spec error
+            typed = parse({k: v for k, v in point.items() if k not in RESERVED})
+            SimConfig(**build(typed)).validate()
+        except (ValueError, TypeError) as exc:
             raise SpecError(f"run {_show(point)}: {exc}") from None
         out = {}
         for k, v in point.items():
-            c = v if k == "case" else _jsonable(getattr(ns, k))
+            c = v if k == "case" else _jsonable(typed[k])
             try:  # the parsed value when it has a JSON form, else the spec's own
                 json.dumps(c)
             except (TypeError, ValueError):
@@ -747,10 +655,9 @@ def _flat_figures(summary: Mapping[str, Any]) -> dict[str, float]:
 
 
 def _run_simulate(params: Mapping[str, Any]) -> dict[str, float]:
-    from ..cli.simulate import build_config
-    from .chain import simulate
+    from .chain import SimConfig, simulate
 
-    res = simulate(build_config(_simulate_namespace(params)))
+    res = simulate(SimConfig.from_dict({k: v for k, v in params.items() if k != "case"}))
     return _flat_figures(res.summary)
 
 
