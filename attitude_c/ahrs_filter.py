@@ -27,7 +27,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
-from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+from .errors import InvalidArgument, InvalidType, NonFiniteError
+from .names import raise_for_status
 
 __all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings", "parse_setting", "setting_option"]
 
