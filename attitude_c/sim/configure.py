@@ -59,7 +59,7 @@ def build(o: Mapping[str, Any]) -> dict[str, Any]:
 def _trajectory(o: Mapping[str, Any], period: float, gyro_name: str) -> tuple[Any, float]:
     """The reference motion the options describe, and the simulated time."""
     given, path = o["trajectory"], o["trajectory_file"]
-    kind = given or ("csv" if path else "paper")
+    kind: Any = given or ("csv" if path else "paper")  # one of TRAJECTORIES (the table's choices)
     duration: float | None = o["duration"]
     if o["firmware"] != "none":
         if given or path:
@@ -82,7 +82,7 @@ def _trajectory(o: Mapping[str, Any], period: float, gyro_name: str) -> tuple[An
 def _csv_trajectory(path: str | None, duration: float | None) -> Any:
     if not path:
         raise ValueError("--trajectory csv needs --trajectory-file CSV")
-    traj = make_trajectory("csv", path=path)
+    traj: Any = make_trajectory("csv", path=path)  # a CsvTrajectory: span, t_start, t_end
     if duration is not None and duration > traj.span * (1 + 1e-9):
         raise ValueError(f"--duration {duration:g} s is longer than the trajectory file {path} ({traj.span:g} s, "
                          f"t = {traj.t_start:g} .. {traj.t_end:g} s): give at most {traj.span:g} s, or leave "
