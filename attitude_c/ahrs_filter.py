@@ -19,7 +19,7 @@ Settings are keyword arguments named as the C struct's fields
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -30,7 +30,7 @@ from ._lib import ffi_lib
 from .errors import InvalidArgument, InvalidType, NonFiniteError
 from .names import raise_for_status
 
-__all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings", "parse_setting", "setting_option"]
+__all__ = ["SETTINGS", "Ahrs", "ahrs", "check_settings", "default_settings", "parse_setting", "setting_option"]
 
 FloatArray = NDArray[np.float64]
 Precision = Literal["f64", "f32"]
@@ -63,6 +63,13 @@ def parse_setting(text: str, option: str = "--set") -> tuple[str, Any]:
     --ahrs-setting`` and ``view --ahrs-setting``. ValueError naming ``option``
     for a malformed text, an unknown name or a value that is not a number."""
     return _settings.parse_assignment(_SPEC, text, option)
+
+
+def check_settings(settings: Mapping[str, Any]) -> None:
+    """Raise as :class:`Ahrs` would for ``settings`` (InvalidArgument/InvalidType naming
+    the setting: unknown, of the wrong type, outside the domain), without a filter."""
+    ffi, lib = ffi_lib("f64")
+    _settings.fill(ffi, lib, _SPEC, settings)
 
 
 def setting_option(option: str) -> Callable[[str], tuple[str, Any]]:

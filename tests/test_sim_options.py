@@ -148,3 +148,6 @@ def test_view_refuses_settings_where_no_filter_runs(capsys) -> None:
     pytest.importorskip("aiohttp", reason="attitude view needs aiohttp: pip install 'attitude-c[view]'")
     assert main(["view", "--stdin", "--ahrs-setting", "acc_tau=3"]) == 2
     assert "--ahrs-setting is for --replay and --simulate" in capsys.readouterr().err
+    # outside the domain: a usage error before anything is opened, as attitude ahrs says it
+    assert main(["view", "--replay", "x.mat", "--ahrs-setting", "acc_tau=-1"]) == 2
+    assert "--ahrs-setting: settings: acc_tau=-1.0 outside its domain" in capsys.readouterr().err

@@ -139,6 +139,13 @@ def _usage_problems(args: argparse.Namespace) -> str | None:
                 "--method after --simulate)")
     if args.ahrs_setting and args.replay is None and args.simulate is None:
         return "--ahrs-setting is for --replay and --simulate (the serial link carries no accelerometer)"
+    if args.ahrs_setting:
+        from ..ahrs_filter import check_settings
+
+        try:
+            check_settings(dict(args.ahrs_setting))
+        except (ValueError, TypeError) as exc:
+            return f"--ahrs-setting: {exc}"
     if args.speed != 1.0 and args.replay is None and args.simulate is None:
         return "--speed is for --replay and --simulate"
     if args.serial is not None:
