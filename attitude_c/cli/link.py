@@ -180,9 +180,23 @@ def _open(cmd: str, args: argparse.Namespace) -> Any:
         return None
 
 
-def cmd_rx(args: argparse.Namespace) -> int:
+def _receive(args: argparse.Namespace, port: Any, protocol: str, show: Callable[[bytes], None],
+             stop: threading.Event, *, count: int | None, duration: float | None, receiver: Any = None) -> Any:
+    """link-rx: the receiver of ``protocol`` (legacy or v2) on ``port``, printing with ``show``,
+    until ``count``, ``duration``, --idle-eof or a stop; ``receiver``: one to go on with
+    (--protocol auto's). Its report."""
     from ..link.transport import run_receiver
+    from ..link.transport2 import run_receiver2
 
+    common: dict[str, Any] = {"count": count, "duration": duration, "stop": stop, "eof_after": args.idle_eof,
+                              "receiver": receiver}
+    if protocol == "v2":
+        return run_receiver2(port, impl=args.impl, on_record=show, keep_records=False, **common)
+    return run_receiver(port, impl=args.impl, block_size=args.block_size, gap_timeout_ms=args.gap_timeout_ms,
+                        on_block=show, keep_blocks=False, **common)
+
+
+def cmd_rx(args: argparse.Namespace) -> int:
     if args.protocol != "v2" and (args.decode or args.protocol == "auto"):
         from ..link import block
 
@@ -205,15 +219,8 @@ def cmd_rx(args: argparse.Namespace) -> int:
     try:
         if args.protocol == "auto":
             rep = _rx_auto(args, port, show, stop)
-        elif args.protocol == "v2":
-            from ..link.transport2 import run_receiver2
-
-            rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
-                                stop=stop, eof_after=args.idle_eof, keep_records=False)
         else:
-            rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
-                               gap_timeout_ms=args.gap_timeout_ms, count=args.count, duration=args.duration,
-                               on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+            rep = _receive(args, port, args.protocol, show, stop, count=args.count, duration=args.duration)
     except AttitudeError as exc:
         print(f"link-rx: {exc}", file=sys.stderr)
         return 2
@@ -420,8 +427,7 @@ def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None],
     """link-rx --protocol auto: listen_auto, then the receiver of the protocol heard; its report."""
     import time
 
-    from ..link.transport import run_receiver
-    from ..link.transport2 import listen_auto, run_receiver2
+    from ..link.transport2 import listen_auto
 
     t0 = time.monotonic()
 
@@ -433,16 +439,15 @@ def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None],
                         eof_after=args.idle_eof)
     if heard.protocol == "legacy":
         print("link-rx: the sender speaks the legacy protocol", file=sys.stderr, flush=True)
-        rep: Any = run_receiver(heard.port, receiver=heard.legacy, count=args.count, duration=left(),
-                                on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+        rep: Any = _receive(args, heard.port, "legacy", show, stop, receiver=heard.legacy, count=args.count,
+                            duration=left())
     elif heard.protocol == "v2":
         print("link-rx: the sender speaks link v2", file=sys.stderr, flush=True)
         count = None if args.count is None else args.count - heard.records
         if count is not None and count <= 0:
             rep = SimpleNamespace(stats=heard.v2.stats.as_dict(), ended_by="count", error="")
         else:
-            rep = run_receiver2(heard.port, impl=args.impl, receiver=heard.v2, count=count, duration=left(),
-                                on_record=show, stop=stop, eof_after=args.idle_eof, keep_records=False)
+            rep = _receive(args, heard.port, "v2", show, stop, receiver=heard.v2, count=count, duration=left())
     else:
         rep = SimpleNamespace(stats={"legacy": heard.legacy.stats.as_dict(), "v2": heard.v2.stats.as_dict()},
                               ended_by=heard.ended_by + ", no protocol heard", error=heard.error)
