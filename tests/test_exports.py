@@ -29,7 +29,7 @@ INTERNAL = re.compile(r"att__\w+")
 def _public_names() -> set[str]:
     """Every identifier the public headers declare, comments removed."""
     text = "\n".join(h.read_text() for h in PUBLIC_HEADERS)
-    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.DOTALL)
     return set(re.findall(r"\b[A-Za-z_]\w*\b", text))
 
 

@@ -207,7 +207,10 @@ def bench_doc_text() -> str:
     return ("# Benchmarks\n\n"
             "Latest figures of every benchmark of the project, one section per benchmark module "
             "(`bench/NAME.py`). Regenerate all of them with `invoke bench`, one with "
-            "`invoke bench --only NAME`; each section gives the machine, the date and the command.\n\n"
+            "`invoke bench --only NAME`; each section gives the machine, the date and the command. "
+            "The sections are docs/bench/NAME.md, each closed by a stamp of its text: they are "
+            "written by the benchmarks only (`tests/test_bench_docs.py` fails on a hand edit), and "
+            "the other pages refer to them rather than repeat their figures.\n\n"
             + "\n\n".join(parts) + "\n")
 
 
