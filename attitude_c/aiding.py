@@ -148,7 +148,8 @@ def gauss_newton(f: ArrayLike, m: ArrayLike, q0: ArrayLike | None = None, declin
                  *, return_info: bool = False, **settings: float) -> Any:
     """Gauss–Newton quaternion (``att_gn_solve``) from ``f``, ``m`` (..., 3),
     starting at ``q0`` ((..., 4) per sample, or one (4,) for all; None: the
-    identity). ``method``: "gauss-newton" (eq. 3.39, damped) or "simplified"
+    closed-form TRIAD attitude, from which every well-posed sample converges;
+    ``[1, 0, 0, 0]`` is the thesis' cold start). ``method``: "gauss-newton" (eq. 3.39, damped) or "simplified"
     (eq. 3.40). Keyword settings (``att_gn_settings``; the defaults of
     ``att_gn_defaults``): max_iter, tol_residual, tol_step, accept_residual,
     damping, max_step, singular_tol. Returns q (..., 4), or (q, GNInfo) with
