@@ -85,6 +85,9 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
     return a
 
 
+_F64 = np.dtype(np.float64)
+
+
 class Ahrs:
     """Streaming attitude filter (one ``att_ahrs`` state).
 
@@ -115,6 +118,12 @@ class Ahrs:
         st = self._lib.att_ahrs_init(self._s, self._set, q)
         if st != 0:
             raise_for_status(st, "q0")
+        # the one-sample fast path's buffers (see update), reused by every call (f64 only)
+        self._in1 = [self._ffi.new("att_real[3]") for _ in range(3)] if self.precision == "f64" else None
+        self._q1 = np.empty(4, dtype=_DTYPES[self.precision])
+        self._q1p = self._ffi.from_buffer("att_real[]", self._q1)
+        self._step = None if self.rate is None else 1.0 / self.rate
+        self._upd = self._lib.att_ahrs_update
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -163,6 +172,28 @@ class Ahrs:
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
                dt: ArrayLike | None = None) -> FloatArray:
         """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4))."""
+        # The fast path (precision f64): one sample of (3,) float64 arrays, dt None or a float:
+        # the rows copied into reused buffers (sizes checked here: memmove does not, and it
+        # refuses strided arrays), one C call, the attitude copied out. The C call checks every
+        # value (finite, dt > 0, units) and leaves the state untouched when it fails: the
+        # general path below then repeats it and names the bad argument.
+        step = self._step if dt is None else dt if isinstance(dt, float) else None
+        bufs, nd, f64 = self._in1, np.ndarray, _F64
+        if (step is not None and bufs is not None and type(gyr) is nd and type(acc) is nd
+                and gyr.shape == (3,) and acc.shape == (3,) and gyr.dtype == f64 and acc.dtype == f64
+                and (mag is None or type(mag) is nd and mag.shape == (3,) and mag.dtype == f64)):
+            g, a, m = bufs
+            move = self._ffi.memmove
+            try:
+                move(g, gyr, 24)
+                move(a, acc, 24)
+                if mag is not None:
+                    move(m, mag, 24)
+                ok = self._upd(self._s, g, a, self._ffi.NULL if mag is None else m, step, self._q1p) == 0
+            except ValueError:
+                ok = False
+            if ok:
+                return self._q1.copy()
         single = np.ndim(gyr) == 1
         g = _vectors(gyr, "gyr")
         a = _vectors(acc, "acc")
