@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
+from ._validate import real, real_array
 from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
 
 __all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings"]
@@ -73,9 +74,7 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
         if optional:
             return None
         raise InvalidArgument(f"{name} is required")
-    a = np.asarray(x)
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
+    a = real_array(x, name)
     if a.ndim not in (1, 2) or a.shape[-1] != 3:
         raise InvalidArgument(f"{name} must have shape (3,) or (N, 3), got {a.shape}")
     a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
@@ -100,18 +99,13 @@ class Ahrs:
     def __init__(self, rate: float | None = None, q0: ArrayLike | None = None,
                  precision: Precision = "f64", **settings: Any) -> None:
         self.precision = _check_precision(precision)
-        if rate is not None:
-            if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
-                raise InvalidType(f"rate must be a number (Hz), got {type(rate).__name__}")
-            if not (np.isfinite(rate) and rate > 0):
-                raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
-        self.rate = None if rate is None else float(rate)
+        self.rate = None if rate is None else real(rate, "rate", "Hz", lo=0.0, lo_open=True)
         self._ffi, self._lib = ffi_lib(self.precision)
         self._set = _settings.fill(self._ffi, self._lib, _SPEC, settings)
         self._s = self._ffi.new("att_ahrs *")
         q = self._ffi.NULL
         if q0 is not None:
-            qa = np.asarray(q0, dtype=np.float64)
+            qa = real_array(q0, "q0").astype(np.float64)
             if qa.shape != (4,):
                 raise InvalidArgument(f"q0 must have shape (4,), got {qa.shape}")
             q = self._ffi.new("att_real[4]", [float(v) for v in qa])
@@ -164,7 +158,7 @@ class Ahrs:
             if self.rate is None:
                 raise InvalidArgument("dt is required when the filter has no rate")
             return np.array([1.0 / self.rate], dtype=_DTYPES[self.precision])
-        d = np.asarray(dt, dtype=np.float64).ravel()
+        d = real_array(dt, "dt").astype(np.float64).ravel()
         if d.size not in (1, n):
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
         return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
@@ -251,7 +245,7 @@ class Ahrs:
         """Rows of ``x`` (N, 3), None where a row is all NaN (absent); None for no ``x``."""
         if x is None:
             return None
-        a = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+        a = real_array(x, name).astype(np.float64).reshape(-1, 3)
         if a.shape[0] != n:
             raise InvalidArgument(f"gyr and {name} must have the same number of samples, got {n}, {a.shape[0]}")
         absent = np.isnan(a).all(axis=1)
