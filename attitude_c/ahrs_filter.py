@@ -84,7 +84,7 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
     return a
 
 
-_F64 = np.dtype(np.float64)
+_F64, _ND = np.dtype(np.float64), np.ndarray  # the fast path of Ahrs.update takes these
 
 
 class Ahrs:
@@ -117,7 +117,7 @@ class Ahrs:
         self._q1 = np.empty(4, dtype=_DTYPES[self.precision])
         self._q1p = self._ffi.from_buffer("att_real[]", self._q1)
         self._step = None if self.rate is None else 1.0 / self.rate
-        self._upd = self._lib.att_ahrs_update
+        self._upd, self._move = self._lib.att_ahrs_update, self._ffi.memmove
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -172,22 +172,23 @@ class Ahrs:
         # value (finite, dt > 0, units) and leaves the state untouched when it fails: the
         # general path below then repeats it and names the bad argument.
         step = self._step if dt is None else dt if isinstance(dt, float) else None
-        bufs, nd, f64 = self._in1, np.ndarray, _F64
-        if (step is not None and bufs is not None and type(gyr) is nd and type(acc) is nd
-                and gyr.shape == (3,) and acc.shape == (3,) and gyr.dtype == f64 and acc.dtype == f64
-                and (mag is None or type(mag) is nd and mag.shape == (3,) and mag.dtype == f64)):
+        bufs = self._in1
+        if (step is not None and bufs is not None and type(gyr) is _ND and type(acc) is _ND
+                and gyr.shape == (3,) and acc.shape == (3,) and gyr.dtype == _F64 and acc.dtype == _F64
+                and (mag is None or type(mag) is _ND and mag.shape == (3,) and mag.dtype == _F64)):
             g, a, m = bufs
-            move = self._ffi.memmove
+            move = self._move
             try:
                 move(g, gyr, 24)
                 move(a, acc, 24)
-                if mag is not None:
+                if mag is None:
+                    m = self._ffi.NULL
+                else:
                     move(m, mag, 24)
-                ok = self._upd(self._s, g, a, self._ffi.NULL if mag is None else m, step, self._q1p) == 0
+                if self._upd(self._s, g, a, m, step, self._q1p) == 0:
+                    return self._q1.copy()
             except ValueError:
-                ok = False
-            if ok:
-                return self._q1.copy()
+                pass
         single = np.ndim(gyr) == 1
         g = _vectors(gyr, "gyr")
         a = _vectors(acc, "acc")
