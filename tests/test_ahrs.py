@@ -272,3 +272,16 @@ def test_the_issue_names_are_the_package_api() -> None:
 
     assert attitude_c.Ahrs is ahrs_filter.Ahrs and attitude_c.ahrs is ahrs_filter.ahrs
     assert "Ahrs" in attitude_c.__all__ and "ahrs" in attitude_c.__all__
+
+
+def test_streaming_bench_smoke():
+    """bench/broad.py's streaming table on 200 synthetic samples (the full run on BROAD:
+    invoke bench --only broad): each of the three filters and the bare loop runs on the
+    same rows; the times are the benchmark's business, not the test's."""
+    from types import SimpleNamespace
+
+    from bench.broad import streaming
+
+    gyr, acc, mag, _ = motion(200, 100.0, (0.2, -0.1, 0.3), noise=0.002)
+    us = streaming([SimpleNamespace(gyr=gyr, acc=acc, mag=mag, rate=100.0)], n=200, rounds=1)
+    assert len(us) == 4 and all(len(v) == 1 and np.isfinite(v[0]) and v[0] >= 0 for v in us.values())
