@@ -28,7 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from ._lib import ffi_lib
 from ._validate import C_INT_RANGES, integer, real, real_array
 from .core import FloatArray, FloatPrecision, _check_precision, _ptr, _records, _shaped, _to_c
-from .errors import InvalidArgument, raise_for_status
+from .errors import InvalidArgument
+from .names import raise_for_status
 
 __all__ = [
     "GN_METHODS",

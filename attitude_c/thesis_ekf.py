@@ -25,7 +25,8 @@ from . import _settings
 from ._lib import ffi_lib
 from ._validate import real, real_array
 from .core import _rows
-from .errors import InvalidArgument, raise_for_status
+from .errors import InvalidArgument
+from .names import raise_for_status
 
 __all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "run"]
 

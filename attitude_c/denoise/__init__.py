@@ -31,7 +31,8 @@ from numpy.typing import ArrayLike, NDArray
 from .._lib import ffi_lib
 from .._validate import C_INT_RANGES, integer, real
 from ..core import _as_real, _check_precision, _ptr, _records, _to_c
-from ..errors import InvalidArgument, InvalidType, RangeError, raise_for_status
+from ..errors import InvalidArgument, InvalidType, RangeError
+from ..names import raise_for_status
 
 __all__ = [
     "THRESHOLDS",
