@@ -209,8 +209,8 @@ def run(quick: bool = False, timing: bool = True) -> str:
                    f"{cs['worst']:.1e} rad; iterations median / 90 % / 99 % / max "
                    f"{' / '.join(f'{x:.0f}' for x in cs['iters'])}); the others stop with a status "
                    f"({', '.join(f'{k}: {v}' for k, v in cs['codes'].items()) or 'none'}) — never a wrong or "
-                   "non-finite attitude.\n")
-    out.append("The thesis' Fig. 3.5 outliers are the identity start's failures, returned as attitudes.\n")
+                   "non-finite attitude.")
+    out.append("\nThe thesis' Fig. 3.5 outliers are the identity start's failures, returned as attitudes.\n")
     rows, missing = broad_table(quick)
     if missing:
         out.append(f"\nBROAD: {missing}.\n")
