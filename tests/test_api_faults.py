@@ -264,8 +264,7 @@ def test_shared_integrator_is_consistent_under_8_threads() -> None:
     a child so that a crash is a failure, not the end of the test run."""
     code = textwrap.dedent("""
         import threading, numpy as np
-        import attitude_c as ac
-from attitude_c import core, denoise
+        from attitude_c import core
         for method, dt in (("rv3", None), ("rv2", None), ("rk4", 0.001)):
             it = core.Integrator(method)
             d = np.tile([0.0, 0.0, 1e-3], (4, 1))  # 4 samples: never a whole number of frames
