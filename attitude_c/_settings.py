@@ -35,15 +35,13 @@ from typing import Any, Callable, Literal
 import numpy as np
 
 from ._options import OptionError
-from .errors import InvalidArgument, InvalidType
+from ._validate import C_INT_RANGES as _INT_RANGES
+from ._validate import integer, real
+from .errors import InvalidArgument
 
 __all__ = ["Choice", "SettingNames", "SettingsSpec", "defaults", "fill", "kinds", "parse_assignment", "read"]
 
 Kind = Literal["real", "int", "choice"]
-
-_INT_RANGES = {"int": (-(2**31), 2**31 - 1), "unsigned int": (0, 2**32 - 1), "long": (-(2**63), 2**63 - 1),
-               "unsigned long": (0, 2**64 - 1), "short": (-(2**15), 2**15 - 1), "unsigned short": (0, 2**16 - 1)}
-
 
 @dataclass(frozen=True)
 class Choice:
@@ -181,18 +179,8 @@ def _value(spec: SettingsSpec, name: str, kind: str, v: Any) -> Any:
     if kind == "choice":
         return spec.choices[name].encode(name, v)
     if kind == "real":
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-            raise InvalidType(f"{name} must be a real number, got {type(v).__name__}")
-        fv = float(v)
-        if not np.isfinite(fv):
-            raise InvalidArgument(f"{name} must be finite, got {fv}")
-        return fv
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-        raise InvalidType(f"{name} must be an integer, got {type(v).__name__}")
-    lo, hi = _INT_RANGES[kind]
-    if not lo <= int(v) <= hi:
-        raise InvalidArgument(f"{name} must be in {lo}..{hi} (C {kind}), got {v}")
-    return int(v)
+        return real(v, name)
+    return integer(v, name, *_INT_RANGES[kind], what=f"C {kind}")
 
 
 def _new(ffi: Any, lib: Any, spec: SettingsSpec, values: Mapping[str, Any]) -> Any:

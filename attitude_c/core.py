@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import names
 from ._lib import ffi_lib
+from ._validate import real_array as _as_real  # the shared array check (its one place)
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
 from .names import INCREMENT_METHODS, METHODS, Method, raise_for_status
 
@@ -106,18 +107,6 @@ def method_code(method: str, lib: Any = None) -> int:
     _check_method(method)
     name = "ATT_METHOD_" + method.upper().replace("-", "_")
     return int(getattr(lib, name)) if lib is not None else names.C[name]
-
-
-def _as_real(x: ArrayLike, name: str) -> NDArray[Any]:
-    """Array of a real numeric dtype (bool, complex, object, str rejected)."""
-    try:
-        a = np.asarray(x)
-    except Exception as exc:  # ragged lists and the like
-        raise InvalidArgument(f"{name} cannot be converted to an array: {exc}") from exc
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(
-            f"{name} must hold real numbers (integer or float dtype), got dtype {a.dtype}")
-    return a
 
 
 def _first_bad(flat_ok: Any) -> int:
