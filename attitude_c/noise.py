@@ -174,7 +174,7 @@ def _nnls(a: FloatArray, y: FloatArray, w: FloatArray) -> tuple[FloatArray, Floa
             chi2 = float(np.sum((aw @ c - yw) ** 2))
             if chi2 < best:
                 best, best_c = chi2, c
-    cov = np.linalg.pinv(aw.T @ aw)
+    cov = np.asarray(np.linalg.pinv(aw.T @ aw), dtype=np.float64)
     return best_c, cov
 
 
@@ -215,17 +215,17 @@ MAPPING: tuple[tuple[str, str, str], ...] = (
     ("gyr_noise_rest", "N of the gyro (rad/√s)",
      "the attitude's process noise at rest is the gyro's own white noise: the angle random walk"),
     ("gyr_noise", "max(N of the gyro, default)",
-     "in motion the process noise also carries model error (scale, misalignment, timing, vibration) "
-     "that no rest recording shows; a gyro noisier than the default raises it"),
+     ("in motion the process noise also carries model error (scale, misalignment, timing, vibration) "
+      "that no rest recording shows; a gyro noisier than the default raises it")),
     ("bias_noise", "max(√(K² + 3·(0.664·B)²/τ_min), default) of the gyro (rad/s/√s)",
-     "the bias is a random walk in the filter: the smallest walk that covers the measured wander "
-     "at every τ ≥ τ_min (the floor's place); turn-on transients and temperature, which a "
-     "recording at one temperature does not show, keep the default as the floor"),
+     ("the bias is a random walk in the filter: the smallest walk that covers the measured wander "
+      "at every τ ≥ τ_min (the floor's place); turn-on transients and temperature, which a "
+      "recording at one temperature does not show, keep the default as the floor")),
     ("rest_noise", "N of the gyro (rad/s·√s)",
      "the zero-rate update measures the bias with the gyro's own reading: its white noise"),
     ("acc_noise", "max(N of the accelerometer / gravity, default) (rad·√s)",
-     "the inclination's noise density is the accelerometer's white noise over g, plus linear "
-     "acceleration in motion, which rest does not show: the default stays as the floor"),
+     ("the inclination's noise density is the accelerometer's white noise over g, plus linear "
+      "acceleration in motion, which rest does not show: the default stays as the floor")),
 )
 #: Uncertainties of the terms are the least-squares 1σ times this: neighbouring octaves share
 #: their data, so their errors are correlated and the fit's own σ is too small; over 36 simulated
@@ -261,8 +261,12 @@ def _worst(x: Terms | AllanResult, name: str) -> Terms:
     if not isinstance(x, AllanResult):
         raise InvalidType(f"{name} must be Terms or an AllanResult, got {type(x).__name__}")
     ts = x.terms
-    return Terms(*(max(getattr(t, f) for t in ts) for f in ("n", "n_sigma", "b", "b_sigma", "k", "k_sigma")),
-                 ts[int(np.argmax([t.b for t in ts]))].tau_min, max(t.adev_min for t in ts))
+
+    def worst(f: str) -> float:
+        return float(max(getattr(t, f) for t in ts))
+
+    return Terms(worst("n"), worst("n_sigma"), worst("b"), worst("b_sigma"), worst("k"), worst("k_sigma"),
+                 ts[int(np.argmax([t.b for t in ts]))].tau_min, worst("adev_min"))
 
 
 def config_text(settings: dict[str, float], source: str) -> str:

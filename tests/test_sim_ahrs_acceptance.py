@@ -18,10 +18,10 @@ the shortened runs guard against regressions at the targets' thresholds."""
 
 from __future__ import annotations
 
+import pytest
+
 from toolchain.ahrs_acceptance import SHORT, TARGETS, bias_step, disturbance, run, static, turntable
 from toolchain.allan_settings import derived
-
-import pytest
 
 pytestmark = pytest.mark.system  # runs the simulator's acceptance scenarios
 

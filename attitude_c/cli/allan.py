@@ -4,7 +4,7 @@ attitude filter's settings they give (docs/noise.md).
 Input: a recording of the sensor at rest (the longer the better: two hours
 give the bias terms; docs/noise.md says how well), one of
 
-  a CSV file as `attitude ahrs` reads it (gx gy gz, ax ay az, t or --rate;
+  a CSV file as attitude ahrs reads it (gx gy gz, ax ay az, t or --rate;
       --columns, --gyr-unit, --acc-unit, --axes as there);
   a BROAD trial (.mat; needs SciPy: pip install 'attitude-c[broad]');
   a recording of the board's stream: attitude-rx's JSON Lines (its rate_dps:
@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import json
-
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -152,7 +151,7 @@ def _main(args: argparse.Namespace) -> int:
     data, rate = _read(path, args)
     res = {name: allan(x, rate) for name, x in data.items()}
     settings = filter_settings(res["gyro"], res.get("accel"), args.gravity)
-    summary = {"file": str(path), "samples": len(data["gyro"]), "rate_hz": rate, "hours": len(data["gyro"]) / rate / 3600,
+    summary: dict[str, Any] = {"file": str(path), "samples": len(data["gyro"]), "rate_hz": rate, "hours": len(data["gyro"]) / rate / 3600,
                "units": {k: dict(zip("NBK", UNITS[k])) for k in res}, "settings": settings,
                "sensors": {k: r.as_dict() for k, r in res.items()}, "out": str(out), "files": ["allan.json"]}
     if not args.no_plots:
