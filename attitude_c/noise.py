@@ -228,9 +228,9 @@ MAPPING: tuple[tuple[str, str, str], ...] = (
       "acceleration in motion, which rest does not show: the default stays as the floor")),
 )
 #: Uncertainties of the terms are the least-squares 1σ times this: neighbouring octaves share
-#: their data, so their errors are correlated and the fit's own σ is too small; over 36 simulated
-#: axes (docs/noise.md, ``invoke allan-sweep``) the spread of K was 1.6–2.3× the undoubled σ,
-#: of N and B 1.3–1.9×.
+#: their data, so their errors are correlated and the fit's own σ is too small. Over two sweeps of
+#: 36 simulated axes each (docs/noise.md, ``invoke allan-sweep``) the spread of the fitted terms
+#: was 1.1–1.4× the undoubled σ (seeds 100–105) and, for K, 2.2× (seeds 0–5).
 UNCERTAINTY_SCALE = 2.0
 
 
@@ -315,4 +315,4 @@ def _panel(ax: Any, r: AllanResult, name: str, unit: str) -> None:
     ax.set_ylabel(f"Allan deviation / {unit}")
     ax.set_title(name, fontsize=9)
     ax.grid(True, which="both", linestyle=":", linewidth=0.6)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper center", fontsize=7)

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from .._io import check_output_dir, write_text, write_with
-from .ahrs import EXIT_IO, EXIT_MISSING, EXIT_OK, EXIT_USAGE, _axes, _csv_options, _Usage
+from .ahrs import EXIT_OK, _csv_options, _Usage, add_csv_options, guarded
 from .options import positive
 
 PROG = "attitude allan"
@@ -44,8 +44,6 @@ UNITS = {"gyro": ("rad/√s", "rad/s", "rad/s/√s"), "accel": ("m/s²·√s", "
 
 
 def register(sub: Any) -> None:
-    from ..recording import UNITS as READ_UNITS
-
     p = sub.add_parser(
         "allan", help="noise terms (Allan deviation) of a rest recording and the filter settings they give",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -54,14 +52,7 @@ def register(sub: Any) -> None:
         "for .mat). See docs/noise.md.")
     p.add_argument("file", metavar="FILE", help="CSV with a header, BROAD trial (.mat) or attitude-rx JSON Lines")
     p.add_argument("--out", metavar="DIR", default=None, help="output folder (default: results/allan-<file stem>)")
-    p.add_argument("--rate", type=positive("--rate"), default=None, help="sampling rate, Hz (CSV without a t column)")
-    p.add_argument("--columns", action="append", default=[], metavar="NAME=HEADER[,NAME=HEADER...]",
-                   help="CSV: the file's column for a name (t gx gy gz ax ay az)")
-    for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
-        units = tuple(READ_UNITS[sensor])
-        p.add_argument(f"--{sensor}-unit", choices=units, default=None,
-                       help=f"CSV: the {what}'s unit (default {units[0]})")
-    p.add_argument("--axes", type=_axes, default="rfu", metavar="XYZ", help="CSV: the IMU's axes (see attitude ahrs)")
+    add_csv_options(p, "t gx gy gz ax ay az")
     p.add_argument("--gravity", type=positive("--gravity"), default=None,
                    help="local gravity, m/s² (acc_noise = N/gravity; default the filter's 9.81)")
     p.add_argument("--write-config", metavar="FILE", default=None,
@@ -87,17 +78,7 @@ class _Block:
 
 
 def main(args: argparse.Namespace) -> int:
-    from ..errors import AttitudeError
-    from . import fail, os_error_line
-
-    try:
-        return _main(args)
-    except (_Usage, AttitudeError, ValueError, TypeError) as exc:
-        return fail(PROG, str(exc), EXIT_USAGE)
-    except ImportError as exc:  # the message names what to install
-        return fail(PROG, str(exc), EXIT_MISSING)
-    except OSError as exc:
-        return fail(PROG, os_error_line(exc), EXIT_IO)
+    return guarded(PROG, _main, args)
 
 
 def _is_stream(path: Path) -> bool:
