@@ -109,10 +109,10 @@ def test_filter_settings_mapping() -> None:
         filter_settings(quiet, quiet, gravity=-1.0)
 
 
-def _rest_csv(path: Path, n: int = 4000) -> Path:
+def _rest_csv(path: Path, n: int = 4000, turn: float = 0.0) -> Path:
     rng = np.random.default_rng(5)
     t = np.arange(n) * 0.01
-    g = rng.standard_normal((n, 3)) * 0.01
+    g = rng.standard_normal((n, 3)) * 0.01 + [0.0, 0.0, turn]
     a = rng.standard_normal((n, 3)) * 0.02 + [0.0, 0.0, 9.81]
     np.savetxt(path, np.column_stack([t, g, a]), delimiter=",", header="t,gx,gy,gz,ax,ay,az", comments="")
     return path
@@ -139,18 +139,28 @@ def test_cli_writes_results_and_config(tmp_path: Path, capsys: pytest.CaptureFix
         assert abs(t["n"] - 1e-3) < 3 * t["n_sigma"], t
 
 
+def test_cli_warns_of_motion(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A recording that turns (0.1 rad/s, above the filter's rest_gyr_th of 0.035) is analysed
+    with a warning: its terms are the motion's."""
+    assert main(["allan", str(_rest_csv(tmp_path / "m.csv", turn=0.1)), "--out", str(tmp_path / "o"),
+                 "--no-plots"]) == 0
+    err = capsys.readouterr().err
+    assert "warning: the gyro is not at rest (100.0% of the samples" in err
+
+
 def test_cli_reads_the_boards_stream(tmp_path: Path) -> None:
     """attitude-rx's JSON Lines (rate_dps, °/s): the gyro's terms."""
     rng = np.random.default_rng(6)
-    lines = [json.dumps({"t": k * 0.08, "n": k, "q": [1, 0, 0, 0], "rate_dps": list(rng.standard_normal(3))})
+    lines = [json.dumps({"t": k * 0.08, "n": k, "q": [1, 0, 0, 0], "rate_dps": list(rng.standard_normal(3) * 0.5)})
              for k in range(600)]
     p = tmp_path / "rx.jsonl"
     p.write_text("\n".join(lines) + "\n")
     assert main(["allan", str(p), "--out", str(tmp_path / "o"), "--no-plots"]) == 0
     s = json.loads((tmp_path / "o" / "allan.json").read_text())
     assert s["rate_hz"] == pytest.approx(12.5) and list(s["sensors"]) == ["gyro"]
-    # 1 °/s white at 12.5 Hz: N = (π/180)·√0.08 rad/√s (±15 %: 600 samples)
-    assert s["settings"]["rest_noise"] == pytest.approx(DEG * math.sqrt(0.08), rel=0.15)
+    # 0.5 °/s white at 12.5 Hz: N = 0.5·(π/180)·√0.08 rad/√s on each axis, within 3 of its 1σ
+    for t in s["sensors"]["gyro"]["terms"]:
+        assert abs(t["n"] - 0.5 * DEG * math.sqrt(0.08)) < 3 * t["n_sigma"], t
 
 
 @pytest.mark.parametrize("args, code, text", [

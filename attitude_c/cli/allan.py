@@ -130,6 +130,7 @@ def _main(args: argparse.Namespace) -> int:
         raise FileNotFoundError(2, "no such file", str(path))
     out = check_output_dir(Path(args.out) if args.out else Path("results") / f"allan-{path.stem}")
     data, rate = _read(path, args)
+    _warn_motion(data["gyro"])
     res = {name: allan(x, rate) for name, x in data.items()}
     settings = filter_settings(res["gyro"], res.get("accel"), args.gravity)
     summary: dict[str, Any] = {"file": str(path), "samples": len(data["gyro"]), "rate_hz": rate, "hours": len(data["gyro"]) / rate / 3600,
@@ -147,6 +148,20 @@ def _main(args: argparse.Namespace) -> int:
         _write_config(Path(args.write_config), config_text(settings, path.name))
     _print(summary, res, args)
     return EXIT_OK
+
+
+def _warn_motion(gyr: np.ndarray) -> None:
+    """A warning (not an error) when the gyro moves: more than 1 % of the samples further than
+    the filter's rest threshold (rest_gyr_th) from zero, as its rest detector judges."""
+    import sys
+
+    from ..ahrs_filter import default_settings
+
+    th = float(default_settings()["rest_gyr_th"])
+    moving = float(np.mean(np.linalg.norm(gyr, axis=1) > th))
+    if moving > 0.01:
+        print(f"{PROG}: warning: the gyro is not at rest ({moving:.1%} of the samples turn faster than "
+              f"rest_gyr_th = {th:g} rad/s): the terms describe the motion, not the noise", file=sys.stderr)
 
 
 def _write_config(path: Path, text: str) -> None:
