@@ -185,6 +185,8 @@ def guarded(prog: str, body: Callable[[argparse.Namespace], int], args: argparse
     except ImportError as exc:  # the message names what to install
         return fail(prog, str(exc), EXIT_MISSING)
     except OSError as exc:
+        if getattr(sys.stdout, "failed", None) is exc:  # stdout itself: the command's caller reports it
+            raise
         return fail(prog, os_error_line(exc), EXIT_IO)
 
 
