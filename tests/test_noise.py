@@ -75,6 +75,7 @@ def _check(terms: tuple[Terms, ...], truth: tuple[float, float, float]) -> None:
         assert abs(t.k / k - 1) < 0.10, (t, k)
 
 
+@pytest.mark.slow  # 2 × 720 000 samples of the sensor models (≈ 10 s idle): the default run, not --fast
 def test_gyro_terms_recovered_from_two_hours() -> None:
     """The ADXRS150 model with a flicker bias and a rate random walk (sim/sensors.py),
     two hours at rest at 100 Hz: N, K within 10 %, B within 30 % on every axis."""
@@ -82,6 +83,7 @@ def test_gyro_terms_recovered_from_two_hours() -> None:
     _check(attitude_c.allan(rate, 1 / DT).terms, truth)
 
 
+@pytest.mark.slow
 def test_accelerometer_terms_recovered_from_two_hours() -> None:
     """The ADIS16405 accelerometer model with a flicker bias and a random walk: the same."""
     y, truth = accel_rest(seed=12)
