@@ -228,9 +228,9 @@ MAPPING: tuple[tuple[str, str, str], ...] = (
       "acceleration in motion, which rest does not show: the default stays as the floor")),
 )
 #: Uncertainties of the terms are the least-squares 1σ times this: neighbouring octaves share
-#: their data, so their errors are correlated and the fit's own σ is too small. Over two sweeps of
-#: 36 simulated axes each (docs/noise.md, ``invoke allan-sweep``) the spread of the fitted terms
-#: was 1.1–1.4× the undoubled σ (seeds 100–105) and, for K, 2.2× (seeds 0–5).
+#: their data, so their errors are correlated and the fit's own σ is too small. In the sweeps of
+#: docs/noise.md (``invoke allan-sweep``) the spread of the fitted terms was 1.1–1.7× the
+#: undoubled σ for N and B, and 1.2–2.5× for K (2.5× where the floor lasts to 30 s).
 UNCERTAINTY_SCALE = 2.0
 
 

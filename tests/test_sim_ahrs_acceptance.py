@@ -66,7 +66,8 @@ def test_settings_from_the_allan_deviation_pass() -> None:
     """The filter's noise settings derived from a rest recording of the same system
     (attitude_c.noise.filter_settings; 10 min of another seed here, 2 h in `invoke
     allan-settings`) meet every target the defaults meet (docs/noise.md has the figures
-    side by side: the bias step is learnt 17× better, the static tilt 12 % worse)."""
+    side by side: the bias step is learnt 13× better; the static tilt is 12 % worse in the
+    shortened run, 18 % better at full length)."""
     from attitude_c.ahrs_filter import default_settings
 
     settings, _, _ = derived(duration=600.0)
