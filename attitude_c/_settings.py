@@ -16,6 +16,10 @@ settings as keywords named as the fields; each is checked by name:
   (``SettingsSpec.field_fn``, e.g. ``att_ahrs_check_settings_field``: the first
   field outside its domain), else those that fail on their own.
 
+Commands take a setting as ``NAME=VALUE`` text (``attitude ahrs --set``,
+``simulate --ahrs-setting``, ``view --ahrs-setting``): :func:`parse_assignment`
+is the one parser of that text for every command.
+
 A struct may expose an integer field by name (``Choice``: the filter's
 ``method`` as ``"rv3-reuse"``) and fields of a nested struct under
 ``<outer>_<inner>`` (the thesis EKF's ``gn_max_iter``).
@@ -30,9 +34,10 @@ from typing import Any, Callable, Literal
 
 import numpy as np
 
+from ._options import OptionError
 from .errors import InvalidArgument, InvalidType
 
-__all__ = ["Choice", "SettingNames", "SettingsSpec", "defaults", "fill", "kinds", "read"]
+__all__ = ["Choice", "SettingNames", "SettingsSpec", "defaults", "fill", "kinds", "parse_assignment", "read"]
 
 Kind = Literal["real", "int", "choice"]
 
@@ -229,3 +234,28 @@ def _outside(ffi: Any, lib: Any, spec: SettingsSpec, s: Any, settings: Mapping[s
     what = "outside its domain" if len(bad) == 1 else "outside their domains" if bad else \
         "together outside the domain"
     return f"{given} {what}"
+
+
+def parse_assignment(spec: SettingsSpec, text: str, option: str) -> tuple[str, Any]:
+    """``NAME=VALUE`` as a command line gives a setting of ``spec``: the name checked
+    against the struct's, the value as its kind takes it (a choice by name, a real a
+    finite number, an integer an integer). The domain is checked when the struct is
+    filled (:func:`fill`). Raises :class:`~attitude_c._options.OptionError` (a
+    ValueError) naming ``option``."""
+    name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name or not value:
+        raise OptionError(f"{option} expects NAME=VALUE, got {text!r}")
+    known = kinds(spec)
+    if name not in known:
+        raise OptionError(f"{option}: unknown {spec.label} setting {name!r} (known: {', '.join(known)})")
+    if known[name] == "choice":
+        return name, value
+    try:
+        v: float | int = float(value) if known[name] == "real" else int(value, 0)
+    except ValueError:
+        what = "a number" if known[name] == "real" else "an integer"
+        raise OptionError(f"{option} {name}: expected {what}, got {value!r}") from None
+    if not np.isfinite(v):
+        raise OptionError(f"{option} {name}: must be finite, got {value!r}")
+    return name, v

@@ -19,7 +19,7 @@ Settings are keyword arguments named as the C struct's fields
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -27,9 +27,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
-from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+from .errors import InvalidArgument, InvalidType, NonFiniteError
+from .names import raise_for_status
 
-__all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings"]
+__all__ = ["SETTINGS", "Ahrs", "ahrs", "check_settings", "default_settings", "parse_setting", "setting_option"]
 
 FloatArray = NDArray[np.float64]
 Precision = Literal["f64", "f32"]
@@ -53,6 +54,32 @@ _SPEC = _settings.SettingsSpec(
 #: The real-valued settings (field names of ``att_ahrs_settings``, read from the
 #: library on first use), besides ``method``.
 SETTINGS: Sequence[str] = _settings.SettingNames(_SPEC, "real")
+
+
+
+def parse_setting(text: str, option: str = "--set") -> tuple[str, Any]:
+    """A filter setting as every command takes it, ``NAME=VALUE`` (``acc_tau=3``,
+    ``method=rv1``): the one parser of ``attitude ahrs --set``, ``simulate
+    --ahrs-setting`` and ``view --ahrs-setting``. ValueError naming ``option``
+    for a malformed text, an unknown name or a value that is not a number."""
+    return _settings.parse_assignment(_SPEC, text, option)
+
+
+def check_settings(settings: Mapping[str, Any]) -> None:
+    """Raise as :class:`Ahrs` would for ``settings`` (InvalidArgument/InvalidType naming
+    the setting: unknown, of the wrong type, outside the domain), without a filter."""
+    ffi, lib = ffi_lib("f64")
+    _settings.fill(ffi, lib, _SPEC, settings)
+
+
+def setting_option(option: str) -> Callable[[str], tuple[str, Any]]:
+    """:func:`parse_setting` for ``option`` (an argparse ``type=``)."""
+    def conv(text: str) -> tuple[str, Any]:
+        return parse_setting(text, option)
+
+    conv.__name__ = "setting"
+    return conv
+
 
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 

@@ -25,7 +25,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
 from .core import FloatArray, FloatPrecision, _check_precision, _ptr, _records, _shaped, _to_c
-from .errors import InvalidArgument, InvalidType, raise_for_status
+from .errors import InvalidArgument, InvalidType
+from .names import raise_for_status
 
 __all__ = ["MODELS", "Calibration", "MagCal", "Model", "apply", "fit", "fit_minmax_2d"]
 

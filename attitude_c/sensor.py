@@ -28,7 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import magcal, names
 from ._lib import ffi_lib
 from .core import FloatPrecision
-from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from .names import raise_for_status
 
 __all__ = ["Sensor", "adc_words"]
 

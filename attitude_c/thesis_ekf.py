@@ -24,7 +24,8 @@ from numpy.typing import ArrayLike, NDArray
 from . import _settings
 from ._lib import ffi_lib
 from .core import _rows
-from .errors import InvalidArgument, InvalidType, raise_for_status
+from .errors import InvalidArgument, InvalidType
+from .names import raise_for_status
 
 __all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "run"]
 

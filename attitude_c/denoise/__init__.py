@@ -30,7 +30,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from .._lib import ffi_lib
 from ..core import _as_real, _check_precision, _ptr, _records, _to_c
-from ..errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from ..errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from ..names import raise_for_status
 
 __all__ = [
     "THRESHOLDS",

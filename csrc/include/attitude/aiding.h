@@ -29,6 +29,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Aiding status codes (range -120..-139). */
 enum {
     ATT_AID_E_ZERO_F = -120,   /* specific force zero (below 1e-30 in norm): no up direction */
@@ -341,5 +343,7 @@ att_status att_magcal2d_add(att_magcal2d *c, const att_real m[3]);
 /* ATT_E_NULL, ATT_AID_E_FEW (fewer than 3 samples), ATT_AID_E_SPAN (an
  * axis with no range). */
 att_status att_magcal2d_solve(const att_magcal2d *c, att_magcal_result *r);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AIDING_H */
