@@ -122,6 +122,9 @@ def _check(x: ArrayLike, rate: float) -> tuple[FloatArray, float]:
     if not np.all(np.isfinite(a)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(a), axis=1))[0])
         raise InvalidArgument(f"x: sample {bad} is not finite")
+    flat = np.flatnonzero(np.ptp(a, axis=0) == 0)
+    if flat.size:
+        raise InvalidArgument(f"x: column {int(flat[0])} is constant (a stuck or disconnected sensor?)")
     return np.asarray(a, dtype=np.float64), float(rate)
 
 
@@ -184,13 +187,14 @@ def _fit(tau: FloatArray, adev: FloatArray, ms: NDArray[np.int64], n: int, at: A
     a, y = _design(tau), adev ** 2
     use = ms >= min(FIT_M_MIN, int(ms[-1]) // 4)
     alpha = np.zeros(len(tau), dtype=np.int64)
-    model = y
+    floor = float(y.max()) * 1e-12  # a deviation of 0 at some τ (a periodic input) keeps a finite weight
+    model = np.maximum(y, floor)
     for _ in range(3):
         edf = _edf(alpha, ms, n, at)
         w = edf / (2 * model ** 2)
         c, cov = _nnls(a[use], y[use], w[use])
         parts = a * c
-        model = np.maximum(parts.sum(axis=1), 1e-300)
+        model = np.maximum(parts.sum(axis=1), floor)
         alpha = np.array(_ALPHA)[np.argmax(parts, axis=1)]
     i = int(np.argmin(adev))
     n2, b2, k2 = c

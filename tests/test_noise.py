@@ -54,6 +54,8 @@ def test_allan_refuses_bad_arguments() -> None:
         x = np.zeros((300, 3))
         x[7, 1] = np.nan
         attitude_c.allan(x, 10.0)
+    with pytest.raises(InvalidArgument, match="column 1 is constant"):
+        attitude_c.allan(np.column_stack([np.arange(300.0), np.ones(300)]), 10.0)
     with pytest.raises(InvalidArgument, match="shape"):
         attitude_c.allan(np.zeros((300, 3, 1)), 10.0)
 
