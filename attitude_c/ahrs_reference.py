@@ -29,7 +29,7 @@ F = NDArray[np.float64]
 _DEFAULTS: dict[str, Any] = {
     "method": "rv3-reuse", "gravity": 9.81, "gyr_noise": 0.01, "gyr_noise_rest": 0.002,
     "bias_noise": 1e-4, "init_att_sigma": 0.1, "init_bias_sigma": 0.01, "acc_tau": 2.0, "acc_noise": 0.025,
-    "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.05, "mag_norm_tol": 0.05,
+    "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.1, "mag_norm_tol": 0.08,
     "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_ref_window": 5.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,

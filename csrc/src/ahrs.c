@@ -31,8 +31,8 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->acc_noise = ATT_R(0.025);
     set->acc_gate = ATT_R(0.2);
     set->acc_reject_max = ATT_R(3.0);
-    set->mag_noise = ATT_R(0.05);
-    set->mag_norm_tol = ATT_R(0.05);
+    set->mag_noise = ATT_R(0.1);
+    set->mag_norm_tol = ATT_R(0.08);
     set->mag_dip_tol = ATT_R(0.17);
     set->mag_ref_tau = ATT_R(30.0);
     set->mag_ref_window = ATT_R(5.0);

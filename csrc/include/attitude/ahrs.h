@@ -96,8 +96,8 @@ typedef struct {
     att_real acc_gate;            /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
                                  (0 = off) */
     att_real acc_reject_max;      /* [s] continuous rejection after which updates resume, 3.0 */
-    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.05 */
-    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.05 */
+    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.1 */
+    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.08 */
     att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.17 (≈10°) */
     att_real mag_ref_tau;         /* [s] the reference (and the candidate) is the weighted mean
                                  of the agreeing samples so far until they hold this much
