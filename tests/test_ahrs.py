@@ -158,7 +158,7 @@ def test_converges_to_truth_and_learns_bias():
     err = angle_deg(q, truth)
     # exact sensors, 60 s of constant turning: unaided, the bias would
     # drift 36°; with the default correction time constants (2.5 s
-    # inclination, 5 s heading; bias learned over tens of seconds,
+    # inclination, 10 s heading; bias learned over tens of seconds,
     # docs/ahrs.md) the error must fall below 0.3° and keep falling
     assert err[-1] < 0.3 and err[-1] < 0.5 * err[1000]
     assert np.linalg.norm(f.bias - bias) < 0.3 * np.linalg.norm(bias)
