@@ -10,7 +10,8 @@ trials (all, undisturbed, disturbed).
 Filters, all on the same trials in one run, each started from its own
 first second at most (no filter is given the reference attitude); every
 peer runs with its published default gains/noises — none is tuned on
-BROAD, and neither is ours beyond the frozen defaults (chosen once by the
+BROAD, and neither is ours beyond the frozen defaults (the magnetic settings
+chosen leave one trial out by ``bench/broad_loo.py``, the others once by the
 coordinate descent below; the cross-validated table shows what tuning on
 held-out trials would give):
 
