@@ -317,8 +317,8 @@ class ReferenceAhrs:
             h = math.hypot(mn[0], mn[1])
             if h > 0:
                 cur = np.array([float(np.linalg.norm(mn)), math.atan2(-mn[2], h)])
-                use, R, f = self._mag_reference(cur, w, dt)  # w: the gyro sample
-                flags |= f
+                use, R, mflags = self._mag_reference(cur, w, dt)  # w: the gyro sample
+                flags |= mflags
                 if use:
                     yh = math.atan2(mn[0], mn[1]) - s["declination"]
                     yh = (yh + math.pi) % (2 * math.pi) - math.pi

@@ -93,11 +93,12 @@ def start_spread(trials: list[Any]) -> list[str]:
     spreads: dict[str, list[float]] = {"d": [], "0": []}
     for t in (t for t in trials if not t.disturbed):
         row = {}
-        for label, kw in (("d", {}), ("0", {"mag_ref_window": 0.0})):
+        runs: tuple[tuple[str, dict[str, Any]], ...] = (("d", {}), ("0", {"mag_ref_window": 0.0}))
+        for label, kw in runs:
             hs = []
             for o in OFFSETS:
                 k = round(o * t.rate)
-                q = np.asarray(ahrs(t.gyr[k:], t.acc[k:], t.mag[k:], rate=t.rate, **kw), float)
+                q = np.asarray(ahrs(t.gyr[k:], t.acc[k:], t.mag[k:], rate=t.rate, **kw), dtype=np.float64)
                 hs.append(broad.errors(q, t.quat[k:], t.movement[k:]).heading)
             row[label] = hs
             spreads[label].append(max(hs) - min(hs))
@@ -117,7 +118,7 @@ def run(quick: bool = False, data: str | None = None) -> str:
     names = [t.name[:2] for t in trials]
     vqf = np.array([f.total for f in score(trials, [run_vqf(t) for t in trials])])
     pts = points(quick)
-    tot = np.array([[f.total for f in score(trials, [run_ours(t, **kw) for t in trials])] for kw in pts])
+    tot = np.array([[f.total for f in score(trials, [run_ours(t, "f64", **kw) for t in trials])] for kw in pts])
     d = default_settings()
     dflt = next(i for i, kw in enumerate(pts) if all(d[k] == v for k, v in kw.items()))
     gv = group_means(trials, score(trials, [run_vqf(t) for t in trials]))
@@ -127,8 +128,8 @@ def run(quick: bool = False, data: str | None = None) -> str:
            + "; ".join(f"{k} {v}" for k, v in (GRID if not quick else {k: v[::2] for k, v in GRID.items()}).items())
            + f". Worst-aware rule: mean + {WORST_WEIGHT}° × largest ratio to VQF.\n",
            "**Leave one trial out** (each trial scored with the grid point chosen on the other 14):\n",
-           "| rule | held-out mean total | undisturbed | disturbed | ratio to VQF: min / median / max | "
-           "points chosen |", "|---|---|---|---|---|---|"]
+           ("| rule | held-out mean total | undisturbed | disturbed | ratio to VQF: min / median / max | "
+            "points chosen |"), "|---|---|---|---|---|---|"]
     und = np.array([not t.disturbed for t in trials])
     for rule in ("mean", "worst-aware"):
         held, chosen = leave_one_out(tot, vqf, rule)
