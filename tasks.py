@@ -21,6 +21,7 @@ ns = Collection(
     sim.sim_acceptance,
     sweep.sweep,
     view.view_soak,
+    view.view_soak_clients,
     view.view_firmware,
     view.view_screenshot,
     Collection("firmware", firmware.build, firmware.sim),
