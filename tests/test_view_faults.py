@@ -148,8 +148,7 @@ def test_a_large_replay_is_streamed_not_held(tmp_path: Path) -> None:
 
     f = tmp_path / "big.jsonl"
     with open(f, "wb") as fh:
-        for k in range(20_000):
-            fh.write(_sample(k))
+        fh.writelines(_sample(k) for k in range(20_000))
     tracemalloc.start()
     try:
         rec = sources.load_recording(f)
@@ -193,7 +192,7 @@ def test_the_history_comes_in_bounded_messages_made_on_demand() -> None:
     HISTORY_CHUNK points, each made when the writer asks for it: a tab that does
     not read costs one message, never the whole history (2.2 MB each before)."""
     hub = _filled_hub(2 * stream.HISTORY_CHUNK + 7)
-    c, hello = hub.add_client()
+    _, hello = hub.add_client()
     msgs = hub.history_messages()
     assert len(hello) < 10_000 and json.loads(hello)["history_points"] == 2 * stream.HISTORY_CHUNK + 7
     first = json.loads(next(msgs))
@@ -299,7 +298,6 @@ def test_accept_errors_are_one_line_every_ten_seconds() -> None:
 # ---- item 5: client actions are quiet --------------------------------------------------------
 
 def test_head_aborted_download_and_ping_flood_print_no_traceback(capfd) -> None:
-    import aiohttp
 
     hub = Hub(recorder=Recorder())
     q = np.tile(Q, (60_000, 1))

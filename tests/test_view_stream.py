@@ -439,7 +439,7 @@ def test_a_failing_tick_keeps_the_stream_going_and_the_recording_partial(tmp_pat
     hub before event details were made JSON-safe) no longer ends the ticker: the next
     samples are recorded and sent, the failure is said once, and the recording is kept
     under its partial name, not renamed into place as if complete."""
-    hub, clock = _hub(tmp_path)
+    hub, _ = _hub(tmp_path)
     c, _ = hub.add_client()
     hub.samples(_sine_rows(0, 2, 100.0))
     real = hub._complete
@@ -474,7 +474,7 @@ def test_an_event_holding_nan_is_kept_and_the_stream_goes_on(tmp_path: Path) -> 
     from attitude_c.view.sources import LineReader
 
     hub, clock = _hub(tmp_path)
-    c, _ = hub.add_client()
+    hub.add_client()
     p = LineReader().feed('{"t":0.1,"report":"BOOT","x":NaN,"y":[Infinity,1]}')
     hub.samples(_sine_rows(0, 1, 100.0))
     hub.event(p.t, p.event, p.detail)

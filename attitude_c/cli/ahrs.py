@@ -34,8 +34,9 @@ Output (--out DIR): attitude.csv (t, quaternion body -> ENU, yaw/pitch/roll
 in degrees; its first line states the frames), attitude.png (estimate and
 reference angles, error components, flags, bias estimate) and summary.json
 (the printed summary; with a reference BROAD's error metric over the
-movement phases of a BROAD trial). Files are written to a temporary name,
-then renamed; summary.json last.
+movement phases of a BROAD trial). Files are written only once every figure
+is computed (a run that fails leaves none), each to a temporary name, then
+renamed; summary.json last.
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ import logging
 import socket
 import sys
 import time
-from collections.abc import Awaitable, Callable, Iterable, Iterator
+from collections.abc import Awaitable, Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 from urllib.parse import urlsplit
@@ -332,8 +332,8 @@ async def _send_file(resp: Any, path: Any, size: int) -> None:
 async def _writer(ws: Any, client: Client, hello: str, history: Iterable[str] = ()) -> None:
     try:
         await ws.send_str(hello)
-        for msg in history:  # one message at a time: send_str waits while the socket is full
-            await ws.send_str(msg)
+        for part in history:  # one message at a time: send_str waits while the socket is full
+            await ws.send_str(part)
         while True:
             msg = await client.queue.get()
             if msg is None:

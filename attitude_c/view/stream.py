@@ -159,11 +159,12 @@ def json_safe(detail: dict[str, Any]) -> dict[str, Any]:
             return [walk(v, depth + 1) for v in x]
         return str(x)
 
+    text: str | None = None
     try:
         out = walk(detail, 0)
         text = json.dumps(out, separators=(",", ":"), allow_nan=False)
     except (ValueError, RecursionError):
-        text = out = None
+        pass
     if text is not None and len(text) <= DETAIL_MAX:
         return out  # type: ignore[no-any-return]
     return {"truncated": (text or repr(detail)[:DETAIL_MAX])[:DETAIL_MAX // 2]}
