@@ -5,12 +5,12 @@ that fails, no stray NumPy warning, every message naming the file. In-process
 
 from __future__ import annotations
 
-import tracemalloc
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import broad_mat, peak_memory
 
 from attitude_c.cli import main
 
@@ -26,14 +26,7 @@ def _run(capsys, *argv: str) -> tuple[int, list[str]]:
 
 
 def _mat(path: Path, **kw) -> Path:
-    from scipy.io import savemat
-
-    d = {"imu_gyr": np.full((N, 3), 0.01), "imu_acc": np.tile([0, 0, 9.81], (N, 1)),
-         "imu_mag": np.tile([20.0, 0, -40.0], (N, 1)), "opt_quat": np.tile([1.0, 0, 0, 0], (N, 1)),
-         "movement": np.ones((N, 1)), "sampling_rate": np.array([[100.0]])}
-    d.update(kw)
-    savemat(path, d)
-    return path
+    return broad_mat(path, N, **kw)
 
 
 @pytest.mark.parametrize("case,kw,says", [
@@ -67,12 +60,7 @@ def test_a_sparse_file_is_refused_at_once_in_one_short_line(tmp_path: Path, caps
     f = tmp_path / "sparse.csv"
     with open(f, "wb") as fh:
         fh.truncate(64 << 20)
-    tracemalloc.start()
-    try:
-        rc, err = _run(capsys, str(f), "--out", str(tmp_path / "out"))
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    (rc, err), peak = peak_memory(lambda: _run(capsys, str(f), "--out", str(tmp_path / "out")))
     assert rc == 2 and err == [f"attitude ahrs: error: {f}: not a text file (a NUL byte at offset 0)"]
     assert peak < 4 << 20, peak  # the probe reads 1 KiB; the rest is the interpreter's own
 
@@ -82,12 +70,7 @@ def test_a_huge_line_is_refused_without_holding_it(tmp_path: Path, capsys) -> No
     with open(f, "w") as fh:
         fh.write("t,gx,gy,gz,ax,ay,az\n0,0,0,0,0,0,9.81\n")
         fh.write("1" * (8 << 20) + "\n")
-    tracemalloc.start()
-    try:
-        rc, err = _run(capsys, str(f), "--out", str(tmp_path / "out"))
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    (rc, err), peak = peak_memory(lambda: _run(capsys, str(f), "--out", str(tmp_path / "out")))
     assert rc == 2 and err == [f"attitude ahrs: error: {f}: line 3: longer than 1,048,576 bytes"], err
     assert peak < 6 << 20, peak  # one bounded piece (1 MiB) at a time, never the 8 MiB line
 

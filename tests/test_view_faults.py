@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ROOT, _missing
+from conftest import ROOT, _missing, broad_mat, peak_memory
 
 import attitude_c
 from attitude_c.cli import build_parser
@@ -113,15 +113,8 @@ def test_odd_replay_lines_are_one_line_naming_the_file_and_line(tmp_path: Path, 
         assert msg.startswith(f"recording '{f}' line 2: ") and len(msg) < 300 and "\n" not in msg, msg
 
 
-def _mat(path: Path, n: int = 50, **kw) -> Path:
-    from scipy.io import savemat
-
-    d = {"imu_gyr": np.full((n, 3), 0.1), "imu_acc": np.tile([0, 0, 9.81], (n, 1)),
-         "imu_mag": np.tile([20.0, 0, -40.0], (n, 1)), "opt_quat": np.tile([1.0, 0, 0, 0], (n, 1)),
-         "movement": np.ones((n, 1)), "sampling_rate": np.array([[100.0]])}
-    d.update(kw)
-    savemat(path, d)
-    return path
+def _mat(path: Path, **kw) -> Path:
+    return broad_mat(path, 50, **kw)
 
 
 @pytest.mark.parametrize("case,kw,says", [
@@ -144,37 +137,32 @@ def test_a_bad_broad_trial_is_refused_before_serving(tmp_path: Path, case: str, 
 def test_a_large_replay_is_streamed_not_held(tmp_path: Path) -> None:
     """The check reads the file a line at a time, and so does the replay: memory
     does not grow with the recording (a 6.3 GB read before issue 29)."""
-    import tracemalloc
-
     f = tmp_path / "big.jsonl"
     with open(f, "wb") as fh:
         fh.writelines(_sample(k) for k in range(20_000))
-    tracemalloc.start()
-    try:
+
+    def check_and_play() -> tuple[int, int]:
         rec = sources.load_recording(f)
-        n = sum(1 for _ in rec.items())
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert rec.samples == n == 20_000
+        return rec.samples, sum(1 for _ in rec.items())
+
+    (samples, n), peak = peak_memory(check_and_play)
+    assert samples == n == 20_000
     # the file is 1.8 MB; read whole (text + 20,000 items of 17 floats) it costs > 15 MB
     assert peak < 1.5e6, peak
 
 
 def test_a_sparse_file_is_refused_at_once(tmp_path: Path) -> None:
-    import tracemalloc
-
     f = tmp_path / "sparse.csv"
     with open(f, "wb") as fh:
         fh.truncate(64 << 20)  # 64 MiB of NUL bytes, none on the disk
-    tracemalloc.start()
-    try:
+
+    def refused() -> str:
         with pytest.raises(InvalidArgument, match="not a text file") as exc:
             sources.load_recording(f)
-        peak = tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
-    assert peak < 1 << 20 and len(str(exc.value)) < 200, (peak, str(exc.value)[:300])
+        return str(exc.value)
+
+    msg, peak = peak_memory(refused)
+    assert peak < 1 << 20 and len(msg) < 200, (peak, msg[:300])
 
 
 # ---- item 4: the history in bounded messages; a client limit -------------------------------

@@ -569,7 +569,7 @@ class Hub:
             if math.isfinite(self._last_wall):
                 gap = now - self._last_wall
                 self._arrival = gap if not math.isfinite(self._arrival) else 0.8 * self._arrival + 0.2 * gap
-            self._last_wall = now
+            self._last_wall = self.clock()  # taken now: a tick slowed by a loaded machine is not a stall
             point = self._chart_point(a, td, te, th)
             self.history.append(json.dumps(point, separators=(",", ":"), allow_nan=False))
             self.points_total += 1
