@@ -320,7 +320,7 @@ async def _one_more(url: str) -> int | str:
     "warmup": "seconds of data before the clients connect, filling the history ring (default 30)",
     "out": "write the figures as JSON here",
 })
-def view_soak_clients(c, seconds=60.0, clients=200, warmup=30.0, out=""):
+def view_soak_clients(c, seconds=60, clients=200, warmup=30, out=""):
     """The display under many clients: the server's memory with CLIENTS WebSockets (readers and
     non-readers) for SECONDS, the first and largest message, the client limit; no browser needed."""
     fig = run_client_soak(float(seconds), int(clients), warmup=float(warmup))
