@@ -140,6 +140,10 @@ O := o
 STATIC_LIB := $(BUILDDIR)/libattitude.a
 endif
 
+# The shared library's objects: position independent, and every symbol hidden
+# but the public headers' declarations (ATT_API_BEGIN/END, attitude/common.h).
+PIC_CFLAGS := -fPIC -fvisibility=hidden
+
 LIB_SRCS := $(sort $(wildcard $(LIB_GLOBS)))
 APP_SRCS := $(if $(filter 1,$(APP)),$(sort $(wildcard csrc/app/*.c)))
 HEADERS  := $(sort $(wildcard csrc/include/attitude/*.h) \
@@ -174,7 +178,7 @@ version:
 # objects rebuild exactly when the compiler or a flag changed.
 STAMP_TEXT := $(CC) $(shell $(CC) --version 2>/dev/null | head -n 1) | $(ATT_CFLAGS) $(TARGET_CFLAGS) \
   $(CPPFLAGS) $(CFLAGS) | $(TARGET_LDFLAGS) $(LDFLAGS) $(TARGET_LIBS) | $(AR) | $(STATIC_APP) \
-  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS)
+  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS) | $(PIC_CFLAGS)
 $(STAMP): FORCE
 	@mkdir -p $(@D)
 	@if [ "$$(cat $@ 2>/dev/null)" != '$(subst ','\'',$(STAMP_TEXT))' ]; then \
@@ -186,7 +190,7 @@ $(BUILDDIR)/obj/%.$(O): csrc/src/%.c $(HEADERS) $(STAMP)
 
 $(BUILDDIR)/obj-pic/%.o: csrc/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
-	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) $(PIC_CFLAGS) -c $< -o $@
 
 $(BUILDDIR)/obj/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
@@ -194,7 +198,7 @@ $(BUILDDIR)/obj/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
 
 $(BUILDDIR)/obj-pic/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
 	@mkdir -p $(@D)
-	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -fPIC -c $< -o $@
+	$(CC) $(ATT_CFLAGS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) $(PIC_CFLAGS) -c $< -o $@
 
 $(BUILDDIR)/obj-app/%.o: csrc/app/%.c $(HEADERS) $(wildcard csrc/app/*.h) $(STAMP)
 	@mkdir -p $(@D)

@@ -109,7 +109,7 @@ class CTwinBase(Generic[V]):
     _m: Any
 
     def set_inputs(self, inputs: Sequence[float] | np.ndarray) -> None:
-        from .errors import raise_for_status
+        from .names import raise_for_status
 
         fn, count, pin = self._SET_INPUTS
         v = check_inputs(inputs, count, pin)

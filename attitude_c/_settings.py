@@ -16,6 +16,10 @@ settings as keywords named as the fields; each is checked by name:
   (``SettingsSpec.field_fn``, e.g. ``att_ahrs_check_settings_field``: the first
   field outside its domain), else those that fail on their own.
 
+Commands take a setting as ``NAME=VALUE`` text (``attitude ahrs --set``,
+``simulate --ahrs-setting``, ``view --ahrs-setting``): :func:`parse_assignment`
+is the one parser of that text for every command.
+
 A struct may expose an integer field by name (``Choice``: the filter's
 ``method`` as ``"rv3-reuse"``) and fields of a nested struct under
 ``<outer>_<inner>`` (the thesis EKF's ``gn_max_iter``).
@@ -30,15 +34,14 @@ from typing import Any, Callable, Literal
 
 import numpy as np
 
-from .errors import InvalidArgument, InvalidType
+from ._options import OptionError
+from ._validate import C_INT_RANGES as _INT_RANGES
+from ._validate import integer, real
+from .errors import InvalidArgument
 
-__all__ = ["Choice", "SettingNames", "SettingsSpec", "defaults", "fill", "kinds", "read"]
+__all__ = ["Choice", "SettingNames", "SettingsSpec", "defaults", "fill", "kinds", "parse_assignment", "read"]
 
 Kind = Literal["real", "int", "choice"]
-
-_INT_RANGES = {"int": (-(2**31), 2**31 - 1), "unsigned int": (0, 2**32 - 1), "long": (-(2**63), 2**63 - 1),
-               "unsigned long": (0, 2**64 - 1), "short": (-(2**15), 2**15 - 1), "unsigned short": (0, 2**16 - 1)}
-
 
 @dataclass(frozen=True)
 class Choice:
@@ -176,18 +179,8 @@ def _value(spec: SettingsSpec, name: str, kind: str, v: Any) -> Any:
     if kind == "choice":
         return spec.choices[name].encode(name, v)
     if kind == "real":
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-            raise InvalidType(f"{name} must be a real number, got {type(v).__name__}")
-        fv = float(v)
-        if not np.isfinite(fv):
-            raise InvalidArgument(f"{name} must be finite, got {fv}")
-        return fv
-    if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
-        raise InvalidType(f"{name} must be an integer, got {type(v).__name__}")
-    lo, hi = _INT_RANGES[kind]
-    if not lo <= int(v) <= hi:
-        raise InvalidArgument(f"{name} must be in {lo}..{hi} (C {kind}), got {v}")
-    return int(v)
+        return real(v, name)
+    return integer(v, name, *_INT_RANGES[kind], what=f"C {kind}")
 
 
 def _new(ffi: Any, lib: Any, spec: SettingsSpec, values: Mapping[str, Any]) -> Any:
@@ -229,3 +222,28 @@ def _outside(ffi: Any, lib: Any, spec: SettingsSpec, s: Any, settings: Mapping[s
     what = "outside its domain" if len(bad) == 1 else "outside their domains" if bad else \
         "together outside the domain"
     return f"{given} {what}"
+
+
+def parse_assignment(spec: SettingsSpec, text: str, option: str) -> tuple[str, Any]:
+    """``NAME=VALUE`` as a command line gives a setting of ``spec``: the name checked
+    against the struct's, the value as its kind takes it (a choice by name, a real a
+    finite number, an integer an integer). The domain is checked when the struct is
+    filled (:func:`fill`). Raises :class:`~attitude_c._options.OptionError` (a
+    ValueError) naming ``option``."""
+    name, sep, value = text.partition("=")
+    name, value = name.strip(), value.strip()
+    if not sep or not name or not value:
+        raise OptionError(f"{option} expects NAME=VALUE, got {text!r}")
+    known = kinds(spec)
+    if name not in known:
+        raise OptionError(f"{option}: unknown {spec.label} setting {name!r} (known: {', '.join(known)})")
+    if known[name] == "choice":
+        return name, value
+    try:
+        v: float | int = float(value) if known[name] == "real" else int(value, 0)
+    except ValueError:
+        what = "a number" if known[name] == "real" else "an integer"
+        raise OptionError(f"{option} {name}: expected {what}, got {value!r}") from None
+    if not np.isfinite(v):
+        raise OptionError(f"{option} {name}: must be finite, got {value!r}")
+    return name, v

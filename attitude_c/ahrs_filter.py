@@ -19,7 +19,7 @@ Settings are keyword arguments named as the C struct's fields
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal
 
 import numpy as np
@@ -27,9 +27,11 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
-from .errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+from ._validate import real, real_array
+from .errors import InvalidArgument, InvalidType, NonFiniteError
+from .names import raise_for_status
 
-__all__ = ["SETTINGS", "Ahrs", "ahrs", "default_settings"]
+__all__ = ["SETTINGS", "Ahrs", "ahrs", "check_settings", "default_settings", "parse_setting", "setting_option"]
 
 FloatArray = NDArray[np.float64]
 Precision = Literal["f64", "f32"]
@@ -54,6 +56,32 @@ _SPEC = _settings.SettingsSpec(
 #: library on first use), besides ``method``.
 SETTINGS: Sequence[str] = _settings.SettingNames(_SPEC, "real")
 
+
+
+def parse_setting(text: str, option: str = "--set") -> tuple[str, Any]:
+    """A filter setting as every command takes it, ``NAME=VALUE`` (``acc_tau=3``,
+    ``method=rv1``): the one parser of ``attitude ahrs --set``, ``simulate
+    --ahrs-setting`` and ``view --ahrs-setting``. ValueError naming ``option``
+    for a malformed text, an unknown name or a value that is not a number."""
+    return _settings.parse_assignment(_SPEC, text, option)
+
+
+def check_settings(settings: Mapping[str, Any]) -> None:
+    """Raise as :class:`Ahrs` would for ``settings`` (InvalidArgument/InvalidType naming
+    the setting: unknown, of the wrong type, outside the domain), without a filter."""
+    ffi, lib = ffi_lib("f64")
+    _settings.fill(ffi, lib, _SPEC, settings)
+
+
+def setting_option(option: str) -> Callable[[str], tuple[str, Any]]:
+    """:func:`parse_setting` for ``option`` (an argparse ``type=``)."""
+    def conv(text: str) -> tuple[str, Any]:
+        return parse_setting(text, option)
+
+    conv.__name__ = "setting"
+    return conv
+
+
 _DTYPES = {"f64": np.float64, "f32": np.float32}
 
 
@@ -73,9 +101,7 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
         if optional:
             return None
         raise InvalidArgument(f"{name} is required")
-    a = np.asarray(x)
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(f"{name} must hold real numbers, got dtype {a.dtype}")
+    a = real_array(x, name)
     if a.ndim not in (1, 2) or a.shape[-1] != 3:
         raise InvalidArgument(f"{name} must have shape (3,) or (N, 3), got {a.shape}")
     a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
@@ -83,6 +109,9 @@ def _vectors(x: ArrayLike | None, name: str, optional: bool = False) -> NDArray[
         i = int(np.argmin(np.isfinite(a).all(axis=1)))
         raise NonFiniteError(f"{name}: sample {i} holds NaN or Inf", index=i)
     return a
+
+
+_F64, _ND = np.dtype(np.float64), np.ndarray  # the fast path of Ahrs.update takes these
 
 
 class Ahrs:
@@ -97,24 +126,25 @@ class Ahrs:
     def __init__(self, rate: float | None = None, q0: ArrayLike | None = None,
                  precision: Precision = "f64", **settings: Any) -> None:
         self.precision = _check_precision(precision)
-        if rate is not None:
-            if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
-                raise InvalidType(f"rate must be a number (Hz), got {type(rate).__name__}")
-            if not (np.isfinite(rate) and rate > 0):
-                raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
-        self.rate = None if rate is None else float(rate)
+        self.rate = None if rate is None else real(rate, "rate", "Hz", lo=0.0, lo_open=True)
         self._ffi, self._lib = ffi_lib(self.precision)
         self._set = _settings.fill(self._ffi, self._lib, _SPEC, settings)
         self._s = self._ffi.new("att_ahrs *")
         q = self._ffi.NULL
         if q0 is not None:
-            qa = np.asarray(q0, dtype=np.float64)
+            qa = real_array(q0, "q0").astype(np.float64)
             if qa.shape != (4,):
                 raise InvalidArgument(f"q0 must have shape (4,), got {qa.shape}")
             q = self._ffi.new("att_real[4]", [float(v) for v in qa])
         st = self._lib.att_ahrs_init(self._s, self._set, q)
         if st != 0:
             raise_for_status(st, "q0")
+        # the one-sample fast path's buffers (see update), reused by every call (f64 only)
+        self._in1 = [self._ffi.new("att_real[3]") for _ in range(3)] if self.precision == "f64" else None
+        self._q1 = np.empty(4, dtype=_DTYPES[self.precision])
+        self._q1p = self._ffi.from_buffer("att_real[]", self._q1)
+        self._step = None if self.rate is None else 1.0 / self.rate
+        self._upd, self._move = self._lib.att_ahrs_update, self._ffi.memmove
 
     @property
     def settings(self) -> dict[str, Any]:
@@ -155,7 +185,7 @@ class Ahrs:
             if self.rate is None:
                 raise InvalidArgument("dt is required when the filter has no rate")
             return np.array([1.0 / self.rate], dtype=_DTYPES[self.precision])
-        d = np.asarray(dt, dtype=np.float64).ravel()
+        d = real_array(dt, "dt").astype(np.float64).ravel()
         if d.size not in (1, n):
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
         return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
@@ -163,6 +193,29 @@ class Ahrs:
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
                dt: ArrayLike | None = None) -> FloatArray:
         """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4))."""
+        # The fast path (precision f64): one sample of (3,) float64 arrays, dt None or a float:
+        # the rows copied into reused buffers (sizes checked here: memmove does not, and it
+        # refuses strided arrays), one C call, the attitude copied out. The C call checks every
+        # value (finite, dt > 0, units) and leaves the state untouched when it fails: the
+        # general path below then repeats it and names the bad argument.
+        step = self._step if dt is None else dt if isinstance(dt, float) else None
+        bufs = self._in1
+        if (step is not None and bufs is not None and type(gyr) is _ND and type(acc) is _ND
+                and gyr.shape == (3,) and acc.shape == (3,) and gyr.dtype == _F64 and acc.dtype == _F64
+                and (mag is None or type(mag) is _ND and mag.shape == (3,) and mag.dtype == _F64)):
+            g, a, m = bufs
+            move = self._move
+            try:
+                move(g, gyr, 24)
+                move(a, acc, 24)
+                if mag is None:
+                    m = self._ffi.NULL
+                else:
+                    move(m, mag, 24)
+                if self._upd(self._s, g, a, m, step, self._q1p) == 0:
+                    return self._q1.copy()
+            except ValueError:
+                pass
         single = np.ndim(gyr) == 1
         g = _vectors(gyr, "gyr")
         a = _vectors(acc, "acc")
@@ -220,7 +273,7 @@ class Ahrs:
         """Rows of ``x`` (N, 3), None where a row is all NaN (absent); None for no ``x``."""
         if x is None:
             return None
-        a = np.asarray(x, dtype=np.float64).reshape(-1, 3)
+        a = real_array(x, name).astype(np.float64).reshape(-1, 3)
         if a.shape[0] != n:
             raise InvalidArgument(f"gyr and {name} must have the same number of samples, got {n}, {a.shape[0]}")
         absent = np.isnan(a).all(axis=1)

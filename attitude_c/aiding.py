@@ -26,8 +26,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
+from ._validate import C_INT_RANGES, integer, real, real_array
 from .core import FloatArray, FloatPrecision, _check_precision, _ptr, _records, _shaped, _to_c
-from .errors import InvalidArgument, InvalidType, raise_for_status
+from .errors import InvalidArgument
+from .names import raise_for_status
 
 __all__ = [
     "GN_METHODS",
@@ -60,12 +62,7 @@ def _pair(f: ArrayLike, m: ArrayLike | None, precision: str) -> tuple[Any, Any, 
 
 
 def _declination(d: Any) -> float:
-    if isinstance(d, bool) or not isinstance(d, (int, float, np.integer, np.floating)):
-        raise InvalidType(f"declination must be a real number (rad), got {type(d).__name__}")
-    d = float(d)
-    if not math.isfinite(d) or abs(d) > math.pi:
-        raise InvalidArgument(f"declination must be a finite angle in [-pi, pi] rad, got {d}")
-    return d
+    return real(d, "declination", "rad", lo=-math.pi, hi=math.pi, domain="a finite angle in [-pi, pi]")
 
 
 def _finish(q: NDArray[Any], status: NDArray[np.intc], lead: tuple[int, ...], what: str,
@@ -148,7 +145,8 @@ def gauss_newton(f: ArrayLike, m: ArrayLike, q0: ArrayLike | None = None, declin
                  *, return_info: bool = False, **settings: float) -> Any:
     """Gauss–Newton quaternion (``att_gn_solve``) from ``f``, ``m`` (..., 3),
     starting at ``q0`` ((..., 4) per sample, or one (4,) for all; None: the
-    identity). ``method``: "gauss-newton" (eq. 3.39, damped) or "simplified"
+    closed-form TRIAD attitude, from which every well-posed sample converges;
+    ``[1, 0, 0, 0]`` is the thesis' cold start). ``method``: "gauss-newton" (eq. 3.39, damped) or "simplified"
     (eq. 3.40). Keyword settings (``att_gn_settings``; the defaults of
     ``att_gn_defaults``): max_iter, tol_residual, tol_step, accept_residual,
     damping, max_step, singular_tol. Returns q (..., 4), or (q, GNInfo) with
@@ -166,19 +164,14 @@ def gauss_newton(f: ArrayLike, m: ArrayLike, q0: ArrayLike | None = None, declin
     for k, v in settings.items():
         if k not in _GN_FIELDS:
             raise InvalidArgument(f"unknown Gauss-Newton setting {k!r} (one of {_GN_FIELDS!r})")
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-            raise InvalidType(f"{k} must be a number, got {type(v).__name__}")
         if k == "max_iter":
-            if int(v) != v or not 1 <= int(v) <= 1000:
-                raise InvalidArgument(f"max_iter must be an integer in 1..1000, got {v}")
-            s.max_iter = int(v)
+            fv = real(v, k)  # an integral float (20.0) is taken too
+            s.max_iter = integer(int(fv) if fv.is_integer() else v, k, 1, 1000)
         else:
-            if not math.isfinite(float(v)) or float(v) < 0:
-                raise InvalidArgument(f"{k} must be finite and >= 0, got {v}")
-            setattr(s, k, float(v))
+            setattr(s, k, real(v, k, lo=0.0))
     q0p: Any = ffi.NULL
     if q0 is not None:
-        qa = np.asarray(q0)
+        qa = real_array(q0, "q0")
         if qa.shape == (4,):
             qa = np.broadcast_to(qa, (n, 4))
         qr, _ = _shaped(qa, "q0", (4,), "start quaternion")
@@ -250,18 +243,10 @@ def align_static(acc: ArrayLike, mag: ArrayLike | None = None, gyr: ArrayLike | 
     ffi, lib = ffi_lib(precision)
     st = ffi.new("att_align_window_settings *")
     lib.att_align_window_defaults(st)
-    if isinstance(min_samples, bool) or not isinstance(min_samples, (int, np.integer)):
-        raise InvalidType(f"min_samples must be an int, got {type(min_samples).__name__}")
-    if min_samples < 2:
-        raise InvalidArgument(f"min_samples must be >= 2, got {min_samples}")
-    st.min_samples = int(min_samples)
+    st.min_samples = integer(min_samples, "min_samples", 2, C_INT_RANGES["unsigned int"][1], "C unsigned int")
     for k, v in (("max_acc_spread", max_acc_spread), ("max_mag_spread", max_mag_spread),
                  ("max_gyr_std", max_gyr_std), ("max_gyr_mean", max_gyr_mean)):
-        if not (isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)):
-            raise InvalidType(f"{k} must be a number, got {type(v).__name__}")
-        if not (math.isfinite(float(v)) and float(v) > 0):
-            raise InvalidArgument(f"{k} must be finite and > 0, got {v}")
-        setattr(st, k, float(v))
+        setattr(st, k, real(v, k, lo=0.0, lo_open=True))
     st.declination_rad = d
     w = ffi.new("att_align_window *")
     raise_for_status(lib.att_align_window_init(w, st), "align_static settings")

@@ -35,7 +35,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import names
 from ._lib import ffi_lib
-from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from ._validate import real_array as _as_real  # the shared array check (its one place)
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from .names import INCREMENT_METHODS, METHODS, Method, raise_for_status
 
 __all__ = [
     "INCREMENT_METHODS",
@@ -62,13 +64,8 @@ __all__ = [
     "rotvec_to_quat",
 ]
 
-#: Integration methods (the type checkers' view; ``METHODS`` is the same list at
-#: run time). The C enum value of each is the library's ``ATT_METHOD_<NAME>``
-#: constant (see :func:`method_code`), never a position here.
-Method = Literal["rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4"]
-METHODS: tuple[Method, ...] = get_args(Method)
-#: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
-INCREMENT_METHODS: tuple[Method, ...] = tuple(m for m in METHODS if m != "rk4")
+# Method, METHODS, INCREMENT_METHODS: spelled in attitude_c.names (below the fixed-point
+# binding, which core runs for precision="fixed"), the same objects here.
 #: Numeric precisions: the two float builds and the fixed-point port.
 Precision = Literal["f64", "f32", "fixed"]
 PRECISIONS: tuple[Precision, ...] = get_args(Precision)
@@ -110,18 +107,6 @@ def method_code(method: str, lib: Any = None) -> int:
     _check_method(method)
     name = "ATT_METHOD_" + method.upper().replace("-", "_")
     return int(getattr(lib, name)) if lib is not None else names.C[name]
-
-
-def _as_real(x: ArrayLike, name: str) -> NDArray[Any]:
-    """Array of a real numeric dtype (bool, complex, object, str rejected)."""
-    try:
-        a = np.asarray(x)
-    except Exception as exc:  # ragged lists and the like
-        raise InvalidArgument(f"{name} cannot be converted to an array: {exc}") from exc
-    if a.dtype.kind not in "iuf":
-        raise InvalidType(
-            f"{name} must hold real numbers (integer or float dtype), got dtype {a.dtype}")
-    return a
 
 
 def _first_bad(flat_ok: Any) -> int:
@@ -365,7 +350,7 @@ class Integrator:
         if self.precision == "fixed":
             if self.method == "rk4":
                 raise InvalidArgument("precision='fixed' does not implement method 'rk4'")
-            from .fixedpoint import _Stream
+            from ._fixedcore import _Stream
 
             _check_q0(q0)  # the float builds' checks first: the same errors in every precision
             self._fx: Any = _Stream(self.method, q0)
@@ -403,7 +388,7 @@ class Integrator:
         """Current attitude quaternion (4,), float64 or float32 after the precision."""
         with self._lock:
             if self._fx is not None:
-                from .fixedpoint import from_q30
+                from ._fixedcore import from_q30
 
                 return from_q30(self._fx.q_q30)
             return np.array([float(self._state.q[i]) for i in range(4)], dtype=self._dtype)

@@ -3,12 +3,12 @@
 One base class, :class:`AttitudeError`, mixed with the builtin exception a
 user would naturally catch (pynacl style): a bad argument is both an
 ``AttitudeError`` and a ``ValueError``; a device timeout is also a
-``TimeoutError``; and so on.
+``TimeoutError``; and so on. Which exception a C status code raises is
+:func:`attitude_c.names.raise_for_status`'s (the codes are read from the
+library there; this module imports nothing of the package).
 """
 
 from __future__ import annotations
-
-from collections.abc import Mapping
 
 
 class AttitudeError(Exception):
@@ -68,19 +68,3 @@ class BlockFormatError(InvalidArgument):
         super().__init__(message)
         self.status = status
         self.index = index
-
-
-def raise_for_status(status: int, what: str, extra: Mapping[str, tuple[type[Exception], str]] | None = None,
-                     index: int | None = None) -> None:
-    """Raise the exception matching C status ``status`` (no-op for ``ATT_OK``).
-
-    ``what`` names the call or argument, so the message says what failed;
-    ``index`` the sample, when there is one. The meaning of every code comes
-    from :data:`attitude_c.names.STATUS`, keyed by the codes' C names;
-    ``extra`` adds a module's own meanings (C name -> (exception class, text)).
-    """
-    if status >= 0:
-        return
-    from . import names
-
-    names.raise_for_status(status, what, extra, index)

@@ -16,7 +16,6 @@ corrected field has the same norm B in every direction:
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, Literal, get_args
 
@@ -24,8 +23,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ._lib import ffi_lib
+from ._validate import C_INT_RANGES, integer, real
 from .core import FloatArray, FloatPrecision, _check_precision, _ptr, _records, _shaped, _to_c
-from .errors import InvalidArgument, InvalidType, raise_for_status
+from .errors import InvalidArgument, InvalidType
+from .names import raise_for_status
 
 __all__ = ["MODELS", "Calibration", "MagCal", "Model", "apply", "fit", "fit_minmax_2d"]
 
@@ -81,17 +82,9 @@ class MagCal:
     def __init__(self, min_samples: int = 20, min_span: float = 0.1, precision: FloatPrecision = "f64") -> None:
         self.precision = _check_precision(precision)
         self._ffi, self._lib = ffi_lib(self.precision)
-        if isinstance(min_samples, bool) or not isinstance(min_samples, (int, np.integer)):
-            raise InvalidType(f"min_samples must be an int, got {type(min_samples).__name__}")
-        if isinstance(min_span, bool) or not isinstance(min_span, (int, float, np.integer, np.floating)):
-            raise InvalidType(f"min_span must be a number, got {type(min_span).__name__}")
-        if min_samples < 10:
-            raise InvalidArgument(f"min_samples must be >= 10, got {min_samples}")
-        if not (math.isfinite(float(min_span)) and 0.0 <= float(min_span) <= 0.577):
-            raise InvalidArgument(f"min_span must be in [0, 0.577], got {min_span}")
         s = self._ffi.new("att_magcal_settings *")
-        s.min_samples = int(min_samples)
-        s.min_span = float(min_span)
+        s.min_samples = integer(min_samples, "min_samples", 10, C_INT_RANGES["unsigned int"][1], "C unsigned int")
+        s.min_span = real(min_span, "min_span", lo=0.0, hi=0.577)
         self._c = self._ffi.new("att_magcal *")
         raise_for_status(self._lib.att_magcal_init(self._c, s), "MagCal")
 

@@ -10,7 +10,7 @@ library, never typed again in Python::
 :data:`STATUS` says, for each status code of the library (keyed by its C
 name), which exception a Python caller gets and what the code means (the
 library's own text, ``att_status_str``: :func:`status_text`);
-:func:`raise_for_status` (re-exported by :mod:`attitude_c.errors`) turns a
+:func:`raise_for_status` turns a
 returned code into that exception. The method names come from the library
 too (:func:`method_names`, ``att_integ_method_name``), and so does the
 number of samples each method consumes per update (:func:`samples_per_update`,
@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
 from functools import cache
-from typing import Any
+from typing import Any, Literal, get_args
 
 from .errors import (
     AttitudeError,
@@ -38,8 +38,11 @@ from .errors import (
 )
 
 __all__ = [
+    "INCREMENT_METHODS",
+    "METHODS",
     "STATUS",
     "C",
+    "Method",
     "method_code",
     "method_names",
     "raise_for_status",
@@ -47,6 +50,15 @@ __all__ = [
     "status_name",
     "status_text",
 ]
+
+#: Integration methods (the type checkers' view; ``METHODS`` is the same list at
+#: run time; :mod:`attitude_c.core` re-exports them). The C enum value of each is the
+#: library's ``ATT_METHOD_<NAME>`` constant (see :func:`method_code`), never a position
+#: here; tests/test_names.py proves the list is the library's.
+Method = Literal["rv1", "rv2", "rv3", "rv3-coning", "rv3-reuse", "rv3-reuse-poly", "rk4"]
+METHODS: tuple[Method, ...] = get_args(Method)
+#: Methods fed with angle increments (``integrate``); ``rk4`` takes rates.
+INCREMENT_METHODS: tuple[Method, ...] = tuple(m for m in METHODS if m != "rk4")
 
 #: Prefixes of the library's constants (the modules' prefixes, upper case).
 PREFIXES = ("ATT_", "TLC2543", "AD7927")

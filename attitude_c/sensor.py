@@ -27,8 +27,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import magcal, names
 from ._lib import ffi_lib
+from ._validate import integer, real, real_array
 from .core import FloatPrecision
-from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
+from .names import raise_for_status
 
 __all__ = ["Sensor", "adc_words"]
 
@@ -38,10 +40,7 @@ _DTYPES = {"f64": np.float64, "f32": np.float32}
 
 
 def _triple(x: ArrayLike, name: str) -> NDArray[np.float64]:
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidType(f"{name} must be a number or 3 numbers: {exc}") from None
+    a = real_array(x, name).astype(np.float64)
     if a.shape == ():
         a = np.full(3, float(a))
     if a.shape != (3,):
@@ -120,8 +119,8 @@ class Sensor:
         """Words (M, 3) of ``n`` conversions each, sampled every ``period`` s → values
         × period (M, 3) (a gyro: angle increments, rad), in the precision's dtype.
         A word above n × 4095 raises :class:`RangeError` naming the sample."""
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)):
-            raise InvalidType(f"n must be an integer, got {type(n).__name__}")
+        n = integer(n, "n", 0, 255, "C uint8_t")  # the C call checks 1..ATT_BLOCK_OVERSAMPLE_MAX
+        period = real(period, "period", "s")  # and period > 0
         w = adc_words(words)
         out = np.empty(w.shape, dtype=_DTYPES[self.precision])
         ffi, lib = self._ffi, self._lib
@@ -150,10 +149,7 @@ class Sensor:
 def _matrix(x: ArrayLike | None) -> NDArray[np.float64]:
     if x is None:
         return _IDENTITY.copy()
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidType(f"matrix must be 3 x 3 numbers: {exc}") from None
+    a = real_array(x, "matrix").astype(np.float64)
     if a.shape == (9,):
         a = a.reshape(3, 3)
     if a.shape != (3, 3):

@@ -23,8 +23,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings
 from ._lib import ffi_lib
+from ._validate import real, real_array
 from .core import _rows
-from .errors import InvalidArgument, InvalidType, raise_for_status
+from .errors import InvalidArgument
+from .names import raise_for_status
 
 __all__ = ["SETTINGS", "ThesisEkfResult", "ahrs_thesis", "default_settings", "run"]
 
@@ -74,13 +76,9 @@ def run(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = Non
     if dt is None:
         if rate is None:
             raise InvalidArgument("give rate (Hz) or dt (s)")
-        if isinstance(rate, bool) or not isinstance(rate, (int, float, np.integer, np.floating)):
-            raise InvalidType(f"rate must be a number (Hz), got {type(rate).__name__}")
-        if not (np.isfinite(rate) and rate > 0):
-            raise InvalidArgument(f"rate must be finite and > 0 (Hz), got {rate}")
-        d = np.array([1.0 / float(rate)], dtype=dtype)
+        d = np.array([1.0 / real(rate, "rate", "Hz", lo=0.0, lo_open=True)], dtype=dtype)
     else:
-        d = np.ascontiguousarray(np.asarray(dt, dtype=np.float64).ravel(), dtype=dtype)
+        d = np.ascontiguousarray(real_array(dt, "dt").astype(np.float64).ravel(), dtype=dtype)
         if d.size not in (1, n):
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
     ffi, lib = ffi_lib(precision)
@@ -88,7 +86,7 @@ def run(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike, rate: float | None = Non
     state = ffi.new("att_tekf *")
     qp = ffi.NULL
     if q0 is not None:
-        qa = np.asarray(q0, dtype=np.float64)
+        qa = real_array(q0, "q0").astype(np.float64)
         if qa.shape != (4,):
             raise InvalidArgument(f"q0 must have shape (4,), got {qa.shape}")
         qp = ffi.new("att_real[4]", [float(v) for v in qa])

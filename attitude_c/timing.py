@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from ._validate import real
 from .core import _rows, quat_to_dcm
 from .errors import InvalidArgument, InvalidType
 
@@ -34,12 +35,7 @@ F = NDArray[np.float64]
 
 
 def _number(x: Any, name: str, unit: str) -> float:
-    if isinstance(x, bool) or not isinstance(x, (int, float, np.integer, np.floating)):
-        raise InvalidType(f"{name} must be a number ({unit}), got {type(x).__name__}")
-    v = float(x)
-    if not (np.isfinite(v) and v > 0):
-        raise InvalidArgument(f"{name} must be finite and > 0 ({unit}), got {x}")
-    return v
+    return real(x, name, unit, lo=0.0, lo_open=True)
 
 
 def _highpass(v: F, half: int) -> F:

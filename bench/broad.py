@@ -55,7 +55,7 @@ other half, and the other way round; the held-out scores of all trials
 are averaged.
 
     python -m bench.broad [--quick] [--no-timing] [--no-cv] [--data DIR]
-    python -m bench.broad --throughput-only [--quick] [--data DIR]   # host throughput table only
+    python -m bench.broad --throughput-only [--quick] [--data DIR]   # host throughput tables only
 
 The peers' attitudes are cached in ``results/bench-cache/broad`` (the ahrs
 package's EKF runs at about 1 ms per sample here: a first full run takes
@@ -387,6 +387,65 @@ def throughput_table(trials: list[Any], rounds: int) -> list[str]:
     return out
 
 
+def streaming(trials: list[Any], n: int, rounds: int) -> dict[str, list[float]]:
+    """µs per sample of one-sample-per-call streaming from Python, per round: ours
+    (``Ahrs.update``, f64), VQF's ``update`` and Fusion's ``update`` on the same first ``n``
+    samples of the trials concatenated, each row a (3,) view of a C-contiguous float64 array
+    (Fusion's in its units: °/s and g, converted before the clock starts), 9-axis every
+    sample; a fresh filter per round, made before the clock starts; the three alternate
+    within each round. "loop only" is the same loop fetching the three rows and calling
+    nothing: the share of every row that is the loop's own."""
+    import imufusion
+    from vqf import VQF
+
+    from attitude_c.ahrs_filter import Ahrs
+
+    g, a, m = (np.ascontiguousarray(np.vstack([getattr(t, k) for t in trials])[:n]) for k in ("gyr", "acc", "mag"))
+    rate = trials[0].rate
+    g_deg, a_g = np.degrees(g), a / 9.81
+
+    def fusion() -> Any:
+        f = imufusion.Ahrs()
+        f.set_settings(imufusion.AhrsSettings(sample_rate=rate, convention=imufusion.CONVENTION_ENU))
+        return f
+
+    def loop(update: Callable[..., Any], g: np.ndarray, a: np.ndarray) -> float:
+        t0 = time.thread_time()  # CPU time: a preemption on a shared machine is not counted
+        for i in range(n):
+            update(g[i], a[i], m[i])
+        return (time.thread_time() - t0) / n * 1e6
+
+    calls: dict[str, Callable[[], float]] = {
+        "attitude_c.Ahrs.update, f64": lambda: loop(Ahrs(rate=rate).update, g, a),
+        f"VQF.update ({_version('VQF')}, C++)": lambda: loop(VQF(1.0 / rate).update, g, a),
+        f"imufusion.Ahrs.update ({_version('Fusion')}, C)": lambda: loop(fusion().update, g_deg, a_g),
+        "loop only (no call)": lambda: loop(lambda *_: None, g, a)}
+    for fn in calls.values():  # warm-up
+        fn()
+    us: dict[str, list[float]] = {k: [] for k in calls}
+    for _ in range(rounds):
+        for k, fn in calls.items():
+            us[k].append(fn())
+    return us
+
+
+def streaming_table(trials: list[Any], rounds: int, n: int = 20_000) -> list[str]:
+    import os
+    import statistics
+
+    load = os.getloadavg()
+    us = streaming(trials, n, rounds)
+    out = [(f"\n**Streaming, one sample per call from Python** (the first {n:,} samples of the trials "
+            f"concatenated; `for i in range(n): f.update(gyr[i], acc[i], mag[i])`, rows as (3,) views "
+            f"of float64 arrays, 9-axis every sample, a fresh filter per round; {rounds} rounds alternating "
+            f"the calls, the thread's CPU time (`time.thread_time`); load average {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f} at "
+            "the start; the times include the loop's own, shown in the last row):\n"),
+           "| what | µs/sample, best round | median round |", "|---|---|---|"]
+    for k, v in us.items():
+        out.append(f"| {k} | {min(v):.2f} | {statistics.median(v):.2f} |")
+    return out
+
+
 # -- plot -------------------------------------------------------------------------------------
 
 def plot(trials: list[Any], figs: dict[str, list[Any]]) -> None:
@@ -510,6 +569,7 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
     if timing:
         out.append("")
         out.extend(throughput_table(trials, 2 if quick else 9))
+        out.extend(streaming_table(trials, 2 if quick else 9))
     return "\n".join(out)
 
 
@@ -522,7 +582,8 @@ if __name__ == "__main__":  # pragma: no cover
         from attitude_c import broad as _broad
 
         _trials = [_broad.load_trial(p) for p in _broad.find_trials(data)]
-        print("\n".join(throughput_table(_trials, 2 if "--quick" in sys.argv else 9)))
+        print("\n".join(throughput_table(_trials, 2 if "--quick" in sys.argv else 9)
+                        + streaming_table(_trials, 2 if "--quick" in sys.argv else 9)))
         sys.exit(0)
     print(run(quick="--quick" in sys.argv, timing="--no-timing" not in sys.argv, cv="--no-cv" not in sys.argv,
               data=data))

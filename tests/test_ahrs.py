@@ -165,6 +165,60 @@ def test_streaming_equals_batch():
     assert np.array_equal(ahrs(gyr, acc, mag, dt=dt), qb)
 
 
+def _state(f: Ahrs) -> tuple:
+    return tuple(f.q.tolist()) + tuple(f.bias.tolist()) + tuple(np.concatenate(f.sigma).tolist()) + (f.flags,)
+
+
+def test_one_sample_fast_path_equals_the_general_path():
+    """update's one-sample path (one C call on reused buffers) gives bit for bit what the
+    general path gives: rows that take it ((3,) float64, dt None or a float) and rows
+    that do not (a strided row, lists, a (1, 3) acc, a 0-d array dt, a big-endian row, a
+    masked array with nothing masked), mixed in one stream, against the batch call."""
+    gyr, acc, mag, _ = motion(240, 100.0, (0.2, -0.1, 0.3), noise=0.002)
+    qb = ahrs(gyr, acc, mag, rate=100.0)
+    wide = np.zeros((240, 6))
+    wide[:, ::2] = gyr  # rows of wide[:, ::2] are (3,) float64 but strided
+    f = Ahrs(rate=100.0)
+    out = []
+    for i in range(240):
+        g, a, m, dt = gyr[i], acc[i], mag[i], None
+        kind = i % 6
+        if kind == 1:
+            g, dt = wide[i, ::2], 0.01
+        elif kind == 2:
+            a, m = acc[i].tolist(), list(mag[i])
+        elif kind == 3:
+            a, dt = acc[i][None], np.array(0.01)
+        elif kind == 4:
+            g, m = gyr[i].astype(">f8"), np.ma.masked_array(mag[i])  # same values, general path
+        out.append(f.update(g, a, m, dt))
+    assert np.array_equal(np.vstack(out), qb)
+    assert all(q.shape == (4,) and q.dtype == np.float64 for q in out)
+    assert out[5] is not out[6] and not np.shares_memory(out[5], out[11])  # fresh arrays
+
+
+@pytest.mark.parametrize("bad", ["gyr-nan", "acc-inf", "mag-nan", "dt-zero", "dt-nan", "dt-negative"])
+def test_one_sample_errors_name_the_argument_and_keep_the_state(bad: str):
+    gyr, acc, mag, _ = motion(60, 100.0, (0.2, -0.1, 0.3), noise=0.002)
+    f, ref_ = Ahrs(rate=100.0), Ahrs(rate=100.0)
+    f.update(gyr[:50], acc[:50], mag[:50])
+    ref_.update(gyr[:50], acc[:50], mag[:50])
+    g, a, m, dt = gyr[50].copy(), acc[50].copy(), mag[50].copy(), None
+    if bad == "gyr-nan":
+        g[1] = np.nan
+    elif bad == "acc-inf":
+        a[2] = np.inf
+    elif bad == "mag-nan":
+        m[0] = np.nan
+    else:
+        dt = {"dt-zero": 0.0, "dt-nan": math.nan, "dt-negative": -0.01}[bad]
+    name = bad.split("-")[0]
+    with pytest.raises(InvalidArgument, match=rf"^{name}: sample 0"):
+        f.update(g, a, m, dt)
+    assert _state(f) == _state(ref_)
+    assert np.array_equal(f.update(gyr[50], acc[50], mag[50]), ref_.update(gyr[50], acc[50], mag[50]))
+
+
 def test_overrange_flag():
     gyr, acc, mag, _ = motion(50, 100.0, (0.0, 0.0, 3.0))
     f = Ahrs(rate=100.0, gyro_range=2.0)
@@ -218,3 +272,16 @@ def test_the_issue_names_are_the_package_api() -> None:
 
     assert attitude_c.Ahrs is ahrs_filter.Ahrs and attitude_c.ahrs is ahrs_filter.ahrs
     assert "Ahrs" in attitude_c.__all__ and "ahrs" in attitude_c.__all__
+
+
+def test_streaming_bench_smoke():
+    """bench/broad.py's streaming table on 200 synthetic samples (the full run on BROAD:
+    invoke bench --only broad): each of the three filters and the bare loop runs on the
+    same rows; the times are the benchmark's business, not the test's."""
+    from types import SimpleNamespace
+
+    from bench.broad import streaming
+
+    gyr, acc, mag, _ = motion(200, 100.0, (0.2, -0.1, 0.3), noise=0.002)
+    us = streaming([SimpleNamespace(gyr=gyr, acc=acc, mag=mag, rate=100.0)], n=200, rounds=1)
+    assert len(us) == 4 and all(len(v) == 1 and np.isfinite(v[0]) and v[0] >= 0 for v in us.values())

@@ -13,13 +13,16 @@ import subprocess
 import sys
 import textwrap
 import threading
+import warnings
 
 import numpy as np
 import pytest
 
-from attitude_c import core
+import attitude_c as ac
+from attitude_c import core, denoise
 from attitude_c import fixedpoint as fx
 from attitude_c.errors import InvalidArgument, InvalidType, RangeError
+from attitude_c.sensor import Sensor
 
 PRECISIONS = ("f64", "f32")
 
@@ -124,6 +127,95 @@ def test_raw_q30_entry_refuses_wrap_and_truncation() -> None:
         fx.integrate_q30(np.array(one), "rv1", q0_q30=np.array([2**31 + 5, 0, 0, 0], dtype=np.int64))
     # integers given as floats holding integers are still accepted
     assert np.array_equal(fx.integrate_q30(np.array(one, dtype=float), "rv1"), fx.integrate_q30(one, "rv1"))
+
+
+# ---- issue 29 item 13: edge types get the library's own error -----------------
+
+def _imu(n: int = 20) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """n samples at rest, level, field north and down (a valid 9-axis input)."""
+    return (np.tile([0.001, 0.0, 0.0], (n, 1)), np.tile([0.0, 0.0, 9.81], (n, 1)),
+            np.tile([0.0, 20.0, -40.0], (n, 1)))
+
+
+def _masked(a: np.ndarray) -> np.ma.MaskedArray:
+    out = np.ma.masked_array(a.copy())
+    out[min(3, len(out) - 1)] = np.ma.masked
+    return out
+
+
+G_, A_, M_ = _imu()
+BIG = 10**400  # an int beyond float64 (float() raises OverflowError)
+CPLX = np.complex128(0.01 + 1e-3j)  # as an array: NumPy's float cast drops the 1e-3j
+Q1 = np.tile([1.0, 0.0, 0.0, 0.0], (20, 1))
+
+#: (call, error class, the argument the message must name); every one raised a NumPy or
+#: Python error from inside, or was accepted with a value changed, before (issue 29 item 13)
+EDGE_CASES = {
+    "Ahrs(rate=10**400)": (lambda: ac.Ahrs(rate=BIG), InvalidArgument, "rate"),
+    "ahrs_thesis(rate=10**400)": (lambda: ac.ahrs_thesis(G_, A_, M_, rate=BIG), InvalidArgument, "rate"),
+    "aiding_delay(rate=10**400)": (lambda: ac.aiding_delay(G_, M_, Q1, BIG), InvalidArgument, "rate"),
+    "Ahrs.update(dt=10**400)": (lambda: ac.Ahrs().update(G_[0], A_[0], M_[0], dt=BIG), InvalidArgument, "dt"),
+    "ahrs(dt=10**400)": (lambda: ac.ahrs(G_, A_, M_, dt=BIG), InvalidArgument, "dt"),
+    "ahrs_thesis(dt=10**400)": (lambda: ac.ahrs_thesis(G_, A_, M_, dt=BIG), InvalidArgument, "dt"),
+    "integrate_rates(dt=10**400)": (lambda: ac.integrate_rates(G_, BIG, "rv1"), InvalidArgument, "dt"),
+    "Ahrs.update(dt=complex)": (lambda: ac.Ahrs().update(G_[0], A_[0], M_[0], dt=CPLX), InvalidType, "dt"),
+    "ahrs(dt=complex array)": (lambda: ac.ahrs(G_, A_, M_, dt=np.full(20, CPLX)), InvalidType, "dt"),
+    "ahrs_thesis(dt=complex array)": (lambda: ac.ahrs_thesis(G_, A_, M_, dt=np.full(20, CPLX)), InvalidType,
+                                      "dt"),
+    "ahrs(dt='0.01')": (lambda: ac.ahrs(G_, A_, M_, dt="0.01"), InvalidType, "dt"),
+    "Ahrs.update(dt='0.01')": (lambda: ac.Ahrs().update(G_[0], A_[0], M_[0], dt="0.01"), InvalidType, "dt"),
+    "ahrs_thesis(dt='0.01')": (lambda: ac.ahrs_thesis(G_, A_, M_, dt="0.01"), InvalidType, "dt"),
+    "Ahrs(q0=strings)": (lambda: ac.Ahrs(q0=["1", "0", "0", "0"]), InvalidType, "q0"),
+    "align(declination=10**400)": (lambda: ac.align(A_, M_, BIG), InvalidArgument, "declination"),
+    "triad(declination=10**400)": (lambda: ac.triad(A_, M_, BIG), InvalidArgument, "declination"),
+    "gauss_newton(declination=10**400)": (lambda: ac.gauss_newton(A_, M_, None, BIG), InvalidArgument,
+                                          "declination"),
+    "align_static(declination=10**400)": (lambda: ac.align_static(A_, M_, declination=BIG), InvalidArgument,
+                                          "declination"),
+    "gauss_newton(tol_step=10**400)": (lambda: ac.gauss_newton(A_, M_, tol_step=BIG), InvalidArgument,
+                                       "tol_step"),
+    "align_static(min_samples=2**64)": (lambda: ac.align_static(A_, M_, min_samples=2**64), InvalidArgument,
+                                        "min_samples"),
+    "align_static(max_acc_spread=10**400)": (lambda: ac.align_static(A_, M_, max_acc_spread=BIG),
+                                             InvalidArgument, "max_acc_spread"),
+    "magcal.fit(min_samples=2**64)": (lambda: ac.magcal.fit(M_, min_samples=2**64), InvalidArgument,
+                                      "min_samples"),
+    "magcal.fit(min_span=10**400)": (lambda: ac.magcal.fit(M_, min_span=BIG), InvalidArgument, "min_span"),
+    "Ahrs(acc_tau=10**400)": (lambda: ac.Ahrs(rate=100.0, acc_tau=BIG), InvalidArgument, "acc_tau"),
+    "Sensor.increments(n=2**64)": (lambda: Sensor(zero=2048, scale=0.01).increments(np.full((2, 3), 2048), n=2**64),
+                                   InvalidArgument, "n"),
+    "denoise.universal_threshold(n=2**64)": (lambda: denoise.universal_threshold(1.0, 2**64),
+                                             InvalidArgument, "n"),
+    "ahrs(masked gyr)": (lambda: ac.ahrs(_masked(G_), A_, M_, rate=100.0), InvalidArgument, "gyr"),
+    "Ahrs.update(masked row)": (lambda: ac.Ahrs(rate=100.0).update(G_[0], _masked(A_[0]), M_[0]),
+                                InvalidArgument, "acc"),
+    "integrate(masked)": (lambda: ac.integrate(_masked(G_), "rv1"), InvalidArgument, "dtheta"),
+    "align(masked)": (lambda: ac.align(_masked(A_), M_), InvalidArgument, "f"),
+    "quat_to_euler(masked)": (lambda: ac.quat_to_euler(_masked(Q1)), InvalidArgument, "q"),
+}
+
+
+@pytest.mark.parametrize("case", list(EDGE_CASES))
+def test_edge_types_get_the_librarys_error_naming_the_argument(case: str) -> None:
+    call, exc, name = EDGE_CASES[case]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a ComplexWarning is a value silently changed
+        with pytest.raises(exc, match=rf"^{name}\b"):
+            call()
+
+
+def test_rate_beyond_int64_is_a_number() -> None:
+    """2**64 Hz is finite and > 0 (the documented domain): taken as the float it is,
+    not a NumPy TypeError (np.isfinite of a Python int beyond uint64)."""
+    assert ac.Ahrs(rate=2**64).rate == 2.0**64
+    assert ac.ahrs(G_, A_, M_, rate=2**64).shape == (20, 4)
+    assert ac.ahrs_thesis(G_, A_, M_, rate=2**64).shape == (20, 4)
+
+
+def test_masked_array_with_nothing_masked_is_its_data() -> None:
+    q = ac.ahrs(G_, A_, M_, rate=100.0)
+    assert np.array_equal(ac.ahrs(np.ma.masked_array(G_), A_, np.ma.masked_array(M_), rate=100.0), q)
+    assert np.array_equal(ac.integrate(np.ma.masked_array(G_), "rv1"), ac.integrate(G_, "rv1"))
 
 
 # ---- item 9: thread safety -----------------------------------------------

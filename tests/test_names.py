@@ -67,7 +67,8 @@ def test_every_status_code_has_one_name_and_a_meaning() -> None:
 def test_raise_for_status_names_the_code() -> None:
     import pytest
 
-    from attitude_c.errors import InvalidArgument, NonFiniteError, RangeError, raise_for_status
+    from attitude_c.errors import InvalidArgument, NonFiniteError, RangeError
+    from attitude_c.names import raise_for_status
 
     with pytest.raises(NonFiniteError, match=r"x: non-finite .* at sample 4 \(status -3, ATT_E_NONFINITE\)") as e:
         raise_for_status(names.C["ATT_E_NONFINITE"], "x", index=4)
@@ -161,7 +162,8 @@ def test_every_code_python_can_see_has_a_text_of_its_own() -> None:
     test_c_programs.py) lists exactly the twins' codes and checks the same in C."""
     import pytest
 
-    from attitude_c.errors import AttitudeError, raise_for_status
+    from attitude_c.errors import AttitudeError
+    from attitude_c.names import raise_for_status
 
     host, library = _host_status_codes(), _library_status_codes()
     assert host and set(host).isdisjoint(library)
@@ -180,7 +182,8 @@ def test_every_code_python_can_see_has_a_text_of_its_own() -> None:
 def test_python_error_texts_are_the_librarys() -> None:
     import pytest
 
-    from attitude_c.errors import AttitudeError, raise_for_status
+    from attitude_c.errors import AttitudeError
+    from attitude_c.names import raise_for_status
 
     for name, (_, text) in names.STATUS.items():
         assert text == names.status_text(names.C[name]) != "unknown status", name

@@ -33,7 +33,9 @@ CFFI_DIR = CSRC / "cffi"
 # Library sources (portable C99) and host-only sources (device models...).
 SOURCE_DIRS = (CSRC / "src", CSRC / "host")
 
-COMPILE_ARGS = ["-std=c99", "-O3", "-fno-strict-aliasing"]
+# -fvisibility=hidden with ATT_NO_EXPORT (attitude/common.h): the extension
+# exports its PyInit function only, none of the library it embeds.
+COMPILE_ARGS = ["-std=c99", "-O3", "-fno-strict-aliasing", "-fvisibility=hidden"]
 
 
 def _rel(p: Path) -> str:
@@ -73,7 +75,7 @@ def make_ffi(precision: str) -> FFI:
         '#include "bindings.h"\n',
         sources=sources(),
         include_dirs=[_rel(INCLUDE), _rel(CSRC / "host"), _rel(CFFI_DIR)],
-        define_macros=[("ATT_REAL_F32", "1")] if precision == "f32" else [],
+        define_macros=[("ATT_NO_EXPORT", "1"), *([("ATT_REAL_F32", "1")] if precision == "f32" else [])],
         extra_compile_args=COMPILE_ARGS,
     )
     return ffi

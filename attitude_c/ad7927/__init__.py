@@ -28,7 +28,8 @@ from typing import Any, Callable, Literal
 import numpy as np
 
 from .._devmodel import CTwinBase, check_level, convert_in_chunks, raise_model_error
-from ..errors import InvalidArgument, InvalidType, NonFiniteError, raise_for_status
+from ..errors import InvalidArgument, InvalidType, NonFiniteError
+from ..names import raise_for_status
 from . import _capi
 from ._errors import AddressMismatch, FrameError
 from .model import (

@@ -118,19 +118,10 @@ class _Usage(Exception):
 
 
 def _settings(items: list[str]) -> dict[str, Any]:
-    out: dict[str, Any] = {}
-    for it in items:
-        k, sep, v = it.partition("=")
-        if not sep or not k:
-            raise _Usage(f"--set {it!r}: expected NAME=VALUE")
-        if k == "method":
-            out[k] = v
-        else:
-            try:
-                out[k] = float(v)
-            except ValueError:
-                raise _Usage(f"--set {it!r}: {v!r} is not a number") from None
-    return out
+    """The --set options: filter settings, parsed by the one parser every command shares."""
+    from ..ahrs_filter import parse_setting
+
+    return dict(parse_setting(it, "--set") for it in items)
 
 
 def _columns(items: list[str]) -> dict[str, str]:

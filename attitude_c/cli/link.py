@@ -6,7 +6,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import signal
 import sys
 import threading
 from collections.abc import Iterator
@@ -16,6 +15,7 @@ from typing import Any, Callable
 from ..errors import AttitudeError
 from . import options
 from .options import integer, positive
+from .stopping import GRACE_S, LineWriter, Stop
 
 
 def _hex_block(b: bytes) -> str:
@@ -52,6 +52,8 @@ EXIT_USAGE = 2  # bad argument or bad input line
 EXIT_GAVE_UP = 3  # a block was given up after the receiver had answered (--on-give-up fail)
 EXIT_NO_RECEIVER = 4  # no handshake from the receiver within --wait seconds
 EXIT_INTERRUPTED = 130  # SIGINT / SIGTERM with a block in progress
+#: ``link-rx``: stopped while stdout stayed blocked past the grace time (lines not printed, counted).
+EXIT_RX_BLOCKED = 3
 #: Seconds between two "waiting for the receiver" messages of link-tx.
 WAIT_NOTE_S = 5.0
 
@@ -136,21 +138,9 @@ def register(sub: Any) -> None:
     p.set_defaults(func=cmd_test)
 
 
-def _stop_on_signals() -> threading.Event:
-    ev = threading.Event()
-
-    def handler(signum: int, frame: Any) -> None:
-        ev.set()
-
-    if threading.current_thread() is threading.main_thread():
-        signal.signal(signal.SIGINT, handler)
-        signal.signal(signal.SIGTERM, handler)
-    return ev
-
-
-def _block_printer() -> Any:
-    """``show(block)`` printing each record of a block as one JSON line (libattitude's
-    block decoder and sequence tracker through attitude_c.link.block)."""
+def _block_printer(write: Callable[[str], None] = print) -> Any:
+    """``show(block)`` writing each record of a block as one JSON line with ``write``
+    (libattitude's block decoder and sequence tracker through attitude_c.link.block)."""
     from ..link import block
 
     tracker = block.SeqTracker()
@@ -161,7 +151,7 @@ def _block_printer() -> Any:
             raw = b[k:k + size]
             rec, span, st = tracker.decode(raw)  # a slip shows in the loss report's "slip"
             if rec is None or span is None:  # no place in the numbering
-                print(json.dumps({"error": tracker.error(st), "raw": raw.hex()}), flush=True)
+                write(json.dumps({"error": tracker.error(st), "raw": raw.hex()}))
                 continue
             out: dict[str, Any]
             if rec.kind == "sample":
@@ -174,7 +164,7 @@ def _block_printer() -> Any:
                 out = rec.as_dict()
                 if rec.is_loss:
                     out.update(first=span.first, count=span.count, slip=span.slip)
-            print(json.dumps(out), flush=True)
+            write(json.dumps(out))
 
     return show
 
@@ -190,9 +180,23 @@ def _open(cmd: str, args: argparse.Namespace) -> Any:
         return None
 
 
-def cmd_rx(args: argparse.Namespace) -> int:
+def _receive(args: argparse.Namespace, port: Any, protocol: str, show: Callable[[bytes], None],
+             stop: threading.Event, *, count: int | None, duration: float | None, receiver: Any = None) -> Any:
+    """link-rx: the receiver of ``protocol`` (legacy or v2) on ``port``, printing with ``show``,
+    until ``count``, ``duration``, --idle-eof or a stop; ``receiver``: one to go on with
+    (--protocol auto's). Its report."""
     from ..link.transport import run_receiver
+    from ..link.transport2 import run_receiver2
 
+    common: dict[str, Any] = {"count": count, "duration": duration, "stop": stop, "eof_after": args.idle_eof,
+                              "receiver": receiver}
+    if protocol == "v2":
+        return run_receiver2(port, impl=args.impl, on_record=show, keep_records=False, **common)
+    return run_receiver(port, impl=args.impl, block_size=args.block_size, gap_timeout_ms=args.gap_timeout_ms,
+                        on_block=show, keep_blocks=False, **common)
+
+
+def cmd_rx(args: argparse.Namespace) -> int:
     if args.protocol != "v2" and (args.decode or args.protocol == "auto"):
         from ..link import block
 
@@ -201,35 +205,36 @@ def cmd_rx(args: argparse.Namespace) -> int:
             print(f"link-rx: {what} needs a block size that is a multiple of {block.fmt().size} (records "
                   f"of the block format), got {args.block_size}", file=sys.stderr)
             return 2
-    stop = _stop_on_signals()
+    stopping = Stop()
+    stop = stopping.event
     port = _open("link-rx", args)
     if port is None:
         return 1
-    show: Callable[[bytes], None] = _block_printer() if args.decode else (lambda b: print(_hex_block(b), flush=True))
+    out = LineWriter(stopping)  # a stop does not wait for a blocked stdout
+    show: Callable[[bytes], None] = _block_printer(out.write) if args.decode \
+        else (lambda b: out.write(_hex_block(b)))
     what = (f"link v2, {args.impl}" if args.protocol == "v2" else f"N={args.block_size}, {args.impl}"
             + (", legacy or link v2" if args.protocol == "auto" else ""))
     print(f"link-rx: listening on {args.port} ({args.baud} 8N1, {what})", file=sys.stderr, flush=True)
     try:
         if args.protocol == "auto":
             rep = _rx_auto(args, port, show, stop)
-        elif args.protocol == "v2":
-            from ..link.transport2 import run_receiver2
-
-            rep = run_receiver2(port, impl=args.impl, count=args.count, duration=args.duration, on_record=show,
-                                stop=stop, eof_after=args.idle_eof, keep_records=False)
         else:
-            rep = run_receiver(port, impl=args.impl, block_size=args.block_size,
-                               gap_timeout_ms=args.gap_timeout_ms, count=args.count, duration=args.duration,
-                               on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+            rep = _receive(args, port, args.protocol, show, stop, count=args.count, duration=args.duration)
     except AttitudeError as exc:
         print(f"link-rx: {exc}", file=sys.stderr)
         return 2
     finally:
         port.close()
-    print("link-rx stats: " + json.dumps(rep.stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
+    stats = {**rep.stats, "lines_lost": out.lost} if out.lost else rep.stats
+    print("link-rx stats: " + json.dumps(stats) + f" (ended by {rep.ended_by})", file=sys.stderr)
     if rep.error:
         print(f"link-rx: {rep.error}", file=sys.stderr)
         return 1
+    if out.lost:
+        print(f"link-rx: stopped with stdout blocked for {GRACE_S:g} s: {out.lost} line(s) of accepted "
+              "data not printed (lines_lost)", file=sys.stderr)
+        return EXIT_RX_BLOCKED
     return 0
 
 
@@ -253,7 +258,7 @@ def cmd_tx(args: argparse.Namespace) -> int:
     from ..link.transport import OUTCOME_INTERRUPTED, OUTCOME_NO_RECEIVER, BlockReport, run_sender
 
     v2 = args.protocol == "v2"
-    stop = _stop_on_signals()
+    stop = Stop().event
     blocks = _tx_input(args, 6 if v2 else args.block_size)  # link v2: 6-byte records
     port = _open("link-tx", args)
     if port is None:
@@ -422,8 +427,7 @@ def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None],
     """link-rx --protocol auto: listen_auto, then the receiver of the protocol heard; its report."""
     import time
 
-    from ..link.transport import run_receiver
-    from ..link.transport2 import listen_auto, run_receiver2
+    from ..link.transport2 import listen_auto
 
     t0 = time.monotonic()
 
@@ -435,16 +439,15 @@ def _rx_auto(args: argparse.Namespace, port: Any, show: Callable[[bytes], None],
                         eof_after=args.idle_eof)
     if heard.protocol == "legacy":
         print("link-rx: the sender speaks the legacy protocol", file=sys.stderr, flush=True)
-        rep: Any = run_receiver(heard.port, receiver=heard.legacy, count=args.count, duration=left(),
-                                on_block=show, stop=stop, eof_after=args.idle_eof, keep_blocks=False)
+        rep: Any = _receive(args, heard.port, "legacy", show, stop, receiver=heard.legacy, count=args.count,
+                            duration=left())
     elif heard.protocol == "v2":
         print("link-rx: the sender speaks link v2", file=sys.stderr, flush=True)
         count = None if args.count is None else args.count - heard.records
         if count is not None and count <= 0:
             rep = SimpleNamespace(stats=heard.v2.stats.as_dict(), ended_by="count", error="")
         else:
-            rep = run_receiver2(heard.port, impl=args.impl, receiver=heard.v2, count=count, duration=left(),
-                                on_record=show, stop=stop, eof_after=args.idle_eof, keep_records=False)
+            rep = _receive(args, heard.port, "v2", show, stop, receiver=heard.v2, count=count, duration=left())
     else:
         rep = SimpleNamespace(stats={"legacy": heard.legacy.stats.as_dict(), "v2": heard.v2.stats.as_dict()},
                               ended_by=heard.ended_by + ", no protocol heard", error=heard.error)

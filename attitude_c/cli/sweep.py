@@ -1,9 +1,12 @@
 """``attitude sweep``: parameter sweeps and Monte Carlo studies on Dask (docs/sweep.md).
 
-Exit codes: 0 every run finished; 1 the sweep finished but some runs raised
-(recorded in the table's ``error`` column); 2 a bad spec or argument; 3 the
-engine is not available (dask/distributed/pandas missing, no scheduler at
-the address); 130 interrupted (rerun the same command to resume).
+Exit codes (docs/cli.md): 0 every run finished; 1 an OS error (the spec
+cannot be read, the output folder or one of its files cannot be written:
+the message names the file), or the sweep finished but some runs raised
+(recorded in the table's ``error`` column); 2 a bad spec or argument (also
+a spec of more runs than ``--max-runs``); 3 the engine is not available
+(dask/distributed/pandas missing, no scheduler at the address); 130
+interrupted (rerun the same command to resume).
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from typing import Any
 from .options import integer
 
 EXIT_RUNS_FAILED = 1
+EXIT_OS = 1  # the convention of every command (docs/cli.md): an OS error is 1
 EXIT_SPEC = 2
 EXIT_ENGINE = 3
 EXIT_INTERRUPTED = 130
@@ -46,8 +50,8 @@ def register(subparsers: Any) -> None:
         "of worker processes by default, an existing cluster with --scheduler -- and write runs.csv "
         "(one row per run: every parameter, every error figure), summary.csv (per grid point: mean "
         "and percentiles over the seeds), one plot per swept parameter and the journal runs.jsonl "
-        "that makes a rerun with the same --out resume. Exit codes: 0 all runs finished, 1 some "
-        "runs raised (recorded), 2 bad spec or argument, 3 engine unavailable, 130 interrupted.",
+        "that makes a rerun with the same --out resume. Exit codes: 0 all runs finished, 1 an OS error "
+        "or some runs raised (recorded), 2 bad spec or argument, 3 engine unavailable, 130 interrupted.",
     )
     p.add_argument("spec", metavar="SPEC", nargs="?", help="the sweep spec (TOML)")
     p.add_argument("--scheduler", metavar="ADDRESS", default=None,
@@ -76,6 +80,9 @@ def register(subparsers: Any) -> None:
                    "(3,17,42; one seed: 7,)")
     g.add_argument("--limit", type=integer("--limit", 1), default=None, metavar="N",
                    help="run only the first N runs of the spec, in its order")
+    g.add_argument("--max-runs", type=integer("--max-runs", 1), default=None, metavar="N",
+                   help="refuse a spec that expands to more than N runs, counted before anything is expanded "
+                   "(default: attitude_c.sim.sweeps.MAX_RUNS, 100000); raise it for a bigger study")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG files")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -120,7 +127,7 @@ def _list_options() -> int:
     print("kind = \"simulate\": options (spec name, command-line option, choices)")
     for name, o in simulate_options().items():
         ch = f"  {{{', '.join(map(str, o.choices))}}}" if o.choices else ""
-        what = {"flag": " (switch: true/false)", "append": " (repeatable: a list of values)"}.get(o.kind, "")
+        what = {"switch": " (switch: true/false)", "repeat": " (repeatable: a list of values)"}.get(o.kind, "")
         print(f"  {name:16s} {o.flag}{what}{ch}")
     print("kind = \"recordings\": estimators")
     for name in sorted(ESTIMATORS):
@@ -142,9 +149,13 @@ def run(args: argparse.Namespace) -> int:
     if args.scheduler and args.workers:
         return fail(prog, "--workers sizes the local cluster: an existing scheduler has its own workers", EXIT_SPEC)
     from ..sim import sweeps
+    from . import os_error_line
 
     try:
-        spec = sweeps.load_spec(args.spec, sets=dict(args.sets or ()), seeds=args.seeds, limit=args.limit)
+        spec = sweeps.load_spec(args.spec, sets=dict(args.sets or ()), seeds=args.seeds, limit=args.limit,
+                                max_runs=args.max_runs or sweeps.MAX_RUNS)
+    except OSError as exc:
+        return fail(prog, os_error_line(exc), EXIT_OS)
     except (AttitudeError, ValueError, TypeError) as exc:
         return fail(prog, f"{args.spec}: {exc}", EXIT_SPEC)
     except ImportError as exc:
@@ -178,8 +189,8 @@ def run(args: argparse.Namespace) -> int:
         return fail(prog, str(exc), EXIT_SPEC)
     except ConnectionError as exc:
         return fail(prog, str(exc), EXIT_ENGINE)
-    except OSError as exc:
-        return fail(prog, f"{exc.filename or out}: {exc.strerror or exc}", EXIT_SPEC)
+    except OSError as exc:  # the sweep names the file (sweeps._named)
+        return fail(prog, os_error_line(exc) if exc.filename else f"{out}: {exc.strerror or exc}", EXIT_OS)
     a = df.attrs
     print(f"ran {a['executed']} run(s), reused {a['reused']}, on {a['engine']} in "
           f"{time.perf_counter() - t0:.1f} s; {a['failed']} failed; wrote {out}/ (runs.csv, summary.csv"

@@ -101,6 +101,12 @@ def register(sub: Any) -> None:
                    "magnetometer data, as BROAD trials do, else the integrator; the page says which runs)")
     g.add_argument("--method", choices=METHODS, default=None,
                    help="integrator method (default rv3; with --estimator auto it asks for the integrator)")
+    from ..ahrs_filter import setting_option
+
+    g.add_argument("--ahrs-setting", type=setting_option("--ahrs-setting"), action="append", default=None,
+                   metavar="NAME=VALUE",
+                   help="a setting of the attitude filter (docs/ahrs.md; as attitude ahrs --set), for --replay of a "
+                   "BROAD trial and --simulate (with --simulate --estimator ahrs); may be repeated")
     p.set_defaults(func=run)
 
 
@@ -116,7 +122,8 @@ def _make_source(args: argparse.Namespace) -> Any:
     if args.stdin:
         return sources.StdinSource(sys.stdin.buffer, "stdin")
     if args.replay is not None:
-        return sources.ReplaySource(args.replay, speed=args.speed, estimator=args.estimator, method=args.method)
+        return sources.ReplaySource(args.replay, speed=args.speed, estimator=args.estimator, method=args.method,
+                                    settings=dict(args.ahrs_setting or ()))
     if args.serial is not None:
         from ..view.sources import DEFAULT_SCALE, DEFAULT_ZERO_CODE
 
@@ -127,7 +134,8 @@ def _make_source(args: argparse.Namespace) -> Any:
                                     scale=args.gyro_scale if args.gyro_scale is not None else DEFAULT_SCALE)
     from ..view.simsource import SimulatorSource, parse_simulate_options
 
-    return SimulatorSource(parse_simulate_options(args.simulate), speed=args.speed)
+    return SimulatorSource(parse_simulate_options(args.simulate, ahrs_settings=dict(args.ahrs_setting or ())),
+                           speed=args.speed)
 
 
 def _usage_problems(args: argparse.Namespace) -> str | None:
@@ -142,6 +150,15 @@ def _usage_problems(args: argparse.Namespace) -> str | None:
     if args.serial is None and args.replay is None and (args.estimator != AUTO or args.method is not None):
         return ("--estimator and --method are for --serial and --replay (with --simulate, give simulate's "
                 "--method after --simulate)")
+    if args.ahrs_setting and args.replay is None and args.simulate is None:
+        return "--ahrs-setting is for --replay and --simulate (the serial link carries no accelerometer)"
+    if args.ahrs_setting:
+        from ..ahrs_filter import check_settings
+
+        try:
+            check_settings(dict(args.ahrs_setting))
+        except (ValueError, TypeError) as exc:
+            return f"--ahrs-setting: {exc}"
     if args.speed != 1.0 and args.replay is None and args.simulate is None:
         return "--speed is for --replay and --simulate"
     if args.serial is not None:

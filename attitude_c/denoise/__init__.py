@@ -29,8 +29,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .._lib import ffi_lib
+from .._validate import C_INT_RANGES, integer, real
 from ..core import _as_real, _check_precision, _ptr, _records, _to_c
-from ..errors import InvalidArgument, InvalidType, NonFiniteError, RangeError, raise_for_status
+from ..errors import InvalidArgument, InvalidType, RangeError
+from ..names import raise_for_status
 
 __all__ = [
     "THRESHOLDS",
@@ -94,12 +96,9 @@ def _choice(value: Any, name: str, allowed: tuple[str, ...]) -> str:
     return value
 
 
-def _count(value: Any, name: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidType(f"{name} must be an int, got {type(value).__name__}")
-    if int(value) < minimum:
-        raise InvalidArgument(f"{name} must be >= {minimum}, got {value}")
-    return int(value)
+def _count(value: Any, name: str, minimum: int, ctype: str = "unsigned long") -> int:
+    """An integer ≥ minimum that fits the C field or argument it goes to (size_t by default)."""
+    return integer(value, name, minimum, C_INT_RANGES[ctype][1], f"C {ctype}")
 
 
 def _c_defaults() -> dict[str, Any]:
@@ -140,7 +139,8 @@ class DenoiseConfig:
         _choice(self.wavelet, "wavelet", WAVELETS)
         _choice(self.threshold, "threshold", THRESHOLDS)
         for name, minimum in (("levels", 1), ("block", 2), ("edge_start", 0), ("edge_end", 0)):
-            object.__setattr__(self, name, _count(getattr(self, name), name, minimum))
+            ctype = "unsigned int" if name == "levels" else "unsigned long"
+            object.__setattr__(self, name, _count(getattr(self, name), name, minimum, ctype))
         if not isinstance(self.detrend, (bool, np.bool_)):
             raise InvalidType(f"detrend must be a bool, got {type(self.detrend).__name__}")
         object.__setattr__(self, "detrend", bool(self.detrend))
@@ -281,12 +281,7 @@ def threshold(c: ArrayLike, value: float, mode: Threshold = "soft", precision: s
 
 
 def _scalar(value: Any, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidType(f"{name} must be a real number, got {type(value).__name__}")
-    v = float(value)
-    if not np.isfinite(v):
-        raise NonFiniteError(f"{name} must be finite, got {v}")
-    return v
+    return real(value, name)
 
 
 def noise_sigma(details: ArrayLike, precision: str = "f64") -> float:

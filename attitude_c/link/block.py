@@ -25,7 +25,8 @@ from dataclasses import dataclass, field
 from typing import Any, Literal, Union
 
 from .._lib import ffi_lib
-from ..errors import BlockFormatError, InvalidArgument, InvalidType, raise_for_status
+from ..errors import BlockFormatError, InvalidArgument, InvalidType
+from ..names import raise_for_status
 
 Kind = Literal["sample", "boot", "selftest", "gave_up", "overrun", "adc_error", "oversample", "channels"]
 #: CHANNELS' board types (``att_block_board``: ATT_BLOCK_BOARD_GYRO3, _AIDED9)

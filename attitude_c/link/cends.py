@@ -7,7 +7,8 @@ from __future__ import annotations
 from typing import Any, Literal
 
 from .._lib import ffi_lib
-from ..errors import InvalidArgument, raise_for_status
+from ..errors import InvalidArgument
+from ..names import raise_for_status
 from .protocol import (
     BLOCK_DEFAULT,
     DEFAULT_ANSWER_TIMEOUT_MS,

@@ -22,7 +22,8 @@ from typing import Any, Literal, Union
 import numpy as np
 
 from .._lib import ffi_lib
-from ..errors import InvalidArgument, InvalidType, raise_for_status
+from ..errors import InvalidArgument, InvalidType
+from ..names import raise_for_status
 from .cends import Impl, make_receiver, make_sender
 from .protocol import (
     BLOCK_MAX,

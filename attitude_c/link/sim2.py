@@ -15,7 +15,8 @@ from __future__ import annotations
 from typing import Literal, Union
 
 from .._lib import ffi_lib
-from ..errors import InvalidArgument, raise_for_status
+from ..errors import InvalidArgument
+from ..names import raise_for_status
 from .sim import Channel, ChannelConfig
 from .v2 import RECORD, Receiver2, Result2, Sender2
 from .v2c import CReceiver2, CSender2, Link2Run

@@ -380,6 +380,59 @@ class ReceiverReport:
     error: str | None = None
 
 
+def serve(port: Any, end: Any, limits: _Limits, count: int | None,
+          on_item: Callable[[bytes], None] | None, keep: list[bytes] | None) -> tuple[str, str]:
+    """The receive loop of both protocols' receivers on a real port: read what came (waiting
+    ``end.wait_s()``), hand it to ``end.feed(data) -> (delivered, answers)``, pass each
+    delivered block or record to ``keep`` and ``on_item`` *before* writing the answers that
+    acknowledge it, until ``limits`` end it, ``end.delivered >= count``, or the port fails.
+    Returns (``ended_by``, the port's error or "")."""
+    try:
+        while True:
+            ended = limits.ended()
+            if ended:
+                return ended, ""
+            data = limits.read(port, end.wait_s())
+            if data is None:
+                return "eof", ""
+            items, out = end.feed(data)
+            for item in items:
+                if keep is not None:
+                    keep.append(item)
+                if on_item is not None:
+                    on_item(item)
+            if out:
+                _write(port, out)
+            if count is not None and end.delivered >= count:
+                return "count", ""
+    except LinkError as exc:
+        return "error", str(exc)
+
+
+class _LegacyEnd:
+    """Receiver B of the paper's protocol for :func:`serve`: millisecond ticks, an answer
+    drained after every byte, one block per acceptance."""
+
+    def __init__(self, rx: Any) -> None:
+        self.rx, self.clock = rx, _Clock()
+
+    @property
+    def delivered(self) -> int:
+        return int(self.rx.stats.blocks_accepted)
+
+    def wait_s(self) -> float:
+        return _wait_s(self.rx.ticks_left(self.clock()))
+
+    def feed(self, data: bytes) -> tuple[list[bytes], bytes]:
+        tick, out, got = self.clock(), bytearray(), []
+        for b in data:
+            if self.rx.sink(b, tick) is Result.ACCEPTED:
+                got.append(self.rx.block)
+            _drain(self.rx, tick, out)  # answer as soon as the byte asks for it
+        _drain(self.rx, tick, out)
+        return got, bytes(out)
+
+
 def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT,
                  gap_timeout_ms: int = DEFAULT_GAP_TIMEOUT_MS, count: int | None = None,
                  duration: float | None = None, on_block: Callable[[bytes], None] | None = None,
@@ -394,38 +447,10 @@ def run_receiver(port: Any, *, impl: Impl = "c", block_size: int = BLOCK_DEFAULT
     ``block_size`` and ``gap_timeout_ms``."""
     rx = receiver if receiver is not None else make_receiver(impl, block_size=block_size,
                                                              gap_timeout=gap_timeout_ms)
-    clock = _Clock()
     rep = ReceiverReport()
-    limits = _Limits(stop, duration, eof_after)
-    try:
-        while True:
-            rep.ended_by = limits.ended()
-            if rep.ended_by:
-                break
-            data = limits.read(port, _wait_s(rx.ticks_left(clock())))
-            if data is None:
-                rep.ended_by = "eof"
-                break
-            tick = clock()
-            out = bytearray()
-            for b in data:
-                if rx.sink(b, tick) is Result.ACCEPTED:
-                    blk = rx.block
-                    if keep_blocks:
-                        rep.blocks.append(blk)
-                    if on_block is not None:
-                        on_block(blk)
-                # answer as soon as the byte asks for it
-                _drain(rx, tick, out)
-            _drain(rx, tick, out)
-            if out:
-                _write(port, bytes(out))
-            if count is not None and rx.stats.blocks_accepted >= count:
-                rep.ended_by = "count"
-                break
-    except LinkError as exc:
-        rep.ended_by = "error"
-        rep.error = str(exc)
+    ended_by, error = serve(port, _LegacyEnd(rx), _Limits(stop, duration, eof_after), count, on_block,
+                            rep.blocks if keep_blocks else None)
+    rep.ended_by, rep.error = ended_by, error or None
     rep.stats = rx.stats.as_dict()
     return rep
 

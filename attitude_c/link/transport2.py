@@ -13,7 +13,7 @@ from typing import Any, Callable, Literal
 import serial
 
 from ..errors import InvalidArgument, LinkError
-from .transport import _Clock, _Limits, _read, _write
+from .transport import _Clock, _Limits, _read, _write, serve
 from .v2 import RECORD, Receiver2, Result2, Sender2
 from .v2c import CReceiver2, CSender2
 
@@ -62,6 +62,28 @@ def _impl(impl: str) -> None:
         raise InvalidArgument(f'impl must be "c" or "python", got {impl!r}')
 
 
+class _V2End:
+    """Receiver B of link v2 for :func:`~attitude_c.link.transport.serve`: the caller's room
+    set before each read, answers drained after every byte, the records a frame delivers."""
+
+    def __init__(self, rx: Any, room: Callable[[], int] | None) -> None:
+        self.rx, self.room, self.delivered = rx, room, 0
+
+    def wait_s(self) -> float:
+        self.rx.set_room(min(0xFFFF, max(0, self.room())) if self.room is not None else 0xFFFF)
+        return 0.01
+
+    def feed(self, data: bytes) -> tuple[list[bytes], bytes]:
+        out, got = bytearray(), []
+        for b in data:
+            if self.rx.sink(b) == Result2.DELIVERED:
+                got.extend(self.rx.delivered)
+            _drain2(self.rx, out)  # answer at once
+        _drain2(self.rx, out)
+        self.delivered += len(got)
+        return got, bytes(out)
+
+
 def run_receiver2(port: Any, *, impl: Impl = "c", count: int | None = None, duration: float | None = None,
                   on_record: Callable[[bytes], None] | None = None, room: Callable[[], int] | None = None,
                   stop: threading.Event | None = None, eof_after: float | None = None,
@@ -73,36 +95,8 @@ def run_receiver2(port: Any, *, impl: Impl = "c", count: int | None = None, dura
     _impl(impl)
     rx: Any = receiver if receiver is not None else (CReceiver2() if impl == "c" else Receiver2())
     rep = Receiver2Report()
-    limits = _Limits(stop, duration, eof_after)
-    n = 0
-    try:
-        while True:
-            rep.ended_by = limits.ended()
-            if rep.ended_by:
-                break
-            rx.set_room(min(0xFFFF, max(0, room())) if room is not None else 0xFFFF)
-            data = limits.read(port, 0.01)
-            if data is None:
-                rep.ended_by = "eof"
-                break
-            out = bytearray()
-            for b in data:
-                if rx.sink(b) == Result2.DELIVERED:
-                    for rec in rx.delivered:
-                        n += 1
-                        if keep_records:
-                            rep.records.append(rec)
-                        if on_record is not None:
-                            on_record(rec)
-                _drain2(rx, out)  # answer at once
-            _drain2(rx, out)
-            if out:
-                _write(port, bytes(out))
-            if count is not None and n >= count:
-                rep.ended_by = "count"
-                break
-    except LinkError as exc:
-        rep.ended_by, rep.error = "error", str(exc)
+    rep.ended_by, rep.error = serve(port, _V2End(rx, room), _Limits(stop, duration, eof_after), count,
+                                    on_record, rep.records if keep_records else None)
     rep.stats = rx.stats.as_dict()
     return rep
 

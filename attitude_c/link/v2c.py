@@ -8,7 +8,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .._lib import ffi_lib
-from ..errors import InvalidArgument, LinkBusy, raise_for_status
+from ..errors import InvalidArgument, LinkBusy
+from ..names import raise_for_status
 from .v2 import (
     DEFAULT_RTO_MS,
     RECORD,

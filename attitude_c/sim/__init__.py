@@ -37,12 +37,8 @@ from .chain import (
     Acquired,
     SimConfig,
     SimResult,
-    Source,
-    SourceOutput,
     acquire,
-    register_source,
     simulate,
-    source,
 )
 from .conditioning import Conditioning
 from .denoising import DENOISE_TIMINGS, Denoise
@@ -52,6 +48,7 @@ from .link import Delivered, Link
 from .outputs import Errors, attitude_angle, compare, wrap_angle
 from .report import format_table, plot_attitude, plot_errors, write_run
 from .sensors import GYRO_PRESETS, Gyro, GyroModel, gyro_preset
+from .sources import Source, SourceOutput, register_source, source
 from .sweeps import load_spec, register_estimator, sweep
 from .trajectory import (
     EARTH,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Callable, Literal, get_args
 
@@ -45,9 +45,10 @@ from .estimator import (
     check_ahrs_settings,
 )
 from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
-from .link import Delivered, Link
+from .link import Link
 from .outputs import compare
 from .sensors import DEG, Gyro, GyroModel, gyro_preset
+from .sources import Source, SourceOutput, register_source, source
 from .trajectory import EARTH, Environment, PaperTrajectory, Trajectory
 
 __all__ = ["PAPER_MAXIMA", "SENSOR_MODES", "Acquired", "SimConfig", "SimResult", "Source", "acquire",
@@ -157,6 +158,19 @@ class SimConfig:
     ahrs_init: Literal["truth", "align"] = "truth"
     board_kind: BoardKind = "gyro3"
     aided: AidedPlan = field(default_factory=AidedPlan)
+
+    @classmethod
+    def from_dict(cls, values: Mapping[str, Any]) -> SimConfig:
+        """The configuration a dict of the simulator's options describes: keys are
+        option names (:data:`attitude_c.sim.options.OPTIONS`, ``cone_angle``; the
+        same as ``attitude simulate --cone-angle``), values as text (``"30,20,25"``)
+        or as Python/TOML values (``[30, 20, 25]``); options not given take their
+        defaults. ValueError/TypeError naming the option for a bad value or options
+        that do not go together (:mod:`attitude_c.sim.configure`). Not validated
+        as a whole: call :meth:`validate` (``simulate`` does)."""
+        from .configure import keywords
+
+        return cls(**keywords(values))
 
     def validate(self) -> None:
         if self.method not in METHODS:
@@ -344,62 +358,6 @@ class SimResult:
     def err_heading(self) -> np.ndarray:
         """Heading = −yaw, so its error is −(yaw error)."""
         return -self.err[:, 0]
-
-
-# ---------------------------------------------------------------------------
-# acquisition sources
-# ---------------------------------------------------------------------------
-
-@dataclass
-class SourceOutput:
-    """What an acquisition source hands the host: the ``delivered`` records, the
-    ``calibration`` to convert them with, the ``backends`` it ran (for the
-    summary) and, when the simulator knows it, the sent stream's record → sample
-    map (``stream_sample``; None: the stream's own numbering is the truth)."""
-
-    delivered: Delivered
-    calibration: Calibration
-    backends: dict[str, Any]
-    stream_sample: np.ndarray | None = None
-    aux: dict[str, AuxStream] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class Source:
-    """An acquisition source that replaces the modeled board (SimConfig.firmware).
-
-    ``acquire(cfg, n, progress)`` delivers the records of n samples;
-    ``check(cfg)`` refuses configurations it cannot run (InvalidArgument);
-    ``trajectory(cfg_period, gyro, conditioning, duration)`` is the motion the
-    source produces (the CLI builds its truth with it); ``description`` says
-    what runs."""
-
-    name: str
-    description: str
-    acquire: Callable[[SimConfig, int, Progress | None], SourceOutput]
-    check: Callable[[SimConfig], None]
-    trajectory: Callable[[float, GyroModel, Conditioning, float], Trajectory]
-
-
-_SOURCES: dict[str, Source] = {}
-
-#: Sources this package knows by name but does not contain: where they come from.
-KNOWN_SOURCES = {"s51": "the AT89S51 firmware in s51 runs from a source checkout: "
-                        "python -m toolchain.simulate --firmware s51 ... (docs/firmware.md)"}
-
-
-def register_source(src: Source) -> None:
-    """Make ``src`` available as ``SimConfig(firmware=src.name)``."""
-    _SOURCES[src.name] = src
-
-
-def source(name: str) -> Source:
-    """The registered source ``name`` (InvalidArgument saying where it comes from if absent)."""
-    try:
-        return _SOURCES[name]
-    except KeyError:
-        hint = KNOWN_SOURCES.get(name, f"registered: {sorted(_SOURCES) or 'none'}")
-        raise InvalidArgument(f"firmware source {name!r} is not available here: {hint}") from None
 
 
 # ---------------------------------------------------------------------------

@@ -3,11 +3,12 @@
 A *spec* (TOML) names a kind of run and the values to run it with:
 
 * ``kind = "simulate"``: one run is one ``attitude simulate`` scenario. Any
-  option of that command can be fixed, gridded or drawn at random: the
-  options are read from the command's own parser
-  (:func:`simulate_options`), so an option added there is sweepable with no
-  change here. Each run's parameters go through that parser and the
-  command's ``build_config``, exactly as on the command line.
+  option of the simulator can be fixed, gridded or drawn at random: the
+  options are the simulator's option table (:mod:`attitude_c.sim.options`,
+  :func:`simulate_options`), which the command's parser is made from, so an
+  option added there is sweepable with no change here. Each run's parameters
+  become its configuration with ``SimConfig.from_dict``, the values checked
+  by the same types as on the command line.
 * ``kind = "recordings"``: one run is one attitude estimator, with one set of
   settings, on one recording (a BROAD trial, :mod:`attitude_c.broad`),
   scored with BROAD's error metric. The estimator is a callable registered
@@ -31,7 +32,7 @@ sweep runs.
 
 from __future__ import annotations
 
-import argparse
+import contextlib
 import hashlib
 import inspect
 import itertools
@@ -52,6 +53,7 @@ import numpy as np
 from .._io import write_with
 from ..core import Method, Precision
 from ..errors import InvalidArgument
+from .options import Option, by_name, parse, parse_value
 
 __all__ = [
     "ESTIMATORS",
@@ -113,82 +115,17 @@ def _toml_loads(text: str) -> dict[str, Any]:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(f"not valid TOML: {exc}") from None
+    except RecursionError:  # tomllib recurses per nesting level: 100,000 brackets are no spec
+        raise SpecError("not valid TOML: arrays or tables nested too deep") from None
 
 
 # ---------------------------------------------------------------------------
-# the simulate option set, read from the command's parser
+# the simulate option set: the simulator's option table
 # ---------------------------------------------------------------------------
 
-class _ParseError(Exception):
-    pass
-
-
-class _RaisingParser(argparse.ArgumentParser):
-    """An ArgumentParser that raises instead of printing usage and exiting."""
-
-    def error(self, message: str) -> Any:  # type: ignore[override]
-        opt = message.partition(": ")[0].removeprefix("argument ")
-        raise _ParseError(message.replace(f"argument {opt}: {opt}: ", f"{opt}: ", 1))  # the validators name it
-
-
-@dataclass(frozen=True)
-class Option:
-    """One sweepable option of ``attitude simulate``."""
-
-    dest: str             #: the parameter name in a spec and in the table (``cone_angle``)
-    flag: str             #: the option on the command line (``--cone-angle``)
-    kind: Literal["value", "flag", "append"]  #: ``flag``: a switch (true/false); ``append``: repeatable
-    choices: tuple[Any, ...] | None
-    help: str
-    unit: str | None = None  #: the value's unit (plot axes), from the option's metavar or help
-
-
-#: argument groups of ``attitude simulate`` that say how a run is shown or stored, not what
-#: runs: not sweepable (the sweep sets the seed itself)
-_CONTROL_GROUPS = ("run",)
-
-
-@lru_cache(maxsize=1)
-def _simulate_parser() -> Any:
-    from ..cli import simulate as cli_simulate
-
-    top = _RaisingParser(prog="attitude")
-    sub = top.add_subparsers(dest="command", parser_class=_RaisingParser)
-    cli_simulate.register(sub)
-    return sub.choices["simulate"]
-
-
-@lru_cache(maxsize=1)
 def _options() -> dict[str, Option]:
-    p = _simulate_parser()
-    control = {id(a) for g in p._action_groups if g.title in _CONTROL_GROUPS for a in g._group_actions}
-    out: dict[str, Option] = {}
-    for a in p._actions:
-        if not a.option_strings or id(a) in control or isinstance(a, argparse._HelpAction):
-            continue
-        flag = max(a.option_strings, key=len)
-        kind: Literal["value", "flag", "append"] = (
-            "flag" if a.nargs == 0 else "append" if isinstance(a, argparse._AppendAction) else "value")
-        out[a.dest] = Option(a.dest, flag, kind, tuple(a.choices) if a.choices else None, a.help or "",
-                             _option_unit(a.metavar, a.help or ""))
-    return out
-
-
-#: Units an option's metavar names (``--period S``), and those its help gives in brackets
-#: (``(deg)``, ``(Hz)``, ``(deg/s; ...)``), as a plot axis writes them.
-_METAVAR_UNITS = {"S": "s", "DEG": "°", "HZ": "Hz", "DEG_S": "°/s", "M_S2": "m/s²"}
-_HELP_UNITS = {"s": "s", "deg": "°", "Hz": "Hz", "deg/s": "°/s", "µT": "µT", "m": "m"}
-
-
-def _option_unit(metavar: Any, help_text: str) -> str | None:
-    """The unit of an option's value: its metavar's, else the one unit its help gives in
-    brackets (None for none, or for several: a triple of mixed units)."""
-    import re
-
-    if isinstance(metavar, str) and metavar in _METAVAR_UNITS:
-        return _METAVAR_UNITS[metavar]
-    found = {_HELP_UNITS[m] for m in re.findall(r"\((s|deg|Hz|deg/s|µT|m)[;,)]", help_text)}
-    return found.pop() if len(found) == 1 else None
+    """The simulator's options a spec can set (the table, :mod:`.options`; the sweep sets the seed)."""
+    return {n: o for n, o in by_name().items() if n not in RESERVED}
 
 
 #: Units of result and setting names by their ending (vectors' ``_0``.. stripped first).
@@ -214,7 +151,8 @@ def _labelled(spec: Spec, name: str) -> str:
 
 
 def simulate_options() -> dict[str, Option]:
-    """The options of ``attitude simulate`` a spec can set, by parameter name."""
+    """The simulator's options a spec can set (those of ``attitude simulate`` but the
+    seed, which the sweep sets, and how a run is kept), by parameter name."""
     return dict(_options())
 
 
@@ -223,6 +161,7 @@ def _option_name(name: str) -> str:
 
 
 def _argv_value(v: Any) -> str:
+    """A value as its command-line text (a table cell)."""
     if isinstance(v, bool):
         return str(v).lower()
     if isinstance(v, float):
@@ -230,31 +169,6 @@ def _argv_value(v: Any) -> str:
     if isinstance(v, (list, tuple)):
         return ",".join(_argv_value(x) for x in v)
     return str(v)
-
-
-def _simulate_argv(params: Mapping[str, Any]) -> list[str]:
-    opts = _options()
-    argv: list[str] = []
-    for k, v in params.items():
-        if k in RESERVED:
-            continue
-        o = opts[k]
-        if o.kind == "flag":
-            if not isinstance(v, bool):
-                raise _ParseError(f"{o.flag} is a switch: give true or false, got {v!r}")
-            if v:
-                argv.append(o.flag)
-        elif o.kind == "append":  # a string (or a list of numbers) is one occurrence; a list of them, several
-            many = isinstance(v, list) and all(isinstance(x, (str, list)) for x in v)
-            argv += [f"{o.flag}={_argv_value(x)}" for x in (v if many else [v])]
-        else:
-            argv.append(f"{o.flag}={_argv_value(v)}")
-    argv += ["--seed", str(int(params.get("seed", 0)))]
-    return argv
-
-
-def _simulate_namespace(params: Mapping[str, Any]) -> Any:
-    return _simulate_parser().parse_args(_simulate_argv(params))
 
 
 def _jsonable(v: Any) -> Any:
@@ -463,13 +377,14 @@ def _table(doc: Mapping[str, Any], name: str) -> dict[str, Any]:
     return t
 
 
-def _check_seeds(seeds_v: Any, where: str) -> list[int]:
-    """A seeds value (a count >= 1 or a list of integers >= 0) as the list of seeds."""
+def _check_seeds(seeds_v: Any, where: str) -> Sequence[int]:
+    """A seeds value (a count >= 1 or a list of integers >= 0) as the seeds (a count:
+    ``range``, so that its size is known before anything is made of it)."""
     if isinstance(seeds_v, bool) or not (isinstance(seeds_v, int) and seeds_v >= 1 or isinstance(seeds_v, list)
                                           and seeds_v and all(isinstance(s, int) and not isinstance(s, bool)
                                                               and 0 <= s < 2**63 for s in seeds_v)):
         raise SpecError(f"{where} must be a count >= 1 or a list of integers >= 0, got {seeds_v!r}")
-    return list(range(seeds_v)) if isinstance(seeds_v, int) else list(seeds_v)
+    return range(seeds_v) if isinstance(seeds_v, int) else list(seeds_v)
 
 
 def _override_note(sets: Mapping[str, Any], seeds: Any, limit: int | None) -> str:
@@ -482,9 +397,15 @@ def _override_note(sets: Mapping[str, Any], seeds: Any, limit: int | None) -> st
     return f"\n# run with: {' '.join(parts)}\n" if parts else ""
 
 
+#: The most runs a spec may expand to (before exclusions), unless the caller allows more
+#: (``load_spec(max_runs=...)``, ``attitude sweep --max-runs``): each run's parameters are
+#: held in memory, about 1.3 KB a run, so the default bounds a spec's expansion by ~130 MB.
+MAX_RUNS = 100_000
+
+
 def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | None = None,
               sets: Mapping[str, Any] | None = None, seeds: int | list[int] | None = None,
-              limit: int | None = None) -> Spec:
+              limit: int | None = None, max_runs: int = MAX_RUNS) -> Spec:
     """Read and expand a spec: a TOML file's path, or the parsed document.
 
     The spec can be cut down without editing it (``attitude sweep --set``,
@@ -494,25 +415,58 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     seeds`` (a count or a list), ``limit`` keeps the first runs in spec order.
     They go through the spec's own checks, errors naming ``--set NAME``.
 
+    The runs are counted before anything is expanded or drawn: a spec of more
+    than ``max_runs`` (cases × grid points × draws × seeds) is refused with the
+    count (``limit`` does not lift it: the whole spec fixes every run's draws).
+
     Raises :class:`SpecError` (one line) for anything that cannot run:
-    unknown keys or options, bad values (checked by the simulate command's
-    own parser and ``SimConfig.validate``), unknown estimators or trials.
+    unknown keys or options, bad values (checked by the simulator's option
+    table and ``SimConfig.validate``), unknown estimators or trials, too many
+    runs; OSError when the spec file cannot be read.
     """
     sets = dict(sets or {})
-    if limit is not None and (isinstance(limit, bool) or not isinstance(limit, int) or limit < 1):
-        raise SpecError(f"--limit must be an integer >= 1, got {limit!r}")
-    source: Path | None = None
+    for what, v in (("--limit", limit), ("max_runs", max_runs)):
+        if v is not None and (isinstance(v, bool) or not isinstance(v, int) or v < 1):
+            raise SpecError(f"{what} must be an integer >= 1, got {v!r}")
+    doc, text, source, base = _read_spec(spec, base)
+    head, kind = _head(doc)
+    name = str(head.get("name") or (source.stem if source else "sweep"))
+    seed_list = _check_seeds(head.get("seeds", 1), "[sweep] seeds") if seeds is None else \
+        _check_seeds(seeds, "--seeds")
+    if text:
+        text += _override_note(sets, seeds, limit)
+    retries, chunk = _retries_chunk(head)
+    parts = _parts(doc, kind, base, sets)
+    if kind == "recordings" and "trial" in parts.pinned:
+        t = parts.pinned.pop("trial")
+        head = {**head, "trials": t if isinstance(t, (str, list)) else str(t)}
+    for k in parts.pinned:  # pinned: off the grid (the draws stay as drawn, so the others' do not change)
+        parts.grid.pop(k, None)
+    data, grid = _recordings(kind, head, base, parts)
+    _check_size(parts, grid, len(seed_list), max_runs)
+    drawn = _drawn(parts)
+    estimators: dict[str, Callable[..., Any]] = {}
+    runs = _expand(kind, parts, grid, drawn, seed_list, estimators)[:limit]
+    random_axes = sorted(k for k in parts.rnd if k not in parts.pinned)
+    over, axes = _axes(kind, head, parts, grid, random_axes, runs, limit)
+    figure = str(head.get("figure", DEFAULT_FIGURE[kind]))
+    return Spec(name=name, kind=kind, runs=runs, axes=[a for a in axes if a not in over], random_axes=random_axes,
+                over=over, figure=figure, text=text, source=source, data=data, retries=retries, chunk=chunk,
+                estimators=estimators)
+
+
+def _read_spec(spec: str | os.PathLike[str] | Mapping[str, Any],
+               base: Path | None) -> tuple[dict[str, Any], str, Path | None, Path]:
+    """(document, its TOML text or "", the file or None, the folder paths are relative to)."""
     if isinstance(spec, Mapping):
-        doc, text = dict(spec), ""
-    else:
-        source = Path(spec)
-        try:
-            text = source.read_text()
-        except OSError as exc:
-            raise SpecError(f"cannot read {str(source)!r}: {exc.strerror or exc}") from None
-        doc = _toml_loads(text)
-        base = base or source.parent
-    base = base or Path.cwd()
+        return dict(spec), "", None, base or Path.cwd()
+    source = Path(spec)
+    text = source.read_text()  # OSError (names the file): an OS error, not a spec error
+    return _toml_loads(text), text, source, base or source.parent
+
+
+def _head(doc: Mapping[str, Any]) -> tuple[dict[str, Any], Kind]:
+    """The [sweep] table, its keys checked, and the spec's kind."""
     unknown = set(doc) - _TOP_KEYS
     if unknown:
         raise SpecError(f"unknown section(s) {sorted(unknown)}; a spec has {sorted(_TOP_KEYS)}")
@@ -523,22 +477,34 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
     kind = head.get("kind", "simulate")
     if kind not in KINDS:
         raise SpecError(f"[sweep] kind must be one of {list(KINDS)}, got {kind!r}")
-    name = str(head.get("name") or (source.stem if source else "sweep"))
-    seed_list = _check_seeds(head.get("seeds", 1), "[sweep] seeds") if seeds is None else \
-        _check_seeds(seeds, "--seeds")
-    if text:
-        text += _override_note(sets, seeds, limit)
+    return head, kind
+
+
+def _retries_chunk(head: Mapping[str, Any]) -> tuple[int, int]:
     retries, chunk = head.get("retries", 2), head.get("chunk", 1)
     for k, v, lo in (("retries", retries, 0), ("chunk", chunk, 1)):
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise SpecError(f"[sweep] {k} must be an integer >= {lo}, got {v!r}")
+    return retries, chunk
 
-    # --- the parameter sets, before expansion -----------------------------------------------
-    fixed = _table(doc, "fixed")
-    grid = _table(doc, "grid")
-    rnd = dict(_table(doc, "random"))
-    cases = doc.get("cases", [{}])
-    excl = doc.get("exclude", [])
+
+@dataclass
+class _Parts:
+    """A spec's parameter sets before expansion (names normalized, values checked alone)."""
+
+    fixed: dict[str, Any]
+    grid: dict[str, list[Any]]
+    rnd: dict[str, Any]
+    cases: list[dict[str, Any]]
+    excl: list[dict[str, Any]]
+    pinned: dict[str, Any]
+    draws: int
+    rseed: int
+
+
+def _parts(doc: Mapping[str, Any], kind: Kind, base: Path, sets: Mapping[str, Any]) -> _Parts:
+    fixed, grid, rnd = _table(doc, "fixed"), _table(doc, "grid"), dict(_table(doc, "random"))
+    cases, excl = doc.get("cases", [{}]), doc.get("exclude", [])
     for nm, v in (("cases", cases), ("exclude", excl)):
         if not (isinstance(v, list) and all(isinstance(x, dict) for x in v)):
             raise SpecError(f"[[{nm}]] must be an array of tables")
@@ -551,93 +517,110 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
         raise SpecError(f"[random] draws must be an integer >= 1, got {draws!r}")
     if isinstance(rseed, bool) or not isinstance(rseed, int) or rseed < 0:
         raise SpecError(f"[random] seed must be an integer >= 0, got {rseed!r}")
-
-    def norm(section: str, d: Mapping[str, Any]) -> dict[str, Any]:
-        out = {}
-        where = "--set" if section == "set" else f"[{section}]"
-        for k, v in d.items():
-            n = _option_name(k)
-            if section == "cases" and n == "label":
-                n, v = "case", str(v)
-            if n == "seed" and section != "exclude":
-                raise SpecError(f"{where} seed: the sweep sets the seed; use [sweep] seeds = N or [list] "
-                                "(or --seeds)")
-            if n == "case" and section not in ("cases", "exclude"):
-                raise SpecError(f"{where} case: reserved for the label of a [[cases]] entry")
-            if kind == "simulate" and n not in _options() and n not in RESERVED:
-                raise SpecError(f"{where} {k}: not an option of attitude simulate (sweepable: "
-                                f"{', '.join(sorted(_options()))})")
-            if n.endswith(("_file", "_path")) and section != "exclude":  # a path: from the spec's folder
-                v = [_path(base, x) for x in v] if section == "grid" and isinstance(v, list) else _path(base, v)
-            out[n] = v
-        return out
-
-    fixed, grid, rnd = norm("fixed", fixed), norm("grid", grid), norm("random", rnd)
-    cases = [norm("cases", c) for c in cases]
-    excl = [norm("exclude", e) for e in excl]
-    pinned = norm("set", sets)
-    clash = set(grid) & set(rnd)
+    parts = _Parts(_norm(kind, base, "fixed", fixed), _norm(kind, base, "grid", grid), _norm(kind, base, "random", rnd),
+                   [_norm(kind, base, "cases", c) for c in cases], [_norm(kind, base, "exclude", e) for e in excl],
+                   _norm(kind, base, "set", sets), draws, rseed)
+    clash = set(parts.grid) & set(parts.rnd)
     if clash:
         raise SpecError(f"parameter(s) {sorted(clash)} both in [grid] and [random]")
-    for k, v in pinned.items() if kind == "simulate" else ():
-        try:  # each value alone, through the command's parser: the error names the key
-            _simulate_namespace({k: v})
-        except _ParseError as exc:
+    for k, v in parts.pinned.items() if kind == "simulate" else ():
+        try:  # each value alone, through the option table: the error names the key
+            parse_value(k, v)
+        except (ValueError, TypeError) as exc:
             raise SpecError(f"--set {k}: {exc}") from None
-    if kind == "recordings" and "trial" in pinned:
-        t = pinned.pop("trial")
-        head = {**head, "trials": t if isinstance(t, (str, list)) else str(t)}
-    for k in pinned:  # pinned: off the grid (the draws stay as drawn, so the others' do not change)
-        grid.pop(k, None)
+    return parts
 
-    drawn: list[dict[str, Any]] = [{}]
-    if rnd:
-        rng = np.random.default_rng(rseed)
-        cols = {k: _draw(k, rnd[k], rng, draws) for k in sorted(rnd)}
-        drawn = [{k: cols[k][i] for k in sorted(rnd)} for i in range(draws)]
-    random_axes = sorted(k for k in rnd if k not in pinned)
 
-    data: Path | None = None
-    trial_files: dict[str, Path] = {}
-    estimators: dict[str, Callable[..., Any]] = {}
-    if kind == "recordings":
-        from .. import broad
+def _norm(kind: Kind, base: Path, section: str, d: Mapping[str, Any]) -> dict[str, Any]:
+    """A section's parameters under their names (``cone-angle`` → ``cone_angle``), paths
+    from the spec's folder; SpecError for a name the kind does not have or reserves."""
+    out = {}
+    where = "--set" if section == "set" else f"[{section}]"
+    for k, v in d.items():
+        n = _option_name(k)
+        if section == "cases" and n == "label":
+            n, v = "case", str(v)
+        if n == "seed" and section != "exclude":
+            raise SpecError(f"{where} seed: the sweep sets the seed; use [sweep] seeds = N or [list] (or --seeds)")
+        if n == "case" and section not in ("cases", "exclude"):
+            raise SpecError(f"{where} case: reserved for the label of a [[cases]] entry")
+        if kind == "simulate" and n not in _options() and n not in RESERVED:
+            raise SpecError(f"{where} {k}: not an option of attitude simulate (sweepable: "
+                            f"{', '.join(sorted(_options()))})")
+        if n.endswith(("_file", "_path")) and section != "exclude":  # a path: from the spec's folder
+            v = [_path(base, x) for x in v] if section == "grid" and isinstance(v, list) else _path(base, v)
+        out[n] = v
+    return out
 
-        d = head.get("data")
-        folder = (base / d) if d else broad.default_dir()
-        if folder is None or not folder.is_dir():
-            raise SpecError(f"[sweep] data: no folder of recordings at {str(folder)!r}")
-        data = folder.resolve()
-        trial_files = _trial_files(data)
-        if not trial_files:
-            raise SpecError(f"[sweep] data: no .mat recordings in {str(data)!r}")
-        trials = head.get("trials", sorted(trial_files))
-        if isinstance(trials, str):
-            trials = [t for t in sorted(trial_files) if Path(t).match(trials)]
-        if not isinstance(trials, list) or not trials:
-            raise SpecError("[sweep] trials: give a list of trial names or a glob matching some")
-        missing = [t for t in trials if t not in trial_files]
-        if missing:
-            raise SpecError(f"[sweep] trials: not in {str(data)!r}: {missing}")
-        if "trial" in grid or "trial" in fixed:
-            raise SpecError("trial: list the recordings in [sweep] trials")
-        grid = {"trial": list(trials), **grid}
-    elif head.get("data") is not None or head.get("trials") is not None:
-        raise SpecError("[sweep] data and trials belong to kind = \"recordings\"")
 
-    # --- expansion: cases × grid × draws × seeds ------------------------------------------
+def _recordings(kind: Kind, head: Mapping[str, Any], base: Path,
+                parts: _Parts) -> tuple[Path | None, dict[str, list[Any]]]:
+    """A recordings spec's folder of trials and the grid with ``trial`` first (the
+    simulate kind: None and the grid as it is)."""
+    if kind != "recordings":
+        if head.get("data") is not None or head.get("trials") is not None:
+            raise SpecError("[sweep] data and trials belong to kind = \"recordings\"")
+        return None, parts.grid
+    from .. import broad
+
+    d = head.get("data")
+    folder = (base / d) if d else broad.default_dir()
+    if folder is None or not folder.is_dir():
+        raise SpecError(f"[sweep] data: no folder of recordings at {str(folder)!r}")
+    data = folder.resolve()
+    trial_files = _trial_files(data)
+    if not trial_files:
+        raise SpecError(f"[sweep] data: no .mat recordings in {str(data)!r}")
+    trials = head.get("trials", sorted(trial_files))
+    if isinstance(trials, str):
+        trials = [t for t in sorted(trial_files) if Path(t).match(trials)]
+    if not isinstance(trials, list) or not trials:
+        raise SpecError("[sweep] trials: give a list of trial names or a glob matching some")
+    missing = [t for t in trials if t not in trial_files]
+    if missing:
+        raise SpecError(f"[sweep] trials: not in {str(data)!r}: {missing}")
+    if "trial" in parts.grid or "trial" in parts.fixed:
+        raise SpecError("trial: list the recordings in [sweep] trials")
+    return data, {"trial": list(trials), **parts.grid}
+
+
+def _check_size(parts: _Parts, grid: Mapping[str, list[Any]], n_seeds: int, max_runs: int) -> None:
+    """Refuse a spec of more than ``max_runs`` runs, counted before anything is expanded."""
+    factors = [(len(parts.cases), "cases"), *((len(v), f"{k} values") for k, v in grid.items()),
+               (max(parts.draws, 1), "draws"), (n_seeds, "seeds")]
+    total = math.prod(n for n, _ in factors)
+    if total > max_runs:
+        how = " × ".join(f"{n:,} {what}" for n, what in factors if n > 1)
+        raise SpecError(f"the spec expands to {total:,} runs ({how}), more than the limit of {max_runs:,}: "
+                        "use fewer seeds, draws or grid values (--seeds, --set), or raise the limit "
+                        "(attitude sweep --max-runs N; load_spec(max_runs=N))")
+
+
+def _drawn(parts: _Parts) -> list[dict[str, Any]]:
+    """The random draws: one dict of drawn values per draw ([{}]: nothing drawn)."""
+    if not parts.rnd:
+        return [{}]
+    rng = np.random.default_rng(parts.rseed)
+    cols = {k: _draw(k, parts.rnd[k], rng, parts.draws) for k in sorted(parts.rnd)}
+    return [{k: cols[k][i] for k in sorted(parts.rnd)} for i in range(parts.draws)]
+
+
+def _expand(kind: Kind, parts: _Parts, grid: Mapping[str, list[Any]], drawn: list[dict[str, Any]],
+            seed_list: Sequence[int], estimators: dict[str, Callable[..., Any]]) -> list[Run]:
+    """cases × grid × draws × seeds, each point checked (:func:`_canonical`), less the
+    excluded and the repeated ones."""
     gkeys = list(grid)
     runs: list[Run] = []
     seen: set[str] = set()
-    for case in cases:
+    for case in parts.cases:
         for combo in itertools.product(*(grid[k] for k in gkeys)):
             for draw in drawn:
                 # a case pins what it names: over the grid and the draws
-                point = {**fixed, **dict(zip(gkeys, combo)), **draw, **case, **pinned}
+                point = {**parts.fixed, **dict(zip(gkeys, combo)), **draw, **case, **parts.pinned}
                 if kind == "recordings":
                     point.setdefault("estimator", "integrator")
                 live = [s for s in seed_list if not any(all({**point, "seed": s}.get(k, _MISSING) == v
-                                                        for k, v in e.items()) for e in excl)]
+                                                        for k, v in e.items()) for e in parts.excl)]
                 if not live:
                     continue
                 canon = _canonical(kind, point, estimators)
@@ -649,21 +632,21 @@ def load_spec(spec: str | os.PathLike[str] | Mapping[str, Any], *, base: Path | 
                         runs.append(Run(key, params))
     if not runs:
         raise SpecError("the spec expands to no run (everything excluded?)")
-    runs = runs[:limit]
+    return runs
 
-    axes = [k for k in gkeys if len({json.dumps(_jsonable(v)) for v in grid[k]}) > 1] + random_axes
-    if len(cases) > 1:
+
+def _axes(kind: Kind, head: Mapping[str, Any], parts: _Parts, grid: Mapping[str, list[Any]],
+          random_axes: list[str], runs: list[Run], limit: int | None) -> tuple[list[str], list[str]]:
+    """(the replicate parameters the summary aggregates over, the swept parameters)."""
+    axes = [k for k in grid if len({json.dumps(_jsonable(v)) for v in grid[k]}) > 1] + random_axes
+    if len(parts.cases) > 1:
         axes.insert(0, "case")
     if limit is not None:  # the axes the runs kept still sweep
         axes = [a for a in axes if len({json.dumps(r.params.get(a)) for r in runs}) > 1]
     over_v = head.get("summary_over", list(DEFAULT_OVER[kind]))
     if not (isinstance(over_v, list) and all(isinstance(x, str) for x in over_v)):
         raise SpecError(f"[sweep] summary_over must be a list of parameter names, got {over_v!r}")
-    over = [_option_name(x) for x in over_v]
-    figure = str(head.get("figure", DEFAULT_FIGURE[kind]))
-    return Spec(name=name, kind=kind, runs=runs, axes=[a for a in axes if a not in over], random_axes=random_axes,
-                over=over, figure=figure, text=text, source=source, data=data, retries=retries, chunk=chunk,
-                estimators=estimators)
+    return [_option_name(x) for x in over_v], axes
 
 
 _MISSING = object()
@@ -672,20 +655,17 @@ _MISSING = object()
 def _canonical(kind: str, point: dict[str, Any], estimators: dict[str, Callable[..., Any]]) -> dict[str, Any]:
     """The run's parameters as the run will see them; SpecError if they cannot run."""
     if kind == "simulate":
-        from ..cli.simulate import build_config
-        from ..errors import AttitudeError
+        from .chain import SimConfig
+        from .configure import build
 
-        try:
-            ns = _simulate_namespace(point)
-        except _ParseError as exc:
-            raise SpecError(f"run {_show(point)}: {exc}") from None
-        try:  # the command's own checks: a combination that cannot run is a spec error
-            build_config(ns).validate()
-        except (AttitudeError, ValueError, TypeError) as exc:
+        try:  # each value alone, then the configuration's own checks: what cannot run is a spec error
+            typed = parse({k: v for k, v in point.items() if k not in RESERVED})
+            SimConfig(**build(typed)).validate()
+        except (ValueError, TypeError) as exc:
             raise SpecError(f"run {_show(point)}: {exc}") from None
         out = {}
         for k, v in point.items():
-            c = v if k == "case" else _jsonable(getattr(ns, k))
+            c = v if k == "case" else _jsonable(typed[k])
             try:  # the parsed value when it has a JSON form, else the spec's own
                 json.dumps(c)
             except (TypeError, ValueError):
@@ -747,10 +727,9 @@ def _flat_figures(summary: Mapping[str, Any]) -> dict[str, float]:
 
 
 def _run_simulate(params: Mapping[str, Any]) -> dict[str, float]:
-    from ..cli.simulate import build_config
-    from .chain import simulate
+    from .chain import SimConfig, simulate
 
-    res = simulate(build_config(_simulate_namespace(params)))
+    res = simulate(SimConfig.from_dict({k: v for k, v in params.items() if k != "case"}))
     return _flat_figures(res.summary)
 
 
@@ -830,23 +809,41 @@ def read_journal(path: Path, *, repair: bool = False) -> dict[str, dict[str, Any
     return done
 
 
+@contextlib.contextmanager
+def _named(path: Path) -> Iterator[None]:
+    """An OSError writing ``path`` names it (a full disk's ENOSPC from a write or an
+    fsync carries no file name, or the temporary one)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.filename is not None and Path(os.fsdecode(exc.filename)).name == path.name:
+            raise
+        raise type(exc)(exc.errno, exc.strerror or str(exc), str(path)) from exc
+
+
 class _Journal:
     def __init__(self, path: Path) -> None:
+        self.path = path
         self.f = open(path, "a", encoding="utf-8")  # noqa: SIM115 - held open for the whole sweep
         self.last_sync = time.monotonic()
 
     def write(self, recs: Iterable[dict[str, Any]]) -> None:
-        for r in recs:
-            self.f.write(json.dumps(r, separators=(",", ":"), allow_nan=True) + "\n")
-        self.f.flush()
-        if time.monotonic() - self.last_sync > 1.0:
-            os.fsync(self.f.fileno())
-            self.last_sync = time.monotonic()
+        with _named(self.path):
+            for r in recs:
+                self.f.write(json.dumps(r, separators=(",", ":"), allow_nan=True) + "\n")
+            self.f.flush()
+            if time.monotonic() - self.last_sync > 1.0:
+                os.fsync(self.f.fileno())
+                self.last_sync = time.monotonic()
 
     def close(self) -> None:
-        self.f.flush()
-        os.fsync(self.f.fileno())
-        self.f.close()
+        try:
+            with _named(self.path):
+                self.f.flush()
+                os.fsync(self.f.fileno())
+        finally:
+            with contextlib.suppress(OSError):
+                self.f.close()
 
 
 class _Lock:
@@ -1061,7 +1058,8 @@ def plot_results(df: Any, spec: Spec, out: Path) -> list[Path]:
 
         def save(p: Path, fig: Any = fig) -> None:
             fig.savefig(p, dpi=100)
-        write_with(path, save)
+        with _named(path):
+            write_with(path, save)
         plt.close(fig)
         files.append(path)
     return files
@@ -1169,7 +1167,8 @@ def sweep(spec: Spec | str | os.PathLike[str] | Mapping[str, Any], client: Any =
 
             def put(p: Path) -> None:
                 p.write_text(text)
-            write_with(folder / "spec.toml", put)
+            with _named(folder / "spec.toml"):
+                write_with(folder / "spec.toml", put)
         return _sweep_locked(sp, folder, client, workers, progress, retry_failed, plots)
     finally:
         lock.release()
@@ -1219,9 +1218,11 @@ def _sweep_locked(sp: Spec, folder: Path, client: Any, workers: int | None,
         bar.close()
 
     df = results_table(sp, records)
-    write_with(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
+    with _named(folder / "runs.csv"):
+        write_with(folder / "runs.csv", lambda p: df.to_csv(p, index=False))
     summ = summarize(df, sp)
-    write_with(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
+    with _named(folder / "summary.csv"):
+        write_with(folder / "summary.csv", lambda p: summ.to_csv(p, index=False))
     files = plot_results(df, sp, folder) if plots else []
     df.attrs.update(plots=[str(f) for f in files])
     df.attrs.update(executed=executed, reused=reused, failed=int((df["error"] != "").sum()), out=str(folder),

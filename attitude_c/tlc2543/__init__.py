@@ -22,14 +22,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .._devmodel import CTwinBase, check_level, convert_in_chunks, raise_model_error
-from ..errors import (
-    DeviceError,
-    DeviceTimeout,
-    InvalidArgument,
-    InvalidType,
-    NonFiniteError,
-    raise_for_status,
-)
+from ..errors import DeviceError, DeviceTimeout, InvalidArgument, InvalidType, NonFiniteError
+from ..names import raise_for_status
 from . import _capi
 from .model import HIGH_Z, RULES, SIGNALS, ProtocolViolation, Timing, Tlc2543Model, quantize
 from .reference import ReferenceDriver

@@ -23,7 +23,7 @@ accelerometer and the magnetometer (a BROAD trial), else the integrator.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -53,7 +53,7 @@ class EstimatorSpec:
     name: str
     summary: str
     needs_acc: bool
-    #: factory(method=..., q0=...) -> Estimator; keywords it does not use are ignored
+    #: factory(method=..., q0=..., rate=..., settings=...) -> Estimator; keywords it does not use are ignored
     make: Callable[..., Estimator]
 
 
@@ -61,7 +61,11 @@ class IntegratorEstimator:
     """The strapdown integrator (:class:`attitude_c.Integrator`): increments
     ``gyr * dt`` for the increment methods, rates with ``dt`` for ``rk4``."""
 
-    def __init__(self, method: core.Method = "rv3", q0: ArrayLike | None = None, **_: Any) -> None:
+    def __init__(self, method: core.Method = "rv3", q0: ArrayLike | None = None,
+                 settings: Mapping[str, Any] | None = None, **_: Any) -> None:
+        if settings:
+            raise InvalidArgument(f"filter settings ({', '.join(settings)}) are for the ahrs estimator, "
+                                  "not the integrator")
         self.integ = core.Integrator(method, q0)
         self.method = method
         self.label = f"integrator {method}"
@@ -77,15 +81,17 @@ class IntegratorEstimator:
 
 
 class AhrsEstimator:
-    """The attitude filter (:class:`attitude_c.Ahrs`, default settings; its own
-    increment method, so ``method`` is not used): one attitude per sample.
+    """The attitude filter (:class:`attitude_c.Ahrs`, the library's default settings
+    but ``settings``: ``attitude view --ahrs-setting``; its own increment method,
+    so ``method`` is not used): one attitude per sample.
     Six-axis for a sample whose field is absent or not finite; a sample whose
     rate or specific force is not finite is skipped (None)."""
 
-    def __init__(self, q0: ArrayLike | None = None, rate: float | None = None, **_: Any) -> None:
+    def __init__(self, q0: ArrayLike | None = None, rate: float | None = None,
+                 settings: Mapping[str, Any] | None = None, **_: Any) -> None:
         from ..ahrs_filter import Ahrs
 
-        self.filter = Ahrs(rate=rate, q0=q0)
+        self.filter = Ahrs(rate=rate, q0=q0, **dict(settings or {}))
         self.label = f"ahrs ({self.filter.settings['method']})"
 
     def update(self, gyr: NDArray[np.float64], dt: float, acc: NDArray[np.float64] | None = None,

@@ -1,7 +1,8 @@
 """The simulator as a source of the display: a thin adapter over
-:mod:`attitude_c.sim`'s public API (``SimConfig``, ``simulate``) and
-``attitude simulate``'s own option parser, so that ``attitude view
---simulate [SIMULATE OPTIONS]`` takes exactly simulate's options.
+:mod:`attitude_c.sim`'s public API (``SimConfig``, ``simulate``) and the
+simulator's option table (:mod:`attitude_c.sim.options`), so that
+``attitude view --simulate [SIMULATE OPTIONS]`` takes exactly the options
+``attitude simulate`` takes for a run.
 
 Everything the view knows of the simulator is in this module: when the
 simulator becomes a pipeline of stages, only this file follows. Today the
@@ -16,45 +17,46 @@ from __future__ import annotations
 import argparse
 import math
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Any
 
 import numpy as np
 
 from ..errors import InvalidArgument
+from ..sim.options import add_arguments, from_namespace
 from .sources import Item, Source, _filter_counters, pace
 from .stream import Hub, row
 
 __all__ = ["SimulatorSource", "parse_simulate_options"]
 
-#: simulate's options that write files or run a budget: not what a display does.
-_NOT_HERE = ("budget", "methods", "budget_ber", "out", "no_plots", "json")
+#: attitude simulate's options that write files or run a budget: not what a display does.
+_NOT_HERE = ("--budget", "--methods", "--budget-ber", "--out", "--no-plots", "--json")
 
 
 def _simulate_parser() -> argparse.ArgumentParser:
-    from ..cli import simulate as sim_cli
-
-    holder = argparse.ArgumentParser(prog="attitude view")
-    sub = holder.add_subparsers()
-    sim_cli.register(sub)
-    p: argparse.ArgumentParser = sub.choices["simulate"]
-    p.prog = "attitude view --simulate"
+    p = argparse.ArgumentParser(prog="attitude view --simulate",
+                                formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+    add_arguments(p)
+    p.add_argument("--no-progress", action="store_true", help="(attitude simulate's; the page shows the progress)")
     return p
 
 
-def parse_simulate_options(argv: Sequence[str]) -> Any:
+def parse_simulate_options(argv: Sequence[str], ahrs_settings: Mapping[str, Any] | None = None) -> Any:
     """``attitude simulate`` options -> the simulator's configuration
-    (``SimConfig``). A bad option exits with simulate's usage message
-    (status 2); one that makes no sense for a display raises InvalidArgument."""
-    from ..cli.simulate import build_config
+    (``SimConfig``); ``ahrs_settings`` (``attitude view --ahrs-setting``) come
+    before those of ``--ahrs-setting`` in ``argv``. A bad option exits with the usage message (status 2);
+    one that makes no sense for a display raises InvalidArgument, options
+    that do not go together ValueError."""
+    from ..sim import SimConfig
+    from ..sim.configure import build
 
-    p = _simulate_parser()
-    args = p.parse_args(list(argv))
-    given = [d for d in _NOT_HERE if getattr(args, d, None) != p.get_default(d)]
+    given = [f for f in _NOT_HERE if any(a == f or a.startswith(f + "=") for a in argv)]
     if given:
-        opts = ", ".join("--" + d.replace("_", "-") for d in given)
-        raise InvalidArgument(f"{opts}: not for the display (attitude simulate writes files and budgets)")
-    return build_config(args)
+        raise InvalidArgument(f"{', '.join(given)}: not for the display (attitude simulate writes files and budgets)")
+    args = _simulate_parser().parse_args(list(argv))
+    if ahrs_settings:
+        args.ahrs_setting = [*ahrs_settings.items(), *(args.ahrs_setting or ())]
+    return SimConfig(**build(from_namespace(args)))
 
 
 class SimulatorSource(Source):

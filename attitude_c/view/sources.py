@@ -21,7 +21,7 @@ import os
 import selectors
 import threading
 import time
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any, Callable, Literal, Union
@@ -574,10 +574,11 @@ class ReplaySource(Source):
     ``estimator="auto"`` (the default) runs the attitude filter when the trial has
     accelerometer and magnetometer data, else the integrator
     (:func:`~attitude_c.view.estimators.choose`); a ``method`` given asks for the
-    integrator (default ``rv3``). The description says which runs, and why."""
+    integrator (default ``rv3``); ``settings``: the attitude filter's settings
+    (``attitude view --ahrs-setting``). The description says which runs, and why."""
 
     def __init__(self, path: str | Path, speed: float = 1.0, estimator: str = AUTO,
-                 method: str | None = None) -> None:
+                 method: str | None = None, settings: Mapping[str, Any] | None = None) -> None:
         super().__init__()
         if not (math.isfinite(speed) and speed > 0):
             raise InvalidArgument(f"speed must be a finite number > 0, got {speed!r}")
@@ -591,8 +592,11 @@ class ReplaySource(Source):
             q0 = trial.quat[int(np.flatnonzero(ok)[0])] if ok.any() else None
             name, why = choose(estimator, has_acc=_has_data(trial.acc), has_mag=_has_data(trial.mag),
                                method_given=method is not None)
-            self.estimator = make_estimator(name, has_acc=True, method=method or "rv3", q0=q0, rate=trial.rate)
+            self.estimator = make_estimator(name, has_acc=True, method=method or "rv3", q0=q0, rate=trial.rate,
+                                            settings=settings)
             what = f"BROAD trial, {self.estimator.label}" + (f"; {why}" if why else "")
+        elif settings:
+            raise InvalidArgument(f"filter settings: {self.rec.name} runs through no filter (a BROAD trial does)")
         self.description = f"replay of {self.rec.name} ({what}) at {speed:g}x"
 
     def run(self, hub: Hub) -> None:

@@ -42,18 +42,7 @@
 #include <string.h>
 
 #include "attitude/block.h"
-
-static void check(int cond)
-{
-    if (!cond) {
-        abort();
-    }
-}
-
-static uint16_t be16(const uint8_t *p)
-{
-    return (uint16_t)((uint16_t)p[0] << 8 | p[1]);
-}
+#include "fuzz_harness.h"
 
 static int8_t s8(uint8_t b)
 {
@@ -99,27 +88,28 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
     int e;
     memset(&zero, 0, sizeof zero);
     if (raw[0] != (uint8_t)ATT_BLOCK_MARK) {
-        int big = be16(raw) > ATT_BLOCK_CODE_MAX || be16(raw + 2) > ATT_BLOCK_CODE_MAX
-                  || be16(raw + 4) > ATT_BLOCK_CODE_MAX;
-        check(b->kind == (uint16_t)ATT_BLOCK_SAMPLE && st == (big ? ATT_BLOCK_E_CODE : ATT_OK));
-        check(b->code[0] == be16(raw) && b->code[1] == be16(raw + 2) && b->code[2] == be16(raw + 4));
+        int big = fuzz_be16(raw) > ATT_BLOCK_CODE_MAX || fuzz_be16(raw + 2) > ATT_BLOCK_CODE_MAX
+                  || fuzz_be16(raw + 4) > ATT_BLOCK_CODE_MAX;
+        FUZZ_CHECK(b->kind == (uint16_t)ATT_BLOCK_SAMPLE && st == (big ? ATT_BLOCK_E_CODE : ATT_OK));
+        FUZZ_CHECK(b->code[0] == fuzz_be16(raw) && b->code[1] == fuzz_be16(raw + 2)
+                   && b->code[2] == fuzz_be16(raw + 4));
         zero.kind = b->kind;
         memcpy(zero.code, b->code, sizeof zero.code);
-        check(memcmp(&zero, b, sizeof zero) == 0); /* nothing else set */
+        FUZZ_CHECK(memcmp(&zero, b, sizeof zero) == 0); /* nothing else set */
         e = att_block_encode_sample(enc, b->code);
-        check(e == st && (st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0));
+        FUZZ_CHECK(e == st && (st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0));
         return;
     }
-    check(b->kind == raw[1]);
+    FUZZ_CHECK(b->kind == raw[1]);
     zero.kind = b->kind;
     switch (raw[1]) {
     case ATT_BLOCK_BOOT:
-        check(b->version == raw[2] && b->period_ticks == (be16(raw + 3) & 0x7FFFu) && b->baud_div == raw[5]
-              && b->link == ((raw[3] & 0x80u) ? 2 : 0));
-        check(st
-              == ((raw[2] == ATT_BLOCK_VERSION && (be16(raw + 3) & 0x7FFFu) >= 1 && raw[5] != 0)
-                      ? ATT_OK
-                      : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(b->version == raw[2] && b->period_ticks == (fuzz_be16(raw + 3) & 0x7FFFu)
+                   && b->baud_div == raw[5] && b->link == ((raw[3] & 0x80u) ? 2 : 0));
+        FUZZ_CHECK(st
+                   == ((raw[2] == ATT_BLOCK_VERSION && (fuzz_be16(raw + 3) & 0x7FFFu) >= 1 && raw[5] != 0)
+                           ? ATT_OK
+                           : ATT_BLOCK_E_FIELD));
         zero.version = b->version;
         zero.period_ticks = b->period_ticks;
         zero.baud_div = b->baud_div;
@@ -127,41 +117,42 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
         e = att_block_encode_boot(enc, (uint16_t)(b->period_ticks | (b->link ? ATT_BLOCK_BOOT_LINK2 : 0)),
                                   b->baud_div);
         if (b->version == ATT_BLOCK_VERSION) { /* the encoder writes no other version */
-            check(e == st);
+            FUZZ_CHECK(e == st);
         }
         break;
     case ATT_BLOCK_SELFTEST:
-        check(b->status == s8(raw[2]) && b->bad_code == be16(raw + 3) && b->attempt == raw[5]);
-        check(st == (s8(raw[2]) < 0 && be16(raw + 3) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(b->status == s8(raw[2]) && b->bad_code == fuzz_be16(raw + 3) && b->attempt == raw[5]);
+        FUZZ_CHECK(
+            st == (s8(raw[2]) < 0 && fuzz_be16(raw + 3) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
         zero.status = b->status;
         zero.bad_code = b->bad_code;
         zero.attempt = b->attempt;
         e = att_block_encode_selftest(enc, b->status, b->bad_code, b->attempt);
-        check(e == st);
+        FUZZ_CHECK(e == st);
         break;
     case ATT_BLOCK_GAVE_UP:
     case ATT_BLOCK_OVERRUN:
-        check(b->first == be16(raw + 2) && b->count == be16(raw + 4));
-        check(st == (b->count != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(b->first == fuzz_be16(raw + 2) && b->count == fuzz_be16(raw + 4));
+        FUZZ_CHECK(st == (b->count != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
         zero.first = b->first;
         zero.count = b->count;
         e = att_block_encode_loss(enc, raw[1], b->first, b->count);
-        check(e == st);
+        FUZZ_CHECK(e == st);
         break;
     case ATT_BLOCK_ADC_ERROR:
-        check(b->first == be16(raw + 2) && b->count == 1 && b->status == s8(raw[4]));
-        check(st == (s8(raw[4]) < 0 && raw[5] == 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(b->first == fuzz_be16(raw + 2) && b->count == 1 && b->status == s8(raw[4]));
+        FUZZ_CHECK(st == (s8(raw[4]) < 0 && raw[5] == 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
         zero.first = b->first;
         zero.count = 1;
         zero.status = b->status;
         e = att_block_encode_adc_error(enc, b->first, b->status);
         if (raw[5] == 0) { /* the encoder always writes 0 there */
-            check(e == st);
+            FUZZ_CHECK(e == st);
         }
         break;
     case ATT_BLOCK_OVERSAMPLE:
-        check(b->oversample == raw[2]);
-        check(
+        FUZZ_CHECK(b->oversample == raw[2]);
+        FUZZ_CHECK(
             st
             == (raw[2] >= 1 && raw[2] <= ATT_BLOCK_OVERSAMPLE_MAX && raw[3] == 0 && raw[4] == 0 && raw[5] == 0
                     ? ATT_OK
@@ -169,26 +160,26 @@ static void check_decoded(const uint8_t *raw, const att_block *b, int st)
         zero.oversample = b->oversample;
         e = att_block_encode_oversample(enc, b->oversample);
         if (raw[3] == 0 && raw[4] == 0 && raw[5] == 0) { /* the encoder always writes 0 there */
-            check(e == st);
+            FUZZ_CHECK(e == st);
         }
         break;
     case ATT_BLOCK_CHANNELS:
-        check(b->board == raw[2] && b->channels == raw[3] && b->acc_every == raw[4]
-              && b->mag_every == raw[5]);
-        check(st == (channels_valid(raw[2], raw[3], raw[4], raw[5]) ? ATT_OK : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(b->board == raw[2] && b->channels == raw[3] && b->acc_every == raw[4]
+                   && b->mag_every == raw[5]);
+        FUZZ_CHECK(st == (channels_valid(raw[2], raw[3], raw[4], raw[5]) ? ATT_OK : ATT_BLOCK_E_FIELD));
         zero.board = b->board;
         zero.channels = b->channels;
         zero.acc_every = b->acc_every;
         zero.mag_every = b->mag_every;
         e = att_block_encode_channels(enc, b->board, b->channels, b->acc_every, b->mag_every);
-        check(e == st);
+        FUZZ_CHECK(e == st);
         break;
     default:
-        check(st == ATT_BLOCK_E_KIND);
+        FUZZ_CHECK(st == ATT_BLOCK_E_KIND);
         return;
     }
-    check(memcmp(&zero, b, sizeof zero) == 0); /* the fields a kind does not use are 0 */
-    check(st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0);
+    FUZZ_CHECK(memcmp(&zero, b, sizeof zero) == 0); /* the fields a kind does not use are 0 */
+    FUZZ_CHECK(st != ATT_OK || memcmp(enc, raw, sizeof enc) == 0);
 }
 
 /* A sample record fed to the tracker: its place in the numbering and its group. */
@@ -196,15 +187,15 @@ static void check_sample(const att_block_seq *before, const att_block_seq *s, co
                          int st)
 {
     int inside = before->next > 0 && (before->part == 1 || before->part == 2);
-    check(st == ATT_OK && sp->count == 1 && sp->slip == 0 && s->synced == before->synced);
+    FUZZ_CHECK(st == ATT_OK && sp->count == 1 && sp->slip == 0 && s->synced == before->synced);
     if (inside) {
-        check(sp->first == before->next - 1 && sp->part == before->part && s->next == before->next);
+        FUZZ_CHECK(sp->first == before->next - 1 && sp->part == before->part && s->next == before->next);
     } else {
-        check(sp->first == before->next && sp->part == 0 && s->next == before->next + 1);
+        FUZZ_CHECK(sp->first == before->next && sp->part == 0 && s->next == before->next + 1);
     }
-    check(s->part == part_after(before, sp->first, sp->part));
-    check(s->oversample == before->oversample && s->channels == before->channels
-          && s->acc_every == before->acc_every && s->mag_every == before->mag_every);
+    FUZZ_CHECK(s->part == part_after(before, sp->first, sp->part));
+    FUZZ_CHECK(s->oversample == before->oversample && s->channels == before->channels
+               && s->acc_every == before->acc_every && s->mag_every == before->mag_every);
 }
 
 /* A loss report (count >= 1) placed by the tracker: adopted, or its slip. */
@@ -214,21 +205,21 @@ static void check_loss(const att_block_seq *before, const att_block_seq *s, cons
     int32_t d;
     uint16_t u;
     if (!before->synced) { /* adopted as it is */
-        check(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp->first == b->first && sp->count == b->count
-              && sp->slip == 0);
-        check(s->synced && s->next == (uint32_t)b->first + b->count);
+        FUZZ_CHECK(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp->first == b->first && sp->count == b->count
+                   && sp->slip == 0);
+        FUZZ_CHECK(s->synced && s->next == (uint32_t)b->first + b->count);
         return;
     }
     u = (uint16_t)(b->first - (uint16_t)before->next);
     d = u < 0x8000u ? (int32_t)u : (int32_t)u - 65536;
-    check(sp->slip == d && st == (d == 0 && !cut ? ATT_OK : ATT_BLOCK_E_SEQ));
+    FUZZ_CHECK(sp->slip == d && st == (d == 0 && !cut ? ATT_OK : ATT_BLOCK_E_SEQ));
     if (d >= 0) {
-        check(sp->first == before->next && sp->count == (uint32_t)d + b->count);
+        FUZZ_CHECK(sp->first == before->next && sp->count == (uint32_t)d + b->count);
     } else {
-        check(sp->first == ((uint32_t)-d > before->next ? 0u : before->next - (uint32_t)-d)
-              && sp->count == b->count);
+        FUZZ_CHECK(sp->first == ((uint32_t)-d > before->next ? 0u : before->next - (uint32_t)-d)
+                   && sp->count == b->count);
     }
-    check(s->next == sp->first + sp->count && s->synced);
+    FUZZ_CHECK(s->next == sp->first + sp->count && s->synced);
 }
 
 /* Feed b to the tracker and check the span against the contract. */
@@ -244,9 +235,9 @@ static void check_seq(att_block_seq *s, const att_block *b)
         return;
     }
     if (b->kind == ATT_BLOCK_BOOT) {
-        check(st == ATT_OK && sp.first == 0 && sp.count == 0 && sp.part == 0 && s->next == 0 && s->synced
-              && s->oversample == 1 && s->channels == 1 && s->acc_every == 0 && s->mag_every == 0
-              && s->part == 0);
+        FUZZ_CHECK(st == ATT_OK && sp.first == 0 && sp.count == 0 && sp.part == 0 && s->next == 0 && s->synced
+                   && s->oversample == 1 && s->channels == 1 && s->acc_every == 0 && s->mag_every == 0
+                   && s->part == 0);
         return;
     }
     valid = b->kind == ATT_BLOCK_SELFTEST
@@ -257,24 +248,25 @@ static void check_seq(att_block_seq *s, const att_block *b)
             || (is_loss(b->kind) && b->count != 0);
     if (!valid) { /* rejected: nothing changes */
         int known = is_loss(b->kind) || b->kind == ATT_BLOCK_OVERSAMPLE || b->kind == ATT_BLOCK_CHANNELS;
-        check(st == (known ? ATT_BLOCK_E_FIELD : ATT_BLOCK_E_KIND) && same_stream(s, &before));
+        FUZZ_CHECK(st == (known ? ATT_BLOCK_E_FIELD : ATT_BLOCK_E_KIND) && same_stream(s, &before));
         return;
     }
     /* placed: a group it interrupts is closed, span.part names the record that was due */
-    check(s->part == 0 && sp.part == (cut ? before.part : 0));
-    check(s->oversample == (b->kind == ATT_BLOCK_OVERSAMPLE ? b->oversample : before.oversample));
+    FUZZ_CHECK(s->part == 0 && sp.part == (cut ? before.part : 0));
+    FUZZ_CHECK(s->oversample == (b->kind == ATT_BLOCK_OVERSAMPLE ? b->oversample : before.oversample));
     if (b->kind == ATT_BLOCK_CHANNELS) {
-        check(s->channels == b->channels && s->acc_every == b->acc_every && s->mag_every == b->mag_every);
+        FUZZ_CHECK(s->channels == b->channels && s->acc_every == b->acc_every
+                   && s->mag_every == b->mag_every);
     } else {
-        check(s->channels == before.channels && s->acc_every == before.acc_every
-              && s->mag_every == before.mag_every);
+        FUZZ_CHECK(s->channels == before.channels && s->acc_every == before.acc_every
+                   && s->mag_every == before.mag_every);
     }
     if (is_loss(b->kind)) {
         check_loss(&before, s, &sp, b, cut, st);
         return;
     }
-    check(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp.first == before.next && sp.count == 0 && sp.slip == 0
-          && s->next == before.next && s->synced == before.synced);
+    FUZZ_CHECK(st == (cut ? ATT_BLOCK_E_SEQ : ATT_OK) && sp.first == before.next && sp.count == 0
+               && sp.slip == 0 && s->next == before.next && s->synced == before.synced);
 }
 
 /* An encoder with arguments from p: ATT_OK exactly in range, and its record decodes back. */
@@ -286,64 +278,65 @@ static void check_encode(uint8_t which, const uint8_t *p)
     switch (which % 8) {
     case 0: {
         uint16_t codes[3];
-        codes[0] = (uint16_t)(be16(p) & 0x1FFF); /* mostly in range, sometimes not */
-        codes[1] = (uint16_t)(be16(p + 2) & 0x1FFF);
-        codes[2] = (uint16_t)(be16(p + 4) & 0x1FFF);
+        codes[0] = (uint16_t)(fuzz_be16(p) & 0x1FFF); /* mostly in range, sometimes not */
+        codes[1] = (uint16_t)(fuzz_be16(p + 2) & 0x1FFF);
+        codes[2] = (uint16_t)(fuzz_be16(p + 4) & 0x1FFF);
         want = codes[0] > ATT_BLOCK_CODE_MAX || codes[1] > ATT_BLOCK_CODE_MAX || codes[2] > ATT_BLOCK_CODE_MAX
                    ? ATT_BLOCK_E_CODE
                    : ATT_OK;
         e = att_block_encode_sample(enc, codes);
-        check(e == want);
+        FUZZ_CHECK(e == want);
         if (e == ATT_OK) {
             d = att_block_decode(enc, &b);
-            check(d == ATT_OK && b.kind == (uint16_t)ATT_BLOCK_SAMPLE
-                  && memcmp(b.code, codes, sizeof codes) == 0);
+            FUZZ_CHECK(d == ATT_OK && b.kind == (uint16_t)ATT_BLOCK_SAMPLE
+                       && memcmp(b.code, codes, sizeof codes) == 0);
         }
         { /* in place, as the firmware does: the codes' memory is the block */
             uint16_t words[3];
             memcpy(words, codes, sizeof codes);
-            check(att_block_encode_sample((uint8_t *)words, words) == want);
+            FUZZ_CHECK(att_block_encode_sample((uint8_t *)words, words) == want);
             if (want == ATT_OK) {
-                check(att_block_decode((const uint8_t *)words, &b) == ATT_OK
-                      && memcmp(b.code, codes, sizeof codes) == 0);
+                FUZZ_CHECK(att_block_decode((const uint8_t *)words, &b) == ATT_OK
+                           && memcmp(b.code, codes, sizeof codes) == 0);
             }
         }
         return;
     }
     case 1:
-        e = att_block_encode_boot(enc, be16(p), p[2]);
-        check(e == ((be16(p) & 0x7FFFu) >= 1 && p[2] != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        e = att_block_encode_boot(enc, fuzz_be16(p), p[2]);
+        FUZZ_CHECK(e == ((fuzz_be16(p) & 0x7FFFu) >= 1 && p[2] != 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_BOOT
-                  && b.period_ticks == (be16(p) & 0x7FFFu) && b.link == ((p[0] & 0x80u) ? 2 : 0)
-                  && b.baud_div == p[2] && b.version == ATT_BLOCK_VERSION);
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_BOOT
+                       && b.period_ticks == (fuzz_be16(p) & 0x7FFFu) && b.link == ((p[0] & 0x80u) ? 2 : 0)
+                       && b.baud_div == p[2] && b.version == ATT_BLOCK_VERSION);
         }
         return;
     case 2:
-        e = att_block_encode_selftest(enc, s8(p[0]), be16(p + 1), p[3]);
-        check(e == (s8(p[0]) < 0 && be16(p + 1) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        e = att_block_encode_selftest(enc, s8(p[0]), fuzz_be16(p + 1), p[3]);
+        FUZZ_CHECK(e
+                   == (s8(p[0]) < 0 && fuzz_be16(p + 1) <= ATT_BLOCK_CODE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_SELFTEST && b.status == s8(p[0])
-                  && b.bad_code == be16(p + 1) && b.attempt == p[3]);
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_SELFTEST
+                       && b.status == s8(p[0]) && b.bad_code == fuzz_be16(p + 1) && b.attempt == p[3]);
         }
         return;
     case 3:
-        e = att_block_encode_loss(enc, p[0] % 6, be16(p + 1), be16(p + 3));
+        e = att_block_encode_loss(enc, p[0] % 6, fuzz_be16(p + 1), fuzz_be16(p + 3));
         want = p[0] % 6 != ATT_BLOCK_GAVE_UP && p[0] % 6 != ATT_BLOCK_OVERRUN ? ATT_BLOCK_E_KIND
-               : be16(p + 3) == 0                                             ? ATT_BLOCK_E_FIELD
+               : fuzz_be16(p + 3) == 0                                        ? ATT_BLOCK_E_FIELD
                                                                               : ATT_OK;
-        check(e == want);
+        FUZZ_CHECK(e == want);
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == p[0] % 6 && b.first == be16(p + 1)
-                  && b.count == be16(p + 3));
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == p[0] % 6
+                       && b.first == fuzz_be16(p + 1) && b.count == fuzz_be16(p + 3));
         }
         return;
     case 5:
         e = att_block_encode_oversample(enc, p[0]);
-        check(e == (p[0] >= 1 && p[0] <= ATT_BLOCK_OVERSAMPLE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(e == (p[0] >= 1 && p[0] <= ATT_BLOCK_OVERSAMPLE_MAX ? ATT_OK : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_OVERSAMPLE
-                  && b.oversample == p[0]);
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_OVERSAMPLE
+                       && b.oversample == p[0]);
         }
         return;
     case 6: {
@@ -356,24 +349,25 @@ static void check_encode(uint8_t which, const uint8_t *p)
         if (lim > ATT_BLOCK_SUM_MAX) {
             lim = ATT_BLOCK_SUM_MAX;
         }
-        sums[0] = be16(p + 1);
-        sums[1] = (uint16_t)(be16(p + 3) >> (p[0] & 3)); /* smaller words too */
+        sums[0] = fuzz_be16(p + 1);
+        sums[1] = (uint16_t)(fuzz_be16(p + 3) >> (p[0] & 3)); /* smaller words too */
         sums[2] = (uint16_t)((uint16_t)p[5] << (p[0] & 7));
         want = n < 1 || n > ATT_BLOCK_OVERSAMPLE_MAX             ? ATT_BLOCK_E_FIELD
                : sums[0] > lim || sums[1] > lim || sums[2] > lim ? ATT_BLOCK_E_CODE
                                                                  : ATT_OK;
         e = att_block_encode_sums(enc, sums, n);
-        check(e == want);
+        FUZZ_CHECK(e == want);
         if (e == ATT_OK) { /* decoded in its stream: after BOOT and OVERSAMPLE n */
             att_block_seq_init(&s);
-            check(att_block_encode_boot(ov, 72, 8) == ATT_OK
-                  && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
-            check(att_block_encode_oversample(ov, n) == ATT_OK
-                  && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
-            check(att_block_seq_decode(&s, enc, &b, &sp) == ATT_OK && b.kind == (uint16_t)ATT_BLOCK_SAMPLE
-                  && memcmp(b.code, sums, sizeof sums) == 0 && sp.first == 0 && sp.count == 1);
+            FUZZ_CHECK(att_block_encode_boot(ov, 72, 8) == ATT_OK
+                       && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
+            FUZZ_CHECK(att_block_encode_oversample(ov, n) == ATT_OK
+                       && att_block_seq_decode(&s, ov, &b, &sp) == ATT_OK);
+            FUZZ_CHECK(att_block_seq_decode(&s, enc, &b, &sp) == ATT_OK
+                       && b.kind == (uint16_t)ATT_BLOCK_SAMPLE && memcmp(b.code, sums, sizeof sums) == 0
+                       && sp.first == 0 && sp.count == 1);
             if (n == 1) { /* n = 1 gives att_block_encode_sample's bytes */
-                check(att_block_encode_sample(ov, sums) == ATT_OK && memcmp(ov, enc, sizeof ov) == 0);
+                FUZZ_CHECK(att_block_encode_sample(ov, sums) == ATT_OK && memcmp(ov, enc, sizeof ov) == 0);
             }
         }
         return;
@@ -382,22 +376,23 @@ static void check_encode(uint8_t which, const uint8_t *p)
         e = att_block_encode_channels(enc, (uint8_t)(p[0] & 3), (uint8_t)(p[1] & 15),
                                       (uint8_t)(p[2] >> (p[4] & 7)),
                                       (uint8_t)(p[3] >> (p[5] & 7))); /* small values, 0s: mostly in range */
-        check(e
-              == (channels_valid(p[0] & 3u, p[1] & 15u, (uint8_t)(p[2] >> (p[4] & 7)),
-                                 (uint8_t)(p[3] >> (p[5] & 7)))
-                      ? ATT_OK
-                      : ATT_BLOCK_E_FIELD));
+        FUZZ_CHECK(e
+                   == (channels_valid(p[0] & 3u, p[1] & 15u, (uint8_t)(p[2] >> (p[4] & 7)),
+                                      (uint8_t)(p[3] >> (p[5] & 7)))
+                           ? ATT_OK
+                           : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_CHANNELS && b.board == (p[0] & 3)
-                  && b.channels == (p[1] & 15) && b.acc_every == enc[4] && b.mag_every == enc[5]);
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_CHANNELS
+                       && b.board == (p[0] & 3) && b.channels == (p[1] & 15) && b.acc_every == enc[4]
+                       && b.mag_every == enc[5]);
         }
         return;
     default:
-        e = att_block_encode_adc_error(enc, be16(p), s8(p[2]));
-        check(e == (s8(p[2]) < 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
+        e = att_block_encode_adc_error(enc, fuzz_be16(p), s8(p[2]));
+        FUZZ_CHECK(e == (s8(p[2]) < 0 ? ATT_OK : ATT_BLOCK_E_FIELD));
         if (e == ATT_OK) {
-            check(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_ADC_ERROR && b.first == be16(p)
-                  && b.count == 1 && b.status == s8(p[2]));
+            FUZZ_CHECK(att_block_decode(enc, &b) == ATT_OK && b.kind == ATT_BLOCK_ADC_ERROR
+                       && b.first == fuzz_be16(p) && b.count == 1 && b.status == s8(p[2]));
         }
         return;
     }
@@ -412,17 +407,18 @@ static void misuse(void)
     att_block_span sp;
     att_block_seq_init(NULL);
     att_block_seq_init(&s);
-    check(att_block_decode(NULL, &b) == ATT_E_NULL && att_block_decode(raw, NULL) == ATT_E_NULL);
-    check(att_block_decode(raw, &b) == ATT_OK);
-    check(att_block_seq_feed(NULL, &b, &sp) == ATT_E_NULL && att_block_seq_feed(&s, NULL, &sp) == ATT_E_NULL
-          && att_block_seq_feed(&s, &b, NULL) == ATT_E_NULL);
-    check(att_block_encode_sample(NULL, codes) == ATT_E_NULL
-          && att_block_encode_sample(raw, NULL) == ATT_E_NULL);
-    check(att_block_encode_boot(NULL, 72, 8) == ATT_E_NULL
-          && att_block_encode_selftest(NULL, -1, 0, 1) == ATT_E_NULL);
-    check(att_block_encode_loss(NULL, ATT_BLOCK_GAVE_UP, 0, 1) == ATT_E_NULL);
-    check(att_block_encode_adc_error(NULL, 0, -1) == ATT_E_NULL);
-    check(att_block_encode_channels(NULL, ATT_BLOCK_BOARD_AIDED9, 7, 1, 1) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_decode(NULL, &b) == ATT_E_NULL && att_block_decode(raw, NULL) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_decode(raw, &b) == ATT_OK);
+    FUZZ_CHECK(att_block_seq_feed(NULL, &b, &sp) == ATT_E_NULL
+               && att_block_seq_feed(&s, NULL, &sp) == ATT_E_NULL
+               && att_block_seq_feed(&s, &b, NULL) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_encode_sample(NULL, codes) == ATT_E_NULL
+               && att_block_encode_sample(raw, NULL) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_encode_boot(NULL, 72, 8) == ATT_E_NULL
+               && att_block_encode_selftest(NULL, -1, 0, 1) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_encode_loss(NULL, ATT_BLOCK_GAVE_UP, 0, 1) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_encode_adc_error(NULL, 0, -1) == ATT_E_NULL);
+    FUZZ_CHECK(att_block_encode_channels(NULL, ATT_BLOCK_BOARD_AIDED9, 7, 1, 1) == ATT_E_NULL);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
@@ -433,7 +429,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         misuse();
     }
     att_block_seq_init(&seq);
-    check(seq.next == 0 && seq.synced == 0);
+    FUZZ_CHECK(seq.next == 0 && seq.synced == 0);
     for (i = 0; i + 7 <= size; i += 7) {
         const uint8_t *raw = data + i + 1;
         if ((data[i] & 1) == 0) {
@@ -450,16 +446,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             }
             if (b.kind == (uint16_t)ATT_BLOCK_SAMPLE) {
                 int big = b.code[0] > lim || b.code[1] > lim || b.code[2] > lim;
-                check(memcmp(b2.code, b.code, sizeof b.code) == 0 && b2.kind == b.kind);
-                check(st2 == (big ? ATT_BLOCK_E_CODE : ATT_OK) && sp2.first + 1 == seq2.next
-                      && sp2.count == 1);
+                FUZZ_CHECK(memcmp(b2.code, b.code, sizeof b.code) == 0 && b2.kind == b.kind);
+                FUZZ_CHECK(st2 == (big ? ATT_BLOCK_E_CODE : ATT_OK) && sp2.first + 1 == seq2.next
+                           && sp2.count == 1);
                 b.kind = (uint16_t)ATT_BLOCK_SAMPLE; /* feed it as a sample, as seq_decode did */
             } else if (st == ATT_BLOCK_E_KIND || st == ATT_BLOCK_E_FIELD) {
-                check(st2 == st && same_stream(&seq2, &seq)); /* not placed */
+                FUZZ_CHECK(st2 == st && same_stream(&seq2, &seq)); /* not placed */
             }
             check_seq(&seq, &b);
             if (st == ATT_OK || b.kind == (uint16_t)ATT_BLOCK_SAMPLE) {
-                check(same_stream(&seq2, &seq)); /* the same placement as decode + feed */
+                FUZZ_CHECK(same_stream(&seq2, &seq)); /* the same placement as decode + feed */
             }
         } else {
             check_encode((uint8_t)(data[i] >> 1), raw);

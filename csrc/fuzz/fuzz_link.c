@@ -43,13 +43,7 @@
 #include <string.h>
 
 #include "attitude/link.h"
-
-static void check(int cond)
-{
-    if (!cond) {
-        abort();
-    }
-}
+#include "fuzz_harness.h"
 
 /* ---- a byte FIFO per direction ---- */
 
@@ -162,7 +156,7 @@ static att_link_result m_poll(amodel *m, uint16_t t, uint8_t *out)
         return ATT_LINK_IDLE;
     case M_SEND_SYN:
         m->attempts++;
-        check(m->attempts <= m->cfg.max_attempts); /* at most the configured attempts */
+        FUZZ_CHECK(m->attempts <= m->cfg.max_attempts); /* at most the configured attempts */
         m->t0 = t;
         m->st = M_WAIT_SYN;
         *out = (uint8_t)ATT_LINK_SYN;
@@ -191,7 +185,7 @@ static att_link_result m_poll(amodel *m, uint16_t t, uint8_t *out)
         m_failed(m);
         return ATT_LINK_TIMEOUT;
     default: /* M_GAVE_UP */
-        check(m->attempts == m->cfg.max_attempts);
+        FUZZ_CHECK(m->attempts == m->cfg.max_attempts);
         m->gave_up++;
         m->st = M_IDLE;
         return ATT_LINK_GAVE_UP;
@@ -353,23 +347,21 @@ static void next_block(session *x)
     x->blocks++;
 }
 
+#define IS_NONE(st)    ((st) == ATT_LINK_NONE)
+#define IS_TIMEOUT(st) ((st) == ATT_LINK_TIMEOUT)
+
 /* ticks_left of both ends against the model, and by polling copies around it. */
 static void check_timers(const session *x)
 {
     uint16_t k = att_link_sender_ticks_left(&x->s, x->tick);
-    uint8_t out;
-    check(k == m_ticks_left(&x->m, x->tick));
+    FUZZ_CHECK(k == m_ticks_left(&x->m, x->tick));
     if (k != 0 && k != (uint16_t)ATT_LINK_NO_TIMER) {
-        att_link_sender a = x->s, b = x->s;
-        check(att_link_sender_poll(&a, (uint16_t)(x->tick + k - 1u), &out) == ATT_LINK_NONE);
-        check(att_link_sender_poll(&b, (uint16_t)(x->tick + k), &out) == ATT_LINK_TIMEOUT);
+        FUZZ_TIMER_ORACLE(att_link_sender, &x->s, x->tick, k, att_link_sender_poll, IS_NONE, IS_TIMEOUT);
     }
     k = att_link_receiver_ticks_left(&x->r, x->tick);
-    check(k == b_ticks_left(&x->bm, x->tick));
+    FUZZ_CHECK(k == b_ticks_left(&x->bm, x->tick));
     if (k != 0 && k != (uint16_t)ATT_LINK_NO_TIMER) {
-        att_link_receiver a = x->r, b = x->r;
-        check(att_link_receiver_poll(&a, (uint16_t)(x->tick + k - 1u), &out) == ATT_LINK_NONE);
-        check(att_link_receiver_poll(&b, (uint16_t)(x->tick + k), &out) == ATT_LINK_TIMEOUT);
+        FUZZ_TIMER_ORACLE(att_link_receiver, &x->r, x->tick, k, att_link_receiver_poll, IS_NONE, IS_TIMEOUT);
     }
 }
 
@@ -380,12 +372,12 @@ static void drain_b(session *x)
         uint8_t out = 0, want = 0;
         att_link_result exp = b_poll(&x->bm, x->tick, &want);
         att_link_result res = att_link_receiver_poll(&x->r, x->tick, &out);
-        check(res == exp && ++guard < 8);
+        FUZZ_CHECK(res == exp && ++guard < 8);
         if (res == ATT_LINK_NONE || res == ATT_LINK_IDLE) {
             return;
         }
         if (res == ATT_LINK_SEND) { /* only the answer to the last byte B took */
-            check(out == want);
+            FUZZ_CHECK(out == want);
             fifo_put(&x->ba, out);
         }
     }
@@ -398,14 +390,14 @@ static void drain_a(session *x)
         uint8_t out = 0, want = 0;
         att_link_result exp = m_poll(&x->m, x->tick, &want);
         att_link_result res = att_link_sender_poll(&x->s, x->tick, &out);
-        check(res == exp);
-        check(++guard < 2 * ATT_LINK_BLOCK_MAX + 16);
+        FUZZ_CHECK(res == exp);
+        FUZZ_CHECK(++guard < 2 * ATT_LINK_BLOCK_MAX + 16);
         if (res == ATT_LINK_SEND) {
-            check(out == want);
+            FUZZ_CHECK(out == want);
             fifo_put(&x->ab, out);
         } else if (res == ATT_LINK_IDLE) {
             next_block(x);
-            check(att_link_sender_start(&x->s, x->blk, x->tick) == ATT_OK);
+            FUZZ_CHECK(att_link_sender_start(&x->s, x->blk, x->tick) == ATT_OK);
             x->m.st = M_SEND_SYN;
             x->m.blk = x->blk;
             x->m.attempts = 0;
@@ -413,7 +405,7 @@ static void drain_a(session *x)
         } else if (res == ATT_LINK_NONE) {
             return;
         }
-        check(x->s.index <= x->s.cfg.block_size);
+        FUZZ_CHECK(x->s.index <= x->s.cfg.block_size);
     }
 }
 
@@ -421,10 +413,10 @@ static void drain_a(session *x)
 static void to_b(session *x, uint8_t byte, int answer)
 {
     att_link_result res = att_link_receiver_sink(&x->r, byte, x->tick);
-    check(res == b_sink(&x->bm, byte, x->tick));
-    check(x->r.index <= x->r.cfg.block_size);
+    FUZZ_CHECK(res == b_sink(&x->bm, byte, x->tick));
+    FUZZ_CHECK(x->r.index <= x->r.cfg.block_size);
     if (res == ATT_LINK_ACCEPTED || res == ATT_LINK_REJECTED) { /* the block B holds */
-        check((att_link_checksum(x->rbuf, x->r.cfg.block_size) == byte) == (res == ATT_LINK_ACCEPTED));
+        FUZZ_CHECK((att_link_checksum(x->rbuf, x->r.cfg.block_size) == byte) == (res == ATT_LINK_ACCEPTED));
     }
     if (answer) {
         drain_b(x);
@@ -452,7 +444,7 @@ static void advance(session *x, uint16_t ticks)
 static void to_a(session *x, uint8_t byte)
 {
     att_link_result exp = m_sink(&x->m, byte, x->tick);
-    check(att_link_sender_sink(&x->s, byte, x->tick) == exp);
+    FUZZ_CHECK(att_link_sender_sink(&x->s, byte, x->tick) == exp);
 }
 
 /* Every documented error once: NULL pointers, bad configurations, corrupted state. */
@@ -468,44 +460,40 @@ static void misuse(const session *x)
     att_link_receiver_config_init(NULL, 6);
     att_link_sender_reset(NULL);
     att_link_receiver_reset(NULL);
-    check(att_link_checksum(NULL, 3) == 0);
+    FUZZ_CHECK(att_link_checksum(NULL, 3) == 0);
     att_link_sender_config_init(&sc, 6);
     att_link_receiver_config_init(&rc, 6);
-    check(att_link_sender_init(NULL, &sc) == ATT_LINK_E_NULL
-          && att_link_sender_init(&s, NULL) == ATT_LINK_E_NULL);
-    check(att_link_receiver_init(NULL, &rc, b) == ATT_LINK_E_NULL
-          && att_link_receiver_init(&r, NULL, b) == ATT_LINK_E_NULL
-          && att_link_receiver_init(&r, &rc, NULL) == ATT_LINK_E_NULL);
-    check(att_link_sender_start(NULL, b, 0) == ATT_LINK_E_NULL
-          && att_link_sender_sink(NULL, 0, 0) == ATT_LINK_E_NULL);
-    check(att_link_sender_poll(NULL, 0, &out) == ATT_LINK_E_NULL
-          && att_link_receiver_sink(NULL, 0, 0) == ATT_LINK_E_NULL);
-    check(att_link_receiver_poll(NULL, 0, &out) == ATT_LINK_E_NULL);
-    check(att_link_sender_ticks_left(NULL, 0) == (uint16_t)ATT_LINK_NO_TIMER);
-    check(att_link_receiver_ticks_left(NULL, 0) == (uint16_t)ATT_LINK_NO_TIMER);
-    check(att_link_sender_init(&s, &sc) == ATT_OK && att_link_sender_start(&s, NULL, 0) == ATT_LINK_E_NULL);
-    check(att_link_sender_poll(&s, 0, NULL) == ATT_LINK_E_NULL);
-    check(att_link_receiver_init(&r, &rc, b) == ATT_OK
-          && att_link_receiver_poll(&r, 0, NULL) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_sender_init(NULL, &sc) == ATT_LINK_E_NULL
+               && att_link_sender_init(&s, NULL) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_receiver_init(NULL, &rc, b) == ATT_LINK_E_NULL
+               && att_link_receiver_init(&r, NULL, b) == ATT_LINK_E_NULL
+               && att_link_receiver_init(&r, &rc, NULL) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_sender_start(NULL, b, 0) == ATT_LINK_E_NULL
+               && att_link_sender_sink(NULL, 0, 0) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_sender_poll(NULL, 0, &out) == ATT_LINK_E_NULL
+               && att_link_receiver_sink(NULL, 0, 0) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_receiver_poll(NULL, 0, &out) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_sender_ticks_left(NULL, 0) == (uint16_t)ATT_LINK_NO_TIMER);
+    FUZZ_CHECK(att_link_receiver_ticks_left(NULL, 0) == (uint16_t)ATT_LINK_NO_TIMER);
+    FUZZ_CHECK(att_link_sender_init(&s, &sc) == ATT_OK
+               && att_link_sender_start(&s, NULL, 0) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_sender_poll(&s, 0, NULL) == ATT_LINK_E_NULL);
+    FUZZ_CHECK(att_link_receiver_init(&r, &rc, b) == ATT_OK
+               && att_link_receiver_poll(&r, 0, NULL) == ATT_LINK_E_NULL);
     /* a state no machine reaches: a struct overwritten */
     s = x->s;
     s.state = 0xEE;
-    check(att_link_sender_sink(&s, 0xBB, 0) == ATT_LINK_E_STATE
-          && att_link_sender_poll(&s, 0, &out) == ATT_LINK_E_STATE);
-    check(att_link_sender_ticks_left(&s, 0) == (uint16_t)ATT_LINK_NO_TIMER);
+    FUZZ_CHECK(att_link_sender_sink(&s, 0xBB, 0) == ATT_LINK_E_STATE
+               && att_link_sender_poll(&s, 0, &out) == ATT_LINK_E_STATE);
+    FUZZ_CHECK(att_link_sender_ticks_left(&s, 0) == (uint16_t)ATT_LINK_NO_TIMER);
     r = x->r;
     r.state = 0xEE;
-    check(att_link_receiver_sink(&r, 0xAA, 0) == ATT_LINK_E_STATE
-          && att_link_receiver_poll(&r, 0, &out) == ATT_LINK_E_STATE);
-    check(att_link_receiver_ticks_left(&r, 0) == (uint16_t)ATT_LINK_NO_TIMER);
+    FUZZ_CHECK(att_link_receiver_sink(&r, 0xAA, 0) == ATT_LINK_E_STATE
+               && att_link_receiver_poll(&r, 0, &out) == ATT_LINK_E_STATE);
+    FUZZ_CHECK(att_link_receiver_ticks_left(&r, 0) == (uint16_t)ATT_LINK_NO_TIMER);
     r = x->r;
     r.block = NULL;
-    check(att_link_receiver_sink(&r, 0xAA, 0) == ATT_LINK_E_NULL);
-}
-
-static uint16_t be16(const uint8_t *p)
-{
-    return (uint16_t)((uint16_t)p[0] << 8 | p[1]);
+    FUZZ_CHECK(att_link_receiver_sink(&r, 0xAA, 0) == ATT_LINK_E_NULL);
 }
 
 /* Header byte 1 bit 7 set: the raw values of the header as configuration,
@@ -519,7 +507,7 @@ static int raw_config(const uint8_t *data)
     att_link_receiver_config rc;
     uint8_t b[ATT_LINK_BLOCK_MAX] = { 0 }, out;
     uint8_t n = data[0], attempts = (uint8_t)(data[1] & 0x7F);
-    uint16_t gap = be16(data + 2), syn = be16(data + 4), answer = be16(data + 6);
+    uint16_t gap = fuzz_be16(data + 2), syn = fuzz_be16(data + 4), answer = fuzz_be16(data + 6);
     int sender_ok = n >= 1 && n <= ATT_LINK_BLOCK_MAX && attempts >= 1 && syn >= 1
                     && syn <= ATT_LINK_TIMEOUT_MAX && answer >= 1 && answer <= ATT_LINK_TIMEOUT_MAX;
     int receiver_ok = n >= 1 && n <= ATT_LINK_BLOCK_MAX && gap >= 1 && gap <= ATT_LINK_TIMEOUT_MAX;
@@ -529,11 +517,11 @@ static int raw_config(const uint8_t *data)
     sc.answer_timeout = answer;
     rc.block_size = n;
     rc.gap_timeout = gap;
-    check(att_link_sender_init(&s, &sc) == (sender_ok ? ATT_OK : ATT_LINK_E_CONFIG));
-    check(att_link_receiver_init(&r, &rc, b) == (receiver_ok ? ATT_OK : ATT_LINK_E_CONFIG));
+    FUZZ_CHECK(att_link_sender_init(&s, &sc) == (sender_ok ? ATT_OK : ATT_LINK_E_CONFIG));
+    FUZZ_CHECK(att_link_receiver_init(&r, &rc, b) == (receiver_ok ? ATT_OK : ATT_LINK_E_CONFIG));
     if (!sender_ok) {
-        check(att_link_sender_poll(&s, 0, &out) < 0 && att_link_sender_sink(&s, 0xBB, 0) < 0);
-        check(att_link_sender_ticks_left(&s, 0) == (uint16_t)ATT_LINK_NO_TIMER);
+        FUZZ_CHECK(att_link_sender_poll(&s, 0, &out) < 0 && att_link_sender_sink(&s, 0xBB, 0) < 0);
+        FUZZ_CHECK(att_link_sender_ticks_left(&s, 0) == (uint16_t)ATT_LINK_NO_TIMER);
     }
     return sender_ok && receiver_ok;
 }
@@ -560,16 +548,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     x.m.cfg.max_attempts = (uint8_t)(data[1] % 8 + 1);
     {
         uint16_t span = (data[1] & 0x40) ? (uint16_t)ATT_LINK_TIMEOUT_MAX : 64;
-        rc.gap_timeout = (uint16_t)(be16(data + 2) % span + 1);
-        x.m.cfg.syn_timeout = (uint16_t)(be16(data + 4) % span + 1);
-        x.m.cfg.answer_timeout = (uint16_t)(be16(data + 6) % span + 1);
+        rc.gap_timeout = (uint16_t)(fuzz_be16(data + 2) % span + 1);
+        x.m.cfg.syn_timeout = (uint16_t)(fuzz_be16(data + 4) % span + 1);
+        x.m.cfg.answer_timeout = (uint16_t)(fuzz_be16(data + 6) % span + 1);
     }
     rc.block_size = x.m.cfg.block_size;
     x.bm.cfg = rc;
     x.bm.out = -1;
-    x.tick = be16(data + 8);
-    check(att_link_sender_init(&x.s, &x.m.cfg) == ATT_OK);
-    check(att_link_receiver_init(&x.r, &rc, x.rbuf) == ATT_OK);
+    x.tick = fuzz_be16(data + 8);
+    FUZZ_CHECK(att_link_sender_init(&x.s, &x.m.cfg) == ATT_OK);
+    FUZZ_CHECK(att_link_receiver_init(&x.r, &rc, x.rbuf) == ATT_OK);
     if (data[10] == 0xA5) {
         misuse(&x);
     }
@@ -628,8 +616,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                 x.bm.t_last = 0;
                 break;
             default:
-                check(att_link_sender_start(&x.s, x.blk, x.tick)
-                      == (x.m.st == M_IDLE ? ATT_OK : ATT_LINK_E_BUSY));
+                FUZZ_CHECK(att_link_sender_start(&x.s, x.blk, x.tick)
+                           == (x.m.st == M_IDLE ? ATT_OK : ATT_LINK_E_BUSY));
                 if (x.m.st == M_IDLE) {
                     x.m.st = M_SEND_SYN;
                     x.m.attempts = 0;
@@ -654,25 +642,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     poll_both(&x);
     check_timers(&x);
     /* A's statistics are the model's counts (16-bit, wrapping) */
-    check(x.s.stats.blocks_sent == (uint16_t)x.m.sent && x.s.stats.blocks_accepted == (uint16_t)x.m.accepted);
-    check(x.s.stats.naks == (uint16_t)x.m.naks && x.s.stats.timeouts == (uint16_t)x.m.timeouts);
-    check(x.s.stats.gave_up == (uint16_t)x.m.gave_up && x.s.stats.bytes_discarded == (uint16_t)x.m.discarded);
+    FUZZ_CHECK(x.s.stats.blocks_sent == (uint16_t)x.m.sent
+               && x.s.stats.blocks_accepted == (uint16_t)x.m.accepted);
+    FUZZ_CHECK(x.s.stats.naks == (uint16_t)x.m.naks && x.s.stats.timeouts == (uint16_t)x.m.timeouts);
+    FUZZ_CHECK(x.s.stats.gave_up == (uint16_t)x.m.gave_up
+               && x.s.stats.bytes_discarded == (uint16_t)x.m.discarded);
     /* B's statistics are the model's counts */
-    check(x.r.stats.syns == x.bm.syns && x.r.stats.blocks_accepted == x.bm.accepted
-          && x.r.stats.naks == x.bm.naks);
-    check(x.r.stats.timeouts == x.bm.timeouts && x.r.stats.resyncs == x.bm.resyncs);
-    check(x.r.stats.bytes_discarded == x.bm.bytes_discarded);
+    FUZZ_CHECK(x.r.stats.syns == x.bm.syns && x.r.stats.blocks_accepted == x.bm.accepted
+               && x.r.stats.naks == x.bm.naks);
+    FUZZ_CHECK(x.r.stats.timeouts == x.bm.timeouts && x.r.stats.resyncs == x.bm.resyncs);
+    FUZZ_CHECK(x.r.stats.bytes_discarded == x.bm.bytes_discarded);
     /* bounded return to idle: at most N + 1 more bytes (no 0xAA) end any block */
     for (k = 0; k <= x.r.cfg.block_size; k++) {
-        check(att_link_receiver_sink(&x.r, 0x00, x.tick) >= 0);
+        FUZZ_CHECK(att_link_receiver_sink(&x.r, 0x00, x.tick) >= 0);
         while (att_link_receiver_poll(&x.r, x.tick, &out) > ATT_LINK_IDLE) {
         }
     }
-    check(att_link_receiver_poll(&x.r, x.tick, &out) == ATT_LINK_IDLE);
+    FUZZ_CHECK(att_link_receiver_poll(&x.r, x.tick, &out) == ATT_LINK_IDLE);
     /* and silence longer than the gap timeout always ends a block too */
-    check(att_link_receiver_sink(&x.r, 0xAA, x.tick) == ATT_LINK_SYN_RX);
-    check(att_link_receiver_poll(&x.r, x.tick, &out) == ATT_LINK_SEND && out == 0xBB);
-    check(att_link_receiver_poll(&x.r, (uint16_t)(x.tick + rc.gap_timeout + 1u), &out) == ATT_LINK_TIMEOUT);
-    check(att_link_receiver_poll(&x.r, (uint16_t)(x.tick + rc.gap_timeout + 1u), &out) == ATT_LINK_IDLE);
+    FUZZ_CHECK(att_link_receiver_sink(&x.r, 0xAA, x.tick) == ATT_LINK_SYN_RX);
+    FUZZ_CHECK(att_link_receiver_poll(&x.r, x.tick, &out) == ATT_LINK_SEND && out == 0xBB);
+    FUZZ_CHECK(att_link_receiver_poll(&x.r, (uint16_t)(x.tick + rc.gap_timeout + 1u), &out)
+               == ATT_LINK_TIMEOUT);
+    FUZZ_CHECK(att_link_receiver_poll(&x.r, (uint16_t)(x.tick + rc.gap_timeout + 1u), &out) == ATT_LINK_IDLE);
     return 0;
 }

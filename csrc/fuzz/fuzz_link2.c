@@ -26,13 +26,7 @@
 #include <string.h>
 
 #include "attitude/link2.h"
-
-#define CHECK(c)              \
-    do {                      \
-        if (!(c)) {           \
-            __builtin_trap(); \
-        }                     \
-    } while (0)
+#include "fuzz_harness.h"
 
 static uint64_t rng_state;
 
@@ -82,34 +76,37 @@ static void deliver_to_b(rig *r, uint8_t byte)
     uint8_t want[6];
     uint16_t room = r->b.room;
     int i, st = att_link2_receiver_sink(&r->b, byte);
-    CHECK(st >= 0);
+    FUZZ_CHECK(st >= 0);
     if (st != ATT_LINK2_DELIVERED) {
-        CHECK(r->b.n_out == 0);
+        FUZZ_CHECK(r->b.n_out == 0);
         return;
     }
-    CHECK(r->b.n_out >= 1 && r->b.n_out <= ATT_LINK2_SAMPLES_MAX && r->b.n_out <= room);
-    CHECK(r->b.room == room - r->b.n_out);
+    FUZZ_CHECK(r->b.n_out >= 1 && r->b.n_out <= ATT_LINK2_SAMPLES_MAX && r->b.n_out <= room);
+    FUZZ_CHECK(r->b.room == room - r->b.n_out);
     for (i = 0; i < r->b.n_out; i++) {
         record(r->delivered, want);
         if (memcmp(want, r->out + 6 * i, 6) != 0) {
             uint32_t k;
-            CHECK(r->may_skip); /* only a rebooted A loses records: find the one delivered */
+            FUZZ_CHECK(r->may_skip); /* only a rebooted A loses records: find the one delivered */
             for (k = r->delivered + 1; k < r->pushed; k++) {
                 record(k, want);
                 if (memcmp(want, r->out + 6 * i, 6) == 0) {
                     break;
                 }
             }
-            CHECK(k < r->pushed);
+            FUZZ_CHECK(k < r->pushed);
             r->delivered = k;
         }
         if (r->delivered >= r->pushed_at_reboot) {
             r->may_skip = 0; /* a record of the new session: no more skipping */
         }
         r->delivered++;
-        CHECK(r->delivered <= r->pushed);
+        FUZZ_CHECK(r->delivered <= r->pushed);
     }
 }
+
+#define QUIET(st) ((st) == ATT_LINK2_NONE || (st) == ATT_LINK2_IDLE)
+#define FIRES(st) ((st) == ATT_LINK2_SEND || (st) == ATT_LINK2_TIMEOUT)
 
 /* ticks_left(now) = k: a copy polled at now + k - 1 does nothing on the clock, one at now + k does. */
 static void check_ticks_left(const att_link2_sender *a, uint16_t now)
@@ -121,32 +118,27 @@ static void check_ticks_left(const att_link2_sender *a, uint16_t now)
     if (k == ATT_LINK2_NO_TIMER) {
         c = *a;
         st = att_link2_sender_poll(&c, (uint16_t)(now + 30000u), &byte);
-        CHECK(st == ATT_LINK2_IDLE || st == ATT_LINK2_NONE);
+        FUZZ_CHECK(st == ATT_LINK2_IDLE || st == ATT_LINK2_NONE);
         return;
     }
     if (k == 0) {
         c = *a;
         st = att_link2_sender_poll(&c, now, &byte);
-        CHECK(st == ATT_LINK2_SEND || st == ATT_LINK2_TIMEOUT);
+        FUZZ_CHECK(st == ATT_LINK2_SEND || st == ATT_LINK2_TIMEOUT);
         return;
     }
-    CHECK(k <= a->cfg.rto + 1u);
-    c = *a;
-    st = att_link2_sender_poll(&c, (uint16_t)(now + k - 1u), &byte);
-    CHECK(st == ATT_LINK2_NONE || st == ATT_LINK2_IDLE);
-    c = *a;
-    st = att_link2_sender_poll(&c, (uint16_t)(now + k), &byte);
-    CHECK(st == ATT_LINK2_SEND || st == ATT_LINK2_TIMEOUT);
+    FUZZ_CHECK(k <= a->cfg.rto + 1u);
+    FUZZ_TIMER_ORACLE(att_link2_sender, a, now, k, att_link2_sender_poll, QUIET, FIRES);
 }
 
 static void sender_invariants(const att_link2_sender *a)
 {
     uint8_t pend = (uint8_t)(a->head - a->base);
-    CHECK(pend <= a->cfg.ring_size);
-    CHECK((uint8_t)(a->hi - a->base) <= pend);
-    CHECK((uint8_t)(a->next - a->base) <= (uint8_t)(a->hi - a->base) || a->next == a->hi);
-    CHECK(a->cur >= 1 && a->cur <= a->cfg.max_samples);
-    CHECK(att_link2_sender_room(a) <= a->cfg.ring_size);
+    FUZZ_CHECK(pend <= a->cfg.ring_size);
+    FUZZ_CHECK((uint8_t)(a->hi - a->base) <= pend);
+    FUZZ_CHECK((uint8_t)(a->next - a->base) <= (uint8_t)(a->hi - a->base) || a->next == a->hi);
+    FUZZ_CHECK(a->cur >= 1 && a->cur <= a->cfg.max_samples);
+    FUZZ_CHECK(att_link2_sender_room(a) <= a->cfg.ring_size);
 }
 
 /* One byte time: A and B hand out a byte each if their line is free. */
@@ -158,7 +150,7 @@ static void hand_out(rig *r)
         do {
             st = att_link2_sender_poll(&r->a, r->t, &byte);
         } while (st == ATT_LINK2_TIMEOUT);
-        CHECK(st >= 0);
+        FUZZ_CHECK(st >= 0);
         if (st == ATT_LINK2_SEND) {
             r->a_line[0] = byte;
             r->a_full = 1;
@@ -166,7 +158,7 @@ static void hand_out(rig *r)
     }
     if (!r->b_full) {
         st = att_link2_receiver_poll(&r->b, &byte);
-        CHECK(st >= 0);
+        FUZZ_CHECK(st >= 0);
         if (st == ATT_LINK2_SEND) {
             r->b_line[0] = byte;
             r->b_full = 1;
@@ -183,7 +175,7 @@ static void byte_time(rig *r)
         r->a_full = 0;
     }
     if (r->b_full) {
-        CHECK(att_link2_sender_sink(&r->a, r->b_line[0], r->t) >= 0);
+        FUZZ_CHECK(att_link2_sender_sink(&r->a, r->b_line[0], r->t) >= 0);
         r->b_full = 0;
     }
     r->t++;
@@ -197,20 +189,20 @@ static void push_all(rig *r, int n)
     uint8_t *slot;
     while (n-- > 0 && att_link2_sender_room(&r->a) > 0) {
         slot = att_link2_sender_tail(&r->a);
-        CHECK(slot != NULL);
+        FUZZ_CHECK(slot != NULL);
         if (r->pushed & 1u) {
             record(r->pushed, slot);
-            CHECK(att_link2_sender_push(&r->a, slot) == ATT_OK);
+            FUZZ_CHECK(att_link2_sender_push(&r->a, slot) == ATT_OK);
         } else {
             record(r->pushed, rec);
-            CHECK(att_link2_sender_push(&r->a, rec) == ATT_OK);
+            FUZZ_CHECK(att_link2_sender_push(&r->a, rec) == ATT_OK);
         }
         r->pushed++;
     }
     if (att_link2_sender_room(&r->a) == 0) {
-        CHECK(att_link2_sender_tail(&r->a) == NULL);
+        FUZZ_CHECK(att_link2_sender_tail(&r->a) == NULL);
         record(r->pushed, rec);
-        CHECK(att_link2_sender_push(&r->a, rec) == ATT_LINK2_E_FULL);
+        FUZZ_CHECK(att_link2_sender_push(&r->a, rec) == ATT_LINK2_E_FULL);
     }
 }
 
@@ -226,8 +218,8 @@ static void mode_link(const uint8_t *data, size_t size)
     cfg.max_samples = (uint8_t)(1u + data[0] % ATT_LINK2_SAMPLES_MAX);
     cfg.rto = (uint16_t)(20u + (data[0] >> 4) * 7u);
     r.t = (uint16_t)(data[0] * 257u);
-    CHECK(att_link2_sender_init(&r.a, &cfg, r.ring) == ATT_OK);
-    CHECK(att_link2_receiver_init(&r.b, r.out) == ATT_OK);
+    FUZZ_CHECK(att_link2_sender_init(&r.a, &cfg, r.ring) == ATT_OK);
+    FUZZ_CHECK(att_link2_receiver_init(&r.b, r.out) == ATT_OK);
     att_link2_receiver_set_room(&r.b, 30);
     for (i = 1; i < size; i++) {
         uint8_t op = data[i];
@@ -257,13 +249,13 @@ static void mode_link(const uint8_t *data, size_t size)
             if (op & 0x10u)
                 deliver_to_b(&r, rng_byte());
             else
-                CHECK(att_link2_sender_sink(&r.a, rng_byte(), r.t) >= 0);
+                FUZZ_CHECK(att_link2_sender_sink(&r.a, rng_byte(), r.t) >= 0);
             break;
         case 7: /* duplicate it */
             if ((op & 0x10u) && r.a_full)
                 deliver_to_b(&r, r.a_line[0]);
             if (!(op & 0x10u) && r.b_full)
-                CHECK(att_link2_sender_sink(&r.a, r.b_line[0], r.t) >= 0);
+                FUZZ_CHECK(att_link2_sender_sink(&r.a, r.b_line[0], r.t) >= 0);
             break;
         case 8:
         case 9: /* records */
@@ -296,8 +288,8 @@ static void mode_link(const uint8_t *data, size_t size)
     att_link2_receiver_set_room(&r.b, 0xFFFFu);
     for (steps = 0; steps < 200000 && (att_link2_sender_pending(&r.a) != 0 || r.a_full || r.b_full); steps++)
         byte_time(&r);
-    CHECK(att_link2_sender_pending(&r.a) == 0);
-    CHECK(r.delivered == r.pushed || (r.pushed == r.pushed_at_reboot && r.delivered <= r.pushed));
+    FUZZ_CHECK(att_link2_sender_pending(&r.a) == 0);
+    FUZZ_CHECK(r.delivered == r.pushed || (r.pushed == r.pushed_at_reboot && r.delivered <= r.pushed));
 }
 
 static void mode_raw(const uint8_t *data, size_t size)
@@ -311,18 +303,18 @@ static void mode_raw(const uint8_t *data, size_t size)
     size_t i, half = size / 2;
     uint16_t t = 0;
     int st, k;
-    CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
+    FUZZ_CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
     att_link2_receiver_set_room(&b, data[0]);
     for (i = 1; i < half; i++) {
         uint16_t room = b.room;
         expected = b.expected;
         st = att_link2_receiver_sink(&b, data[i]);
-        CHECK(st >= 0);
+        FUZZ_CHECK(st >= 0);
         if (st == ATT_LINK2_DELIVERED) {
-            CHECK(b.n_out >= 1 && b.n_out <= room && b.n_out <= ATT_LINK2_SAMPLES_MAX);
-            CHECK((uint8_t)(b.expected - expected) == b.n_out);
+            FUZZ_CHECK(b.n_out >= 1 && b.n_out <= room && b.n_out <= ATT_LINK2_SAMPLES_MAX);
+            FUZZ_CHECK((uint8_t)(b.expected - expected) == b.n_out);
         } else {
-            CHECK(b.expected == expected || st == ATT_LINK2_FRAME);
+            FUZZ_CHECK(b.expected == expected || st == ATT_LINK2_FRAME);
         }
         if (data[i] & 1u) {
             while (att_link2_receiver_poll(&b, &byte) == ATT_LINK2_SEND) {
@@ -351,44 +343,44 @@ static void mode_raw(const uint8_t *data, size_t size)
         (void)att_link2_receiver_sink(&b, 0);
         for (j = 0; j < len + 4u; j++) {
             if (f[j] == 0) {
-                CHECK(att_link2_receiver_sink(&b, (uint8_t)(run + 1u)) == ATT_LINK2_NONE);
+                FUZZ_CHECK(att_link2_receiver_sink(&b, (uint8_t)(run + 1u)) == ATT_LINK2_NONE);
                 run = 0;
             } else {
-                CHECK(att_link2_receiver_sink(&b, f[j]) == ATT_LINK2_NONE);
+                FUZZ_CHECK(att_link2_receiver_sink(&b, f[j]) == ATT_LINK2_NONE);
                 run++;
             }
         }
-        CHECK(att_link2_receiver_sink(&b, (uint8_t)(run + 1u)) == ATT_LINK2_NONE);
+        FUZZ_CHECK(att_link2_receiver_sink(&b, (uint8_t)(run + 1u)) == ATT_LINK2_NONE);
         st = att_link2_receiver_sink(&b, 0);
-        CHECK(st == (k == 0 ? ATT_LINK2_FRAME : ATT_LINK2_DELIVERED));
+        FUZZ_CHECK(st == (k == 0 ? ATT_LINK2_FRAME : ATT_LINK2_DELIVERED));
     }
-    CHECK(b.n_out == 1 && out[0] == 0x01 && out[1] == 0x23 && out[4] == 0x07 && out[5] == 0x89);
+    FUZZ_CHECK(b.n_out == 1 && out[0] == 0x01 && out[1] == 0x23 && out[4] == 0x07 && out[5] == 0x89);
 
     /* A: any bytes (forged ACKs included) at any times: its bookkeeping holds */
     att_link2_sender_config_init(&cfg, 8);
     cfg.max_samples = 3;
     cfg.rto = 50;
-    CHECK(att_link2_sender_init(&a, &cfg, ring) == ATT_OK);
+    FUZZ_CHECK(att_link2_sender_init(&a, &cfg, ring) == ATT_OK);
     for (i = half; i < size; i++) {
         if ((data[i] & 3u) == 0u) {
             memset(rec, data[i], 6);
             (void)att_link2_sender_push(&a, rec);
         }
         st = att_link2_sender_sink(&a, data[i], t);
-        CHECK(st >= 0);
+        FUZZ_CHECK(st >= 0);
         t = (uint16_t)(t + (data[i] >> 2));
         check_ticks_left(&a, t);
         while ((st = att_link2_sender_poll(&a, t, &byte)) == ATT_LINK2_SEND || st == ATT_LINK2_TIMEOUT) {
         }
-        CHECK(st >= 0);
+        FUZZ_CHECK(st >= 0);
         sender_invariants(&a);
     }
     /* NULLs and a corrupted state */
-    CHECK(att_link2_receiver_sink(NULL, 0) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_receiver_sink(NULL, 0) == ATT_LINK2_E_NULL);
     b.len = 200;
-    CHECK(att_link2_receiver_sink(&b, 1) == ATT_LINK2_E_STATE);
+    FUZZ_CHECK(att_link2_receiver_sink(&b, 1) == ATT_LINK2_E_STATE);
     a.tx = 9;
-    CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
+    FUZZ_CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
 }
 
 /* -- mode 3: well-formed frames and ACKs (valid CRC, fuzzer-chosen fields) -- */
@@ -444,7 +436,7 @@ static void expect_ack(att_link2_receiver *b, rx_model *m, int flags)
     uint8_t d[8], want[10], byte;
     size_t n, i;
     if (flags < 0) {
-        CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
+        FUZZ_CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
         return;
     }
     d[0] = (uint8_t)(ATT_LINK2_T_ACK | flags);
@@ -452,12 +444,12 @@ static void expect_ack(att_link2_receiver *b, rx_model *m, int flags)
     d[2] = m->synced ? (uint8_t)(m->expected + (m->room > 127u ? 127u : m->room)) : 0u;
     want[0] = 0;
     n = rcobs(d, with_crc(d, 3), want + 1);
-    CHECK(n == 8);
+    FUZZ_CHECK(n == 8);
     want[9] = 0;
     for (i = 0; i < 10; i++) {
-        CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_SEND && byte == want[i]);
+        FUZZ_CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_SEND && byte == want[i]);
     }
-    CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
+    FUZZ_CHECK(att_link2_receiver_poll(b, &byte) == ATT_LINK2_IDLE);
     m->last_limit = d[2];
 }
 
@@ -470,10 +462,10 @@ static void frame_to_b(att_link2_receiver *b, rx_model *m, const uint8_t *out, u
     unsigned cnt = 0, k, c;
     int valid, st, flags;
     n = rcobs(f, with_crc(f, len), wire);
-    CHECK(att_link2_receiver_sink(b, 0) == ATT_LINK2_NONE);
+    FUZZ_CHECK(att_link2_receiver_sink(b, 0) == ATT_LINK2_NONE);
     for (i = 0; i < n; i++) {
         st = att_link2_receiver_sink(b, wire[i]);
-        CHECK(st == (i < ATT_LINK2_WIRE_MAX ? ATT_LINK2_NONE : ATT_LINK2_DISCARDED));
+        FUZZ_CHECK(st == (i < ATT_LINK2_WIRE_MAX ? ATT_LINK2_NONE : ATT_LINK2_DISCARDED));
     }
     st = att_link2_receiver_sink(b, 0);
     switch (h & 0xC0u) {
@@ -494,12 +486,12 @@ static void frame_to_b(att_link2_receiver *b, rx_model *m, const uint8_t *out, u
         break;
     }
     if (!valid || len < 2) {
-        CHECK(st == ATT_LINK2_BAD_FRAME);
+        FUZZ_CHECK(st == ATT_LINK2_BAD_FRAME);
         expect_ack(b, m, -1);
         return;
     }
     if (h == ATT_LINK2_T_SYN) {
-        CHECK(st == ATT_LINK2_FRAME);
+        FUZZ_CHECK(st == ATT_LINK2_FRAME);
         m->synced = 1;
         m->expected = seq;
         expect_ack(b, m, ATT_LINK2_F_SYNACK);
@@ -508,7 +500,7 @@ static void frame_to_b(att_link2_receiver *b, rx_model *m, const uint8_t *out, u
     flags = (h & ATT_LINK2_E_BIT) ? ATT_LINK2_F_EPOCH : 0;
     off = (uint8_t)(m->expected - seq);
     if (!m->synced || off > 127u) {
-        CHECK(st == ATT_LINK2_FRAME);
+        FUZZ_CHECK(st == ATT_LINK2_FRAME);
         expect_ack(b, m, m->synced ? (ATT_LINK2_F_GAP | flags) : ATT_LINK2_F_NOSESSION);
         return;
     }
@@ -517,14 +509,14 @@ static void frame_to_b(att_link2_receiver *b, rx_model *m, const uint8_t *out, u
         k = m->room;
     }
     if (k == 0) {
-        CHECK(st == ATT_LINK2_FRAME);
+        FUZZ_CHECK(st == ATT_LINK2_FRAME);
     } else {
-        CHECK(st == ATT_LINK2_DELIVERED && b->n_out == k);
+        FUZZ_CHECK(st == ATT_LINK2_DELIVERED && b->n_out == k);
         for (i = 0; i < k; i++) {
             for (c = 0; c < 3; c++) {
                 uint16_t v = (h & ATT_LINK2_T_RAW) ? (uint16_t)((f[2 + 2 * c] << 8) | f[3 + 2 * c])
                                                    : code_at(f + 2, 3 * (off + (unsigned)i) + c);
-                CHECK(out[6 * i + 2 * c] == (uint8_t)(v >> 8) && out[6 * i + 2 * c + 1] == (uint8_t)v);
+                FUZZ_CHECK(out[6 * i + 2 * c] == (uint8_t)(v >> 8) && out[6 * i + 2 * c + 1] == (uint8_t)v);
             }
         }
         m->expected = (uint8_t)(m->expected + k);
@@ -543,24 +535,24 @@ static void ack_to_a(att_link2_sender *a, uint8_t flags, uint8_t ack, uint8_t li
     d[0] = (uint8_t)(ATT_LINK2_T_ACK | (flags & 0x0Fu));
     d[1] = ack;
     d[2] = limit;
-    CHECK(rcobs(d, with_crc(d, 3), wire) == 8);
-    CHECK(att_link2_sender_sink(a, 0, t) == ATT_LINK2_NONE);
+    FUZZ_CHECK(rcobs(d, with_crc(d, 3), wire) == 8);
+    FUZZ_CHECK(att_link2_sender_sink(a, 0, t) == ATT_LINK2_NONE);
     for (i = 0; i < 8; i++) {
-        CHECK(att_link2_sender_sink(a, wire[i], t) == ATT_LINK2_NONE);
+        FUZZ_CHECK(att_link2_sender_sink(a, wire[i], t) == ATT_LINK2_NONE);
     }
     st = att_link2_sender_sink(a, 0, t);
-    CHECK(st == ATT_LINK2_FRAME || st == ATT_LINK2_BAD_FRAME);
-    CHECK(a->head == head);
+    FUZZ_CHECK(st == ATT_LINK2_FRAME || st == ATT_LINK2_BAD_FRAME);
+    FUZZ_CHECK(a->head == head);
     if (st == ATT_LINK2_BAD_FRAME) { /* acknowledges records never sent: ignored */
-        CHECK((uint8_t)(ack - base) > (uint8_t)(hi - base) && a->base == base && a->hi == hi
-              && a->next == next);
+        FUZZ_CHECK((uint8_t)(ack - base) > (uint8_t)(hi - base) && a->base == base && a->hi == hi
+                   && a->next == next);
         return;
     }
     if (flags & ATT_LINK2_F_NOSESSION) { /* B lost the session: SYN again at base, ring kept */
-        CHECK(a->base == base && att_link2_sender_ticks_left(a, t) == 0);
+        FUZZ_CHECK(a->base == base && att_link2_sender_ticks_left(a, t) == 0);
         return;
     }
-    CHECK(a->base == base || (a->base == ack && (uint8_t)(ack - base) <= (uint8_t)(hi - base)));
+    FUZZ_CHECK(a->base == base || (a->base == ack && (uint8_t)(ack - base) <= (uint8_t)(hi - base)));
 }
 
 /* The calls every unusable or absent sender / receiver must refuse. */
@@ -574,30 +566,30 @@ static void refusals(void)
     att_link2_sender_reset(NULL);
     att_link2_receiver_reset(NULL);
     att_link2_receiver_set_room(NULL, 3);
-    CHECK(att_link2_crc(NULL, 3) == 0);
-    CHECK(att_link2_sender_ticks_left(NULL, 0) == ATT_LINK2_NO_TIMER);
-    CHECK(att_link2_sender_room(NULL) == 0 && att_link2_sender_pending(NULL) == 0);
-    CHECK(att_link2_sender_tail(NULL) == NULL);
-    CHECK(att_link2_sender_push(NULL, ring) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_sink(NULL, 1, 0) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_poll(NULL, 0, &byte) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_crc(NULL, 3) == 0);
+    FUZZ_CHECK(att_link2_sender_ticks_left(NULL, 0) == ATT_LINK2_NO_TIMER);
+    FUZZ_CHECK(att_link2_sender_room(NULL) == 0 && att_link2_sender_pending(NULL) == 0);
+    FUZZ_CHECK(att_link2_sender_tail(NULL) == NULL);
+    FUZZ_CHECK(att_link2_sender_push(NULL, ring) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_sink(NULL, 1, 0) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_poll(NULL, 0, &byte) == ATT_LINK2_E_NULL);
     att_link2_sender_config_init(&cfg, 1);
-    CHECK(att_link2_sender_init(NULL, &cfg, ring) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_init(&a, NULL, ring) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_init(&a, &cfg, NULL) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_init(&a, &cfg, ring) == ATT_OK);
-    CHECK(att_link2_sender_push(&a, NULL) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_sender_poll(&a, 0, NULL) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_receiver_init(NULL, out) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_receiver_init(&b, NULL) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_receiver_poll(NULL, &byte) == ATT_LINK2_E_NULL);
-    CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
-    CHECK(att_link2_receiver_poll(&b, NULL) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_init(NULL, &cfg, ring) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_init(&a, NULL, ring) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_init(&a, &cfg, NULL) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_init(&a, &cfg, ring) == ATT_OK);
+    FUZZ_CHECK(att_link2_sender_push(&a, NULL) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_sender_poll(&a, 0, NULL) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_receiver_init(NULL, out) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_receiver_init(&b, NULL) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_receiver_poll(NULL, &byte) == ATT_LINK2_E_NULL);
+    FUZZ_CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
+    FUZZ_CHECK(att_link2_receiver_poll(&b, NULL) == ATT_LINK2_E_NULL);
     b.tx_pos = 3; /* past tx_len: corrupted */
-    CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
+    FUZZ_CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
     b.tx_pos = 0;
     b.tx_len = 11; /* longer than tx */
-    CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
+    FUZZ_CHECK(att_link2_receiver_poll(&b, &byte) == ATT_LINK2_E_STATE);
 }
 
 /* Mode 3: d[0..3] configure A (any values: out of range ones must be refused
@@ -622,7 +614,7 @@ static void mode_frames(const uint8_t *data, size_t size)
         return;
     }
     att_link2_sender_config_init(&cfg, data[3]);
-    CHECK(cfg.ring_size == data[3] && cfg.rto == 200 && cfg.max_samples == ATT_LINK2_SAMPLES_DEFAULT);
+    FUZZ_CHECK(cfg.ring_size == data[3] && cfg.rto == 200 && cfg.max_samples == ATT_LINK2_SAMPLES_DEFAULT);
     if (data[2] & 0x80u) { /* otherwise the defaults */
         cfg.rto = (uint16_t)((data[0] << 8) | data[1]);
         cfg.max_samples = (uint8_t)(data[2] & 0x7Fu);
@@ -631,17 +623,17 @@ static void mode_frames(const uint8_t *data, size_t size)
            && (cfg.ring_size & (cfg.ring_size - 1)) == 0 && cfg.max_samples >= 1
            && cfg.max_samples <= ATT_LINK2_SAMPLES_MAX && cfg.rto >= 1 && cfg.rto <= ATT_LINK2_TIMEOUT_MAX;
     st = att_link2_sender_init(&a, &cfg, ring);
-    CHECK(st == (a_ok ? ATT_OK : ATT_LINK2_E_CONFIG));
+    FUZZ_CHECK(st == (a_ok ? ATT_OK : ATT_LINK2_E_CONFIG));
     if (!a_ok) {
         memset(rec, 0, sizeof(rec));
-        CHECK(att_link2_sender_room(&a) == 0 && att_link2_sender_pending(&a) == 0);
-        CHECK(att_link2_sender_tail(&a) == NULL);
-        CHECK(att_link2_sender_push(&a, rec) == ATT_LINK2_E_STATE);
-        CHECK(att_link2_sender_sink(&a, 0, 0) == ATT_LINK2_E_STATE);
-        CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
-        CHECK(att_link2_sender_ticks_left(&a, 0) == ATT_LINK2_NO_TIMER);
+        FUZZ_CHECK(att_link2_sender_room(&a) == 0 && att_link2_sender_pending(&a) == 0);
+        FUZZ_CHECK(att_link2_sender_tail(&a) == NULL);
+        FUZZ_CHECK(att_link2_sender_push(&a, rec) == ATT_LINK2_E_STATE);
+        FUZZ_CHECK(att_link2_sender_sink(&a, 0, 0) == ATT_LINK2_E_STATE);
+        FUZZ_CHECK(att_link2_sender_poll(&a, 0, &byte) == ATT_LINK2_E_STATE);
+        FUZZ_CHECK(att_link2_sender_ticks_left(&a, 0) == ATT_LINK2_NO_TIMER);
     }
-    CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
+    FUZZ_CHECK(att_link2_receiver_init(&b, out) == ATT_OK);
     memset(&m, 0, sizeof(m));
     while (i < size) {
         uint8_t op = data[i++];
@@ -685,8 +677,8 @@ static void mode_frames(const uint8_t *data, size_t size)
             expect_ack(&b, &m, -1);
             break;
         case 3: /* a stray byte and a delimiter: a bad frame, nothing answered */
-            CHECK(att_link2_receiver_sink(&b, (uint8_t)(op | 1u)) == ATT_LINK2_NONE);
-            CHECK(att_link2_receiver_sink(&b, 0) == ATT_LINK2_BAD_FRAME);
+            FUZZ_CHECK(att_link2_receiver_sink(&b, (uint8_t)(op | 1u)) == ATT_LINK2_NONE);
+            FUZZ_CHECK(att_link2_receiver_sink(&b, 0) == ATT_LINK2_BAD_FRAME);
             expect_ack(&b, &m, -1);
             break;
         default:
@@ -699,8 +691,8 @@ static void mode_frames(const uint8_t *data, size_t size)
                 rec[0] = (uint8_t)(op >> 4);
                 i++;
                 room = att_link2_sender_room(&a);
-                CHECK((att_link2_sender_tail(&a) == NULL) == (room == 0));
-                CHECK(att_link2_sender_push(&a, rec) == (room != 0 ? ATT_OK : ATT_LINK2_E_FULL));
+                FUZZ_CHECK((att_link2_sender_tail(&a) == NULL) == (room == 0));
+                FUZZ_CHECK(att_link2_sender_push(&a, rec) == (room != 0 ? ATT_OK : ATT_LINK2_E_FULL));
                 break;
             case 5: /* A sends (to nowhere) */
                 for (j = 0; j < 2000
@@ -708,7 +700,7 @@ static void mode_frames(const uint8_t *data, size_t size)
                                 || st == ATT_LINK2_TIMEOUT);
                      j++) {
                 }
-                CHECK(st >= 0);
+                FUZZ_CHECK(st >= 0);
                 break;
             case 6: /* a valid ACK */
                 ack_to_a(&a, (uint8_t)(op >> 4), x, y, t);
@@ -725,8 +717,6 @@ static void mode_frames(const uint8_t *data, size_t size)
         }
     }
 }
-
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

@@ -26,6 +26,7 @@ att_status att_align_accmag(const att_real f_b[3], const att_real m_b[3], att_re
             return ATT_E_ARG;
         if (!aid_unit(f_b, fu))
             return ATT_AID_E_ZERO_F;
+        mu[0] = mu[1] = mu[2] = ATT_R(0.0); /* unused without m_b: defined on every path (gcc -O3) */
     }
     /* f_b = |f| [−cθ sγ, sθ, cθ cγ] (third row of C = R_z R_x R_y) */
     r = att_sqrt(fu[0] * fu[0] + fu[2] * fu[2]);

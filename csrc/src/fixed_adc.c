@@ -15,7 +15,7 @@
 
 /* (hi:lo) = x · y, unsigned 32 × 32 → 64 bits from 16 × 16-bit products
  * (also used by att_fx_adc_init in fixed_adc_init.c) */
-void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
+void att__fx_uprod(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
 {
     uint32_t p0 = (uint32_t)(uint16_t)x * (uint16_t)y;
     uint32_t p1 = (uint32_t)(uint16_t)x * (uint16_t)(y >> 16);
@@ -43,7 +43,7 @@ void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
 static int fx_adc_scale(int32_t d, int32_t m, uint8_t sh, int32_t *out)
 {
     uint32_t hi, lo, add, r;
-    att_fx_uprod_(d < 0 ? 0u - (uint32_t)d : (uint32_t)d, (uint32_t)m, &hi, &lo);
+    att__fx_uprod(d < 0 ? 0u - (uint32_t)d : (uint32_t)d, (uint32_t)m, &hi, &lo);
     if (sh <= 32u) {
         add = (1ul << (sh - 1u)) - (d < 0 ? 1u : 0u);
         lo += add;
@@ -73,7 +73,7 @@ static int fx_adc_scale(int32_t d, int32_t m, uint8_t sh, int32_t *out)
 #else
 #include "fixed_prim.h"
 
-void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
+void att__fx_uprod(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo)
 {
     fx_uprod(x, y, hi, lo);
 }

@@ -20,7 +20,7 @@ static att_status fx_adc_gain(uint32_t scale_q32, uint32_t period_ns, int32_t *m
     int16_t p;
     uint8_t nb = 0, qb;
     int16_t ex;
-    att_fx_uprod_(scale_q32, period_ns, &hi, &lo);
+    att__fx_uprod(scale_q32, period_ns, &hi, &lo);
     for (p = 63; p > -80 && nb < 32u; --p) {
         if (p >= 32) {
             bit = (hi >> (uint8_t)(p - 32)) & 1u;

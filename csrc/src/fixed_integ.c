@@ -60,15 +60,15 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
         || ((method == ATT_FX_RV3 || method == ATT_FX_RV3_CONING) && n != 3u)) {
         return ATT_E_ARG;
     }
-    if (!att_fx_dtheta_ok_(d, (uint8_t)(3u * n))) {
+    if (!att__fx_dtheta_ok(d, (uint8_t)(3u * n))) {
         return (att_status)ATT_FX_E_RANGE;
     }
     switch (method) {
     case ATT_FX_RV3:
-        att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, 0, phi);
+        att__fx_phi_rv3(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, 0, phi);
         break;
     case ATT_FX_RV3_CONING:
-        att_fx_phi_rv3_(d, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, 0, phi);
+        att__fx_phi_rv3(d, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, 0, phi);
         break;
     case ATT_FX_RV2:
         fx_phi2(d, d + 3, ATT_FX_K_RV2, 1, 0, phi);
@@ -81,7 +81,7 @@ att_status att_fx_phi(att_fx_method method, const att_q30 *d, uint8_t n, att_q30
         } else if (n == 2u) {
             fx_phi2(d, d + 3, ATT_FX_K_RV3R_START, 0, 0, phi);
         } else {
-            att_fx_phi_reuse_(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, 0, phi);
+            att__fx_phi_reuse(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, 0, phi);
         }
         break;
     }
@@ -153,14 +153,14 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
         }
         t = fx_dither_seed(s->q);
         if (m == ATT_FX_RV3) {
-            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
+            att__fx_phi_rv3(s->buf, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
         } else {
-            att_fx_phi_rv3_(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
+            att__fx_phi_rv3(s->buf, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
         }
     } else if (fx_is_reuse(m)) {
         t = fx_dither_seed(s->q);
         if (s->nbuf == 2u) {
-            att_fx_phi_reuse_(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta,
+            att__fx_phi_reuse(s->buf + 3u * s->old, s->buf + 3u * (s->old ^ 1u), dtheta,
                               m == (uint8_t)ATT_FX_RV3_REUSE_POLY, t, phi);
         } else if (s->nbuf == 1u) {
             fx_phi2(s->buf, dtheta, ATT_FX_K_RV3R_START, 0, t, phi);
@@ -181,7 +181,7 @@ int att_fx_integ_update(att_fx_integ *s, const att_q30 dtheta[3], att_q30 q_out[
     } else {
         return (att_status)ATT_FX_E_METHOD;
     }
-    st = att_fx_apply_(s->q, phi, t);
+    st = att__fx_apply(s->q, phi, t);
     if (st != ATT_OK) {
         return st;
     }
@@ -250,18 +250,18 @@ att_status att_fx_integ_batch(att_fx_integ *s, const att_q30 *dtheta, size_t n, 
             att_q30 phi[3];
             uint32_t t = fx_dither_seed(s->q);
             if (s->method == ATT_FX_RV3) {
-                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
+                att__fx_phi_rv3(dtheta + 3u * i, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
             } else {
-                att_fx_phi_rv3_(dtheta + 3u * i, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
+                att__fx_phi_rv3(dtheta + 3u * i, ATT_FX_K_RV3C_13, ATT_FX_K_RV3C_23, t, phi);
             }
-            r = att_fx_apply_(s->q, phi, t);
+            r = att__fx_apply(s->q, phi, t);
             i += 3u;
         } else if (fx_is_reuse(s->method) && i >= 2u) {
             att_q30 phi[3];
             uint32_t t = fx_dither_seed(s->q);
-            att_fx_phi_reuse_(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i,
+            att__fx_phi_reuse(dtheta + 3u * (i - 2u), dtheta + 3u * (i - 1u), dtheta + 3u * i,
                               s->method == (uint8_t)ATT_FX_RV3_REUSE_POLY, t, phi);
-            r = att_fx_apply_(s->q, phi, t);
+            r = att__fx_apply(s->q, phi, t);
             if (r == ATT_OK && i + 1u == n) { /* leave the history in the state */
                 fx_copy3(s->buf, dtheta + 3u * (i - 1u));
                 fx_copy3(s->buf + 3, dtheta + 3u * i);

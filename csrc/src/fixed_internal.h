@@ -39,8 +39,8 @@
 #define FX_ROR(x, k)      ((uint32_t)(((x) >> (k)) | ((x) << (32u - (k)))))
 #define FX_DITHER30(t, k) ((t) != 0u ? FX_ROR(t, k) >> 2 : 0x20000000ul)
 
-uint32_t att_fx_dither_seed_(const att_q30 q[4]);
-#define fx_dither_seed att_fx_dither_seed_
+uint32_t att__fx_dither_seed(const att_q30 q[4]);
+#define fx_dither_seed att__fx_dither_seed
 
 /* Domain of q(Φ): |Φ|² ≤ 9.6 rad². The check forms the exact sum of
  * squares (Q4.60, unsigned, < 3·2^62), rounds it to Q.24 (shift 36) and
@@ -52,27 +52,27 @@ uint32_t att_fx_dither_seed_(const att_q30 q[4]);
     ((uint32_t)((uint32_t)(x) + (uint32_t)ATT_FX_DTHETA_MAX) > 2u * (uint32_t)ATT_FX_DTHETA_MAX)
 
 /* (hi:lo) = x · y, unsigned 32 × 32 → 64 bits (fixed_adc.c) */
-void att_fx_uprod_(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo);
+void att__fx_uprod(uint32_t x, uint32_t y, uint32_t *hi, uint32_t *lo);
 
 /* 1 if every one of the n values satisfies |x| ≤ ATT_FX_DTHETA_MAX. */
-int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n);
+int att__fx_dtheta_ok(const att_q30 *d, uint8_t n);
 
 /* Φ = Δθ1 + Δθ2 + Δθ3 + (k13 Δθ1) × Δθ3 + (k23 Δθ2) × (Δθ3 − Δθ1)
  * (three-sample form with k12 = k23), inputs checked by the caller. */
-void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3]);
+void att__fx_phi_rv3(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3]);
 
 /* Reuse forms with two previous increments: Φ = d3 + (k13 d1 + k23 d2) × d3,
  * plus (k12 d1) × d2 for the polynomial form (poly != 0); inputs checked by
  * the caller. */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+void att__fx_phi_reuse(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
                        uint32_t t, att_q30 phi[3]);
 
 /* c = cos(φ/2), s = sin(φ/2)/(φ/2) (Q2.30) for Φ with |Φ|² ≤ 9.6. */
-void att_fx_cs_(const att_q30 phi[3], int32_t *c, int32_t *s);
+void att__fx_cs(const att_q30 phi[3], int32_t *c, int32_t *s);
 
 /* Q ← Q ⊗ q(Φ) with the folded renormalization; Φ checked by the caller
  * (|Φ|² ≤ 9.6). Returns ATT_FX_E_RANGE (q untouched) if |Q|² − 1 is
  * outside ±2^-20, i.e. q was not a unit quaternion of this module. */
-att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t);
+att_status att__fx_apply(att_q30 q[4], const att_q30 phi[3], uint32_t t);
 
 #endif /* ATT_FIXED_INTERNAL_H */

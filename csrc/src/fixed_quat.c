@@ -70,7 +70,7 @@ att_status att_fx_quat_mul(const att_q30 a[4], const att_q30 b[4], att_q30 out[4
     return ATT_OK;
 }
 
-/* q(Φ) = [c, s·Φ/2]: c, s from att_fx_cs_ (Horner in v = φ²/8), vector
+/* q(Φ) = [c, s·Φ/2]: c, s from att__fx_cs (Horner in v = φ²/8), vector
  * part Q2.30 × Q2.30 → shift 31. |Φ|² > 9.6 → ATT_FX_E_RANGE. */
 att_status att_fx_rotvec_to_quat(const att_q30 phi[3], att_q30 q[4])
 {
@@ -81,7 +81,7 @@ att_status att_fx_rotvec_to_quat(const att_q30 phi[3], att_q30 q[4])
     if (!fx_phi_in_range(phi, FX_PHI2_MAX_Q24)) {
         return (att_status)ATT_FX_E_RANGE;
     }
-    att_fx_cs_(phi, &c, &s);
+    att__fx_cs(phi, &c, &s);
     q[1] = fx_mul(s, phi[0], 31);
     q[2] = fx_mul(s, phi[1], 31);
     q[3] = fx_mul(s, phi[2], 31);

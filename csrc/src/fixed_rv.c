@@ -35,7 +35,7 @@ static const int32_t fx_deg_vmax[6] = { 28378L, 2349547L, 24989211L, 113507487L,
 #endif
 
 #ifndef FX_KERNEL_ONLY
-uint32_t att_fx_dither_seed_(const att_q30 q[4])
+uint32_t att__fx_dither_seed(const att_q30 q[4])
 {
     uint32_t x = (uint32_t)q[0] ^ (uint32_t)q[1] ^ (uint32_t)q[2] ^ (uint32_t)q[3];
     x ^= x >> 16;
@@ -46,7 +46,7 @@ uint32_t att_fx_dither_seed_(const att_q30 q[4])
     return (x != 0u) ? x : 1u; /* 0 would mean "no dither" */
 }
 
-int att_fx_dtheta_ok_(const att_q30 *d, uint8_t n)
+int att__fx_dtheta_ok(const att_q30 *d, uint8_t n)
 {
     uint8_t i;
     for (i = 0; i < n; ++i) {
@@ -319,7 +319,7 @@ static void fxc_phi_rv3(void)
 }
 
 #ifndef FX_KERNEL_ONLY
-void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
+void att__fx_phi_rv3(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
 {
     fx_dp = d;
     fx_t = t;
@@ -338,7 +338,7 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
  * Φ of a reuse form from d = [Δθ1, Δθ2, Δθ3] at fx_dp (Δθ3 the newest) into
  * fxr[0..2]: Φ = Δθ3 + u × Δθ3 (+ p × Δθ2 with poly), u = k13 Δθ1 + k23 Δθ2
  * (one rounding of the exact two-term sum), p = k12 Δθ1 (the arithmetic of
- * the fast att_fx_phi_reuse_). Registers: k13, k23 in R6, R2; p to R3..R5
+ * the fast att__fx_phi_reuse). Registers: k13, k23 in R6, R2; p to R3..R5
  * (poly only); u to R0..R2 (u2 over k23 once its sum is formed); operand
  * in R7; Φ_0 goes to R6, Φ_1 over u2 (component 2 uses u0, u1, p0, p1
  * only), Φ_2 over R5. The form is kept in fx_k (0 or 4) until the
@@ -397,7 +397,7 @@ static void fxc_phi_reuse(uint8_t poly)
 #endif
 
 #ifndef FX_KERNEL_ONLY
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+void att__fx_phi_reuse(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
                        uint32_t t, att_q30 phi[3])
 {
     att_q30 w[9]; /* the three increments in one array for fx_ld7 */
@@ -455,7 +455,7 @@ static void fxc_cs(void)
 }
 
 #ifndef FX_KERNEL_ONLY
-void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
+void att__fx_cs(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
     fxr[0].s = phi[0];
     fxr[1].s = phi[1];
@@ -535,7 +535,7 @@ static att_status fxc_apply(void)
 }
 
 #ifndef FX_KERNEL_ONLY
-att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
+att_status att__fx_apply(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 {
     fxr[0].s = phi[0];
     fxr[1].s = phi[1];
@@ -560,7 +560,7 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
     if (((fxa.w.hi + 8u) >> 4) > FX_PHI2_MAX_Q24) {
         return (att_status)ATT_FX_E_RANGE;
     }
-    return att_fx_apply_(q, phi, fx_dither_seed(q));
+    return att__fx_apply(q, phi, fx_dither_seed(q));
 }
 #endif
 
@@ -628,7 +628,7 @@ att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method m
  * so no saturation is needed. Subtracted products use a negated operand
  * (one multiply-accumulate each).
  */
-void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
+void att__fx_phi_rv3(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, att_q30 phi[3])
 {
     int32_t a0, a1, a2, b0, b1, b2, w0, w1, w2, e0, e1, e2;
     fx_acc acc;
@@ -680,7 +680,7 @@ void att_fx_phi_rv3_(const att_q30 d[9], int32_t k13, int32_t k23, uint32_t t, a
  * rv3-reuse |u_i| ≤ (8/60)·0.4, |Φ_i| ≤ 0.4 + 2·0.053·0.4 < 0.45;
  * poly |u_i| ≤ (152/720)·0.4, |Φ_i| ≤ 0.4 + 2·(0.084 + 0.0006)·0.4 < 0.47.
  */
-void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
+void att__fx_phi_reuse(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d3[3], uint8_t poly,
                        uint32_t t, att_q30 phi[3])
 {
     int32_t p0 = 0, p1 = 0, p2 = 0, u0, u1, u2, k13, k23;
@@ -729,7 +729,7 @@ void att_fx_phi_reuse_(const att_q30 d1[3], const att_q30 d2[3], const att_q30 d
  *     degree from fx_deg_vmax (degree 1, v ≤ 2.6e-5 i.e. φ ≤ 0.0145 rad,
  *     is the common case and has a short path: c = 1 − v exactly).
  */
-void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
+void att__fx_cs(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 {
     fx_acc acc;
     int32_t v, c, s;
@@ -765,7 +765,7 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
 
 /*
  * Q ← Q ⊗ q(Φ), renormalization folded into q:
- *  1-2. c, s from att_fx_cs_.
+ *  1-2. c, s from att__fx_cs.
  *  3. e = |Q|² − 1: exact Q4.60 sum minus 2^60; |e| < 2^-20 is required
  *     (else ATT_FX_E_RANGE, Q untouched: Q was not a unit quaternion of
  *     this module); e/2 rounded to Q2.30 (shift 31).
@@ -784,12 +784,12 @@ void att_fx_cs_(const att_q30 phi[3], int32_t *cp, int32_t *sp)
  *     (Q2.30 × Q2.30 = Q60, doubled); the exact sum of each component is
  *     bounded by |Q||q| ≈ 2^61 and rounded once to Q2.30 (shift 31).
  */
-att_status att_fx_apply_(att_q30 q[4], const att_q30 phi[3], uint32_t t)
+att_status att__fx_apply(att_q30 q[4], const att_q30 phi[3], uint32_t t)
 {
     fx_acc acc;
     int32_t c, c2, s, e, h1, h2, h3, q0, q1, q2, q3;
 
-    att_fx_cs_(phi, &c, &s);
+    att__fx_cs(phi, &c, &s);
     q0 = q[0];
     q1 = q[1];
     q2 = q[2];
@@ -859,7 +859,7 @@ att_status att_fx_update_phi(att_q30 q[4], const att_q30 phi[3])
     }
     {
         uint32_t t = fx_dither_seed(q);
-        return att_fx_apply_(q, phi, t);
+        return att__fx_apply(q, phi, t);
     }
 }
 
@@ -875,8 +875,8 @@ att_status att_fx_update_rv3(att_q30 q[4], const att_q30 d[9])
         return (att_status)ATT_FX_E_RANGE;
     }
     t = fx_dither_seed(q);
-    att_fx_phi_rv3_(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
-    return att_fx_apply_(q, phi, t);
+    att__fx_phi_rv3(d, ATT_FX_K_RV3_13, ATT_FX_K_RV3_23, t, phi);
+    return att__fx_apply(q, phi, t);
 }
 
 att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method method)
@@ -889,12 +889,12 @@ att_status att_fx_update_reuse(att_q30 q[4], const att_q30 d[9], att_fx_method m
     if (q == 0 || d == 0) {
         return ATT_E_NULL;
     }
-    if (!att_fx_dtheta_ok_(d, 9u)) {
+    if (!att__fx_dtheta_ok(d, 9u)) {
         return (att_status)ATT_FX_E_RANGE;
     }
     t = fx_dither_seed(q);
-    att_fx_phi_reuse_(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, t, phi);
-    return att_fx_apply_(q, phi, t);
+    att__fx_phi_reuse(d, d + 3, d + 6, method == ATT_FX_RV3_REUSE_POLY, t, phi);
+    return att__fx_apply(q, phi, t);
 }
 
 #endif /* compact / fast */

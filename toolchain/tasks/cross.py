@@ -55,6 +55,11 @@ def _run(cmd: Sequence[str], verbose: bool) -> None:
                          f"{proc.stdout}{proc.stderr}")
 
 
+#: The shared library's objects: every symbol hidden but the public headers'
+#: declarations (ATT_API_BEGIN/END, attitude/common.h), as make and CMake do.
+HIDDEN = ["-fvisibility=hidden"]
+
+
 class BuildError(RuntimeError):
     pass
 
@@ -124,7 +129,7 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
     products["static"] = lib
 
     if t.shared and t.kind == "gcc":
-        pobjs = _compile_all(t, srcs, out / "obj-pic", t.pic_flags, defines, verbose)
+        pobjs = _compile_all(t, srcs, out / "obj-pic", [*t.pic_flags, *HIDDEN], defines, verbose)
         real = out / f"libattitude.so.{version()}"
         _run(shared_link_cmd(t, pobjs, real), verbose)
         for link in (f"libattitude.so.{SOVERSION}", "libattitude.so"):

@@ -60,6 +60,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Sizes and special values. */
 enum {
     AD7927_CHANNELS = 8,     /* analog inputs VIN0..VIN7 */
@@ -229,5 +231,7 @@ int ad7927_power_down(ad7927 *dev);
 /* The 16-bit DIN word of a control write (WRITE = 1), for HAL tests and
  * transcripts: (AD7927_CR_WRITE | bits) << AD7927_DIN_SHIFT. */
 uint16_t ad7927_din_word(uint16_t control_bits);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AD7927_H */

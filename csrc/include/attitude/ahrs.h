@@ -52,6 +52,8 @@
 #include "attitude/common.h"
 #include "attitude/integrator.h"
 
+ATT_API_BEGIN
+
 /* Attitude-filter status codes (range -140..-159). */
 enum {
     ATT_E_AHRS_DT = -140,       /* time step not finite or ≤ 0 */
@@ -274,5 +276,7 @@ att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bia
 
 /* ATT_AHRS_F_* of the last update (0 when s is NULL). */
 int att_ahrs_flags(const att_ahrs *s);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AHRS_H */

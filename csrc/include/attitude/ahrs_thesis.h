@@ -48,6 +48,8 @@
 #include "attitude/aiding.h"
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Status codes of the thesis EKF (range -150..-159 of the filter's). */
 enum {
     ATT_E_TEKF_DT = -150,       /* time step not finite or ≤ 0 */
@@ -139,5 +141,7 @@ unsigned long att_tekf_gn_skipped(const att_tekf *s);
 
 /* ATT_TEKF_F_* of the last update (0 when s is NULL). */
 int att_tekf_flags(const att_tekf *s);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AHRS_THESIS_H */

@@ -29,6 +29,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Aiding status codes (range -120..-139). */
 enum {
     ATT_AID_E_ZERO_F = -120,   /* specific force zero (below 1e-30 in norm): no up direction */
@@ -191,7 +193,10 @@ att_status att_align_window_solve(const att_align_window *w, att_real q[4]);
  * cond(J) > 1/singular_tol).
  *
  * Accuracy (noise-free, warm start within 0.3 rad, double): the truth to
- * < 1e-12 rad in ≤ 6 iterations (tests/test_aiding.py); never non-finite. */
+ * < 1e-12 rad in ≤ 6 iterations (tests/test_aiding.py); never non-finite.
+ * Without a start (q0 NULL) TRIAD's attitude, an exact root of r (the
+ * gravity direction matched, the field in the up/north plane), is the
+ * start: every well-posed sample converges, noisy or not. */
 typedef enum {
     ATT_GN_GAUSS_NEWTON = 0, /* Jacobian at every iterate (eq. 3.39), damped */
     ATT_GN_SIMPLIFIED = 1    /* Jacobian of the start only (eq. 3.40), damped */
@@ -219,7 +224,8 @@ typedef struct {
 void att_gn_defaults(att_gn_settings *s);
 
 /* Solve for q from f_b and m_b (both required; any units), starting at
- * q0 (body → true nav; any nonzero scale; NULL: identity), settings s
+ * q0 (body → true nav; any nonzero scale; NULL: the TRIAD attitude of
+ * f_b and m_b, att_triad, from which every well-posed sample converges), settings s
  * (NULL: the defaults). r (may be NULL) is written whatever the status
  * (except ATT_E_NULL/ATT_E_ARG/ATT_E_NONFINITE). Status: ATT_E_NULL,
  * ATT_E_NONFINITE, ATT_E_ARG (bad settings, |D| > π, q0 zero),
@@ -228,7 +234,7 @@ void att_gn_defaults(att_gn_settings *s);
 att_status att_gn_solve(const att_real f_b[3], const att_real m_b[3], att_real declination_rad,
                         const att_real q0[4], const att_gn_settings *s, att_real q[4], att_gn_result *r);
 
-/* Batch form (as att_triad_n): q0 n starts (NULL: identity), per-record
+/* Batch form (as att_triad_n): q0 n starts (NULL: TRIAD's), per-record
  * iterations and final |r| (each may be NULL; written for every record
  * whose inputs were valid, see att_gn_solve). */
 att_status att_gn_solve_n(const att_real *f_b, const att_real *m_b, att_real declination_rad,
@@ -341,5 +347,7 @@ att_status att_magcal2d_add(att_magcal2d *c, const att_real m[3]);
 /* ATT_E_NULL, ATT_AID_E_FEW (fewer than 3 samples), ATT_AID_E_SPAN (an
  * axis with no range). */
 att_status att_magcal2d_solve(const att_magcal2d *c, att_magcal_result *r);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AIDING_H */

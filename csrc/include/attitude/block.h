@@ -153,6 +153,8 @@
 #include "attitude/common.h"
 #include "attitude/link.h"
 
+ATT_API_BEGIN
+
 /* Format constants. */
 enum {
     ATT_BLOCK_SIZE = 6,            /* bytes of one record (= ATT_LINK_BLOCK_DEFAULT) */
@@ -350,5 +352,7 @@ int att_block_seq_feed(att_block_seq *s, const att_block *b, att_block_span *spa
  * ATT_BLOCK_E_FIELD (as att_block_decode; not placed, the stream is
  * unchanged) or ATT_BLOCK_E_SEQ (as att_block_seq_feed). */
 int att_block_seq_decode(att_block_seq *s, const uint8_t *raw, att_block *out, att_block_span *span);
+
+ATT_API_END
 
 #endif /* ATTITUDE_BLOCK_H */

@@ -22,6 +22,22 @@
 #include <stdint.h>
 #endif
 
+/* Exported symbols. The library's shared objects are compiled with
+ * -fvisibility=hidden (invoke cross-build, make, CMake, the Python
+ * extension): a function is exported only when a public header of this
+ * directory declares it between ATT_API_BEGIN and ATT_API_END (at the top
+ * and bottom of each header). Internals (att__NAME, declared in the
+ * internal headers of csrc/src) stay hidden. ATT_NO_EXPORT exports none of the
+ * library (a build that embeds it in another shared object: the Python
+ * extension). SDCC and CFFI's cdef see empty macros. */
+#if defined(__GNUC__) && !defined(__SDCC) && !defined(ATT_CDEF) && !defined(ATT_NO_EXPORT)
+#define ATT_API_BEGIN _Pragma("GCC visibility push(default)")
+#define ATT_API_END   _Pragma("GCC visibility pop")
+#else
+#define ATT_API_BEGIN
+#define ATT_API_END
+#endif
+
 /* SDCC has no double (it warns and uses float): the 8051 build is float. */
 #if defined(ATT_REAL_F32) || defined(__SDCC)
 typedef float att_real;
@@ -51,6 +67,8 @@ enum {
 };
 typedef int att_status;
 
+ATT_API_BEGIN
+
 /* Short English description of a status code (static storage): every code
  * of every module's header has its own, distinct text (csrc/src/common.c,
  * one table); "unknown status" for any other value. Never NULL. */
@@ -58,5 +76,7 @@ const char *att_status_str(int status);
 
 /* Size of att_real in bytes in this build (4 = float, 8 = double). */
 int att_real_size(void);
+
+ATT_API_END
 
 #endif /* ATTITUDE_COMMON_H */

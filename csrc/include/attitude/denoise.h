@@ -64,6 +64,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Wavelets (Daubechies, extremal phase; names as in PyWavelets). */
 typedef enum {
     ATT_WDEN_HAAR = 0, /* 2 taps, 1 vanishing moment (= db1) */
@@ -246,5 +248,7 @@ int att_wden_flush(att_wden *s, att_real *out, size_t out_cap, size_t *n_out);
 #define ATT_WDEN_SCRATCH_LEN(block)         (2 * (block))
 #define ATT_WDEN_LATENCY(block, edge_start) ((block)-1 - (edge_start))
 #endif
+
+ATT_API_END
 
 #endif /* ATTITUDE_DENOISE_H */

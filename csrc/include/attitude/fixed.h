@@ -51,6 +51,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 typedef int32_t att_q30; /* Q2.30 */
 typedef int32_t att_q28; /* Q4.28 */
 
@@ -233,5 +235,7 @@ att_status att_fx_adc_init(att_fx_adc *a, const int32_t zero_q8[3], const uint32
  * nearest (one rounding of an exact 64-bit product). |Δθ_i| >
  * ATT_FX_DTHETA_MAX → ATT_FX_E_RANGE (dtheta untouched). code_i ≤ 65535. */
 att_status att_fx_adc_convert(const att_fx_adc *a, const uint16_t code[3], att_q30 dtheta[3]);
+
+ATT_API_END
 
 #endif /* ATTITUDE_FIXED_H */

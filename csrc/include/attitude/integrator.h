@@ -22,6 +22,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Integration methods. The numbers are part of the ABI (Python, the
  * fixed-point port and attitude-rx map names to them): new methods are
  * appended. */
@@ -178,5 +180,7 @@ att_status att_integ_batch(att_integ *s, const att_real *dtheta, size_t n, att_r
  * earlier call). */
 att_status att_integ_rk4_batch(att_integ *s, const att_real *omega, size_t n, const att_real *h, size_t n_h,
                                att_real *q_out, size_t *n_out, size_t *err_index);
+
+ATT_API_END
 
 #endif /* ATTITUDE_INTEGRATOR_H */

@@ -31,6 +31,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Memory space of the sender's state, block and output byte: on the
  * 8051 (SDCC) they live in internal RAM (the small model's default), so
  * 1-byte __data pointers replace 3-byte generic ones -- this divides the
@@ -199,5 +201,7 @@ uint16_t att_link_receiver_ticks_left(const att_link_receiver *r, uint16_t now);
 
 /* Sum of n bytes modulo 256 (the protocol's checksum). */
 uint8_t att_link_checksum(const uint8_t *data, uint8_t n);
+
+ATT_API_END
 
 #endif /* ATTITUDE_LINK_H */

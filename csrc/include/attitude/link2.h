@@ -82,6 +82,8 @@
 #include "attitude/common.h"
 #include "attitude/link.h" /* ATT_LINK_MEM */
 
+ATT_API_BEGIN
+
 /* Protocol constants. */
 enum {
     ATT_LINK2_DELIM = 0x00,     /* frame delimiter on the wire */
@@ -398,5 +400,7 @@ uint32_t att_link2_crc_byte(uint32_t reg, uint8_t byte);
 
 /* CRC-32C of n bytes (check value of "123456789": 0xE3069283). */
 uint32_t att_link2_crc(const uint8_t *data, uint16_t n);
+
+ATT_API_END
 
 #endif /* ATTITUDE_LINK2_H */

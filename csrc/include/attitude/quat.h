@@ -26,6 +26,8 @@
 
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 /* Orthogonality tolerance of att_dcm_to_quat, in millionths (0.01). */
 enum {
     ATT_DCM_ORTHO_TOL_PPM = 10000
@@ -114,5 +116,7 @@ att_status att_quat_to_euler_n(const att_real *q, att_real *e, size_t n, size_t 
 att_status att_euler_to_quat_n(const att_real *e, att_real *q, size_t n, size_t *err_index);
 att_status att_quat_heading_n(const att_real *q, att_real *heading, size_t n, size_t *err_index);
 att_status att_dcm_heading_n(const att_real *C, att_real *heading, size_t n, size_t *err_index);
+
+ATT_API_END
 
 #endif /* ATTITUDE_QUAT_H */

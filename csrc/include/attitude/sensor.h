@@ -57,6 +57,8 @@
 #include "attitude/block.h"
 #include "attitude/common.h"
 
+ATT_API_BEGIN
+
 enum {
     ATT_SENSOR_ZERO_MAX = 65535, /* largest zero reading (codes) */
     ATT_SENSOR_DET_RECIP = 1000  /* a correction needs |det M| ≥ 1/1000: a misalignment, scale-factor
@@ -99,5 +101,7 @@ att_status att_sensor_convert(const att_sensor *s, const uint16_t words[3], uint
  * increment is written. */
 att_status att_sensor_increments(const att_sensor *s, const uint16_t *words, size_t m, uint8_t n,
                                  att_real period, att_real *dtheta, size_t *err_index);
+
+ATT_API_END
 
 #endif /* ATTITUDE_SENSOR_H */

@@ -44,6 +44,8 @@
 #include "attitude/common.h"
 #include "attitude/tlc2543_hal.h"
 
+ATT_API_BEGIN
+
 /* Input byte fields and addresses (datasheet "input data byte"). */
 enum {
     TLC2543_CH_X = 0,        /* board wiring: gyro X on AIN0 */
@@ -146,5 +148,7 @@ int16_t tlc2543_signed(const tlc2543 TLC2543_DATA *dev, uint16_t word) TLC2543_C
 
 /* Number of I/O clocks of one cycle in the configured mode (8, 12, 16). */
 uint8_t tlc2543_clocks(const tlc2543 TLC2543_DATA *dev) TLC2543_COLD;
+
+ATT_API_END
 
 #endif /* ATTITUDE_TLC2543_H */

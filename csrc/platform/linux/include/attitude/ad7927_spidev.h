@@ -36,6 +36,8 @@
 
 #include "attitude/ad7927.h"
 
+ATT_API_BEGIN
+
 /* SCLK limits of the AD7927 (datasheet f_SCLK). */
 enum {
     AD7927_SPIDEV_HZ_MIN = 10000,   /* 10 kHz */
@@ -82,5 +84,7 @@ int ad7927_spidev_close(ad7927_spidev *s);
 /* The ad7927_hal.transfer of this HAL (ctx = the ad7927_spidev). Returns 0,
  * or -1 with s->last_errno (EIO on a short transfer). */
 int ad7927_spidev_transfer(void *ctx, const uint16_t *tx, uint16_t *rx, uint8_t n, uint32_t hold_ns);
+
+ATT_API_END
 
 #endif /* ATTITUDE_AD7927_SPIDEV_H */
