@@ -19,6 +19,8 @@ ns = Collection(
     link.fuzz,
     sim.sim,
     sim.sim_acceptance,
+    sim.allan_settings,
+    sim.allan_sweep,
     sweep.sweep,
     view.view_soak,
     view.view_soak_clients,

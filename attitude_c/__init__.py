@@ -78,3 +78,9 @@ __all__ += ["aiding_delay"]
 from .thesis_ekf import ahrs_thesis
 
 __all__ += ["ahrs_thesis"]
+
+# Noise identification (docs/noise.md): the Allan deviation of a rest recording, its noise terms
+# and the filter settings they give (needs allantools: pip install 'attitude-c[noise]').
+from .noise import allan
+
+__all__ += ["allan"]

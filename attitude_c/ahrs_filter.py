@@ -48,7 +48,7 @@ def _method(name: str, v: Any) -> int:
 _SPEC = _settings.SettingsSpec(
     "att_ahrs_settings", "att_ahrs_default_settings", "att_ahrs_check_settings", label="filter",
     domain="ahrs.h: noises and times > 0, '0 = off' fields ≥ 0, |sensor_delay| ≤ 1 s, "
-    "|acc_delay|, |mag_delay| ≤ 0.05 s",
+    "|acc_delay|, |mag_delay| ≤ 0.05 s, 0 ≤ mag_ref_window ≤ mag_ref_tau",
     choices={"method": _settings.Choice(_method, lambda code: names.method_names()[code])},
     field_fn="att_ahrs_check_settings_field")
 

@@ -29,8 +29,8 @@ F = NDArray[np.float64]
 _DEFAULTS: dict[str, Any] = {
     "method": "rv3-reuse", "gravity": 9.81, "gyr_noise": 0.01, "gyr_noise_rest": 0.002,
     "bias_noise": 1e-4, "init_att_sigma": 0.1, "init_bias_sigma": 0.01, "acc_tau": 2.0, "acc_noise": 0.025,
-    "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.05, "mag_norm_tol": 0.05,
-    "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
+    "acc_gate": 0.2, "acc_reject_max": 3.0, "mag_noise": 0.1, "mag_norm_tol": 0.08,
+    "mag_dip_tol": 0.17, "mag_ref_tau": 30.0, "mag_ref_window": 5.0, "mag_reject_max": 60.0, "mag_reject_factor": 2.0,
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
@@ -137,7 +137,9 @@ class ReferenceAhrs:
         self.acc_norm_lp = 0.0
         self.acc_rej = 0.0
         self.mag_ref: F | None = None
+        self.mag_ref_w = 0.0  # the weight (s) each field estimate holds
         self.mag_cand = np.zeros(2)
+        self.mag_cand_w = 0.0
         self.mag_cand_t = 0.0
         self.mag_undist = 0.0
         self.mag_rej = 0.0
@@ -171,6 +173,59 @@ class ReferenceAhrs:
         x += K * (y - float((H @ x)[0]))
         A = np.eye(6) - np.outer(K, H[0])
         self.P = A @ self.P @ A.T + R * np.outer(K, K)
+
+    # -- the magnetic reference ---------------------------------------------
+    def _agrees(self, est: F, cur: F) -> bool:
+        s = self.s
+        return bool(abs(cur[0] - est[0]) <= s["mag_norm_tol"] * est[0] and abs(cur[1] - est[1]) <= s["mag_dip_tol"])
+
+    def _weight(self, dt: float) -> float:
+        """A field sample's weight: dt times the share its dip keeps of the information
+        when the inclination's variance P_xx + P_yy adds to the variance (mag_dip_tol/2)²."""
+        v = (self.s["mag_dip_tol"] / 2) ** 2
+        return dt * v / (v + self.P[0, 0] + self.P[1, 1])
+
+    def _learn(self, est: F, weight: float, cur: F, w: float) -> tuple[F, float]:
+        """Weighted running mean of (norm, dip) whose weight stops growing at mag_ref_tau."""
+        total = min(weight + w, self.s["mag_ref_tau"])
+        return est + (w / total) * (cur - est), total
+
+    def _mag_reference(self, cur: F, gyr: F, dt: float) -> tuple[bool, float, int]:
+        """The reference and candidate against one field sample cur = (norm, dip): (use it, its R, flags)."""
+        s = self.s
+        R = s["mag_noise"] ** 2 / dt
+        w = self._weight(dt)
+        if self.mag_ref is None:  # the first sample starts both
+            self.mag_ref, self.mag_ref_w = cur.copy(), w
+            self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
+            self.mag_undist = s["mag_min_undisturbed"]
+        elif self._agrees(self.mag_cand, cur):
+            self.mag_cand, self.mag_cand_w = self._learn(self.mag_cand, self.mag_cand_w, cur, w)
+            if float(np.sum(gyr * gyr)) >= s["mag_new_gyr"] ** 2:
+                self.mag_cand_t += dt
+        else:
+            self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
+        if self._agrees(self.mag_ref, cur):
+            self.mag_ref, self.mag_ref_w = self._learn(self.mag_ref, self.mag_ref_w, cur, w)
+            self.mag_undist += dt
+            if self.mag_undist >= s["mag_min_undisturbed"]:
+                self.mag_rej = 0.0
+                return True, R, 0
+            self.mag_rej += dt
+            return False, R, 8
+        if self.mag_ref_w < s["mag_ref_window"]:  # not established yet: it starts again here
+            self.mag_ref, self.mag_ref_w = cur.copy(), w
+            self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            return True, R, 0
+        if self.mag_cand_t >= s["mag_new_time"]:  # a new homogeneous field
+            self.mag_ref, self.mag_ref_w = self.mag_cand.copy(), self.mag_cand_w
+            self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            return True, R, 16
+        self.mag_undist = 0.0
+        self.mag_rej += dt
+        if self.mag_rej >= s["mag_reject_max"]:  # bounded rejection: weak updates
+            return True, R * s["mag_reject_factor"] ** 2, 8
+        return False, R, 8
 
     # -- one sample --------------------------------------------------------
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: float) -> F:
@@ -262,44 +317,8 @@ class ReferenceAhrs:
             h = math.hypot(mn[0], mn[1])
             if h > 0:
                 cur = np.array([float(np.linalg.norm(mn)), math.atan2(-mn[2], h)])
-                if self.P[0, 0] + self.P[1, 1] > (s["mag_dip_tol"] / 2) ** 2:
-                    self.mag_ref = None  # inclination too uncertain to learn the dip from
-                if self.mag_ref is None:
-                    self.mag_ref, self.mag_cand = cur.copy(), cur.copy()
-                    self.mag_undist = s["mag_min_undisturbed"]
-
-                def near(r: F) -> bool:
-                    return bool(abs(cur[0] - r[0]) <= s["mag_norm_tol"] * r[0]
-                                and abs(cur[1] - r[1]) <= s["mag_dip_tol"])
-
-                kr = dt / (s["mag_ref_tau"] + dt)
-                if near(self.mag_cand):
-                    self.mag_cand = self.mag_cand + kr * (cur - self.mag_cand)
-                    if float(np.sum(w * w)) >= s["mag_new_gyr"] ** 2:
-                        self.mag_cand_t += dt
-                else:
-                    self.mag_cand, self.mag_cand_t = cur.copy(), 0.0
-                R = s["mag_noise"] ** 2 / dt
-                use = False
-                if near(self.mag_ref):
-                    self.mag_ref = self.mag_ref + kr * (cur - self.mag_ref)
-                    self.mag_undist += dt
-                    if self.mag_undist >= s["mag_min_undisturbed"]:
-                        self.mag_rej, use = 0.0, True
-                    else:
-                        flags |= 8
-                        self.mag_rej += dt
-                elif self.mag_cand_t >= s["mag_new_time"]:
-                    self.mag_ref = self.mag_cand.copy()
-                    self.mag_rej, self.mag_undist, use = 0.0, s["mag_min_undisturbed"], True
-                    flags |= 16
-                else:
-                    self.mag_undist = 0.0
-                    flags |= 8
-                    self.mag_rej += dt
-                    if self.mag_rej >= s["mag_reject_max"]:
-                        R *= s["mag_reject_factor"] ** 2
-                        use = True
+                use, R, mflags = self._mag_reference(cur, w, dt)  # w: the gyro sample
+                flags |= mflags
                 if use:
                     yh = math.atan2(mn[0], mn[1]) - s["declination"]
                     yh = (yh + math.pi) % (2 * math.pi) - math.pi

@@ -10,7 +10,8 @@ trials (all, undisturbed, disturbed).
 Filters, all on the same trials in one run, each started from its own
 first second at most (no filter is given the reference attitude); every
 peer runs with its published default gains/noises — none is tuned on
-BROAD, and neither is ours beyond the frozen defaults (chosen once by the
+BROAD, and neither is ours beyond the frozen defaults (the magnetic settings
+chosen leave one trial out by ``bench/broad_loo.py``, the others once by the
 coordinate descent below; the cross-validated table shows what tuning on
 held-out trials would give):
 
@@ -315,6 +316,27 @@ def cross_validate(trials: list[Any], rounds: int) -> tuple[list[tuple[str, dict
     return rows, broad.mean_figures(held)["total"]
 
 
+def ratio_lines(trials: list[Any], figs: dict[str, list[Any]]) -> list[str]:
+    """This filter's per-trial total error as a ratio to VQF's: each group's mean beside VQF's and the
+    distribution (min / median / max, trials above 1.5×)."""
+    import statistics
+
+    r = np.array([a.total / b.total for a, b in zip(figs["attitude_c f64"], figs["VQF"])])
+    out = ["\n**Per-trial ratio to VQF** (total error, attitude_c f64 / VQF):\n",
+           "| group | trials | attitude_c f64 mean total | VQF mean total | ratio min / median / max | above 1.5× |",
+           "|---|---|---|---|---|---|"]
+    for g in ("all", "undisturbed", "disturbed"):
+        sel = [i for i, t in enumerate(trials) if g == "all" or (t.disturbed == (g == "disturbed"))]
+        if not sel:
+            continue
+        rs = r[sel]
+        above = ", ".join(trials[i].name[:2] for i in sel if r[i] > 1.5) or "none"
+        out.append(f"| {g} | {len(sel)} | {np.mean([figs['attitude_c f64'][i].total for i in sel]):.3f} | "
+                   f"{np.mean([figs['VQF'][i].total for i in sel]):.3f} | {rs.min():.2f} / "
+                   f"{statistics.median(rs):.2f} / {rs.max():.2f} | {above} |")
+    return out
+
+
 # -- cost -----------------------------------------------------------------------------------
 
 def armv4t_counts(delays: bool = False, precisions: tuple[str, ...] = ("f32", "f64")) -> list[tuple[str, float]]:
@@ -529,6 +551,8 @@ def run(quick: bool = False, timing: bool = True, cv: bool = True, data: str | N
         out.append(f"| {g} | " + " | ".join(
             f"{gm[k][g]['total']:.3f} / {gm[k][g]['heading']:.3f} / {gm[k][g]['inclination']:.3f}"
             for k in keys) + " |")
+    if "VQF" in figs:
+        out.extend(ratio_lines(trials, figs))
     if "attitude_c f32" in qs:
         d = max(abs(a.total - b.total) for a, b in zip(figs["attitude_c f64"], figs["attitude_c f32"]))
         ang = max(float(np.degrees(np.max(broad.error_angles(a, b)[0])))

@@ -18,9 +18,10 @@ the shortened runs guard against regressions at the targets' thresholds."""
 
 from __future__ import annotations
 
-from toolchain.ahrs_acceptance import SHORT, TARGETS, bias_step, disturbance, static, turntable
-
 import pytest
+
+from toolchain.ahrs_acceptance import SHORT, TARGETS, bias_step, disturbance, run, static, turntable
+from toolchain.allan_settings import derived
 
 pytestmark = pytest.mark.system  # runs the simulator's acceptance scenarios
 
@@ -59,3 +60,18 @@ def test_magnetic_disturbance_is_rejected() -> None:
     assert f.values["disturbance_tilt_deg"] <= TARGETS["disturbance_tilt_deg"][0], f.info
     assert f.values["disturbance_heading_deg"] <= TARGETS["disturbance_heading_deg"][0], f.info
     assert f.info["mag_rejected_fraction"] > 0.3  # the 30 s were rejected, not absorbed: 30 of 90 s
+
+
+def test_settings_from_the_allan_deviation_pass() -> None:
+    """The filter's noise settings derived from a rest recording of the same system
+    (attitude_c.noise.filter_settings; 10 min of another seed here, 2 h in `invoke
+    allan-settings`) meet every target the defaults meet (docs/noise.md has the figures
+    side by side: the bias step is learnt 13× better; the static tilt is 12 % worse in the
+    shortened run, 18 % better at full length)."""
+    from attitude_c.ahrs_filter import default_settings
+
+    settings, _, _ = derived(duration=600.0)
+    assert settings["gyr_noise_rest"] < default_settings()["gyr_noise_rest"] / 10  # the sensor's, not the default
+    for f in run(SHORT, 0, settings).values():
+        for k, v in f.values.items():
+            assert v <= TARGETS[k][0], (k, v, f.info)

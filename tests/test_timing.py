@@ -107,10 +107,12 @@ def test_compensated_filter_beats_the_uncompensated_one():
     e1 = np.degrees(ref.quat_angle(ahrs(gyr, acc, mag, rate=RATE, acc_delay=d_acc + 0.5 / RATE,
                                         mag_delay=d_mag + 0.5 / RATE), qh))[late].mean()
     # uncompensated, the lags turn the aiding vectors by |ω|·d (up to 1.7 rad/s × 18 ms ≈ 1.7°)
-    # and the filter follows them part-way (0.41° mean here); compensated, what is left is the
+    # and the filter follows them part-way (0.42° mean here); compensated, what is left is the
     # series' truncation |θ|³/6 ≤ 5e-6 rad and the filter's own dynamic error on this motion
-    # (0.014° here): a tenth of the uncompensated error is a bound with margin both ways
-    assert e0 > 0.2 and e1 < 0.1 * e0
+    # (0.048° here, nearly all heading: the integration error the heading update removes with
+    # its 10 s time constant; 0.014° with a 5 s one): a fifth of the uncompensated error is a
+    # bound with margin both ways
+    assert e0 > 0.2 and e1 < 0.2 * e0
 
 
 def test_exported():

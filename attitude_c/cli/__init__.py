@@ -23,7 +23,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any, NoReturn
 
-from . import ahrs, calibrate, demo, link, simulate, sweep, view
+from . import ahrs, allan, calibrate, demo, link, simulate, sweep, view
 
 
 class _VersionAction(argparse.Action):
@@ -86,7 +86,7 @@ def _quiet_stdout(stream: Any) -> None:
 
 
 # The subcommand modules, in the order their commands are listed.
-_MODULES = (simulate, sweep, link, demo, view, ahrs, calibrate)
+_MODULES = (simulate, sweep, link, demo, view, ahrs, allan, calibrate)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -45,7 +45,7 @@ import argparse
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -74,10 +74,26 @@ def _axes(text: str) -> str:
     return text.lower()
 
 
-def register(sub: Any) -> None:
+def add_csv_options(p: Any, names: str) -> None:
+    """The options of a CSV recording (``attitude ahrs``, ``attitude allan``): --rate,
+    --columns (``names``: the columns the command reads), the sensors' units and --axes."""
     from ..frames import AXES_PRESETS
     from ..recording import UNITS
 
+    p.add_argument("--rate", type=positive("--rate"), default=None, help="sampling rate, Hz (CSV without a t column)")
+    p.add_argument("--columns", action="append", default=[], metavar="NAME=HEADER[,NAME=HEADER...]",
+                   help=f"CSV: the file's column for a name ({names})")
+    for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
+        units = tuple(UNITS[sensor])
+        p.add_argument(f"--{sensor}-unit", choices=units, default=None,
+                       help=f"CSV: the {what}'s unit (default {units[0]})")
+    p.add_argument("--axes", type=_axes, default="rfu", metavar="XYZ",
+                   help="CSV: where the IMU's x, y, z axes point, letters of r l f b u d (right, left, forward, "
+                   "back, up, down): " + "; ".join(f"{k} = {v}" for k, v in AXES_PRESETS.items())
+                   + " (default rfu)")
+
+
+def register(sub: Any) -> None:
     p = sub.add_parser(
         "ahrs", help="run the attitude filter (gyro + accelerometer + magnetometer) on a recording",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -87,21 +103,11 @@ def register(sub: Any) -> None:
     p.add_argument("file", metavar="FILE", help="BROAD trial (.mat) or CSV with a header")
     p.add_argument("--out", metavar="DIR", default=None,
                    help="output folder (default: results/ahrs-<file stem>)")
-    p.add_argument("--rate", type=positive("--rate"), default=None, help="sampling rate, Hz (CSV without a t column)")
     p.add_argument("--precision", choices=("f64", "f32"), default="f64")
     p.add_argument("--six-axis", action="store_true", help="ignore the magnetometer")
     p.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
                    help="a filter setting (docs/ahrs.md), e.g. --set acc_tau=3 --set method=rv1")
-    p.add_argument("--columns", action="append", default=[], metavar="NAME=HEADER[,NAME=HEADER...]",
-                   help="CSV: the file's column for a name (t gx gy gz ax ay az mx my mz qw qx qy qz)")
-    for sensor, what in (("gyr", "gyro"), ("acc", "accelerometer"), ("mag", "magnetometer")):
-        units = tuple(UNITS[sensor])
-        p.add_argument(f"--{sensor}-unit", choices=units, default=None,
-                       help=f"CSV: the {what}'s unit (default {units[0]})")
-    p.add_argument("--axes", type=_axes, default="rfu", metavar="XYZ",
-                   help="CSV: where the IMU's x, y, z axes point, letters of r l f b u d (right, left, forward, "
-                   "back, up, down): " + "; ".join(f"{k} = {v}" for k, v in AXES_PRESETS.items())
-                   + " (default rfu)")
+    add_csv_options(p, "t gx gy gz ax ay az mx my mz qw qx qy qz")
     p.add_argument("--euler", choices=("zxy", "zyx"), default="zxy",
                    help="Euler sequence of the output: zxy the library's (default), zyx aerospace yaw-pitch-roll")
     p.add_argument("--estimate-mag-delay", action="store_true",
@@ -158,18 +164,26 @@ def _read(path: Path, args: argparse.Namespace) -> tuple[Any, np.ndarray | None]
     return rec, tr.movement
 
 
-def main(args: argparse.Namespace) -> int:
+def guarded(prog: str, body: Callable[[argparse.Namespace], int], args: argparse.Namespace) -> int:
+    """``body(args)``, with a user mistake, a missing package or an OS error reported as its
+    one line and exit status (EXIT_USAGE, EXIT_MISSING, EXIT_IO); also ``attitude allan``'s."""
     from ..errors import AttitudeError
     from . import fail, os_error_line
 
     try:
-        return _main(args)
+        return body(args)
     except (_Usage, AttitudeError, ValueError, TypeError) as exc:
-        return fail(PROG, str(exc), EXIT_USAGE)
+        return fail(prog, str(exc), EXIT_USAGE)
     except ImportError as exc:  # the message names what to install
-        return fail(PROG, str(exc), EXIT_MISSING)
+        return fail(prog, str(exc), EXIT_MISSING)
     except OSError as exc:
-        return fail(PROG, os_error_line(exc), EXIT_IO)
+        if getattr(sys.stdout, "failed", None) is exc:  # stdout itself: the command's caller reports it
+            raise
+        return fail(prog, os_error_line(exc), EXIT_IO)
+
+
+def main(args: argparse.Namespace) -> int:
+    return guarded(PROG, _main, args)
 
 
 def _run(rec: Any, mag: np.ndarray | None, precision: str,

@@ -279,7 +279,7 @@ def merged_config(old: str, configs: list[sensorcal.SensorConfig]) -> str:
                 placed.add(c.prefix)
     for c in configs:
         if c.prefix not in placed:
-            out.extend(["# attitude calibrate", *c.lines()])
+            out.extend([getattr(c, "comment", "# attitude calibrate"), *c.lines()])
     return "\n".join(out) + "\n"
 
 

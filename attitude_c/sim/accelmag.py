@@ -61,9 +61,12 @@ __all__ = [
     "VectorSensorModel",
     "accel_preset",
     "ar1",
+    "drift",
     "filtered",
+    "flicker",
     "mag_preset",
     "markov",
+    "random_walk",
     "white_noise",
 ]
 
@@ -97,7 +100,9 @@ class VectorSensorModel:
     ``bias_sigma`` 1σ turn-on bias per axis (units); ``scale_sigma`` 1σ
     scale-factor error (fraction); ``misalignment_sigma`` 1σ of each
     off-diagonal element of M (rad); ``markov_sigma``, ``markov_tau``
-    first-order Markov bias (units, s; σ = 0: none); ``output`` analog
+    first-order Markov bias (units, s; σ = 0: none); ``bias_instability``
+    flicker bias B (units: Allan deviation floor 0.664 B) and ``random_walk``
+    bias random walk K (units/√s), 0: none (docs/noise.md); ``output`` analog
     (``null_v`` + ``scale_v`` V per unit) or digital (``lsb`` units per count,
     None: not quantized); ``sources``: where each figure comes from.
     """
@@ -112,6 +117,8 @@ class VectorSensorModel:
     misalignment_sigma: float
     markov_sigma: float = 0.0
     markov_tau: float = 100.0
+    bias_instability: float = 0.0
+    random_walk: float = 0.0
     output: Output = "digital"
     lsb: float | None = None
     scale_v: float = 0.0
@@ -124,7 +131,7 @@ class VectorSensorModel:
         if self.output not in get_args(Output):
             raise InvalidArgument(f"output must be one of {get_args(Output)}, got {self.output!r}")
         for nm in ("range", "noise_density", "bias_sigma", "scale_sigma", "misalignment_sigma",
-                   "markov_sigma", "markov_tau", "null_v", "scale_v"):
+                   "markov_sigma", "markov_tau", "bias_instability", "random_walk", "null_v", "scale_v"):
             v = getattr(self, nm)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise InvalidArgument(f"{self.name}: {nm} must be a finite number >= 0, got {v!r}")
@@ -295,6 +302,42 @@ def white_noise(n: int, dt: float, density: float, bandwidth_hz: float | None,
     return ar1(e, a, sigma * math.sqrt(1 - a * a), e[0] * sigma)
 
 
+def flicker(n: int, dt: float, b: float, rng: np.random.Generator) -> np.ndarray:
+    """(n, 3) flicker (1/f) noise of bias-instability coefficient ``b`` (units)
+    sampled every dt: two-sided PSD ``S(f) = b²/(2π f)`` (IEEE Std 952, annex C),
+    whose Allan deviation is flat at ``b·√(2 ln 2/π) = 0.664 b``. Spectral
+    synthesis over 4n samples (Gaussian Fourier coefficients of variance
+    ``S(f_k)·M/dt``, no DC), of which the first n are kept: the lowest
+    frequency 1/(4 n dt) keeps the plateau within 1.4 % up to τ = n·dt/4."""
+    if b == 0 or n == 0:
+        return np.zeros((n, 3))
+    m = 1 << max(2, (4 * n - 1).bit_length())
+    f = np.fft.rfftfreq(m, dt)[1:]
+    amp = np.sqrt(b * b / (2 * math.pi * f) * m / dt / 2)
+    w = np.zeros((m // 2 + 1, 3), dtype=complex)
+    w[1:] = (rng.standard_normal((len(f), 3)) + 1j * rng.standard_normal((len(f), 3))) * amp[:, None]
+    w[-1] = w[-1].real * math.sqrt(2)  # the Nyquist coefficient is real, of variance S·M/dt
+    return np.fft.irfft(w, n=m, axis=0)[:n]
+
+
+def random_walk(n: int, dt: float, k: float, rng: np.random.Generator) -> np.ndarray:
+    """(n, 3) random walk of density ``k`` (units/√s, a rate random walk for a
+    gyro) sampled every dt, from 0: steps of σ ``k·√dt``; its Allan deviation
+    is ``k·√(τ/3)``."""
+    if k == 0 or n == 0:
+        return np.zeros((n, 3))
+    steps = rng.standard_normal((n, 3)) * (k * math.sqrt(dt))
+    steps[0] = 0.0
+    return np.cumsum(steps, axis=0)
+
+
+def drift(n: int, dt: float, b: float, k: float, rng: np.random.Generator) -> np.ndarray:
+    """The in-run bias of a part: :func:`flicker` (``b``) plus :func:`random_walk`
+    (``k``), each drawn only when non-zero (the noise stream of a part without
+    them is unchanged)."""
+    return flicker(n, dt, b, rng) + random_walk(n, dt, k, rng)
+
+
 def markov(n: int, dt: float, sigma: float, tau: float, rng: np.random.Generator) -> np.ndarray:
     """(n, 3) first-order Markov process (thesis eq. 3.54) sampled every dt:
     ``x(k+1) = e^{−dt/τ} x(k) + w(k)``, stationary σ, started stationary."""
@@ -366,6 +409,7 @@ class VectorSensor:
             u = u @ self.soft_iron.T + self.hard_iron
         y = u @ self.errors.matrix.T + self.errors.bias
         y = y + markov(k, dt, m.markov_sigma, m.markov_tau, rng)
+        y = y + drift(k, dt, m.bias_instability, m.random_walk, rng)
         y = y + white_noise(k, dt, m.noise_density, m.bandwidth_hz, rng)
         y = np.clip(y, -m.range, m.range)
         if m.output == "digital" and m.lsb is not None:

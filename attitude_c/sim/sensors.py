@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidArgument
-from .accelmag import ar1, filtered, switched_off
+from .accelmag import ar1, drift, filtered, switched_off
 from .trajectory import Trajectory
 
 __all__ = [
@@ -50,7 +50,9 @@ class GyroModel:
     seed, removed by calibration up to noise); ``noise_density`` white rate
     noise (°/s/√Hz); ``bandwidth_hz`` first-order low-pass −3 dB bandwidth
     (None = no filter); ``scale_error`` residual scale-factor error after
-    calibration (fraction).
+    calibration (fraction); ``bias_instability_dps`` flicker bias B (°/s: the
+    Allan deviation's floor is 0.664 B) and ``rate_random_walk`` K
+    (°/s/√s), 0 = none (in-run bias drift, docs/noise.md).
     """
 
     name: str
@@ -61,6 +63,8 @@ class GyroModel:
     noise_density: float
     bandwidth_hz: float | None
     scale_error: float = 0.0
+    bias_instability_dps: float = 0.0
+    rate_random_walk: float = 0.0
 
     def without(self, *, noise: bool = False, bias: bool = False, bandwidth: bool = False,
                 scale: bool = False) -> GyroModel:
@@ -120,7 +124,13 @@ def filtered_rate(traj: Trajectory, t: np.ndarray, tau: float) -> np.ndarray:
 def rate_noise(n: int, dt: float, gyro: GyroModel, rng: np.random.Generator) -> np.ndarray:
     """(n, 3) rate noise (rad/s) at a spacing dt: white noise of the gyro's
     density through its first-order filter (an exact AR(1) sequence), or,
-    without a filter, the equivalent of exactly integrated white noise."""
+    without a filter, the equivalent of exactly integrated white noise; plus
+    the in-run drift (flicker, rate random walk) when the model has it."""
+    return _white_rate(n, dt, gyro, rng) + drift(n, dt, gyro.bias_instability_dps * DEG,
+                                                 gyro.rate_random_walk * DEG, rng)
+
+
+def _white_rate(n: int, dt: float, gyro: GyroModel, rng: np.random.Generator) -> np.ndarray:
     nd = gyro.noise_density * DEG
     if nd == 0 or n == 0:
         return np.zeros((n, 3))

@@ -69,6 +69,7 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
     X(mag_norm_tol) \
     X(mag_dip_tol) \
     X(mag_ref_tau) \
+    X(mag_ref_window) \
     X(mag_reject_max) \
     X(mag_reject_factor) \
     X(mag_new_time) \

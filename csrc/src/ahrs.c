@@ -31,10 +31,11 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->acc_noise = ATT_R(0.025);
     set->acc_gate = ATT_R(0.2);
     set->acc_reject_max = ATT_R(3.0);
-    set->mag_noise = ATT_R(0.05);
-    set->mag_norm_tol = ATT_R(0.05);
+    set->mag_noise = ATT_R(0.1);
+    set->mag_norm_tol = ATT_R(0.08);
     set->mag_dip_tol = ATT_R(0.17);
     set->mag_ref_tau = ATT_R(30.0);
+    set->mag_ref_window = ATT_R(5.0);
     set->mag_reject_max = ATT_R(60.0);
     set->mag_reject_factor = ATT_R(2.0);
     set->mag_new_time = ATT_R(20.0);
@@ -78,16 +79,37 @@ typedef struct {
 /* clang-format on */
 
 static const setting_domain DOMAINS[] = {
-    DOMAIN(gravity, GT, 0),           DOMAIN(gyr_noise, GT, 0),         DOMAIN(gyr_noise_rest, GT, 0),
-    DOMAIN(bias_noise, GE, 0),        DOMAIN(init_att_sigma, GT, 0),    DOMAIN(init_bias_sigma, GE, 0),
-    DOMAIN(acc_tau, GE, 0),           DOMAIN(acc_noise, GT, 0),         DOMAIN(acc_gate, GE, 0),
-    DOMAIN(acc_reject_max, GT, 0),    DOMAIN(mag_noise, GT, 0),         DOMAIN(mag_norm_tol, GT, 0),
-    DOMAIN(mag_dip_tol, GT, 0),       DOMAIN(mag_ref_tau, GT, 0),       DOMAIN(mag_reject_max, GT, 0),
-    DOMAIN(mag_reject_factor, GE, 1), DOMAIN(mag_new_time, GT, 0),      DOMAIN(mag_min_undisturbed, GE, 0),
-    DOMAIN(mag_new_gyr, GE, 0),       DOMAIN(declination, ABS, ATT_PI), DOMAIN(rest_time, GE, 0),
-    DOMAIN(rest_tau, GT, 0),          DOMAIN(rest_gyr_th, GT, 0),       DOMAIN(rest_acc_th, GT, 0),
-    DOMAIN(rest_noise, GT, 0),        DOMAIN(gyro_range, GE, 0),        DOMAIN(overrange_sigma, GE, 0),
-    DOMAIN(sensor_delay, ABS, 1.0),   DOMAIN(acc_delay, ABS, 0.05),     DOMAIN(mag_delay, ABS, 0.05),
+    DOMAIN(gravity, GT, 0),
+    DOMAIN(gyr_noise, GT, 0),
+    DOMAIN(gyr_noise_rest, GT, 0),
+    DOMAIN(bias_noise, GE, 0),
+    DOMAIN(init_att_sigma, GT, 0),
+    DOMAIN(init_bias_sigma, GE, 0),
+    DOMAIN(acc_tau, GE, 0),
+    DOMAIN(acc_noise, GT, 0),
+    DOMAIN(acc_gate, GE, 0),
+    DOMAIN(acc_reject_max, GT, 0),
+    DOMAIN(mag_noise, GT, 0),
+    DOMAIN(mag_norm_tol, GT, 0),
+    DOMAIN(mag_dip_tol, GT, 0),
+    DOMAIN(mag_ref_tau, GT, 0),
+    DOMAIN(mag_ref_window, GE, 0),
+    DOMAIN(mag_reject_max, GT, 0),
+    DOMAIN(mag_reject_factor, GE, 1),
+    DOMAIN(mag_new_time, GT, 0),
+    DOMAIN(mag_min_undisturbed, GE, 0),
+    DOMAIN(mag_new_gyr, GE, 0),
+    DOMAIN(declination, ABS, ATT_PI),
+    DOMAIN(rest_time, GE, 0),
+    DOMAIN(rest_tau, GT, 0),
+    DOMAIN(rest_gyr_th, GT, 0),
+    DOMAIN(rest_acc_th, GT, 0),
+    DOMAIN(rest_noise, GT, 0),
+    DOMAIN(gyro_range, GE, 0),
+    DOMAIN(overrange_sigma, GE, 0),
+    DOMAIN(sensor_delay, ABS, 1.0),
+    DOMAIN(acc_delay, ABS, 0.05),
+    DOMAIN(mag_delay, ABS, 0.05),
     DOMAIN(tilt_tau, GE, 0),
 };
 
@@ -115,6 +137,10 @@ att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const cha
     }
     for (i = 0; i < sizeof DOMAINS / sizeof DOMAINS[0] && bad == NULL; i++) {
         if (!in_domain(set, &DOMAINS[i])) {
+            bad = DOMAINS[i].name;
+        }
+        if (bad == NULL && DOMAINS[i].offset == offsetof(att_ahrs_settings, mag_ref_window)
+            && set->mag_ref_window > set->mag_ref_tau) { /* the weight is capped at mag_ref_tau */
             bad = DOMAINS[i].name;
         }
     }
@@ -197,6 +223,8 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->mag_cand[1] = 0;
     s->mag_cand_t = 0;
     s->mag_undist_t = 0;
+    s->mag_ref_w = 0;
+    s->mag_cand_w = 0;
     s->rest_t = 0;
     s->aligned = (q0 != NULL);
     s->acc_init = 0;
@@ -454,12 +482,12 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->k_norm = dt / (ATT_R(10.0) + dt);
         c->k_rest = dt / (set->rest_tau + dt);
         c->k_acc = (set->acc_tau > 0) ? dt / (set->acc_tau + dt) : ATT_R(1.0);
-        c->k_mag = dt / (set->mag_ref_tau + dt);
         c->q_att = set->gyr_noise * set->gyr_noise * dt;
         c->q_att_rest = set->gyr_noise_rest * set->gyr_noise_rest * dt;
         c->q_bias = set->bias_noise * set->bias_noise * dt;
         c->r_acc = set->acc_noise * set->acc_noise / dt;
         c->r_mag = set->mag_noise * set->mag_noise / dt;
+        c->v_dip = set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25);
         c->r_rest = set->rest_noise * set->rest_noise / dt;
         c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
         c->tilt = set->tilt_tau > 0;
@@ -723,53 +751,69 @@ static int field_agrees(const att_ahrs_settings *set, const att_real ref[2], att
     return att_fabs(nm - ref[0]) <= set->mag_norm_tol * ref[0] && att_fabs(dip - ref[1]) <= set->mag_dip_tol;
 }
 
-static void field_lowpass(att_real ref[2], att_real k, att_real nm, att_real dip)
+/* A field estimate (norm, dip) as a weighted running mean: *W (the weight it
+ * holds, s) grows by the sample's weight w up to mag_ref_tau, and the sample
+ * moves the estimate by w/W (the mean of the samples so far, then a first-order
+ * low-pass of time constant mag_ref_tau). */
+static void field_learn(att_real est[2], att_real *W, att_real w, att_real tau, att_real nm, att_real dip)
 {
-    ref[0] += k * (nm - ref[0]);
-    ref[1] += k * (dip - ref[1]);
+    att_real k;
+    *W += w;
+    if (*W > tau) {
+        *W = tau;
+    }
+    k = w / *W;
+    est[0] += k * (nm - est[0]);
+    est[1] += k * (dip - est[1]);
 }
 
-/* Magnetic reference, start and candidate: the reference is (re)set to the
- * sample until the inclination's 1σ is below half of mag_dip_tol; the
- * candidate tracks a field consistent with itself, its time running only
- * while turning (a field fixed to the body changes with the attitude). */
-static void mag_candidate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real nm,
-                          att_real dip, att_real dt)
+static void field_set(att_real est[2], att_real *W, att_real w, att_real nm, att_real dip)
+{
+    est[0] = nm;
+    est[1] = dip;
+    *W = w;
+}
+
+/* Magnetic reference, start and candidate: the first sample starts both; the
+ * candidate learns a field consistent with itself (else restarts from the
+ * sample), its time running only while turning (a field fixed to the body
+ * changes with the attitude). */
+static void mag_candidate(att_ahrs *s, const att_real gyr[3], att_real nm, att_real dip, att_real w,
+                          att_real dt)
 {
     const att_ahrs_settings *set = &s->set;
-    if (s->P[0][0] + s->P[1][1] > set->mag_dip_tol * set->mag_dip_tol * ATT_R(0.25)) {
-        s->mag_ref_valid = 0; /* the inclination is not known well enough to learn the dip */
-    }
     if (!s->mag_ref_valid) {
-        s->mag_ref[0] = s->mag_cand[0] = nm;
-        s->mag_ref[1] = s->mag_cand[1] = dip;
+        field_set(s->mag_ref, &s->mag_ref_w, w, nm, dip);
+        field_set(s->mag_cand, &s->mag_cand_w, w, nm, dip);
         s->mag_ref_valid = 1;
         s->mag_undist_t = set->mag_min_undisturbed;
+        s->mag_cand_t = 0;
+        return;
     }
     if (field_agrees(set, s->mag_cand, nm, dip)) {
-        field_lowpass(s->mag_cand, k->k_mag, nm, dip);
+        field_learn(s->mag_cand, &s->mag_cand_w, w, set->mag_ref_tau, nm, dip);
         if (gyr[0] * gyr[0] + gyr[1] * gyr[1] + gyr[2] * gyr[2] >= set->mag_new_gyr * set->mag_new_gyr) {
             s->mag_cand_t += dt;
         }
     } else {
-        s->mag_cand[0] = nm;
-        s->mag_cand[1] = dip;
+        field_set(s->mag_cand, &s->mag_cand_w, w, nm, dip);
         s->mag_cand_t = 0;
     }
 }
 
 /* Magnetic disturbance: the sample against the reference. Undisturbed (for
- * mag_min_undisturbed), it is used and adapts the reference; disturbed, a
- * candidate held for mag_new_time becomes the reference, else it is rejected
- * until mag_reject_max, then used with the noise ×mag_reject_factor². 1 when
- * used, with its noise *r. */
-static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real dip, att_real dt, int *flags,
-                      att_real *r)
+ * mag_min_undisturbed), it is used and the reference learns it; disturbed, a
+ * reference that holds less than mag_ref_window of weight restarts from the
+ * sample (used), a candidate held for mag_new_time becomes the reference, else
+ * the sample is rejected until mag_reject_max, then used with the noise
+ * ×mag_reject_factor². 1 when used, with its noise *r. */
+static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real dip, att_real w, att_real dt,
+                      int *flags, att_real *r)
 {
     const att_ahrs_settings *set = &s->set;
     *r = k->r_mag;
     if (field_agrees(set, s->mag_ref, nm, dip)) {
-        field_lowpass(s->mag_ref, k->k_mag, nm, dip);
+        field_learn(s->mag_ref, &s->mag_ref_w, w, set->mag_ref_tau, nm, dip);
         s->mag_undist_t += dt;
         if (s->mag_undist_t >= set->mag_min_undisturbed) {
             s->mag_rej_time = 0;
@@ -779,12 +823,15 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
         s->mag_rej_time += dt;
         return 0;
     }
-    if (s->mag_cand_t >= set->mag_new_time) { /* a new homogeneous field: it becomes the reference */
-        s->mag_ref[0] = s->mag_cand[0];
-        s->mag_ref[1] = s->mag_cand[1];
+    if (s->mag_ref_w < set->mag_ref_window || s->mag_cand_t >= set->mag_new_time) {
+        if (s->mag_ref_w < set->mag_ref_window) { /* not yet established: start again here */
+            field_set(s->mag_ref, &s->mag_ref_w, w, nm, dip);
+        } else { /* a new homogeneous field: it becomes the reference */
+            field_set(s->mag_ref, &s->mag_ref_w, s->mag_cand_w, s->mag_cand[0], s->mag_cand[1]);
+            *flags |= ATT_AHRS_F_MAG_RELEARNED;
+        }
         s->mag_rej_time = 0;
         s->mag_undist_t = set->mag_min_undisturbed;
-        *flags |= ATT_AHRS_F_MAG_RELEARNED;
         return 1;
     }
     s->mag_undist_t = 0;
@@ -798,11 +845,13 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
 }
 
 /* Magnetometer: m_n = C m; its norm and dip against the reference, its
- * horizontal heading minus the declination measures δθz. */
+ * horizontal heading minus the declination measures δθz. A sample's weight in
+ * the reference is dt·σ²/(σ² + P_xx + P_yy), σ = mag_dip_tol/2: its dip's
+ * share of information while the inclination is uncertain. */
 static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real gyr[3],
                        const att_real mag[3], att_real dt, att_real x[NX], int *flags)
 {
-    att_real m[3], h, nm, dip, r;
+    att_real m[3], h, nm, dip, r, w;
     mat_vec(C, mag, m);
     h = att_sqrt(m[0] * m[0] + m[1] * m[1]);
     if (!(h > 0)) {
@@ -810,8 +859,9 @@ static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9],
     }
     nm = norm3(m);
     dip = att_atan2(-m[2], h);
-    mag_candidate(s, k, gyr, nm, dip, dt);
-    if (mag_accept(s, k, nm, dip, dt, flags, &r)) {
+    w = dt * k->v_dip / (k->v_dip + s->P[0][0] + s->P[1][1]);
+    mag_candidate(s, gyr, nm, dip, w, dt);
+    if (mag_accept(s, k, nm, dip, w, dt, flags, &r)) {
         update_mag(s->P, x, 2, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r);
     }
 }

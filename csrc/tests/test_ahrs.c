@@ -117,6 +117,14 @@ static void test_settings_field_names(void)
     CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
     CHECK(field != NULL && strcmp(field, "declination") == 0);
     att_ahrs_default_settings(&set);
+    set.mag_ref_window = set.mag_ref_tau; /* 0 ≤ mag_ref_window ≤ mag_ref_tau, ends included */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_OK);
+    set.mag_ref_window = 0;
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_OK);
+    set.mag_ref_window = set.mag_ref_tau * (att_real)1.01; /* the reference's weight never gets there */
+    CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
+    CHECK(field != NULL && strcmp(field, "mag_ref_window") == 0);
+    att_ahrs_default_settings(&set);
     set.tilt_tau = (att_real)-1; /* the last field */
     CHECK_EQ_INT(att_ahrs_check_settings_field(&set, &field), ATT_E_AHRS_SETTINGS);
     CHECK(field != NULL && strcmp(field, "tilt_tau") == 0);
@@ -159,14 +167,14 @@ static void test_static_convergence(void)
     att_euler_to_quat(e, qt);
     att_euler_to_quat(e0, q0);
     CHECK_EQ_INT(att_ahrs_init(&s, NULL, q0), ATT_OK);
-    for (k = 0; k < 12000; ++k) {
+    for (k = 0; k < 24000; ++k) {
         CHECK_EQ_INT(att_ahrs_update(&s, w, f, m, (att_real)0.01, q), ATT_OK);
     }
-    /* 120 s: the bulk of the 20° goes in the first seconds (correction time
+    /* 240 s: the bulk of the 20° goes in the first seconds (correction time
      * constants of a few seconds in motion); once rest is declared (1.5 s) the
      * process noise is gyr_noise_rest and the time constants are acc_noise /
-     * gyr_noise_rest = 12.5 s (tilt), mag_noise / gyr_noise_rest = 25 s
-     * (heading): 0.034° remain after 60 s, e^-2.4 of that after 120 s: < 0.01° */
+     * gyr_noise_rest = 12.5 s (tilt), mag_noise / gyr_noise_rest = 50 s
+     * (heading): 0.063° remain after 120 s, e^-2.4 of that after 240 s: < 0.01° */
     CHECK(qangle(q, qt) < 0.01 * 3.14159265 / 180);
     if (qangle(q, qt) >= 0.01 * 3.14159265 / 180) {
         printf("static error %g rad\n", qangle(q, qt));

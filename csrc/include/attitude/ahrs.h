@@ -27,12 +27,14 @@
  *   - magnetometer (optional per call: mag == NULL is six-axis): the field
  *     rotated into the navigation frame gives the magnetic heading; the
  *     update touches δθ_z and the bias only (never roll or pitch). The
- *     field's norm and dip are compared with a reference learned while
- *     undisturbed (and only once the inclination's 1σ is below half of
- *     mag_dip_tol: before that every sample is used and re-sets it); a sample outside mag_norm_tol / mag_dip_tol is
- *     rejected; a new field that stays consistent with itself for
- *     mag_new_time seconds of turning becomes the reference; after
- *     mag_reject_max seconds of continuous rejection updates resume with
+ *     field's norm and dip are compared with a reference, the weighted
+ *     mean of the agreeing samples (weight dt, less while the inclination
+ *     is uncertain; a low-pass of time constant mag_ref_tau once it holds
+ *     that much); until it holds mag_ref_window seconds a disagreeing
+ *     sample restarts it, after that a sample outside mag_norm_tol /
+ *     mag_dip_tol is rejected; a new field that stays consistent with
+ *     itself for mag_new_time seconds of turning becomes the reference;
+ *     after mag_reject_max seconds of continuous rejection updates resume with
  *     the noise scaled by mag_reject_factor (bounded rejection time);
  *   - rest: when the gyro and accelerometer stay within rest_gyr_th /
  *     rest_acc_th of their low-pass values for rest_time seconds, the
@@ -96,11 +98,17 @@ typedef struct {
     att_real acc_gate;            /* [rad] innovation gate (magnitude of the 2-D innovation), 0.2
                                  (0 = off) */
     att_real acc_reject_max;      /* [s] continuous rejection after which updates resume, 3.0 */
-    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.05 */
-    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.05 */
+    att_real mag_noise;           /* [rad·√s] heading measurement noise density (R = σ²/dt), 0.1 */
+    att_real mag_norm_tol;        /* [1] relative field-norm tolerance vs the reference, 0.08 */
     att_real mag_dip_tol;         /* [rad] dip tolerance vs the reference, 0.17 (≈10°) */
-    att_real mag_ref_tau;         /* [s] time constant of the reference's adaptation while
-                                 undisturbed, 30 */
+    att_real mag_ref_tau;         /* [s] the reference (and the candidate) is the weighted mean
+                                 of the agreeing samples so far until they hold this much
+                                 weight, then a first-order low-pass with this time
+                                 constant, 30 */
+    att_real mag_ref_window;      /* [s] weight (seconds of well-levelled field) the reference
+                                 needs before it rejects: until then a sample outside the
+                                 tolerances restarts it from that sample; 0 ≤ it ≤
+                                 mag_ref_tau, 5 (docs/ahrs.md, "Magnetic reference") */
     att_real mag_reject_max;      /* [s] continuous rejection after which updates resume with the
                                  noise scaled by mag_reject_factor (bounded rejection), 60 */
     att_real mag_reject_factor;   /* [1] ≥ 1, see mag_reject_max, 2 */
@@ -170,7 +178,8 @@ typedef struct {
     att_real k_norm;        /* dt/(10 s + dt): low-pass of |a| (unit check) */
     att_real k_rest;        /* dt/(rest_tau + dt) */
     att_real k_acc;         /* dt/(acc_tau + dt), 1 when acc_tau = 0 */
-    att_real k_mag;         /* dt/(mag_ref_tau + dt) */
+    att_real v_dip;         /* (mag_dip_tol/2)²: the dip variance that halves a field sample's
+                            weight in the reference */
     att_real q_att;         /* gyr_noise²·dt */
     att_real q_att_rest;    /* gyr_noise_rest²·dt */
     att_real q_bias;        /* bias_noise²·dt */
@@ -208,6 +217,8 @@ typedef struct {
     att_real mag_rej_time; /* [s] continuous magnetometer rejection */
     att_real mag_cand[2];  /* candidate reference norm and dip */
     att_real mag_cand_t;   /* [s] time the candidate has held while turning */
+    att_real mag_ref_w;    /* [s] weight the reference holds (≤ mag_ref_tau) */
+    att_real mag_cand_w;   /* [s] weight the candidate holds */
     att_real mag_undist_t; /* [s] time the field has agreed with the reference */
     att_real rest_gyr[3];  /* rest detector low-pass of ω [rad/s] */
     att_real rest_acc[3];  /* rest detector low-pass of a [m/s²] */
