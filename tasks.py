@@ -23,6 +23,7 @@ ns = Collection(
     sim.allan_sweep,
     sweep.sweep,
     view.view_soak,
+    view.view_soak_clients,
     view.view_firmware,
     view.view_screenshot,
     Collection("firmware", firmware.build, firmware.sim),

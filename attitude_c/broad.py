@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _text
 from .errors import InvalidArgument
 
 __all__ = [
@@ -127,20 +128,39 @@ def load_trial(path: str | Path) -> Trial:
     if missing:
         raise InvalidArgument(f"path: {str(p)!r} is not a BROAD trial (missing {', '.join(missing)})")
 
+    where = f"path: {str(p)!r}"
+
     def arr(key: str, cols: int) -> FloatArray:
-        a = np.ascontiguousarray(d[key], dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] != cols:
-            raise InvalidArgument(f"path: {str(p)!r}: {key} has shape {a.shape}, expected (N, {cols})")
+        raw = np.asarray(d[key])
+        if raw.dtype.kind not in "biuf":  # complex, text, cells: not a BROAD array (never cut to its real part)
+            raise InvalidArgument(f"{where}: {key} holds {raw.dtype.name} values, expected real numbers")
+        a = np.ascontiguousarray(raw, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] != cols or a.shape[0] != n:
+            raise InvalidArgument(f"{where}: {key} has shape {a.shape}, expected ({n}, {cols})")
         return a
 
+    n = int(np.shape(d["imu_gyr"])[0]) if np.ndim(d["imu_gyr"]) else 0
+    if n == 0:
+        raise InvalidArgument(f"{where}: imu_gyr holds no sample")
     gyr = arr("imu_gyr", 3)
-    n = gyr.shape[0]
     pos = arr("opt_pos", 3) if "opt_pos" in d else np.full((n, 3), np.nan)
+    movement = np.asarray(d["movement"]).ravel()
+    if movement.size != n:
+        raise InvalidArgument(f"{where}: movement has {movement.size} values, expected {n} (one per sample)")
     table = _groups_table(p.parent)
     groups = table.get(p.stem) or _groups_from_name(p.stem)
-    return Trial(name=p.stem, rate=float(np.asarray(d["sampling_rate"]).ravel()[0]), gyr=gyr,
+    return Trial(name=p.stem, rate=_rate(d["sampling_rate"], where), gyr=gyr,
                  acc=arr("imu_acc", 3), mag=arr("imu_mag", 3), quat=arr("opt_quat", 4), pos=pos,
-                 movement=np.asarray(d["movement"]).ravel().astype(bool), groups=tuple(groups))
+                 movement=movement.astype(bool), groups=tuple(groups))
+
+
+def _rate(value: object, where: str) -> float:
+    """The trial's sampling_rate: one real number, finite and > 0 (Hz)."""
+    a = np.asarray(value)
+    if a.size != 1 or a.dtype.kind not in "biuf" or not (np.isfinite(a).all() and float(a.ravel()[0]) > 0):
+        raise InvalidArgument(f"{where}: sampling_rate must be one finite number > 0 (Hz), got "
+                              f"{_text.clip(repr(a.ravel().tolist()))}")
+    return float(a.ravel()[0])
 
 
 def find_trials(folder: str | Path | None = None) -> list[Path]:

@@ -22,12 +22,15 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from . import _text
 from .core import dcm_to_quat
 from .errors import InvalidArgument
 from .frames import axes_matrix
@@ -95,15 +98,25 @@ def gyro_scale(gyr: FloatArray, field: FloatArray, rate: float) -> float:
     return num / den if r >= MIN_CORRELATION else math.nan
 
 
+def _text_lines(path: Path) -> Iterator[tuple[int, str]]:
+    """The file's lines (0-based numbers), bounded (:mod:`attitude_c._text`): a line that is
+    not text raises :class:`InvalidArgument` naming the file and line."""
+    _text.probe_text(path)
+    with open(path, "rb") as fh:
+        for lineno, line, problem in _text.lines(fh):
+            if problem is not None:
+                raise InvalidArgument(f"{path}: line {lineno}: {problem}")
+            yield lineno - 1, line
+
+
 def _header(path: Path) -> tuple[list[str], str | None, int]:
     """The header's names (lower case), the delimiter (None: spaces) and the header's line number
-    (0-based: comment lines starting with # may come first)."""
-    with open(path, encoding="utf-8-sig", newline="") as fh:  # -sig: a spreadsheet's byte-order mark
-        for k, line in enumerate(fh):
-            if line.strip() and not line.lstrip().startswith("#"):
-                break
-        else:
-            raise InvalidArgument(f"{path}: no header line")
+    (0-based: comment lines starting with # may come first). A byte-order mark is dropped."""
+    for k, line in _text_lines(path):
+        if line.strip() and not line.lstrip().startswith("#"):
+            break
+    else:
+        raise InvalidArgument(f"{path}: no header line")
     try:
         delim: str | None = csv.Sniffer().sniff(line, delimiters=",;\t ").delimiter
     except csv.Error:
@@ -111,6 +124,30 @@ def _header(path: Path) -> tuple[list[str], str | None, int]:
     if delim == " ":
         delim = None  # runs of spaces
     return [c.strip().lower() for c in (line.split(delim) if delim else line.split())], delim, k
+
+
+def _table(path: Path, delim: str | None, at: int, width: int) -> FloatArray:
+    """The numeric rows below the header (line ``at``), read streaming with bounded lines."""
+    rows = (line for k, line in _text_lines(path) if k > at)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)  # "input contained no data": said below, naming the file
+            data = np.loadtxt(rows, delimiter=delim, ndmin=2, comments="#")
+    except InvalidArgument:  # a line that is not text (it names the file and line)
+        raise
+    except ValueError as exc:
+        raise InvalidArgument(f"{path}: not a numeric table below the header "
+                              f"({_text.clip(str(exc).splitlines()[0] if str(exc) else '', 120)})") from None
+    if data.shape[0] == 0:
+        raise InvalidArgument(f"{path}: no data rows below the header")
+    if data.shape[1] != width or data.shape[0] < 2:
+        raise InvalidArgument(f"{path}: expected {width} columns (the header's) and at least 2 rows, "
+                              f"got {data.shape[1]} columns, {data.shape[0]} rows")
+    return np.asarray(data, dtype=np.float64)
+
+
+def _names(header: list[str]) -> str:
+    return _text.clip(", ".join(header), 200)
 
 
 def _lookup(header: list[str], columns: dict[str, str]) -> dict[str, int]:
@@ -129,7 +166,7 @@ def _lookup(header: list[str], columns: dict[str, str]) -> dict[str, int]:
                                   f"({', '.join(header)})")
     need = [n for n in COLUMNS["gyr"] + COLUMNS["acc"] if n not in where]
     if need:
-        raise InvalidArgument(f"the header lacks column(s) {', '.join(need)} (header: {', '.join(header)}; "
+        raise InvalidArgument(f"the header lacks column(s) {', '.join(need)} (header: {_names(header)}; "
                               "name others with --columns, e.g. gx=GyroX)")
     return where
 
@@ -157,14 +194,11 @@ def read_csv(path: str | Path, columns: dict[str, str] | None = None, units: dic
         raise InvalidArgument(f"units: unknown sensor(s) {', '.join(bad)} (known: {', '.join(UNITS)})")
     R = axes_matrix(axes)
     header, delim, at = _header(p)
-    where = _lookup(header, dict(columns or {}))
     try:
-        data = np.loadtxt(p, delimiter=delim, skiprows=at + 1, ndmin=2, comments="#", encoding="utf-8")
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise InvalidArgument(f"{p}: not a numeric table below the header ({exc})") from None
-    if data.shape[1] != len(header) or data.shape[0] < 2:
-        raise InvalidArgument(f"{p}: expected {len(header)} columns (the header's) and at least 2 rows, "
-                              f"got {data.shape[1]} columns, {data.shape[0]} rows")
+        where = _lookup(header, dict(columns or {}))
+    except InvalidArgument as exc:
+        raise InvalidArgument(f"{p}: {exc}") from None
+    data = _table(p, delim, at, len(header))
 
     def take(sensor: str) -> FloatArray | None:
         names = COLUMNS[sensor]
@@ -181,10 +215,13 @@ def read_csv(path: str | Path, columns: dict[str, str] | None = None, units: dic
     if ref is not None:
         ref = _times(ref, np.asarray(dcm_to_quat(R.T), dtype=np.float64))  # C_rfu^n = C_imu^n R^T (rows lost by the reference stay NaN)
     k = None if mag is None else gyro_scale(gyr, mag, rate)
-    if "gyr" not in units:
-        _refuse_deg_per_s(gyr, k)
-    if "acc" not in units:
-        _refuse_g(acc)
+    try:
+        if "gyr" not in units:
+            _refuse_deg_per_s(gyr, k)
+        if "acc" not in units:
+            _refuse_g(acc)
+    except InvalidArgument as exc:
+        raise InvalidArgument(f"{p}: {exc}") from None
     return Recording(t=t, rate=rate, gyr=gyr, acc=acc, mag=mag, ref=ref, gyr_scale=k)
 
 

@@ -190,3 +190,29 @@ def angle_deg(qa, qb):
     from attitude_c import reference as ref
 
     return np.degrees(ref.quat_angle(qa, qb))
+
+
+def broad_mat(path: Path, n: int = 50, **fields) -> Path:
+    """A BROAD-format .mat trial of ``n`` samples at 100 Hz, at rest and level (gyro 0.01 rad/s
+    on each axis), ``fields`` replacing any of its arrays (a test's fault). Needs SciPy."""
+    import numpy as np
+    from scipy.io import savemat
+
+    d = {"imu_gyr": np.full((n, 3), 0.01), "imu_acc": np.tile([0, 0, 9.81], (n, 1)),
+         "imu_mag": np.tile([20.0, 0, -40.0], (n, 1)), "opt_quat": np.tile([1.0, 0, 0, 0], (n, 1)),
+         "movement": np.ones((n, 1)), "sampling_rate": np.array([[100.0]])}
+    d.update(fields)
+    savemat(path, d)
+    return path
+
+
+def peak_memory(fn):
+    """``(fn(), the peak of Python's allocations while it ran, bytes)`` (tracemalloc)."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        out = fn()
+        return out, tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()

@@ -118,7 +118,7 @@ def test_usage_and_source_errors_are_one_line_with_their_exit_status(tmp_path: P
     _one_line_error(_run("--simulate", "--budget"), 2, "--budget: not for the display")
     _one_line_error(_run("--simulate", "--period", "-1"), 2, "--period: must be a finite number > 0")
     _one_line_error(_run("--stdin", "--port", "70000"), 2, "--port: must be in 0..65535")
-    _one_line_error(_run("--stdin", "--display-rate", "500"), 2, "--display-rate: must be a finite number > 0 and <= 100")
+    _one_line_error(_run("--stdin", "--display-rate", "500"), 2, "--display-rate: must be a finite number >= 1 and <= 100")
     _one_line_error(_run(), 2, "one of the arguments --stdin --serial --replay --simulate is required")
     _one_line_error(_run("--stdin", "--record", str(tmp_path / "no" / "dir" / "r.csv")), 1,
                     "cannot write the recording")

@@ -62,6 +62,11 @@ def _sine_rows(k0: int, k: int, rate_hz: float) -> list[tuple[float, ...]]:
     return [row(t[i], q[i], n=k0 + i) for i in range(k)]
 
 
+def _history(hub: Hub) -> list[list]:
+    """The points a client connecting now receives after its hello (every history message)."""
+    return [p for m in hub.history_messages() for p in json.loads(m)["points"]]
+
+
 def _frames(msgs: list[str | None]) -> list[dict]:
     return [json.loads(m) for m in msgs if m is not None]
 
@@ -168,7 +173,7 @@ def test_several_clients_get_the_same_frames_and_late_ones_the_history() -> None
         if k == 9:
             c, hello = hub.add_client()
             h = json.loads(hello)
-            assert len(h["history"]) == 10 and h["last"]["n"] == 49
+            assert len(_history(hub)) == h["history_points"] == 10 and h["last"]["n"] == 49
     fa = [a.queue.get_nowait() for _ in range(a.queue.qsize())]
     fb = [b.queue.get_nowait() for _ in range(b.queue.qsize())]
     fc = [c.queue.get_nowait() for _ in range(c.queue.qsize())]
@@ -176,12 +181,12 @@ def test_several_clients_get_the_same_frames_and_late_ones_the_history() -> None
     assert len(fa) == len(fb) == 16 and fa == fb and a.dropped == b.dropped == 30 - 16
     assert fc == fa[-len(fc):] and len(fc) == 16
     # the history is a ring of history_s * display_rate points (2 s at 20 frames/s)
-    assert len(json.loads(hub.add_client()[1])["history"]) == 30
+    assert len(_history(hub)) == 30
     for k in range(30, 60):
         hub.samples(_sine_rows(k * 5, 5, 100.0))
         clock.now += 0.05
         hub.tick()
-    h = json.loads(hub.add_client()[1])["history"]
+    h = _history(hub)
     assert len(h) == 40 and h[-1][0] == pytest.approx(3.0)
     hub.remove_client(a)
     assert a.closed and a.queue.get_nowait() is None and a not in hub.clients
@@ -396,24 +401,111 @@ def test_recording_keeps_events_in_order_and_is_complete_or_absent(tmp_path: Pat
     assert hub.recorder.counts() == (3, 3)
 
 
-def test_recording_error_leaves_no_partial_file(tmp_path: Path) -> None:
+def test_a_recording_error_keeps_the_rows_written_under_a_partial_name(tmp_path: Path) -> None:
+    """The disk fills in the middle of a row: the recording is not renamed into place
+    (it is not complete) but kept as r.partial.csv, cut after its last whole row."""
     rec = Recorder(tmp_path / "r.csv")
+    hub = Hub(recorder=rec)
+    hub.samples(_sine_rows(0, 3, 100.0))
+    hub.tick()
+    rec.snapshot().result(timeout=10)  # three rows on disk
+    real = rec._fh
 
     class Full(io.StringIO):
         def write(self, s: str) -> int:
+            real.write(s[:7])  # a piece of the next row reaches the disk, then the disk is full
+            real.flush()
             raise OSError(28, "No space left on device")
 
         def tell(self) -> int:
             return 0
 
-    rec._fh.close()
+        def close(self) -> None:
+            real.close()
+
     rec._fh = Full()  # type: ignore[assignment]
-    hub = Hub(recorder=rec)
-    hub.samples([row(0.1, [1, 0, 0, 0])])
+    hub.samples(_sine_rows(3, 1, 100.0))
     hub.tick()
-    assert rec.close() is None
+    kept = rec.close()
+    assert kept == tmp_path / "r.partial.csv"
     assert rec.error is not None and "No space left" in rec.error
     assert not (tmp_path / "r.csv").exists() and not (tmp_path / "r.csv.part").exists()
+    rows = list(csv.DictReader(kept.read_text(encoding="utf-8").splitlines()))
+    assert [r["n"] for r in rows] == ["0", "1", "2"]
+
+
+def test_a_failing_tick_keeps_the_stream_going_and_the_recording_partial(tmp_path: Path, capsys) -> None:
+    """Issue 29 item 1: a tick that raises (here: a JSON line holding NaN reached the
+    hub before event details were made JSON-safe) no longer ends the ticker: the next
+    samples are recorded and sent, the failure is said once, and the recording is kept
+    under its partial name, not renamed into place as if complete."""
+    hub, _ = _hub(tmp_path)
+    c, _ = hub.add_client()
+    hub.samples(_sine_rows(0, 2, 100.0))
+    real = hub._complete
+
+    def broken(a):
+        raise RuntimeError("a bug")
+
+    async def main() -> None:
+        stop = asyncio.Event()
+        hub._complete = broken  # type: ignore[method-assign]
+        task = asyncio.ensure_future(hub.run(stop))
+        await asyncio.sleep(0)  # the first tick runs (and fails)
+        hub._complete = real  # type: ignore[method-assign]
+        hub.samples(_sine_rows(2, 3, 100.0))
+        stop.set()
+        await asyncio.wait_for(task, 10)
+
+    asyncio.run(main())
+    assert hub.failure == "RuntimeError: a bug"
+    assert capsys.readouterr().err.count("a display tick failed") == 1
+    frames = _frames([c.queue.get_nowait() for _ in range(c.queue.qsize())])
+    assert frames[-1]["last"]["n"] == 4
+    kept = hub.recorder.close(complete=hub.failure is None)
+    assert kept == tmp_path / "rec.partial.csv" and not (tmp_path / "rec.csv").exists()
+    assert [r["n"] for r in csv.DictReader(kept.read_text(encoding="utf-8").splitlines())] == ["2", "3", "4"]
+
+
+def test_an_event_holding_nan_is_kept_and_the_stream_goes_on(tmp_path: Path) -> None:
+    """Issue 29 item 1: {"report": "BOOT", "x": NaN} (Python's json reads NaN) used to
+    make Hub.tick raise in json.dumps(allow_nan=False). The event is kept with NaN as
+    null, in the frame, the hello and the recording, and the next samples follow."""
+    from attitude_c.view.sources import LineReader
+
+    hub, clock = _hub(tmp_path)
+    hub.add_client()
+    p = LineReader().feed('{"t":0.1,"report":"BOOT","x":NaN,"y":[Infinity,1]}')
+    hub.samples(_sine_rows(0, 1, 100.0))
+    hub.event(p.t, p.event, p.detail)
+    hub.samples(_sine_rows(1, 2, 100.0))
+    clock.now += 0.04
+    frame = json.loads(hub.tick())
+    assert frame["events"][0]["detail"] == {"x": None, "y": [None, 1]} and frame["last"]["n"] == 2
+    assert json.loads(hub.hello())["events"][0]["detail"] == {"x": None, "y": [None, 1]}
+    hub.samples(_sine_rows(3, 1, 100.0))
+    clock.now += 0.04
+    assert json.loads(hub.tick())["last"]["n"] == 3
+    assert hub.recorder.close() == tmp_path / "rec.csv"
+    rows = list(csv.DictReader((tmp_path / "rec.csv").read_text(encoding="utf-8").splitlines()))
+    assert [r["event"] or r["n"] for r in rows] == ["0", "BOOT", "1", "2", "3"]
+    assert json.loads(rows[1]["detail"]) == {"x": None, "y": [None, 1]}
+
+
+def test_event_details_are_bounded() -> None:
+    """A detail JSON cannot carry whole, or a huge one, is replaced by its start
+    (the hub keeps the last 100 events for every new tab)."""
+    hub, _ = _hub()
+    deep: list = []
+    for _ in range(50):
+        deep = [deep]
+    hub.event(0, "error", {"line": "x" * 100_000})
+    hub.event(0, "error", {"deep": deep, "obj": object()})
+    frame = json.loads(hub.tick())
+    details = [e["detail"] for e in frame["events"]]
+    assert all(len(json.dumps(d)) <= stream.DETAIL_MAX for d in details)
+    assert all(set(d) == {"truncated"} for d in details)
+    hub.recorder.close()
 
 
 def test_hub_run_ticks_at_the_display_rate_and_stops() -> None:

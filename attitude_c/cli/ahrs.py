@@ -34,8 +34,9 @@ Output (--out DIR): attitude.csv (t, quaternion body -> ENU, yaw/pitch/roll
 in degrees; its first line states the frames), attitude.png (estimate and
 reference angles, error components, flags, bias estimate) and summary.json
 (the printed summary; with a reference BROAD's error metric over the
-movement phases of a BROAD trial). Files are written to a temporary name,
-then renamed; summary.json last.
+movement phases of a BROAD trial). Files are written only once every figure
+is computed (a run that fails leaves none), each to a temporary name, then
+renamed; summary.json last.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._io import check_output_dir, write_text, write_with
+from .._io import check_output_dir, write_results
 from .options import positive
 
 PROG = "attitude ahrs"
@@ -205,13 +206,24 @@ def _run(rec: Any, mag: np.ndarray | None, precision: str,
     return q, np.array(ends), np.array(flags), np.array(bias)
 
 
+def _about(path: Path, fn: Any, *a: Any) -> Any:
+    """``fn(*a)``, its complaint about the file's content naming the file."""
+    from ..errors import InvalidArgument
+
+    try:
+        return fn(*a)
+    except (InvalidArgument, ValueError) as exc:
+        text = str(exc)
+        raise _Usage(text if str(path) in text else f"{path}: {text}") from None
+
+
 def _main(args: argparse.Namespace) -> int:
     path = Path(args.file)
     if not path.is_file():
         raise FileNotFoundError(2, "no such file", str(path))
     settings = _settings(args.set)
     out = check_output_dir(Path(args.out) if args.out else Path("results") / f"ahrs-{path.stem}")
-    rec, movement = _read(path, args)
+    rec, movement = _about(path, _read, path, args)
     mag = None if args.six_axis else rec.mag
     if args.estimate_mag_delay and mag is None:
         raise _Usage("--estimate-mag-delay needs a magnetometer (mx my mz columns, not --six-axis)")
@@ -224,19 +236,21 @@ def _main(args: argparse.Namespace) -> int:
         from ..timing import aiding_delay
 
         summary["mag_delay_estimate_s"] = aiding_delay(rec.gyr, np.asarray(mag), q, float(rec.rate), mask=movement)
-    e = _write_attitude(out / "attitude.csv", rec.t, q, args)
     if rec.ref is not None:
         from .. import broad
 
-        summary["errors_deg"] = broad.errors(q, rec.ref, movement).as_dict()
+        summary["errors_deg"] = _about(path, broad.errors, q, rec.ref, movement).as_dict()
         summary["errors_over"] = "movement phases" if movement is not None else "all samples"
-    written = ["attitude.csv"]
+    e, table, head = _attitude_table(rec.t, q, args)
+    files: list[tuple[Path, Any]] = [(out / "attitude.csv", lambda tmp: np.savetxt(
+        tmp, table, delimiter=",", fmt="%.9g", header=head, comments=""))]
     if not args.no_plots:
-        _plot(out / "attitude.png", path, rec, q, e, movement, (ends, flags, bias), args.euler)
-        written.append("attitude.png")
-    written.append("summary.json")
-    summary["files"] = written
-    write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+        files.append((out / "attitude.png", lambda tmp: _plot(tmp, path, rec, q, e, movement, (ends, flags, bias),
+                                                               args.euler)))
+    summary["files"] = [f.name for f, _ in files] + ["summary.json"]
+    text = json.dumps(summary, indent=2) + "\n"
+    files.append((out / "summary.json", lambda tmp: tmp.write_text(text, encoding="utf-8")))
+    write_results(files)  # only now, every figure computed: a run that fails leaves no file of its own
     _print(summary, path, mag is None, args)
     return EXIT_OK
 
@@ -257,8 +271,8 @@ def _summary(args: argparse.Namespace, path: Path, rec: Any, mag: Any, settings:
     return s
 
 
-def _write_attitude(path: Path, t: np.ndarray, q: np.ndarray, args: argparse.Namespace) -> np.ndarray:
-    """attitude.csv, its first line stating the frames; returns the Euler angles (°)."""
+def _attitude_table(t: np.ndarray, q: np.ndarray, args: argparse.Namespace) -> tuple[np.ndarray, np.ndarray, str]:
+    """The Euler angles (°), attitude.csv's rows and its header (its first line states the frames)."""
     from ..frames import euler
 
     e = np.degrees(euler(q, args.euler))
@@ -267,10 +281,7 @@ def _write_attitude(path: Path, t: np.ndarray, q: np.ndarray, args: argparse.Nam
     note = (f"# body x right, y forward, z up (IMU axes {args.axes}); quaternion body -> ENU, scalar first; "
             f"Euler {seq}, degrees")
     head = f"t,qw,qx,qy,qz,yaw_{args.euler}_deg,pitch_{args.euler}_deg,roll_{args.euler}_deg"
-    table = np.column_stack([t, q, e])
-    write_with(path, lambda tmp: np.savetxt(tmp, table, delimiter=",", fmt="%.9g", header=note + "\n" + head,
-                                            comments=""))
-    return np.asarray(e)
+    return np.asarray(e), np.column_stack([t, q, e]), note + "\n" + head
 
 
 def _plot(path: Path, src: Path, rec: Any, q: np.ndarray, e: np.ndarray, movement: Any,

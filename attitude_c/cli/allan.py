@@ -111,7 +111,7 @@ def _read_stream(path: Path) -> tuple[dict[str, np.ndarray], float]:
     from ..view.stream import COLUMNS
 
     rec = load_recording(path)
-    rows = np.array([p for _, what, p in rec.items if what == "sample"], dtype=float)
+    rows = np.array([p for _, what, p in rec.items() if what == "sample"], dtype=float)
     i = COLUMNS.index("rate_x")
     rate, t = rows[:, i:i + 3], rows[:, COLUMNS.index("t")]
     if not np.all(np.isfinite(rate)):

@@ -22,15 +22,22 @@ EXIT_USAGE = 2  # bad option
 EXIT_SERVE = 3  # cannot serve: the address cannot be listened on, or aiohttp is missing
 
 DEFAULT_PORT = 8765
+#: --stall's largest value (s): a stream quiet for an hour is stalled whatever its rate.
+STALL_MAX_S = 3600.0
+#: --speed's range: a thousandth of real time to a thousand times it.
+SPEED_RANGE = (1e-3, 1e3)
 
 
 def register(sub: Any) -> None:
+    from ..view.stream import DISPLAY_RATE_MAX, DISPLAY_RATE_MIN, HISTORY_MAX_S
+
     p = sub.add_parser(
         "view", help="live attitude display in a web browser (local web server)",
         description="Serve a page showing the attitude live: attitude and heading indicators, the body "
         "axes in 3D, strip charts of the angles and rates, the link's counters and the rate received. "
         "Every sample is recorded (download it from the page as CSV). The server listens on "
-        "127.0.0.1 only, unless --bind says otherwise.",
+        "127.0.0.1 only, unless --bind says otherwise, and answers only to this machine's names "
+        "(--allow-host adds others).",
         epilog="exit statuses: 0 stopped with Ctrl-C; 1 the source cannot be opened or read; 2 bad "
         "option; 3 cannot listen on the address (or aiohttp missing). See docs/view.md.")
     src = p.add_mutually_exclusive_group(required=True)
@@ -48,23 +55,29 @@ def register(sub: Any) -> None:
                      "--period 0.005 --duration 600")
     g = p.add_argument_group("server")
     g.add_argument("--bind", default="127.0.0.1", metavar="ADDRESS",
-                   help="address to listen on (default 127.0.0.1; anything else lets other machines "
-                   "watch and download, with a warning)")
+                   help="address to listen on (default 127.0.0.1; an address that is not loopback lets "
+                   "other machines watch and download, with a warning)")
+    g.add_argument("--allow-host", action="append", default=[], metavar="NAME",
+                   help="also answer to this host name (repeatable; '*': to any name). By default the server "
+                   "answers only to the loopback names, this machine's own names and addresses, and --bind "
+                   "(a page of another site resolved to this machine gets nothing)")
     g.add_argument("--port", type=_int_range("--port", 0, 65535), default=DEFAULT_PORT,
                    help=f"TCP port (default {DEFAULT_PORT}; 0: any free port)")
-    g.add_argument("--display-rate", type=options.real("--display-rate", gt=0, le=100),
-                   default=25.0, metavar="HZ", help="frames per second sent to the page (default 25, at most 100)")
-    g.add_argument("--history", type=_positive("--history"), default=600.0, metavar="S",
-                   help="seconds of chart history kept for the page (the longest window; default 600)")
-    g.add_argument("--stall", type=_positive("--stall"), default=1.0, metavar="S",
+    g.add_argument("--display-rate", type=options.real("--display-rate", ge=DISPLAY_RATE_MIN, le=DISPLAY_RATE_MAX),
+                   default=25.0, metavar="HZ",
+                   help=f"frames per second sent to the page (default 25, {DISPLAY_RATE_MIN:g} to {DISPLAY_RATE_MAX:g})")
+    g.add_argument("--history", type=options.real("--history", gt=0, le=HISTORY_MAX_S), default=HISTORY_MAX_S,
+                   metavar="S", help=f"seconds of chart history kept for the page (the longest window; default "
+                   f"and most {HISTORY_MAX_S:g})")
+    g.add_argument("--stall", type=options.real("--stall", gt=0, le=STALL_MAX_S), default=1.0, metavar="S",
                    help="seconds without a sample before the page says the stream stalled (at least "
                    "four sample intervals; default 1)")
     g.add_argument("--record", metavar="CSV", default=None,
                    help="keep the recording in this file (written as CSV.part, renamed at the end); "
                    "default: a temporary file, removed at the end")
     g = p.add_argument_group("replay and simulator")
-    g.add_argument("--speed", type=_positive("--speed"), default=1.0,
-                   help="times real time (default 1)")
+    g.add_argument("--speed", type=options.real("--speed", ge=SPEED_RANGE[0], le=SPEED_RANGE[1]), default=1.0,
+                   help=f"times real time (default 1, {SPEED_RANGE[0]:g} to {SPEED_RANGE[1]:g})")
     g = p.add_argument_group("serial port")
     g.add_argument("--baud", type=_int_range("--baud", 50, 4_000_000), default=9600,
                    help="line rate (default 9600, 8N1)")
@@ -188,10 +201,9 @@ def run(args: argparse.Namespace) -> int:
         _err(f"cannot listen on {args.bind} port {args.port}: {exc.strerror or exc}")
         return EXIT_SERVE
     port = sock.getsockname()[1]
-    loopback = server.is_loopback(args.bind)
-    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(args.bind, args.bind)  # any address: this machine's
-    url = f"http://{host if ':' not in host else f'[{host}]'}:{port}/"
-    if not loopback:
+    hosts = server.HostPolicy.for_bind(args.bind, args.allow_host)
+    url = _url(sock)
+    if not server.is_loopback(args.bind):
         _err(f"warning: listening on {args.bind}, not the loopback address: anyone who can reach this "
              f"machine on port {port} can watch the attitude and download the recording (the page "
              "cannot change anything)")
@@ -206,7 +218,7 @@ def run(args: argparse.Namespace) -> int:
         loop = asyncio.get_running_loop()
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.add_signal_handler(sig, stop.set)
-        await server.serve(hub, source, sock, stop, loopback_only=loopback, on_ready=ready)
+        await server.serve(hub, source, sock, stop, hosts=hosts, on_ready=ready)
 
     try:
         asyncio.run(main())
@@ -214,11 +226,19 @@ def run(args: argparse.Namespace) -> int:
         pass
     finally:
         sock.close()
-        kept = recorder.close()
+        kept = recorder.close(complete=hub.failure is None)
     samples, events = recorder.counts()
     where = f" in {kept}" if kept is not None else ""
     _err(f"stopped: {samples} samples and {events} events recorded{where}")
-    if recorder.error is not None:
-        _err(f"the recording is incomplete: {recorder.error}")
+    why = recorder.error or (f"a display tick failed ({hub.failure})" if hub.failure else None)
+    if why is not None:
+        _err(f"the recording is incomplete: {why}")
         return EXIT_SOURCE
     return EXIT_OK
+
+
+def _url(sock: Any) -> str:
+    """The page's URL: the address listened on (this machine's loopback one for a wildcard)."""
+    host, port = sock.getsockname()[:2]
+    host = {"0.0.0.0": "127.0.0.1", "::": "::1"}.get(host, host)
+    return f"http://{host if ':' not in host else f'[{host}]'}:{port}/"

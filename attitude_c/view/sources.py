@@ -17,6 +17,8 @@ import csv
 import io
 import json
 import math
+import os
+import selectors
 import threading
 import time
 from collections.abc import Iterable, Iterator, Mapping
@@ -27,6 +29,7 @@ from typing import IO, Any, Callable, Literal, Union
 import numpy as np
 from numpy.typing import NDArray
 
+from .. import _text
 from ..errors import AttitudeError, InvalidArgument
 from .estimators import AUTO, Estimator, choose, make_estimator
 from .stream import Hub, row
@@ -45,6 +48,9 @@ DEFAULT_ZERO_CODE = 2048.0
 DEFAULT_SCALE = math.radians(90.0) / 2048.0
 #: Seconds between attempts to reopen a serial port that failed.
 REOPEN_S = 1.0
+#: The largest source time a line may carry (s; about 317 years): beyond it a time is a
+#: mistake (a replay would wait for it for ever). Unix time stamps (1.8e9 s) pass.
+MAX_TIME_S = 1e10
 
 
 class Source:
@@ -181,23 +187,29 @@ class LineReader:
         self._roles: dict[str, Any] = {}
 
     def feed(self, line: str) -> Parsed:
-        """Parse one line. Raises ValueError (with a reason) for a broken line."""
+        """Parse one line. Raises ValueError (with a reason, one short line) for a broken line."""
         s = line.strip()
         if not s or s.startswith("#"):
             return _SKIP
-        if s.startswith(("{", "[")):
-            return self._json(s)
-        return self._csv(s)
+        try:
+            if s.startswith(("{", "[")):
+                return self._json(s)
+            return self._csv(s)
+        except (ValueError, TypeError, KeyError, IndexError, OverflowError, csv.Error) as exc:
+            text = str(exc) if not isinstance(exc, KeyError) else f"no {exc} field"
+            raise ValueError(_text.clip(text, 160)) from None
 
     def _json(self, s: str) -> Parsed:
         try:
             d = json.loads(s)
         except json.JSONDecodeError as exc:
             raise ValueError(f"not JSON: {exc.msg}") from None
+        except RecursionError:
+            raise ValueError("not JSON this reader takes: nested too deep") from None
         if not isinstance(d, dict):
             raise TypeError("not a JSON object")
         if "q" in d:
-            t = float(d["t"])
+            t = _time(d["t"])
             q = _vec(d, "q", 4)
             eul = None
             if all(k in d for k in _CSV_EULER_DEG):
@@ -211,7 +223,7 @@ class LineReader:
             counters.update(_filter_counters(_vec(d, "bias_dps", 3), d.get("flags")))
             p.counters = counters or None
             return p
-        t = float(d.get("t", float("nan")))
+        t = _time(d.get("t"), required=False)
         if "report" in d:
             detail = {k: v for k, v in d.items() if k not in ("t", "report")}
             return Parsed("event", t, event=str(d["report"]), detail=detail)
@@ -225,7 +237,7 @@ class LineReader:
         return Parsed("counters", t, counters={"other_records": 1})
 
     def _csv(self, s: str) -> Parsed:
-        fields = next(csv.reader([s]))
+        fields = next(csv.reader([s]), [])
         if self._cols is None:
             self._header(fields)
             return _SKIP
@@ -237,9 +249,7 @@ class LineReader:
             v = fields[i].strip() if i < len(fields) else ""
             return float(v) if v else float("nan")
 
-        t = num(r["t"])
-        if not math.isfinite(t):
-            raise ValueError("no time")
+        t = _time(num(r["t"]))
         ev = r.get("event")
         if ev is not None and cols[ev] < len(fields) and fields[cols[ev]].strip():
             det = fields[cols[r["detail"]]].strip() if r.get("detail") and cols[r["detail"]] < len(fields) else ""
@@ -283,6 +293,17 @@ class LineReader:
         self._cols, self._roles = cols, r
 
 
+def _time(v: Any, required: bool = True) -> float:
+    """A line's source time: a finite number of seconds within ±:data:`MAX_TIME_S` (NaN when
+    absent and not ``required``)."""
+    t = float("nan") if v is None else float(v)
+    if math.isnan(t) and not required:
+        return t
+    if not (math.isfinite(t) and abs(t) <= MAX_TIME_S):
+        raise ValueError(f"time {v!r}: must be a finite number of seconds within ±{MAX_TIME_S:g}")
+    return t
+
+
 def _apply(p: Parsed, hub: Hub, src: Source) -> None:
     if p.kind == "sample" and p.sample is not None:
         hub.samples([p.sample])
@@ -297,38 +318,106 @@ def _apply(p: Parsed, hub: Hub, src: Source) -> None:
             src.set_counts(p.counters)
 
 
+class _StoppableFd(io.RawIOBase):
+    """A descriptor read only when it has data, or not at all once :meth:`wake` was
+    called: the reading thread then sees the end of the input and returns. The
+    source's thread never blocks inside a buffered object of the interpreter's
+    (sys.stdin), which a daemon thread would hold locked at exit (CPython aborts
+    with "_enter_buffered_busy" when it flushes standard input at shutdown)."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__()
+        self._fd = fd
+        self._wake_lock = threading.Lock()  # wake() (any thread) never writes to a closed, reused descriptor
+        self._wake_r, self._wake_w = os.pipe()
+        self._sel = selectors.DefaultSelector()
+        self._sel.register(fd, selectors.EVENT_READ)
+        self._sel.register(self._wake_r, selectors.EVENT_READ)
+
+    def readable(self) -> bool:
+        return True
+
+    def readinto(self, buf: Any) -> int:
+        ready = {key.fd for key, _ in self._sel.select()}
+        if self._wake_r in ready:
+            return 0
+        data = os.read(self._fd, len(buf))
+        buf[:len(data)] = data
+        return len(data)
+
+    def wake(self) -> None:
+        with self._wake_lock, contextlib.suppress(OSError):
+            if self._wake_w >= 0:
+                os.write(self._wake_w, b"x")
+
+    def close(self) -> None:
+        with self._wake_lock:
+            if self._wake_w >= 0:
+                self._sel.close()
+                os.close(self._wake_r)
+                os.close(self._wake_w)
+                self._wake_r = self._wake_w = -1
+        super().close()
+
+
 class StdinSource(Source):
     """attitude-rx's output on a stream (``attitude-rx --format jsonl | attitude view --stdin``).
 
-    A broken line is counted (``bad_lines``) and shown as an error event, never
-    fatal. End of input makes the source *lost* ("input ended")."""
+    A broken line (not JSON or CSV this reader knows, longer than
+    :data:`attitude_c._text.MAX_LINE`, not UTF-8) is counted (``bad_lines``)
+    and shown as an error event, never fatal. End of input makes the source
+    *lost* ("input ended"). A stream with a descriptor is read through it
+    (:meth:`stop` then ends the thread even while the input is idle)."""
 
     def __init__(self, stream: IO[bytes] | IO[str], name: str = "stdin") -> None:
         super().__init__()
         self.stream = stream
         self.description = f"{name} (attitude-rx JSON Lines or CSV)"
         self.name = name
+        self._fd: _StoppableFd | None = None
+        with contextlib.suppress(AttributeError, OSError, ValueError):
+            self._fd = _StoppableFd(stream.fileno())
+
+    def stop(self) -> None:
+        super().stop()
+        if self._fd is not None:
+            self._fd.wake()
+
+    def _lines(self) -> Iterator[tuple[int, str, str | None]]:
+        if self._fd is not None:
+            yield from _text.lines(io.BufferedReader(self._fd, 1 << 16))
+        elif isinstance(self.stream, io.TextIOBase):
+            for k, line in enumerate(self.stream, 1):
+                yield k, line, None
+        else:
+            yield from _text.lines(self.stream)  # type: ignore[arg-type]
 
     def run(self, hub: Hub) -> None:
         reader = LineReader()
         hub.status("running", f"reading {self.name}")
         last_t = 0.0
-        for lineno, raw in enumerate(self.stream, 1):
-            if self._stop.is_set():
-                return
-            line = raw.decode("utf-8", "replace") if isinstance(raw, bytes) else str(raw)
-            self.count("lines")
-            try:
-                p = reader.feed(line)
-            except (ValueError, TypeError, KeyError) as exc:
-                self.count("bad_lines")
-                hub.event(last_t, "error", {"error": f"{self.name} line {lineno}: {exc}",
-                                            "line": line.strip()[:200]})
-                continue
-            if math.isfinite(p.t):
-                last_t = p.t
-            _apply(p, hub, self)
-        hub.status("lost", f"input ended ({self.name} closed)")
+        try:
+            for lineno, line, problem in self._lines():
+                if self._stop.is_set():
+                    return
+                self.count("lines")
+                try:
+                    if problem is not None:
+                        raise ValueError(problem)
+                    p = reader.feed(line)
+                except ValueError as exc:
+                    self.count("bad_lines")
+                    hub.event(last_t, "error", {"error": f"{self.name} line {lineno}: {exc}",
+                                                "line": _text.clip(line.strip(), 200)})
+                    continue
+                if math.isfinite(p.t):
+                    last_t = p.t
+                _apply(p, hub, self)
+        finally:
+            if self._fd is not None:
+                self._fd.close()
+        if not self._stop.is_set():
+            hub.status("lost", f"input ended ({self.name} closed)")
 
 
 # ---------------------------------------------------------------------------------------
@@ -390,19 +479,56 @@ def pace(hub: Hub, items: Iterable[Item], speed: float, stop: threading.Event,
 
 @dataclass
 class Recording:
-    """A recording loaded for replay: its items in order, or BROAD's arrays."""
+    """A recording checked for replay: its lines (read again, streaming, by
+    :meth:`items` when it plays: memory does not grow with the file), or BROAD's
+    arrays."""
 
     name: str
     kind: Literal["lines", "broad"]
-    items: list[Item]
     samples: int
+    path: Path | None = None
     trial: Any = None  # attitude_c.broad.Trial for kind "broad"
+
+    def items(self, on_bad: Callable[[int, str], None] | None = None) -> Iterator[Item]:
+        """The items of a recording of lines, in order (``on_bad(line, why)`` for a line
+        that cannot be read now; default: raise :class:`InvalidArgument`)."""
+        assert self.path is not None
+        yield from _line_items(self.path, on_bad or _refuse(self.path))
+
+
+def _refuse(path: Path) -> Callable[[int, str], None]:
+    def bad(lineno: int, why: str) -> None:
+        raise InvalidArgument(f"recording {str(path)!r} line {lineno}: {why}")
+    return bad
+
+
+def _line_items(path: Path, on_bad: Callable[[int, str], None]) -> Iterator[Item]:
+    reader = LineReader()
+    last_t = 0.0
+    with open(path, "rb") as fh:
+        for lineno, line, problem in _text.lines(fh):
+            try:
+                if problem is not None:
+                    raise ValueError(problem)
+                x = reader.feed(line)
+            except ValueError as exc:
+                on_bad(lineno, str(exc))
+                continue
+            t = x.t if math.isfinite(x.t) else last_t
+            if x.kind == "sample":
+                yield t, "sample", x.sample
+            elif x.kind == "event":
+                yield t, "event", (x.event, x.detail)
+            elif x.kind == "counters" and x.counters:
+                yield t, "counters", x.counters
+            last_t = t
 
 
 def load_recording(path: str | Path) -> Recording:
-    """Read a recording: attitude-rx's JSON Lines or CSV, a view recording
+    """Check a recording: attitude-rx's JSON Lines or CSV, a view recording
     (CSV), ``attitude simulate``'s ``timeseries.csv``, or a BROAD trial
-    (``.mat``). Raises :class:`InvalidArgument` naming the file (and line)."""
+    (``.mat``). Every line is read once, streaming (the replay reads them
+    again). Raises :class:`InvalidArgument` naming the file (and line)."""
     p = Path(path)
     if not p.is_file():
         raise InvalidArgument(f"recording {str(p)!r}: no such file")
@@ -410,31 +536,17 @@ def load_recording(path: str | Path) -> Recording:
         from .. import broad
 
         trial = broad.load_trial(p)
-        return Recording(p.name, "broad", [], trial.n, trial)
+        return Recording(p.name, "broad", trial.n, p, trial)
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InvalidArgument(f"recording {str(p)!r}: cannot read it ({exc})") from None
-    reader = LineReader()
-    items: list[Item] = []
-    samples = 0
-    for lineno, line in enumerate(io.StringIO(text), 1):
-        try:
-            x = reader.feed(line)
-        except (ValueError, TypeError, KeyError, IndexError) as exc:
-            raise InvalidArgument(f"recording {str(p)!r} line {lineno}: {exc}") from None
-        if x.kind == "sample":
-            items.append((x.t, "sample", x.sample))
-            samples += 1
-        elif x.kind == "event":
-            items.append((x.t if math.isfinite(x.t) else (items[-1][0] if items else 0.0), "event",
-                          (x.event, x.detail)))
-        elif x.kind == "counters" and x.counters:
-            items.append((x.t if math.isfinite(x.t) else (items[-1][0] if items else 0.0), "counters",
-                          x.counters))
+        _text.probe_text(p)
+        rec = Recording(p.name, "lines", 0, p)
+        samples = sum(1 for _, what, _ in rec.items() if what == "sample")
+    except OSError as exc:
+        raise InvalidArgument(f"recording {str(p)!r}: cannot read it ({exc.strerror or exc})") from None
     if samples == 0:
         raise InvalidArgument(f"recording {str(p)!r}: no attitude sample in it")
-    return Recording(p.name, "lines", items, samples)
+    rec.samples = samples
+    return rec
 
 
 def _broad_items(trial: Any, estimator: Estimator) -> Iterator[Item]:
@@ -494,11 +606,16 @@ class ReplaySource(Source):
             assert self.estimator is not None
             items: Iterable[Item] = _broad_items(self.rec.trial, self.estimator)
         else:
-            items = self.rec.items
+            items = self.rec.items(lambda lineno, why: self._bad_line(hub, lineno, why))
         n = pace(hub, items, self.speed, self._stop, on_counters=self.set_counts)
         self.set_counts({"replayed": n})
         if not self._stop.is_set():
             hub.status("ended", f"replay of {self.rec.name} finished ({n} samples)")
+
+    def _bad_line(self, hub: Hub, lineno: int, why: str) -> None:
+        """A line that changed since the check: counted, shown, and the replay goes on."""
+        self.count("bad_lines")
+        hub.event(float("nan"), "error", {"error": f"{self.rec.name} line {lineno}: {why}"})
 
 
 # ---------------------------------------------------------------------------------------

@@ -28,6 +28,7 @@ import collections
 import concurrent.futures
 import csv
 import io
+import itertools
 import json
 import math
 import os
@@ -36,7 +37,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Union
@@ -84,6 +85,19 @@ _SOURCE_STATES = ("starting", "running", "ended", "lost")
 #: Event kinds that are notes, not counted as reports or errors.
 _NOTE = "note"
 
+#: The longest history a hub keeps (s): the page's longest chart window (10 min).
+HISTORY_MAX_S = 600.0
+#: The display rate's range (frames/s): at least one frame a second (the stall and
+#: rate figures need it), at most 100 (more than a screen refreshes).
+DISPLAY_RATE_MIN, DISPLAY_RATE_MAX = 1.0, 100.0
+#: Chart points per history message: a tab that connects gets the history in
+#: messages of this many points (about 150 bytes each: ~75 kB a message), each sent
+#: when the previous one was taken by the socket, so a tab that does not read
+#: holds one such message in the server, never the whole history.
+HISTORY_CHUNK = 500
+#: Serialized size (bytes) above which an event's detail is replaced by its start.
+DETAIL_MAX = 2048
+
 _DEG = 180.0 / math.pi
 
 
@@ -128,6 +142,34 @@ def _num(x: float, nd: int = 3) -> float | None:
     return round(float(x), nd) if math.isfinite(x) else None
 
 
+def json_safe(detail: dict[str, Any]) -> dict[str, Any]:
+    """``detail`` as strict JSON can carry it: non-finite numbers become None,
+    other objects their ``str``; nesting deeper than 20 levels, or a detail whose
+    JSON exceeds :data:`DETAIL_MAX` bytes, becomes ``{"truncated": its start}``."""
+    def walk(x: Any, depth: int) -> Any:
+        if isinstance(x, float):
+            return x if math.isfinite(x) else None
+        if x is None or isinstance(x, (bool, int, str)):
+            return x
+        if depth > 20:
+            raise ValueError("nested too deep")
+        if isinstance(x, dict):
+            return {str(k): walk(v, depth + 1) for k, v in x.items()}
+        if isinstance(x, (list, tuple)):
+            return [walk(v, depth + 1) for v in x]
+        return str(x)
+
+    text: str | None = None
+    try:
+        out = walk(detail, 0)
+        text = json.dumps(out, separators=(",", ":"), allow_nan=False)
+    except (ValueError, RecursionError):
+        pass
+    if text is not None and len(text) <= DETAIL_MAX:
+        return out  # type: ignore[no-any-return]
+    return {"truncated": (text or repr(detail)[:DETAIL_MAX])[:DETAIL_MAX // 2]}
+
+
 @dataclass
 class _Event:
     t: float
@@ -153,8 +195,9 @@ class Recorder:
     written by one worker thread so the event loop never waits for the disk.
 
     ``path``: where the recording is kept (written to ``PATH.part`` and
-    renamed into place by :meth:`close`: complete or absent); None keeps it in
-    a temporary directory removed by :meth:`close`.
+    renamed into place by :meth:`close` when complete, else to
+    :func:`partial_name`); None keeps it in a temporary directory removed by
+    :meth:`close`.
     """
 
     def __init__(self, path: str | Path | None = None) -> None:
@@ -230,11 +273,14 @@ class Recorder:
         with self._lock:
             return self.samples, self.events
 
-    def close(self) -> Path | None:
-        """Finish writing. Returns the kept recording's path (None if it was
-        temporary, or could not be completed: an error says why)."""
+    def close(self, complete: bool = True) -> Path | None:
+        """Finish writing. Returns the kept recording's path: ``FILE`` when the
+        recording is complete, :func:`partial_name` (``FILE.partial.csv``, cut
+        after its last whole row) when it is not -- ``complete`` False (the
+        stream was cut short) or a write failed (:attr:`error` says why) --
+        None when it was temporary or nothing could be kept."""
         if self._closed:
-            return self.keep if self.keep is not None and self.error is None else None
+            return self.path if self.keep is not None and self.path.exists() else None
         self._closed = True
         self._pool.submit(self._flush).result()
         self._pool.shutdown(wait=True)
@@ -246,12 +292,38 @@ class Recorder:
             shutil.rmtree(self._tmpdir, ignore_errors=True)
             return None
         assert self.keep is not None
-        if self.error is not None:
-            self.path.unlink(missing_ok=True)  # complete or absent
+        dest = self.keep if complete and self.error is None else partial_name(self.keep)
+        try:
+            if dest != self.keep:
+                _cut_after_last_row(self.path)
+            os.replace(self.path, dest)
+        except OSError as exc:
+            self.error = self.error or f"recording {self.path}: {exc.strerror or exc}"
             return None
-        os.replace(self.path, self.keep)
-        self.path = self.keep
-        return self.keep
+        self.path = dest
+        return dest
+
+
+def partial_name(path: Path) -> Path:
+    """Where a recording that is not complete is kept: ``run.csv`` -> ``run.partial.csv``."""
+    return path.with_name(f"{path.stem}.partial{path.suffix or '.csv'}")
+
+
+def _cut_after_last_row(path: Path) -> None:
+    """Truncate ``path`` after its last newline (a write that failed may have cut a row)."""
+    with open(path, "rb+") as fh:
+        end = fh.seek(0, os.SEEK_END)
+        pos = end
+        while pos > 0:
+            step = min(1 << 16, pos)
+            fh.seek(pos - step)
+            block = fh.read(step)
+            k = block.rfind(b"\n")
+            if k >= 0:
+                fh.truncate(pos - step + k + 1)
+                return
+            pos -= step
+        fh.truncate(0)
 
 
 def _g(x: float) -> str:
@@ -341,8 +413,11 @@ class Hub:
         for name, v in (("display_rate", display_rate), ("history_s", history_s), ("stall_s", stall_s)):
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise InvalidArgument(f"{name} must be a finite number > 0, got {v!r}")
-        if display_rate > 100:
-            raise InvalidArgument(f"display_rate must be at most 100 frames/s, got {display_rate!r}")
+        if not DISPLAY_RATE_MIN <= display_rate <= DISPLAY_RATE_MAX:
+            raise InvalidArgument(f"display_rate must be {DISPLAY_RATE_MIN:g}..{DISPLAY_RATE_MAX:g} frames/s, "
+                                  f"got {display_rate!r}")
+        if history_s > HISTORY_MAX_S:
+            raise InvalidArgument(f"history_s must be at most {HISTORY_MAX_S:g} s, got {history_s!r}")
         self.recorder = recorder
         self.description = description
         self.display_rate = float(display_rate)
@@ -364,6 +439,8 @@ class Hub:
         self.events: collections.deque[dict[str, Any]] = collections.deque(maxlen=100)
         self.event_counts: dict[str, int] = {}
         self.seq = 0
+        self.points_total = 0  # chart points ever made (the ring holds the newest len(history))
+        self.failure: str | None = None  # the first tick that failed: what it held is not recorded
         self.samples_in = 0
         self.frames_dropped = 0  # by clients that have gone, plus the live ones at frame time
         self._prev_q = np.full(4, np.nan)
@@ -388,8 +465,10 @@ class Hub:
 
     def event(self, t: float, kind: str, detail: dict[str, Any] | None = None) -> None:
         """Queue a report (``"BOOT"``, ``"OVERRUN"``...), an ``"error"`` or a
-        ``"note"`` at source time ``t``. Never blocks."""
-        self._intake.append(("e", _Event(float(t), str(kind), dict(detail or {}))))
+        ``"note"`` at source time ``t``. Never blocks. The detail is kept as JSON
+        can carry it (:func:`json_safe`: NaN and infinities as null, at most
+        :data:`DETAIL_MAX` bytes)."""
+        self._intake.append(("e", _Event(float(t), str(kind)[:64], json_safe(dict(detail or {})))))
 
     def status(self, state: SourceState, text: str = "") -> None:
         """The source's own condition (see :data:`SourceState`)."""
@@ -490,9 +569,10 @@ class Hub:
             if math.isfinite(self._last_wall):
                 gap = now - self._last_wall
                 self._arrival = gap if not math.isfinite(self._arrival) else 0.8 * self._arrival + 0.2 * gap
-            self._last_wall = now
+            self._last_wall = self.clock()  # taken now: a tick slowed by a loaded machine is not a stall
             point = self._chart_point(a, td, te, th)
             self.history.append(json.dumps(point, separators=(",", ":"), allow_nan=False))
+            self.points_total += 1
             self._last = self._last_sample(a[-1], td[-1], te[-1], th[-1])
             n_fin = a[np.isfinite(a[:, _N]), _N]
             self._rate.add(now, k, float(n_fin[-1]) if n_fin.size else float("nan"))
@@ -597,17 +677,37 @@ class Hub:
         return "live", self._source_text
 
     def hello(self) -> str:
-        """The first message to a client: what the stream is, and its recent history."""
+        """The first message to a client: what the stream is, and how many points of
+        history follow (:meth:`history_messages`)."""
         state, text = self.state()
         msg = {"type": "hello", "session": self.session, "seq": self.seq, "source": self.description,
                "display_rate": self.display_rate, "history_s": self.history_s, "columns": list(CHART_COLUMNS),
-               "events": list(self.events), "last": self._last,
+               "events": list(self.events), "last": self._last, "history_points": len(self.history),
                "state": state, "text": text, "counters": self.counters(), "hub": self._hub_counters()}
-        head = json.dumps(msg, separators=(",", ":"), allow_nan=False)
-        return head[:-1] + ',"history":[' + ",".join(self.history) + "]}"
+        return json.dumps(msg, separators=(",", ":"), allow_nan=False)
+
+    def history_messages(self) -> Iterator[str]:
+        """The history as it is now, in messages of at most :data:`HISTORY_CHUNK`
+        points, oldest first, each made when it is asked for (a client that reads
+        slowly costs one message; points the ring dropped meanwhile are skipped).
+        Call it with :meth:`add_client`: the points after it come in frames."""
+        end = self.points_total
+        return self._history_from(end - len(self.history), end)
+
+    def _history_from(self, first: int, end: int) -> Iterator[str]:
+        while first < end:
+            oldest = self.points_total - len(self.history)
+            first = max(first, oldest)
+            if first >= end:
+                return
+            k = min(end, first + HISTORY_CHUNK)
+            pts = itertools.islice(self.history, first - oldest, k - oldest)
+            yield '{"type":"history","points":[' + ",".join(pts) + "]}"
+            first = k
 
     def add_client(self) -> tuple[Client, str]:
-        """A new client and its hello message (to send before anything queued)."""
+        """A new client and its hello message (to send, then :meth:`history_messages`
+        taken at the same time, before anything queued)."""
         c = Client(self.client_queue)
         self.clients.add(c)
         return c, self.hello()
@@ -626,7 +726,7 @@ class Hub:
         loop = asyncio.get_running_loop()
         due = loop.time()
         while not stop.is_set():
-            self.tick()
+            self._safe_tick()
             due += period
             delay = due - loop.time()
             if delay < 0:  # fell behind (a busy machine): do not try to catch up
@@ -636,4 +736,16 @@ class Hub:
                 await asyncio.wait_for(stop.wait(), timeout=delay)
             except asyncio.TimeoutError:
                 pass
-        self.tick()
+        self._safe_tick()
+
+    def _safe_tick(self) -> None:
+        """:meth:`tick`, whose failure (a bug) must not stop the display: the first is
+        kept in :attr:`failure` (the recording then misses what that tick held and is
+        kept as partial) and said once on stderr; the ticks go on."""
+        try:
+            self.tick()
+        except Exception as exc:  # noqa: BLE001 - the stream goes on; the recording says it is partial
+            if self.failure is None:
+                self.failure = f"{type(exc).__name__}: {exc}"[:300]
+                print(f"attitude view: error: a display tick failed ({self.failure}); the stream goes on, "
+                      "the recording will be kept as partial", file=sys.stderr, flush=True)

@@ -1,4 +1,5 @@
-"""Display tasks: ``invoke view-soak`` (the long run of ``attitude view``) and
+"""Display tasks: ``invoke view-soak`` (the long run of ``attitude view``),
+``invoke view-soak-clients`` (its memory under many clients) and
 ``invoke view-firmware`` (the firmware in s51 -> attitude-rx -> view recipe).
 See docs/view.md."""
 
@@ -183,6 +184,158 @@ def run_soak(seconds: float, *, period: float = 0.005, tabs: int = 2, history: f
     return figures
 
 
+#: A WebSocket handshake a raw socket sends, then never reads (a tab that stopped reading).
+_WS_REQUEST = ("GET /ws HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+               "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n")
+
+
+def _non_reader(port: int) -> Any:
+    """A connected WebSocket that never reads: its receive buffer is as small as the
+    kernel allows, so what the server cannot send stays in the server."""
+    import socket
+
+    s = socket.socket()
+    s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    s.connect(("127.0.0.1", port))
+    s.sendall(_WS_REQUEST.format(port=port).encode())
+    return s
+
+
+async def _reader(url: str, stats: dict[str, Any], stop: Any) -> None:
+    """A tab that reads everything: the size of its first message and of its largest."""
+    import asyncio
+
+    import aiohttp
+
+    async with aiohttp.ClientSession() as session, session.ws_connect(url + "ws", max_msg_size=0) as ws:
+        first = True
+        while not stop.is_set():
+            try:
+                msg = await ws.receive(timeout=0.5)
+            except asyncio.TimeoutError:
+                continue
+            if msg.type != aiohttp.WSMsgType.TEXT:
+                break
+            n = len(msg.data)
+            if first:
+                stats["first"].append(n)
+                first = False
+            stats["largest"] = max(stats["largest"], n)
+            stats["messages"] += 1
+            if '"type":"frame"' in msg.data[:40]:
+                stats["hub"] = json.loads(msg.data).get("hub", stats.get("hub"))
+
+
+def run_client_soak(seconds: float = 60.0, clients: int = 200, *, warmup: float = 30.0, rate: float = 200.0,
+                    display_rate: float = 100.0, every: float = 5.0,
+                    log: Callable[[str], None] | None = None) -> dict[str, Any]:
+    """``attitude view --simulate`` at ``rate`` samples/s and ``display_rate`` frames/s;
+    after ``warmup`` seconds (the history ring filling), ``clients`` WebSockets for
+    ``seconds``: half read everything, half never read a byte; one more beyond the
+    server's limit. The server's resident memory every ``every`` seconds, the
+    first and largest message a reader got, the refusals, and the stop."""
+    import asyncio
+
+    from attitude_c.view.server import MAX_CLIENTS
+
+    say = log or (lambda line: print(line, flush=True))
+    v = ViewProcess("--port", "0", "--display-rate", f"{display_rate:g}", "--simulate", "--duration",
+                    f"{warmup + seconds + 60:g}", "--period", f"{1 / rate:g}", "--method", "rv3-reuse",
+                    "--calibration", "5", "--no-progress")
+    fig: dict[str, Any] = {"clients": clients, "readers": clients - clients // 2, "non_readers": clients // 2,
+                           "seconds": seconds, "warmup_s": warmup, "rate_hz": rate, "display_rate": display_rate,
+                           "max_clients": MAX_CLIENTS}
+    stats: dict[str, Any] = {"first": [], "largest": 0, "messages": 0, "hub": {}}
+    rss: list[tuple[float, float]] = []
+    raw: list[Any] = []
+
+    async def main() -> None:
+        stop = asyncio.Event()
+        await _until_live(v.url)  # the simulation runs first, then plays
+        await asyncio.sleep(warmup)
+        fig["rss_before_mb"] = round(v.rss_mb(), 2)
+        readers = [asyncio.ensure_future(_reader(v.url, stats, stop)) for _ in range(fig["readers"])]
+        for _ in range(fig["non_readers"]):
+            raw.append(_non_reader(v.port))
+        await asyncio.sleep(1.0)
+        fig["beyond_the_limit"] = await _one_more(v.url)
+        t0 = time.monotonic()
+        while (el := time.monotonic() - t0) < seconds:
+            rss.append((round(el, 1), round(v.rss_mb(), 2)))
+            say(f"view-soak-clients: t={el:5.1f} s  rss={rss[-1][1]:7.1f} MiB  hub={stats['hub'].get('clients')} "
+                f"clients, {stats['hub'].get('history_points')} history points, py_blocks "
+                f"{stats['hub'].get('py_blocks')}")
+            await asyncio.sleep(every)
+        rss.append((round(time.monotonic() - t0, 1), round(v.rss_mb(), 2)))
+        fig["hub"] = dict(stats["hub"])
+        stop.set()
+        await asyncio.gather(*readers, return_exceptions=True)
+
+    try:
+        say(f"view-soak-clients: {v.url}; warm-up {warmup:g} s, then {clients} clients for {seconds:g} s")
+        asyncio.run(main())
+        for s in raw:
+            s.close()
+        rc, err = v.stop()
+    finally:
+        v.kill()
+    fig["rss_mb"] = rss
+    fig["rss_max_mb"] = max(m for _, m in rss)
+    fig["rss_growth_mb"] = round(rss[-1][1] - rss[0][1], 2)
+    fig["first_message_bytes"] = max(stats["first"]) if stats["first"] else None
+    fig["largest_message_bytes"] = stats["largest"]
+    fig["readers_served"] = len(stats["first"])
+    fig["messages_read"] = stats["messages"]
+    fig["exit_status"] = rc
+    fig["stderr_lines"] = len(err.strip().splitlines())
+    fig["tracebacks"] = err.count("Traceback")
+    fig["stopped_line"] = err.strip().splitlines()[-1] if err.strip() else ""
+    return fig
+
+
+async def _until_live(url: str, timeout: float = 600.0) -> None:
+    import aiohttp
+
+    async with aiohttp.ClientSession() as session, session.ws_connect(url + "ws", max_msg_size=0) as ws:
+        while json.loads((await ws.receive(timeout=timeout)).data).get("state") != "live":
+            pass
+
+
+async def _one_more(url: str) -> int | str:
+    """Open a WebSocket now: the HTTP status of a refusal, or "open"."""
+    import aiohttp
+
+    async with aiohttp.ClientSession() as session:
+        try:
+            ws = await session.ws_connect(url + "ws")
+        except aiohttp.WSServerHandshakeError as exc:
+            return exc.status
+        await ws.close()
+        return "open"
+
+
+@task(help={
+    "seconds": "seconds the clients stay connected (default 60)",
+    "clients": "WebSocket clients: half read everything, half never read (default 200)",
+    "warmup": "seconds of data before the clients connect, filling the history ring (default 30)",
+    "out": "write the figures as JSON here",
+})
+def view_soak_clients(c, seconds=60, clients=200, warmup=30, out=""):
+    """The display under many clients: the server's memory with CLIENTS WebSockets (readers and
+    non-readers) for SECONDS, the first and largest message, the client limit; no browser needed."""
+    fig = run_client_soak(float(seconds), int(clients), warmup=float(warmup))
+    text = json.dumps(fig, indent=2)
+    print(text)
+    if out:
+        Path(out).write_text(text + "\n")
+    ok = fig["exit_status"] == 0 and fig["tracebacks"] == 0 and fig["readers_served"] == fig["readers"]
+    print(f"view-soak-clients: {'OK' if ok else 'FAILED'}: memory {fig['rss_before_mb']:.1f} MiB before the "
+          f"clients, at most {fig['rss_max_mb']:.1f} MiB with them; first message {fig['first_message_bytes']} "
+          f"bytes, largest {fig['largest_message_bytes']}; one more client: {fig['beyond_the_limit']}")
+    if not ok:
+        raise SystemExit(1)
+
+
 @task(help={
     "minutes": "simulated (and wall-clock) minutes (default 10)",
     "rate": "samples per second (default 200)",
@@ -285,4 +438,4 @@ def view_screenshot(c, out="", seconds=12.0):
     print(f"view-screenshot: wrote {path}")
 
 
-TOP_LEVEL = (view_soak, view_firmware, view_screenshot)
+TOP_LEVEL = (view_soak, view_soak_clients, view_firmware, view_screenshot)

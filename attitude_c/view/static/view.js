@@ -51,6 +51,7 @@
       let m;
       try { m = JSON.parse(ev.data); } catch (e) { return; }
       if (m.type === "hello") onHello(m);
+      else if (m.type === "history") onHistory(m);
       else if (m.type === "frame") onFrame(m);
     };
     ws.onclose = () => {
@@ -102,6 +103,14 @@
     renderEvents(null);
     renderCounters();
     updateStatus();
+    S.dirty = true;
+  }
+
+  // the history follows the hello in messages of a few hundred points, oldest first,
+  // before any frame (the server sends them one at a time)
+  function onHistory(m) {
+    for (const p of m.points || []) S.points.push(p);
+    trim();
     S.dirty = true;
   }
 
