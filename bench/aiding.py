@@ -75,7 +75,7 @@ def throughput(quick: bool) -> list[tuple[str, float]]:
     """(what, samples per second) of the batch calls on the host."""
     import attitude_c as ac
     from attitude_c import reference as R
-    from attitude_c import reference_aiding as RA
+    from attitude_c.reference import aiding as RA
 
     from .host import _best
 
@@ -103,7 +103,7 @@ def cold_starts(n: int = 20_000, q0: Any = None) -> dict[str, Any]:
     """Gauss–Newton from ``q0`` (None: TRIAD's attitude) on random attitudes (|pitch| < 89°)."""
     import attitude_c as ac
     from attitude_c import reference as R
-    from attitude_c import reference_aiding as RA
+    from attitude_c.reference import aiding as RA
     from attitude_c.names import status_name
 
     rng = np.random.default_rng(2)

@@ -1,6 +1,6 @@
 """attitude_c.ahrs (attitude_c.ahrs_filter): the attitude filter against its NumPy model and the truth.
 
-Differential: the C filter (double) against attitude_c.ahrs_reference (matrix
+Differential: the C filter (double) against attitude_c.reference.ahrs (matrix
 form of the same equations, written from docs/ahrs.md) on synthetic motion
 and on a BROAD segment; the float build against the double build. Truth:
 closed-form constant-rate motion (q(t) = q0 ⊗ exp(ω t), exact sensors), where
@@ -19,7 +19,7 @@ from conftest import G, angle_deg, motion
 from attitude_c import broad, names
 from attitude_c import reference as ref
 from attitude_c.ahrs_filter import Ahrs, ahrs, default_settings
-from attitude_c.ahrs_reference import ahrs_reference
+from attitude_c.reference.ahrs import ahrs_reference
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
 
 
@@ -311,7 +311,7 @@ def test_defaults_documented():
     d = default_settings()
     assert d["method"] == "rv3-reuse"
     assert math.isclose(d["gravity"], 9.81)
-    from attitude_c import ahrs_reference as mref
+    from attitude_c.reference import ahrs as mref
     assert d == pytest.approx(mref._DEFAULTS)  # the model uses the library's defaults
 
 

@@ -1,6 +1,6 @@
 """attitude_c.ahrs_thesis: the UAV thesis's EKF against its NumPy model and the truth.
 
-Differential: the C filter (double) against attitude_c.thesis_ekf_reference
+Differential: the C filter (double) against attitude_c.reference.thesis_ekf
 (the thesis's equations in matrix form, NumPy Gauss–Newton) on synthetic
 motion and on a BROAD segment; the float build against the double build.
 Truth: closed-form constant-rate motion and a static attitude (exact
@@ -19,7 +19,7 @@ from attitude_c import broad
 from attitude_c import reference as ref
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
 from attitude_c.thesis_ekf import default_settings, run
-from attitude_c.thesis_ekf_reference import thesis_ekf_reference
+from attitude_c.reference.thesis_ekf import thesis_ekf_reference
 
 
 @pytest.mark.parametrize("kw,given_q0", [({}, False),
@@ -115,5 +115,5 @@ def test_defaults_documented():
     d = default_settings()
     assert d == {"gyr_noise": 0.01, "bias_noise": 0.0, "meas_noise": 0.025, "init_q_sigma": 0.05,
                  "init_bias_sigma": 0.03, "declination": 0.0, "gn_max_iter": 20}
-    from attitude_c.thesis_ekf_reference import _DEFAULTS
+    from attitude_c.reference.thesis_ekf import _DEFAULTS
     assert {k: d[k] for k in _DEFAULTS} == _DEFAULTS

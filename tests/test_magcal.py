@@ -10,7 +10,7 @@ import pytest
 
 import attitude_c as ac
 from attitude_c import reference as R
-from attitude_c import reference_aiding as RA
+from attitude_c.reference import aiding as RA
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
 from attitude_c.magcal import Calibration
 

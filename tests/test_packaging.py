@@ -134,7 +134,21 @@ def test_invoke_build_isolates_only_when_needed() -> None:
 #: (pyproject.toml [project] dependencies), and what only one function imports
 #: on demand with a message naming what to install (scipy: attitude_c.broad's .mat reader).
 _DEPENDENCIES = {"cffi", "numpy", "serial", "matplotlib", "tqdm"}
-_ON_DEMAND = {"scipy", "aiohttp", "dask", "distributed", "pandas", "tomli"}  # optional: imported where needed, with a message saying what to install
+def _extras_imports() -> set[str]:
+    """The optional dependencies the package itself uses (pyproject's extras but test, dev and
+    bench, which serve the tests and benchmarks), by import name: each is imported where it is
+    needed, with a message saying what to install."""
+    import re
+    import tomllib
+
+    from conftest import ROOT
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
+    return {re.split(r"[<>=;\[ ]", req, maxsplit=1)[0].lower() for name, reqs in extras.items()
+            if name not in {"test", "dev", "bench"} for req in reqs}
+
+
+_ON_DEMAND = _extras_imports()
 
 
 def test_the_package_imports_nothing_outside_itself() -> None:

@@ -200,14 +200,14 @@ def generate(seed: int = 20100601, n: int = 64) -> list[Case]:
 
 
 def aiding_cases(rng: np.random.Generator, n: int = 48) -> list[Case]:
-    """The aiding solvers (attitude/aiding.h) against attitude_c.reference_aiding:
+    """The aiding solvers (attitude/aiding.h) against attitude_c.reference.aiding:
     alignment (nine- and six-axis), TRIAD and Gauss–Newton (both methods) on noisy
     body vectors of random attitudes (|pitch| ≤ 80°: the float tolerances below
     assume atan2 and the cross products away from the vertical), the static window,
     the three ellipsoid fits, the 2-D min/max method and the apply function, plus a
     parallel pair, a zero field and a non-finite sample (the error names the record)."""
     from attitude_c import reference as ref
-    from attitude_c import reference_aiding as ra
+    from attitude_c.reference import aiding as ra
 
     out: list[Case] = []
     decl = float(_f32(np.array([0.25]))[0])

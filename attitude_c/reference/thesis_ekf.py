@@ -5,8 +5,8 @@ form: the 7×7 Φ = I + F h with F's blocks built column by column from
 quaternion products (``reference.quat_multiply``), P ← Φ P Φᵀ + Q, the gain
 K = P Hᵀ (H P Hᵀ + R)⁻¹ by ``numpy.linalg.solve`` with an explicit H = [I₄ 0],
 the Joseph form; the measurement from the NumPy Gauss–Newton
-(``reference_aiding.gauss_newton``), the first attitude from
-``reference_aiding.align``. Not from the C source (hand-expanded products,
+(``reference.aiding.gauss_newton``), the first attitude from
+``reference.aiding.align``. Not from the C source (hand-expanded products,
 a Cholesky solve). Slow (a Python loop per sample): for differential tests.
 """
 
@@ -17,8 +17,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import reference as ref
-from . import reference_aiding as refaid
+from .. import reference as ref
+from . import aiding as refaid
 
 __all__ = ["thesis_ekf_reference"]
 

@@ -33,10 +33,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .core import METHODS  # the names only (importing core loads no C extension)
+from ..core import METHODS  # the names only (importing core loads no C extension)
 
 if TYPE_CHECKING:  # types only: the reference runs without the C library
-    from .core import FloatPrecision, Method
+    from ..core import FloatPrecision, Method
 
 __all__ = [
     "COEFFICIENTS",
