@@ -209,6 +209,14 @@ class Trajectory:
         t = np.asarray(t, dtype=float)
         return np.zeros(t.shape + (3,))
 
+    def position(self, t: Any) -> np.ndarray:
+        """Position of the body (m, ENU): the origin unless the trajectory translates."""
+        return np.zeros(np.shape(t) + (3,))
+
+    def velocity(self, t: Any) -> np.ndarray:
+        """Velocity of the body (m/s, ENU): zero unless the trajectory translates."""
+        return np.zeros(np.shape(t) + (3,))
+
     def specific_force(self, t: Any, env: Environment = EARTH) -> np.ndarray:
         """What a perfect accelerometer reads (m/s², body axes): ``Cᵀ (a_n − g_n)``."""
         return to_body(self.quat(t), self.accel_nav(t) - env.gravity_nav)
