@@ -290,6 +290,20 @@ def format_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _gnss_log_step(res: SimResult, path: Path, steps: list[tuple[Path, Callable[[Path], object]]]) -> dict[str, Any]:
+    """Add the GNSS log's writer to ``steps``; the receiver and its fix counts for the summary."""
+    from .gnss_log import log_format, nmea_stream, ubx_stream
+
+    cfg = res.config
+    rx = cfg.gnss
+    assert rx is not None
+    fixes = rx.fixes(cfg.trajectory, cfg.duration, cfg.seed)
+    stream = nmea_stream if log_format(path) == "nmea" else ubx_stream
+    steps.append((path, lambda p: p.write_bytes(stream(fixes, rx.utc_start))))
+    return {**rx.to_dict(), "epochs": len(fixes), "fixes_3d": int(np.sum(fixes["fix_type"] == 3)),
+            "fixes_2d": int(np.sum(fixes["fix_type"] == 2)), "no_fix": int(np.sum(fixes["fix_type"] == 0))}
+
+
 def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
     """Write timeseries.csv (sensors.csv when the run has an accelerometer or a
     magnetometer), errors.png, attitude.png and summary.json (last) into out,
@@ -318,6 +332,10 @@ def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
                   (files["attitude_png"], lambda p: _draw_attitude(res, p))]
         if res.bias is not None:
             steps.append((files["bias_png"], lambda p: _draw_bias(res, p)))
+    if res.config.gnss is not None and res.config.gnss_log:
+        files["gnss_log"] = out / res.config.gnss_log
+        summary["gnss"] = _gnss_log_step(res, files["gnss_log"], steps)
+        summary["files"]["gnss_log"] = str(res.config.gnss_log)
     steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n",
                                                             encoding="utf-8")))
     write_results(steps)

@@ -656,7 +656,8 @@ class CsvTrajectory(Trajectory):
 
 
 TrajectoryKind = Literal["paper", "paper-translation", "coning", "static", "turntable", "level-turn",
-                         "constant-rate", "csv"]
+                         "constant-rate", "csv", "fixed-wing", "fixed-wing-turn", "car", "car-brake",
+                         "car-roundabout"]
 TRAJECTORIES: tuple[TrajectoryKind, ...] = get_args(TrajectoryKind)
 
 #: The translation of ``paper-translation`` when none is given (m, ENU).
@@ -666,7 +667,8 @@ PAPER_TRANSLATION_M = (5.0, 5.0, 1.0)
 def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
     """Build a trajectory by name (``paper``, ``paper-translation``, ``coning``,
     ``static``, ``turntable``, ``level-turn``, ``constant-rate``, ``csv`` with
-    ``path=``)."""
+    ``path=``; the vehicles of :mod:`.vehicle`: ``fixed-wing``, ``fixed-wing-turn``,
+    ``car``, ``car-brake``, ``car-roundabout``)."""
     if kind == "paper":
         return PaperTrajectory(**kw)
     if kind == "paper-translation":
@@ -685,6 +687,10 @@ def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
         return StaticTrajectory(**kw)
     if kind == "constant-rate":
         return ConstantRateTrajectory(**kw)
+    if kind in ("fixed-wing", "fixed-wing-turn", "car", "car-brake", "car-roundabout"):
+        from .vehicle import vehicle_trajectory  # the vehicles build on this module
+
+        return vehicle_trajectory(kind, **kw)
     if kind == "csv":
         if "path" not in kw:
             raise InvalidArgument("the csv trajectory needs path=")
