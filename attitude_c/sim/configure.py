@@ -94,6 +94,12 @@ def _csv_trajectory(path: str | None, duration: float | None) -> Any:
 
 def _shape(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
     """make_trajectory's keywords for a trajectory of ``kind`` (angles in rad)."""
+    if kind in _VEHICLE_OPTIONS:
+        return _vehicle(kind, o)
+    given = [n for n in _VEHICLE_KEYS if o[n] is not None]
+    if given:
+        raise ValueError(f"--{given[0].replace('_', '-')} is an option of the vehicle trajectories "
+                         f"({', '.join(_VEHICLE_OPTIONS)})")
     if kind in ("paper", "paper-translation"):
         kw: dict[str, Any] = {"amplitude": [math.radians(v) for v in o["amplitude"]],
                               "frequency": list(o["frequency"]), "phase": [math.radians(v) for v in o["phase"]]}
@@ -108,12 +114,6 @@ def _shape(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
         return {"rate": [0.0, 0.0, math.radians(o["turntable_rate"])]}
     if kind == "level-turn":
         return {"peak_rate": math.radians(o["turn_rate"]), "turns": o["turns"], "rest": o["rest"]}
-    if kind in _VEHICLE_OPTIONS:
-        return _vehicle(kind, o)
-    given = [n for n in ("speed", "bank", "turn_time", "brake_g", "radius") if o[n] is not None]
-    if given:
-        raise ValueError(f"--{given[0].replace('_', '-')} is an option of the vehicle trajectories "
-                         f"({', '.join(_VEHICLE_OPTIONS)})")
     return {}
 
 
@@ -121,12 +121,13 @@ def _shape(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
 _VEHICLE_OPTIONS = {"fixed-wing": ("speed", "bank"), "fixed-wing-turn": ("speed", "bank", "turn_time"),
                     "car": ("speed", "radius", "brake_g"), "car-brake": ("speed", "brake_g"),
                     "car-roundabout": ("speed", "radius", "turns")}
+_VEHICLE_KEYS = ("speed", "bank", "turn_time", "brake_g", "radius")
 
 
 def _vehicle(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
     """make_trajectory's keywords for a vehicle: the options given, and the environment's g."""
     allowed = _VEHICLE_OPTIONS[kind]
-    wrong = [n for n in ("speed", "bank", "turn_time", "brake_g", "radius") if o[n] is not None and n not in allowed]
+    wrong = [n for n in _VEHICLE_KEYS if o[n] is not None and n not in allowed]
     if wrong:
         raise ValueError(f"--{wrong[0].replace('_', '-')} does not apply to --trajectory {kind} (it takes "
                          f"{', '.join('--' + n.replace('_', '-') for n in allowed)})")
