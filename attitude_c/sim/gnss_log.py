@@ -120,7 +120,20 @@ _NO_ACC = 0xFFFF_FFFF
 
 
 def _mm(x: float) -> int:
-    return int(round(x * 1000.0))
+    return round(x * 1000.0)
+
+
+def _pvt_solution(fix: Any) -> tuple[int, ...]:
+    """lon, lat, height, hMSL, hAcc, vAcc, velN, velE, velD, gSpeed, headMot, sAcc, headAcc
+    in NAV-PVT's integer units (no fix: zeros and the largest accuracies)."""
+    if int(fix["fix_type"]) < 2:
+        return (0, 0, 0, 0, _NO_ACC, _NO_ACC, 0, 0, 0, 0, 0, _NO_ACC, 180 * 100_000)
+    speed = float(fix["speed"])
+    head_acc = min(math.degrees(float(fix["s_acc"]) / speed), 180.0) if speed > 0 else 180.0
+    h = _mm(float(fix["h"]))
+    return (round(float(fix["lon"]) * 1e7), round(float(fix["lat"]) * 1e7), h, h, _mm(float(fix["h_acc"])),
+            _mm(float(fix["v_acc"])), _mm(float(fix["vn"])), _mm(float(fix["ve"])), _mm(float(fix["vd"])),
+            _mm(speed), round(float(fix["track"]) * 1e5), _mm(float(fix["s_acc"])), round(head_acc * 1e5))
 
 
 def ubx_nav_pvt(fix: Any, utc_start: datetime.datetime = DEFAULT_UTC_START) -> bytes:
@@ -128,19 +141,10 @@ def ubx_nav_pvt(fix: Any, utc_start: datetime.datetime = DEFAULT_UTC_START) -> b
     when = _utc(float(fix["t_measured"]), utc_start, 0.001)
     gps_ms = round((when - _GPS_EPOCH).total_seconds() * 1000) + GPS_UTC_LEAP_S * 1000
     ok = int(fix["fix_type"]) >= 2
-    speed = float(fix["speed"]) if ok else 0.0
-    head_acc = min(math.degrees(float(fix["s_acc"]) / speed), 180.0) if ok and speed > 0 else 180.0
-    z = dict(lon=0, lat=0, h=0, hacc=_NO_ACC, vacc=_NO_ACC, vn=0, ve=0, vd=0, gs=0, head=0, sacc=_NO_ACC)
-    if ok:
-        z = dict(lon=int(round(float(fix["lon"]) * 1e7)), lat=int(round(float(fix["lat"]) * 1e7)),
-                 h=_mm(float(fix["h"])), hacc=_mm(float(fix["h_acc"])), vacc=_mm(float(fix["v_acc"])),
-                 vn=_mm(float(fix["vn"])), ve=_mm(float(fix["ve"])), vd=_mm(float(fix["vd"])), gs=_mm(speed),
-                 head=int(round(float(fix["track"]) * 1e5)), sacc=_mm(float(fix["s_acc"])))
     payload = _PVT.pack(
         gps_ms % _WEEK_MS, when.year, when.month, when.day, when.hour, when.minute, when.second, 0x07, 50,
         when.microsecond * 1000, int(fix["fix_type"]), 0x01 if ok else 0x00, 0, int(fix["nsat"]),
-        z["lon"], z["lat"], z["h"], z["h"], z["hacc"], z["vacc"], z["vn"], z["ve"], z["vd"], z["gs"], z["head"],
-        z["sacc"], int(round(head_acc * 1e5)), int(round(float(fix["pdop"]) * 100)), 0 if ok else 1, 0, 0, 0, 0)
+        *_pvt_solution(fix), round(float(fix["pdop"]) * 100), 0 if ok else 1, 0, 0, 0, 0)
     body = bytes((0x01, 0x07)) + struct.pack("<H", len(payload)) + payload
     return b"\xb5\x62" + body + fletcher8(body)
 

@@ -149,7 +149,7 @@ class VehicleTrajectory(Trajectory):
         self.total = float(sum(leg.duration for leg in legs))
         # position knots: every leg start and ramp end, then at most 1 s apart
         edges = np.unique(np.concatenate([starts, starts + ramps, [self.total]]))
-        self._knots = np.unique(np.concatenate([np.linspace(a, b, int(math.ceil((b - a) / 1.0)) + 1)
+        self._knots = np.unique(np.concatenate([np.linspace(a, b, math.ceil((b - a) / 1.0) + 1)
                                                 for a, b in zip(edges[:-1], edges[1:])]))
         self._pos_knots = self.position0 + np.concatenate(
             [np.zeros((1, 3)), np.cumsum(self._gl(self._knots[:-1], self._knots[1:]), axis=0)])
