@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import datetime
 import io
+import json
 import math
 from dataclasses import replace
 
@@ -229,3 +230,25 @@ def test_options_configure_the_receiver() -> None:
         SimConfig.from_dict({"gnss": "none", "gnss_outage": "1,2"})
     with pytest.raises(ValueError, match="nmea or"):
         SimConfig.from_dict({"gnss_log": "fix.log"})
+
+
+def test_simulate_writes_the_gnss_log_beside_the_run(tmp_path, capsys) -> None:
+    from attitude_c.cli import main
+
+    out = tmp_path / "run"
+    args = ["simulate", "--trajectory", "fixed-wing-turn", "--sensors", "ideal", "--link", "none", "--calibration",
+            "0", "--no-plots", "--no-progress", "--out", str(out), "--gnss-outage", "40,70"]
+    assert main([*args, "--gnss-log", "fix.ubx"]) == 0
+    assert main([*args, "--gnss-log", "fix.nmea", "--gnss", "ideal"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["files"]["gnss_log"] == "fix.nmea" and summary["gnss"]["model"] == "ideal"
+    # ideal: 10 Hz over the 83 s turn (0 .. 83 s inclusive), 300 epochs without a fix in 40 .. 70 s
+    assert summary["gnss"]["epochs"] == 831 and summary["gnss"]["no_fix"] == 300
+    msgs = list(pyubx2.UBXReader(io.BytesIO((out / "fix.ubx").read_bytes())))
+    assert len(msgs) == 5 * 83 + 1  # the neo-m8n preset's 5 Hz
+    lines = (out / "fix.nmea").read_text().splitlines()
+    assert len(lines) == 4 * 831 and all(pynmea2.parse(s, check=True) for s in lines[:8])
+    assert sorted(p.name for p in out.iterdir()) == ["fix.nmea", "fix.ubx", "summary.json", "timeseries.csv"]
+    capsys.readouterr()
+    assert main([*args, "--gnss-log", "fix.txt"]) == 2
+    assert "name it *.nmea or *.ubx" in capsys.readouterr().err
