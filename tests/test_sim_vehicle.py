@@ -135,3 +135,13 @@ def test_options_build_the_vehicles() -> None:
         SimConfig.from_dict({"trajectory": "car-brake", "bank": 30})
     with pytest.raises(ValueError, match="vehicle trajectories"):
         SimConfig.from_dict({"trajectory": "paper", "speed": 30})
+
+
+def test_vehicle_figure(tmp_path) -> None:
+    import matplotlib.image as mpimg
+
+    from attitude_c.sim.report import draw_vehicle
+
+    draw_vehicle(make_trajectory("car-roundabout"), tmp_path / "v.png", "roundabout")
+    img = mpimg.imread(tmp_path / "v.png")
+    assert img.shape[0] > 200 and img.shape[1] > 500 and img.std() > 0.05  # a drawn figure, not a blank page
