@@ -145,3 +145,18 @@ def test_vehicle_figure(tmp_path) -> None:
     draw_vehicle(make_trajectory("car-roundabout"), tmp_path / "v.png", "roundabout")
     img = mpimg.imread(tmp_path / "v.png")
     assert img.shape[0] > 200 and img.shape[1] > 500 and img.std() > 0.05  # a drawn figure, not a blank page
+
+
+@pytest.mark.parametrize("case", ["turn", "brake", "roundabout", "outage-in-turn"])
+def test_acceptance_cases_build(case: str) -> None:
+    from attitude_c.sim.vehicle import ACCEPTANCE_CASES
+
+    cfg = SimConfig.from_dict(ACCEPTANCE_CASES[case])
+    assert cfg.gnss is not None and cfg.gnss.model.name == "neo-m8n"
+    tr = cfg.trajectory
+    if case == "outage-in-turn":
+        (a, b), = cfg.gnss.outages
+        assert b - a == 30.0
+        # the whole outage and the 10 s after it lie at full 30° bank
+        t = np.linspace(a, b + 10.0, 401)
+        np.testing.assert_allclose(tr.euler(t)[:, 2], -math.radians(30.0), atol=1e-12)

@@ -45,7 +45,7 @@ from ..errors import InvalidArgument
 from ..reference import euler_to_quat
 from .trajectory import _GL_W, _GL_X, STANDARD_GRAVITY, Trajectory, euler_rates_to_body
 
-__all__ = ["VEHICLE_PRESETS", "Leg", "VehicleTrajectory", "car", "car_brake", "car_roundabout", "coordinated_rate",
+__all__ = ["ACCEPTANCE_CASES", "VEHICLE_PRESETS", "Leg", "VehicleTrajectory", "car", "car_brake", "car_roundabout", "coordinated_rate",
            "fixed_wing", "fixed_wing_turn", "vehicle_trajectory"]
 
 Vehicle = Literal["fixed-wing", "car"]
@@ -349,6 +349,19 @@ def car(speed: float = 15.0, radius: float = 20.0, brake_g: float = 0.5,
     return VehicleTrajectory("car", legs, "car", gravity=gravity,
                              params={"speed_m_s": speed, "radius_m": radius, "brake_g": brake_g})
 
+
+#: Issue 30's acceptance cases as the simulator's options (``SimConfig.from_dict(case)``;
+#: on the command line ``--trajectory fixed-wing-turn --gnss neo-m8n ...``): the 60 s
+#: coordinated turn at 30° bank and 60 m/s, braking at 0.5 g, a roundabout, and a 30 s
+#: GNSS outage in a turn (a 90 s turn held from 13 s to 103 s, no fix from 40 s to 70 s:
+#: 33 s of turn left after the fix returns for the 10 s recovery).
+ACCEPTANCE_CASES: dict[str, dict[str, Any]] = {
+    "turn": {"trajectory": "fixed-wing-turn", "speed": 60.0, "bank": 30.0, "turn_time": 60.0, "gnss": "neo-m8n"},
+    "brake": {"trajectory": "car-brake", "brake_g": 0.5, "gnss": "neo-m8n"},
+    "roundabout": {"trajectory": "car-roundabout", "gnss": "neo-m8n"},
+    "outage-in-turn": {"trajectory": "fixed-wing-turn", "speed": 60.0, "bank": 30.0, "turn_time": 90.0,
+                       "gnss": "neo-m8n", "gnss_outage": [[40.0, 70.0]]},
+}
 
 _BUILDERS = {"fixed-wing": fixed_wing, "fixed-wing-turn": fixed_wing_turn, "car": car, "car-brake": car_brake,
              "car-roundabout": car_roundabout}
