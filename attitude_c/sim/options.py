@@ -39,8 +39,8 @@ from .accelmag import ACCEL_PRESETS, MAG_PRESETS
 from .aided import AidedPlan, BoardKind, HostConfig
 from .denoising import DENOISE_TIMINGS
 from .estimator import ESTIMATORS
-from .gnss_model import GNSS_PRESETS
 from .frontend import ACCEL_FRONTENDS, MAG_FRONTENDS
+from .gnss_model import GNSS_PRESETS
 from .sensors import GYRO_PRESETS
 from .trajectory import TRAJECTORIES
 
