@@ -160,3 +160,16 @@ def test_acceptance_cases_build(case: str) -> None:
         # the whole outage and the 10 s after it lie at full 30° bank
         t = np.linspace(a, b + 10.0, 401)
         np.testing.assert_allclose(tr.euler(t)[:, 2], -math.radians(30.0), atol=1e-12)
+
+
+def test_help_gives_the_units() -> None:
+    import argparse
+
+    from attitude_c.sim.options import add_arguments
+
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    text = " ".join(p.format_help().split())
+    for phrase in ("speed (m/s)", "coordinated turn (deg", "full bank (s)", "deceleration (g = 9.80665 m/s²)",
+                   "roundabout (m)", "fix rate (Hz, 1..10)", "delivery (s)", "DVE,DVN,DVU (m/s)"):
+        assert phrase in text, phrase
