@@ -44,6 +44,7 @@ from .estimator import (
     Integrate,
     check_ahrs_settings,
 )
+from .gnss_model import GnssReceiver
 from .host import AuxCalibration, AuxStream, Calibration, Decoded, HostDecoder
 from .link import Link
 from .outputs import compare
@@ -127,6 +128,12 @@ class SimConfig:
     default to ``environment``'s), ``precision`` f64/f32 and ``ahrs_init``
     ("truth": the true initial attitude, as the integrator; "align": the
     filter's own alignment on its first sample).
+
+    ``gnss``: a GNSS receiver on the vehicle (:class:`.gnss_model.GnssReceiver`;
+    None: none); ``gnss_log``: the name of the fix log (``*.nmea`` or ``*.ubx``)
+    :func:`.report.write_run` writes beside the run's files (a relative name: in
+    the output directory). The estimators do not read the fixes yet (issue 30's
+    filters).
     """
 
     trajectory: Trajectory = field(default_factory=PaperTrajectory)
@@ -158,6 +165,8 @@ class SimConfig:
     ahrs_init: Literal["truth", "align"] = "truth"
     board_kind: BoardKind = "gyro3"
     aided: AidedPlan = field(default_factory=AidedPlan)
+    gnss: GnssReceiver | None = None
+    gnss_log: str | None = None
 
     @classmethod
     def from_dict(cls, values: Mapping[str, Any]) -> SimConfig:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any
 
 from .accelmag import MagDisturbance, accel_preset, mag_preset
@@ -53,7 +54,8 @@ def build(o: Mapping[str, Any]) -> dict[str, Any]:
                 conditioning=Conditioning(follower=thesis_board),
                 board=Board(oversample=o["oversample"], sample_at=o["sample_at"]), calibration_s=o["calibration"],
                 link=o["link"], ber=o["ber"], link_attempts=o["attempts"], seed=o["seed"],
-                firmware=None if o["firmware"] == "none" else o["firmware"], denoise=_denoise(o), **extra)
+                firmware=None if o["firmware"] == "none" else o["firmware"], denoise=_denoise(o), **_gnss(o),
+                **extra)
 
 
 def _trajectory(o: Mapping[str, Any], period: float, gyro_name: str) -> tuple[Any, float]:
@@ -92,6 +94,12 @@ def _csv_trajectory(path: str | None, duration: float | None) -> Any:
 
 def _shape(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
     """make_trajectory's keywords for a trajectory of ``kind`` (angles in rad)."""
+    if kind in _VEHICLE_OPTIONS:
+        return _vehicle(kind, o)
+    given = [n for n in _VEHICLE_KEYS if o[n] is not None]
+    if given:
+        raise ValueError(f"--{given[0].replace('_', '-')} is an option of the vehicle trajectories "
+                         f"({', '.join(_VEHICLE_OPTIONS)})")
     if kind in ("paper", "paper-translation"):
         kw: dict[str, Any] = {"amplitude": [math.radians(v) for v in o["amplitude"]],
                               "frequency": list(o["frequency"]), "phase": [math.radians(v) for v in o["phase"]]}
@@ -107,6 +115,56 @@ def _shape(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
     if kind == "level-turn":
         return {"peak_rate": math.radians(o["turn_rate"]), "turns": o["turns"], "rest": o["rest"]}
     return {}
+
+
+#: The options each vehicle trajectory takes (the others do not apply to it).
+_VEHICLE_OPTIONS = {"fixed-wing": ("speed", "bank"), "fixed-wing-turn": ("speed", "bank", "turn_time"),
+                    "car": ("speed", "radius", "brake_g"), "car-brake": ("speed", "brake_g"),
+                    "car-roundabout": ("speed", "radius", "turns")}
+_VEHICLE_KEYS = ("speed", "bank", "turn_time", "brake_g", "radius")
+
+
+def _vehicle(kind: str, o: Mapping[str, Any]) -> dict[str, Any]:
+    """make_trajectory's keywords for a vehicle: the options given, and the environment's g."""
+    allowed = _VEHICLE_OPTIONS[kind]
+    wrong = [n for n in _VEHICLE_KEYS if o[n] is not None and n not in allowed]
+    if wrong:
+        raise ValueError(f"--{wrong[0].replace('_', '-')} does not apply to --trajectory {kind} (it takes "
+                         f"{', '.join('--' + n.replace('_', '-') for n in allowed)})")
+    kw = {n: o[n] for n in allowed if n != "turns" and o[n] is not None}
+    if kind == "car-roundabout":
+        kw["turns"] = o["turns"]
+    if o["gravity"] is not None:
+        kw["gravity"] = o["gravity"]
+    return kw
+
+
+def _gnss(o: Mapping[str, Any]) -> dict[str, Any]:
+    """The GNSS options as SimConfig keywords ({}: no receiver)."""
+    from .gnss_log import log_format
+    from .gnss_model import BadFix, GnssReceiver, Quality, gnss_preset
+
+    name = o["gnss"] or ("neo-m8n" if o["gnss_log"] else "none")
+    extras = [k for k in ("gnss_rate", "gnss_latency", "gnss_outage", "gnss_quality", "gnss_bad_fix", "gnss_origin")
+              if o[k]]
+    if name == "none":
+        if extras or o["gnss_log"]:
+            raise ValueError(f"--{extras[0].replace('_', '-') if extras else 'gnss-log'} needs a GNSS receiver: "
+                             "give --gnss PRESET")
+        return {}
+    model = gnss_preset(name)
+    if o["gnss_log"]:
+        log_format(o["gnss_log"])  # a wrong name fails before the run
+    if o["gnss_rate"] is not None or o["gnss_latency"] is not None:
+        model = replace(model, rate_hz=o["gnss_rate"] or model.rate_hz,
+                        latency_s=model.latency_s if o["gnss_latency"] is None else o["gnss_latency"])
+    kw: dict[str, Any] = {"model": model, "outages": tuple(tuple(w) for w in o["gnss_outage"] or ()),
+                          "quality": tuple(Quality(a, b, int(f), int(n), h, p)
+                                           for a, b, f, n, h, p in o["gnss_quality"] or ()),
+                          "bad_fixes": tuple(BadFix(a, b, (e, n, u)) for a, b, e, n, u in o["gnss_bad_fix"] or ())}
+    if o["gnss_origin"] is not None:
+        kw["origin"] = tuple(o["gnss_origin"])
+    return {"gnss": GnssReceiver(**kw), "gnss_log": o["gnss_log"]}
 
 
 def _settings(o: Mapping[str, Any]) -> dict[str, Any]:

@@ -40,6 +40,7 @@ from .aided import AidedPlan, BoardKind, HostConfig
 from .denoising import DENOISE_TIMINGS
 from .estimator import ESTIMATORS
 from .frontend import ACCEL_FRONTENDS, MAG_FRONTENDS
+from .gnss_model import GNSS_PRESETS
 from .sensors import GYRO_PRESETS
 from .trajectory import TRAJECTORIES
 
@@ -66,9 +67,10 @@ SYSTEM = "system"
 AIDED = "the aided board (nine channels over link v2 into the filter; docs/simulation.md)"
 ACCELMAG = "accelerometer and magnetometer (read by the host beside the gyros; docs/simulation.md)"
 DENOISE = "wavelet denoising of the gyro rates (docs/denoise.md)"
+GNSS = "GNSS receiver (a fix log beside the run's files; docs/simulation.md)"
 RUN = "run"
 #: The groups, in the order ``attitude simulate --help`` shows them.
-GROUPS = (SCENARIO, SYSTEM, AIDED, ACCELMAG, DENOISE, RUN)
+GROUPS = (SCENARIO, SYSTEM, AIDED, ACCELMAG, DENOISE, GNSS, RUN)
 
 
 @dataclass(frozen=True)
@@ -191,10 +193,22 @@ OPTIONS: tuple[Option, ...] = (
            5.0, real("--turntable-rate"), unit="°/s", metavar="DEG_S"),
     Option("turn_rate", "level-turn trajectory: peak turn rate (deg/s)", SCENARIO, 10.0, positive("--turn-rate"),
            unit="°/s", metavar="DEG_S"),
-    Option("turns", "level-turn trajectory: turns (negative: clockwise)", SCENARIO, 1.0, real("--turns"),
-           metavar="N"),
+    Option("turns", "level-turn and car-roundabout trajectories: turns (negative: clockwise)", SCENARIO, 1.0,
+           real("--turns"), metavar="N"),
     Option("rest", "level-turn trajectory: rest before and after the turn (s)", SCENARIO, 10.0, nonneg("--rest"),
            unit="s", metavar="S"),
+    Option("speed", "vehicle trajectories: speed (m/s) (default: fixed-wing, fixed-wing-turn 60; car 15; "
+           "car-brake 20; car-roundabout 8)", SCENARIO, type=positive("--speed"), unit="m/s", metavar="M_S",
+           derived_default=True),
+    Option("bank", "fixed-wing, fixed-wing-turn: bank of the (first) coordinated turn (deg; tan(bank) = V "
+           "omega / g) (default 30)", SCENARIO, type=real("--bank", gt=0, lt=80), unit="°", metavar="DEG",
+           derived_default=True),
+    Option("turn_time", "fixed-wing-turn: time held at full bank (s) (default 60)", SCENARIO,
+           type=positive("--turn-time"), unit="s", metavar="S", derived_default=True),
+    Option("brake_g", "car, car-brake: braking deceleration (g = 9.80665 m/s²) (default 0.5)", SCENARIO,
+           type=real("--brake-g", gt=0, le=1.5), unit="g", metavar="G", derived_default=True),
+    Option("radius", "car, car-roundabout: radius of the roundabout (m) (default 20)", SCENARIO,
+           type=positive("--radius"), unit="m", metavar="M", derived_default=True),
     # --- system -----------------------------------------------------------------------------
     Option("estimator", "integrator: the paper's strapdown integrator of the gyros (--method, --precision); "
            "ahrs: the attitude filter (docs/ahrs.md) fed the gyro rates, the accelerometer (needs --accel) and "
@@ -271,6 +285,26 @@ OPTIONS: tuple[Option, ...] = (
            type=integer("--denoise-block", 8, 4096), metavar="N"),
     Option("denoise_timing", "aligned: post-processing (sample k stays at k); realtime: each attitude judged the "
            "denoiser's latency later", DENOISE, "aligned", choices=DENOISE_TIMINGS),
+    # --- GNSS receiver -----------------------------------------------------------------------
+    Option("gnss", "GNSS receiver preset (default none; neo-m8n when --gnss-log is given)", GNSS,
+           choices=("none", *GNSS_PRESETS)),
+    Option("gnss_log", "write the receiver's fixes as a log beside the run's files: NAME.nmea (NMEA 0183 RMC, VTG, "
+           "GGA, GSA) or NAME.ubx (UBX NAV-PVT); a relative name goes into the output directory", GNSS,
+           metavar="FILE"),
+    Option("gnss_rate", "fix rate (Hz, 1..10) (default: the preset's)", GNSS, type=real("--gnss-rate", ge=1, le=10),
+           unit="Hz", metavar="HZ"),
+    Option("gnss_latency", "delay from a fix's measurement to its delivery (s) (default: the preset's)", GNSS,
+           type=nonneg("--gnss-latency"), unit="s", metavar="S"),
+    Option("gnss_outage", "no fix from START to END (s); may be repeated", GNSS, type=floats("--gnss-outage", (2,)),
+           metavar="START,END", kind="repeat"),
+    Option("gnss_quality", "a degraded fix from START to END (s): fix type (2 or 3), satellites, HDOP, PDOP; may "
+           "be repeated", GNSS, type=floats("--gnss-quality", (6,)), metavar="START,END,FIX,NSAT,HDOP,PDOP",
+           kind="repeat"),
+    Option("gnss_bad_fix", "a velocity jump the receiver does not flag from START to END (s): DVE,DVN,DVU (m/s); "
+           "may be repeated", GNSS, type=floats("--gnss-bad-fix", (5,)), metavar="START,END,DVE,DVN,DVU",
+           kind="repeat"),
+    Option("gnss_origin", "latitude, longitude (deg) and ellipsoidal height (m) of the ENU origin (default "
+           "32.06,118.80,10: Nanjing, an assumption)", GNSS, type=floats("--gnss-origin", (3,)), metavar="LAT,LON,H"),
     # --- run --------------------------------------------------------------------------------
     Option("seed", "random seed (noise, bias, channel errors)", RUN, 0, integer("--seed", 0, 2**63 - 1)),
 )

@@ -105,6 +105,36 @@ def _draw_attitude(res: SimResult, path: Path, dpi: int = 90) -> None:
             ax.set_ylabel(f"{name} / °")
 
 
+def draw_vehicle(traj: Any, path: Path, title: str, dpi: int = 90) -> None:
+    """A vehicle trajectory (:mod:`.vehicle`): its ground track (north over east, m;
+    start marked) and, over t, its bank and pitch (°) and its speed (m/s); PNG to
+    ``path`` as it is (the caller makes the write atomic)."""
+    from .._plot import plt
+
+    pyplot = plt()
+    t = np.linspace(0.0, traj.total, 3000)
+    p, e = traj.position(t), np.degrees(traj.euler(t))
+    fig, (ax0, ax1) = pyplot.subplots(1, 2, figsize=(9.0, 3.6))
+    try:
+        ax0.plot(p[:, 0], p[:, 1], color="black", linewidth=1.0)
+        ax0.plot(p[:1, 0], p[:1, 1], "o", color="black", markersize=4, label="start")
+        ax0.set_aspect("equal", adjustable="datalim")
+        ax0.set_xlabel("east / m")
+        ax0.set_ylabel("north / m")
+        ax1.plot(t, e[:, 2], color="black", linewidth=1.0, label="bank (roll γ) / °")
+        ax1.plot(t, e[:, 1], color="0.5", linewidth=1.0, linestyle="--", label="pitch θ / °")
+        ax1.plot(t, traj.speed(t), color="0.3", linewidth=0.8, linestyle=":", label="speed / (m/s)")
+        ax1.set_xlabel("t / s")
+        for ax in (ax0, ax1):
+            ax.grid(True, linestyle=":", linewidth=0.6)
+            ax.legend(loc="best", fontsize=8)
+        fig.suptitle(title, fontsize=9.5)
+        fig.tight_layout()
+        fig.savefig(path, dpi=dpi, format="png")
+    finally:
+        pyplot.close(fig)
+
+
 def plot_bias(res: SimResult, path: Path, dpi: int = 90) -> None:
     """The filter's gyro-bias estimate per body axis (°/s) beside the bias the
     estimator's rates actually carry (their mean minus the true rates' over the run),
@@ -290,6 +320,20 @@ def format_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _gnss_log_step(res: SimResult, path: Path, steps: list[tuple[Path, Callable[[Path], object]]]) -> dict[str, Any]:
+    """Add the GNSS log's writer to ``steps``; the receiver and its fix counts for the summary."""
+    from .gnss_log import log_format, nmea_stream, ubx_stream
+
+    cfg = res.config
+    rx = cfg.gnss
+    assert rx is not None
+    fixes = rx.fixes(cfg.trajectory, cfg.duration, cfg.seed)
+    stream = nmea_stream if log_format(path) == "nmea" else ubx_stream
+    steps.append((path, lambda p: p.write_bytes(stream(fixes, rx.utc_start))))
+    return {**rx.to_dict(), "epochs": len(fixes), "fixes_3d": int(np.sum(fixes["fix_type"] == 3)),
+            "fixes_2d": int(np.sum(fixes["fix_type"] == 2)), "no_fix": int(np.sum(fixes["fix_type"] == 0))}
+
+
 def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
     """Write timeseries.csv (sensors.csv when the run has an accelerometer or a
     magnetometer), errors.png, attitude.png and summary.json (last) into out,
@@ -306,6 +350,8 @@ def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
         files["attitude_png"] = out / "attitude.png"
         if res.bias is not None:
             files["bias_png"] = out / "bias.png"
+        if hasattr(res.config.trajectory, "vehicle"):
+            files["vehicle_png"] = out / "vehicle.png"
     summary = dict(res.summary)
     summary["files"] = {k: v.name for k, v in files.items()}
     # write_results gives each writer the temporary path it renames into place: the writers
@@ -318,6 +364,13 @@ def write_run(res: SimResult, out: Path, plots: bool = True) -> dict[str, Path]:
                   (files["attitude_png"], lambda p: _draw_attitude(res, p))]
         if res.bias is not None:
             steps.append((files["bias_png"], lambda p: _draw_bias(res, p)))
+        if "vehicle_png" in files:
+            steps.append((files["vehicle_png"], lambda p: draw_vehicle(res.config.trajectory, p,
+                                                                       "Vehicle — " + _title(res))))
+    if res.config.gnss is not None and res.config.gnss_log:
+        files["gnss_log"] = out / res.config.gnss_log
+        summary["gnss"] = _gnss_log_step(res, files["gnss_log"], steps)
+        summary["files"]["gnss_log"] = str(res.config.gnss_log)
     steps.append((files["summary"], lambda p: p.write_text(json.dumps(to_jsonable(summary), indent=2) + "\n",
                                                             encoding="utf-8")))
     write_results(steps)

@@ -209,6 +209,14 @@ class Trajectory:
         t = np.asarray(t, dtype=float)
         return np.zeros(t.shape + (3,))
 
+    def position(self, t: Any) -> np.ndarray:
+        """Position of the body (m, ENU): the origin unless the trajectory translates."""
+        return np.zeros(np.shape(t) + (3,))
+
+    def velocity(self, t: Any) -> np.ndarray:
+        """Velocity of the body (m/s, ENU): zero unless the trajectory translates."""
+        return np.zeros(np.shape(t) + (3,))
+
     def specific_force(self, t: Any, env: Environment = EARTH) -> np.ndarray:
         """What a perfect accelerometer reads (m/s², body axes): ``Cᵀ (a_n − g_n)``."""
         return to_body(self.quat(t), self.accel_nav(t) - env.gravity_nav)
@@ -648,7 +656,8 @@ class CsvTrajectory(Trajectory):
 
 
 TrajectoryKind = Literal["paper", "paper-translation", "coning", "static", "turntable", "level-turn",
-                         "constant-rate", "csv"]
+                         "constant-rate", "csv", "fixed-wing", "fixed-wing-turn", "car", "car-brake",
+                         "car-roundabout"]
 TRAJECTORIES: tuple[TrajectoryKind, ...] = get_args(TrajectoryKind)
 
 #: The translation of ``paper-translation`` when none is given (m, ENU).
@@ -658,7 +667,8 @@ PAPER_TRANSLATION_M = (5.0, 5.0, 1.0)
 def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
     """Build a trajectory by name (``paper``, ``paper-translation``, ``coning``,
     ``static``, ``turntable``, ``level-turn``, ``constant-rate``, ``csv`` with
-    ``path=``)."""
+    ``path=``; the vehicles of :mod:`.vehicle`: ``fixed-wing``, ``fixed-wing-turn``,
+    ``car``, ``car-brake``, ``car-roundabout``)."""
     if kind == "paper":
         return PaperTrajectory(**kw)
     if kind == "paper-translation":
@@ -677,6 +687,10 @@ def make_trajectory(kind: TrajectoryKind, **kw: Any) -> Trajectory:
         return StaticTrajectory(**kw)
     if kind == "constant-rate":
         return ConstantRateTrajectory(**kw)
+    if kind in ("fixed-wing", "fixed-wing-turn", "car", "car-brake", "car-roundabout"):
+        from .vehicle import vehicle_trajectory  # the vehicles build on this module
+
+        return vehicle_trajectory(kind, **kw)
     if kind == "csv":
         if "path" not in kw:
             raise InvalidArgument("the csv trajectory needs path=")
