@@ -20,7 +20,7 @@ Settings are keyword arguments named as the C struct's fields
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -145,6 +145,36 @@ class Ahrs:
         self._lib.att_ahrs_sigma(self._s, a, b)
         return np.array(list(a)), np.array(list(b))
 
+    def _covariance(self) -> tuple[FloatArray, FloatArray]:
+        a = self._ffi.new("att_real[9]")
+        b = self._ffi.new("att_real[9]")
+        self._lib.att_ahrs_covariance(self._s, a, b)
+        return np.array(list(a)).reshape(3, 3), np.array(list(b)).reshape(3, 3)
+
+    @property
+    def covariance(self) -> FloatArray:
+        """Attitude error covariance (3, 3), rad², float64: of the rotation vector δθ about the
+        fixed ENU axes with q_true = exp(δθ) ⊗ q (``att_ahrs_covariance``; [2, 2] is the heading
+        variance). ``covariance.ravel()`` is ROS's ``sensor_msgs/Imu.orientation_covariance``
+        layout (row-major). docs/ahrs.md, "Uncertainty"."""
+        return self._covariance()[0]
+
+    @property
+    def bias_covariance(self) -> FloatArray:
+        """Gyro-bias error covariance (3, 3), (rad/s)², body frame."""
+        return self._covariance()[1]
+
+    @property
+    def heading_sigma(self) -> float:
+        """1σ of the heading error (rad): the square root of ``covariance[2, 2]``."""
+        return float(np.sqrt(max(self._covariance()[0][2, 2], 0.0)))
+
+    @property
+    def heading_observable(self) -> bool:
+        """False in six-axis mode and once :attr:`heading_sigma` has grown past the setting
+        ``heading_sigma_max`` without a magnetometer update (``ATT_AHRS_F_NO_HEADING``)."""
+        return not self.flags & names.C["ATT_AHRS_F_NO_HEADING"]
+
     @property
     def flags(self) -> int:
         """``ATT_AHRS_F_*`` bits of the last sample."""
@@ -160,9 +190,19 @@ class Ahrs:
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
         return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
 
+    @overload
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,
+               dt: ArrayLike | None = ..., covariance: Literal[False] = ...) -> FloatArray: ...
+
+    @overload
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,
+               dt: ArrayLike | None = ..., *, covariance: Literal[True]) -> tuple[FloatArray, FloatArray]: ...
+
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
-               dt: ArrayLike | None = None) -> FloatArray:
-        """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4))."""
+               dt: ArrayLike | None = None, covariance: bool = False) -> Any:
+        """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4)). With
+        ``covariance=True`` also the attitude covariance after each sample ((3, 3) or
+        (N, 3, 3), rad², as :attr:`covariance`): returns ``(q, cov)``."""
         single = np.ndim(gyr) == 1
         g = _vectors(gyr, "gyr")
         a = _vectors(acc, "acc")
@@ -184,12 +224,18 @@ class Ahrs:
         def p(x: NDArray[Any] | None) -> Any:
             return ffi.NULL if x is None else ffi.cast("att_real *", ffi.from_buffer(x))
 
-        st = self._lib.att_ahrs_batch(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
+        if covariance:
+            cov = np.empty((n, 3, 3), dtype=dtype)
+            st = self._lib.att_ahrs_batch_cov(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), p(cov), err)
+        else:
+            st = self._lib.att_ahrs_batch(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
         if st != 0:
             i = int(err[0])
             if st == self._lib.ATT_E_AHRS_DT:
                 raise InvalidArgument(f"dt: sample {i}: the time step must be finite and > 0")
             raise_for_status(st, "ahrs", index=i)
+        if covariance:
+            return (out[0], cov[0]) if single else (out, cov)
         return out[0] if single else out  # float64 for f64 (no copy), float32 for f32
 
     def update_sparse(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
@@ -235,18 +281,34 @@ class Ahrs:
         return f"Ahrs(rate={self.rate}, precision={self.precision!r})"
 
 
+@overload
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
+         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
+         covariance: Literal[False] = ..., **settings: Any) -> FloatArray: ...
+
+
+@overload
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
+         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
+         *, covariance: Literal[True], **settings: Any) -> tuple[FloatArray, FloatArray]: ...
+
+
 def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float | None = None,
          dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
-         **settings: Any) -> FloatArray:
+         covariance: bool = False, **settings: Any) -> Any:
     """Run the filter over N samples: (N, 3) arrays → (N, 4) quaternions (body → ENU).
 
     ``rate`` (Hz) or ``dt`` (s, scalar or per sample) gives the time step;
     ``mag=None`` is six-axis operation (heading from the gyro only).
+    ``covariance=True`` returns ``(q, cov)``, cov (N, 3, 3) the attitude error
+    covariance after each sample (rad², ENU; :attr:`Ahrs.covariance`).
     """
+    if not isinstance(covariance, (bool, np.bool_)):
+        raise InvalidType(f"covariance must be True or False, got {type(covariance).__name__}")
     if rate is None and dt is None:
         raise InvalidArgument("give rate (Hz) or dt (s)")
     g = np.asarray(gyr)
     if g.ndim != 2:
         raise InvalidArgument(f"gyr must have shape (N, 3), got {g.shape}")
     f = Ahrs(rate=rate, q0=q0, precision=precision, **settings)
-    return f.update(gyr, acc, mag, dt=dt)
+    return f.update(gyr, acc, mag, dt=dt, covariance=bool(covariance))

@@ -34,7 +34,7 @@ _DEFAULTS: dict[str, Any] = {
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
-    "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0,
+    "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
@@ -149,6 +149,16 @@ class ReferenceAhrs:
         self.tilt_start: F | None = np.zeros((0, 3))
         self.tilt_dts: list[float] = []
         self.flags = 0
+        self.heading_measured = False  # a magnetometer update has been made
+
+    @property
+    def covariance(self) -> F:
+        """The attitude block of P (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q)."""
+        return self.P[:3, :3].copy()
+
+    @property
+    def bias_covariance(self) -> F:
+        return self.P[3:, 3:].copy()
 
     # -- the Kalman pieces -------------------------------------------------
     def _predict(self, C: F, dt: float, rest: bool) -> None:
@@ -304,6 +314,7 @@ class ReferenceAhrs:
                     yh = math.atan2(mn[0], mn[1]) - s["declination"]
                     yh = (yh + math.pi) % (2 * math.pi) - math.pi
                     self._scalar(x, 2, yh, R, (2, 3, 4, 5))
+                    self.heading_measured = True
         if rest:
             flags |= 2
             assert self.rest_g is not None
@@ -318,6 +329,9 @@ class ReferenceAhrs:
         if self.tilt_start is not None and len(self.tilt_start):
             self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
+        # heading observability: measured at least once, and its 1σ within the bound since
+        if not (self.heading_measured and self.P[2, 2] <= s["heading_sigma_max"] ** 2):
+            flags |= 32
         self.flags = flags
         out = self.reported()
         if s["sensor_delay"]:

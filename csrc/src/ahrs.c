@@ -52,6 +52,8 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->acc_delay = ATT_R(0.0);
     set->mag_delay = ATT_R(0.0);
     set->tilt_tau = ATT_R(3.0);
+    set->heading_sigma_max = ATT_R(0.0873);
+    set->gyr_noise_turn = ATT_R(0.0);
 }
 
 static int fin(att_real x)
@@ -88,7 +90,7 @@ static const setting_domain DOMAINS[] = {
     DOMAIN(rest_tau, GT, 0),          DOMAIN(rest_gyr_th, GT, 0),       DOMAIN(rest_acc_th, GT, 0),
     DOMAIN(rest_noise, GT, 0),        DOMAIN(gyro_range, GE, 0),        DOMAIN(overrange_sigma, GE, 0),
     DOMAIN(sensor_delay, ABS, 1.0),   DOMAIN(acc_delay, ABS, 0.05),     DOMAIN(mag_delay, ABS, 0.05),
-    DOMAIN(tilt_tau, GE, 0),
+    DOMAIN(tilt_tau, GE, 0),          DOMAIN(heading_sigma_max, GT, 0), DOMAIN(gyr_noise_turn, GE, 0),
 };
 
 static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
@@ -188,6 +190,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     set_initial_cov(s);
     s->step.dt = 0;
     s->step.tilt = 0; /* read by att_ahrs_attitude before the first update */
+    s->step.turn = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -205,6 +208,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->tilt_mean = 1;
     s->tilt_t = 0;
     s->flags = 0;
+    s->heading_seen = 0;
     return ATT_OK;
 }
 
@@ -463,6 +467,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_rest = set->rest_noise * set->rest_noise / dt;
         c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
         c->tilt = set->tilt_tau > 0;
+        c->turn = set->gyr_noise_turn > 0;
         if (c->tilt) {
             /* ζω0 = 1/τ, ω0² = 2/τ²; at rest τ grows as the state's own inclination
              * time constant does, by gyr_noise/gyr_noise_rest */
@@ -591,6 +596,18 @@ static int detect_rest(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3
     return s->rest_t >= set->rest_time;
 }
 
+/* The turn-rate part of the attitude's process noise, (gyr_noise_turn·|ω − b|)²·dt =
+ * gyr_noise_turn²·|Δθ|²/dt (ahrs.h): the gyro's scale and misalignment errors turn an
+ * attitude error out of the rotation itself. */
+static att_real turn_noise(const att_ahrs *s, const att_real dth[3], att_real dt)
+{
+    att_real k = s->set.gyr_noise_turn;
+    if (!s->step.turn) {
+        return 0;
+    }
+    return k * k * (dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]) / dt;
+}
+
 /* Propagation: the bias-corrected increment through the integrator, then
  * P ← F P Fᵀ + Q (at rest with the gyro's own noise), plus overrange_sigma² on
  * the attitude when over range. C = C_b^n of the propagated attitude. 0, or
@@ -607,7 +624,7 @@ static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3],
         return -1;
     }
     q2C(s->integ.q, C);
-    propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
+    propagate_cov(s->P, C, dt, (rest ? k->q_att_rest : k->q_att) + turn_noise(s, dth, dt), k->q_bias);
     if (over) {
         att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
         s->P[0][0] += o;
@@ -847,6 +864,18 @@ static void inject(att_ahrs *s, const att_ahrs_step *k, const att_real x[NX])
     s->bias[2] += x[5];
 }
 
+/* Heading observability (ahrs.h, ATT_AHRS_F_NO_HEADING): p_head is P[2][2] before the
+ * magnetometer's stage; only a magnetometer update lowers it (the accelerometer's and
+ * the zero-rate updates have zero gain on the heading and leave that entry as it is). */
+static int heading_flag(att_ahrs *s, att_real p_head)
+{
+    att_real m = s->set.heading_sigma_max;
+    if (s->P[2][2] < p_head) {
+        s->heading_seen = 1;
+    }
+    return (s->heading_seen && s->P[2][2] <= m * m) ? 0 : ATT_AHRS_F_NO_HEADING;
+}
+
 /* Output: the reported attitude, predicted over sensor_delay (when set) with
  * the corrected rate, q ⊗ exp((ω − b)·d). */
 static att_status write_output(const att_ahrs *s, const att_real gyr[3], att_real q_out[4])
@@ -872,7 +901,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 {
     att_ahrs save;
     const att_ahrs_step *k;
-    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3];
+    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3], p_head;
     att_status st;
     int rest, flags;
     if (s == NULL || gyr == NULL) {
@@ -900,6 +929,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, x, &flags, f_n) && k->tilt) {
         tilt_lowpass(s, k, f_n, dt, rest);
     }
+    p_head = s->P[2][2];
     if (mag != NULL) {
         mag_update(s, k, C, gyr, mag, dt, x, &flags);
     }
@@ -908,7 +938,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         zero_rate_update(s, k, x);
     }
     inject(s, k, x);
-    s->flags = flags;
+    s->flags = flags | heading_flag(s, p_head);
     if (!finite_state(s)) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
@@ -918,6 +948,13 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
                           size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index)
+{
+    return att_ahrs_batch_cov(s, gyr, acc, mag, n, dt, n_dt, q_out, NULL, err_index);
+}
+
+att_status att_ahrs_batch_cov(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
+                              size_t n, const att_real *dt, size_t n_dt, att_real *q_out, att_real *cov_out,
+                              size_t *err_index)
 {
     size_t k;
     if (s == NULL || gyr == NULL || acc == NULL || dt == NULL) {
@@ -934,6 +971,9 @@ att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc,
                 *err_index = k;
             }
             return st;
+        }
+        if (cov_out != NULL) {
+            att_ahrs_covariance(s, cov_out + 9 * k, NULL);
         }
     }
     return ATT_OK;
@@ -970,6 +1010,25 @@ att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bia
     for (i = 0; i < 3; i++) {
         att_sigma[i] = att_sqrt(s->P[i][i] > 0 ? s->P[i][i] : 0);
         bias_sigma[i] = att_sqrt(s->P[3 + i][3 + i] > 0 ? s->P[3 + i][3 + i] : 0);
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_covariance(const att_ahrs *s, att_real att_cov[9], att_real bias_cov[9])
+{
+    int i, j;
+    if (s == NULL) {
+        return ATT_E_NULL;
+    }
+    for (i = 0; i < 3; i++) {
+        for (j = 0; j < 3; j++) {
+            if (att_cov != NULL) {
+                att_cov[3 * i + j] = s->P[i][j];
+            }
+            if (bias_cov != NULL) {
+                bias_cov[3 * i + j] = s->P[3 + i][3 + j];
+            }
+        }
     }
     return ATT_OK;
 }
