@@ -35,6 +35,7 @@ _DEFAULTS: dict[str, Any] = {
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
     "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
+    "gyr_noise_turn": 0.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
@@ -161,13 +162,15 @@ class ReferenceAhrs:
         return self.P[3:, 3:].copy()
 
     # -- the Kalman pieces -------------------------------------------------
-    def _predict(self, C: F, dt: float, rest: bool) -> None:
+    def _predict(self, C: F, dt: float, rest: bool, rate: F) -> None:
         """Q: the attitude's process noise density is the gyro's own at rest (no motion,
-        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise."""
+        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise,
+        plus ``gyr_noise_turn`` times the corrected turn rate |ω − b| (scale and misalignment)."""
         Fm = np.eye(6)
         Fm[:3, 3:] = -C * dt
         sg = self.s["gyr_noise_rest"] if rest else self.s["gyr_noise"]
-        Q = np.diag([sg ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
+        qa = (sg ** 2 + (self.s["gyr_noise_turn"] * float(np.linalg.norm(rate))) ** 2) * dt
+        Q = np.diag([qa] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
         self.P = Fm @ self.P @ Fm.T + Q
 
     def _scalar(self, x: F, j: int, y: float, R: float, states: tuple[int, ...]) -> None:
@@ -221,7 +224,7 @@ class ReferenceAhrs:
             self.q = _qmul(self.q, _exp(phi))
             self.q = self.q / np.linalg.norm(self.q)
         C = _dcm(self.q)
-        self._predict(C, dt, rest)
+        self._predict(C, dt, rest, w - self.b)
         if flags & 1:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)

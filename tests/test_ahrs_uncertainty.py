@@ -54,6 +54,16 @@ def test_covariance_and_flags_match_reference(nine_axis):
         assert flags_r[0] & NO_HEADING and not flags_r[-1] & NO_HEADING and f.heading_observable
 
 
+def test_turn_noise_matches_reference():
+    """gyr_noise_turn: the process noise grows with |ω − b| (off by default)."""
+    gyr, acc, mag, _ = motion(600, 100.0, (2.0, -1.0, 3.0), noise=0.002)
+    _, cov = ahrs(gyr, acc, mag, rate=100.0, covariance=True, gyr_noise_turn=0.01)
+    cr, _, _ = _reference_run(gyr, acc, mag, 100.0, gyr_noise_turn=0.01)
+    assert np.abs(cov - cr).max() < 1e-14  # as above
+    _, c0 = ahrs(gyr, acc, mag, rate=100.0, covariance=True)
+    assert cov[-1][0, 0] > 1.5 * c0[-1][0, 0]  # (0.01·3.9 rad/s)² against 0.01²: the term is taken
+
+
 def test_flags_per_sample_match_reference_through_rejection():
     """The field switched off for a while (six-axis samples): observable until the heading's
     σ passes the bound, then again after the field returns; C and model agree on every sample."""
