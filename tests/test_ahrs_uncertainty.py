@@ -54,14 +54,23 @@ def test_covariance_and_flags_match_reference(nine_axis):
         assert flags_r[0] & NO_HEADING and not flags_r[-1] & NO_HEADING and f.heading_observable
 
 
-def test_turn_noise_matches_reference():
-    """gyr_noise_turn: the process noise grows with |ω − b| (off by default)."""
-    gyr, acc, mag, _ = motion(600, 100.0, (2.0, -1.0, 3.0), noise=0.002)
-    _, cov = ahrs(gyr, acc, mag, rate=100.0, covariance=True, gyr_noise_turn=0.01)
-    cr, _, _ = _reference_run(gyr, acc, mag, 100.0, gyr_noise_turn=0.01)
-    assert np.abs(cov - cr).max() < 1e-14  # as above
-    _, c0 = ahrs(gyr, acc, mag, rate=100.0, covariance=True)
-    assert cov[-1][0, 0] > 1.5 * c0[-1][0, 0]  # (0.01·3.9 rad/s)² against 0.01²: the term is taken
+def test_turn_variance_closed_form():
+    """turn_sigma: at a constant turn rate w the reported variance adds v with
+    v_k = a v_(k−1) + (σ_t w)² dt, a = τ/(τ + dt): v_n = (σ_t w)² dt (1 − aⁿ)/(1 − a); the attitude
+    itself is the same as with the term off (the gains use P alone)."""
+    w = np.array([2.0, -1.0, 3.0])
+    gyr, acc, mag, truth = motion(600, 100.0, tuple(w), noise=0.0)
+    # the bias states off (zero prior, no random walk): their gains are 0, b stays 0 exactly
+    kw = {"turn_sigma": 0.01, "turn_tau": 2.0, "init_bias_sigma": 0.0, "bias_noise": 0.0, "q0": truth[0]}
+    q1, c1 = ahrs(gyr, acc, mag, rate=100.0, covariance=True, **kw)
+    q0, c0 = ahrs(gyr, acc, mag, rate=100.0, covariance=True, **{**kw, "turn_sigma": 0.0})
+    np.testing.assert_array_equal(q1, q0)
+    a, u = 2.0 / 2.01, (0.01 * np.linalg.norm(w)) ** 2 * 0.01  # |ω − b| = |w|
+    n = np.arange(1, 601)
+    v = u * (1 - a ** n) / (1 - a)
+    # the same recursion in double, 600 steps: ~1e-13 relative; the difference of two P's ~1e-2
+    # rad² carries their rounding (1e-18 absolute)
+    np.testing.assert_allclose(c1 - c0, v[:, None, None] * np.eye(3), rtol=1e-12, atol=1e-17)
 
 
 def test_flags_per_sample_match_reference_through_rejection():

@@ -53,7 +53,8 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->mag_delay = ATT_R(0.0);
     set->tilt_tau = ATT_R(3.0);
     set->heading_sigma_max = ATT_R(0.0873);
-    set->gyr_noise_turn = ATT_R(0.0);
+    set->turn_sigma = ATT_R(0.003);
+    set->turn_tau = ATT_R(5.0);
 }
 
 static int fin(att_real x)
@@ -90,7 +91,8 @@ static const setting_domain DOMAINS[] = {
     DOMAIN(rest_tau, GT, 0),          DOMAIN(rest_gyr_th, GT, 0),       DOMAIN(rest_acc_th, GT, 0),
     DOMAIN(rest_noise, GT, 0),        DOMAIN(gyro_range, GE, 0),        DOMAIN(overrange_sigma, GE, 0),
     DOMAIN(sensor_delay, ABS, 1.0),   DOMAIN(acc_delay, ABS, 0.05),     DOMAIN(mag_delay, ABS, 0.05),
-    DOMAIN(tilt_tau, GE, 0),          DOMAIN(heading_sigma_max, GT, 0), DOMAIN(gyr_noise_turn, GE, 0),
+    DOMAIN(tilt_tau, GE, 0),          DOMAIN(heading_sigma_max, GT, 0), DOMAIN(turn_sigma, GE, 0),
+    DOMAIN(turn_tau, GT, 0),
 };
 
 static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
@@ -191,6 +193,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->step.dt = 0;
     s->step.tilt = 0; /* read by att_ahrs_attitude before the first update */
     s->step.turn = 0;
+    s->turn_var = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -467,7 +470,9 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_rest = set->rest_noise * set->rest_noise / dt;
         c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
         c->tilt = set->tilt_tau > 0;
-        c->turn = set->gyr_noise_turn > 0;
+        c->turn = set->turn_sigma > 0;
+        c->k_turn = set->turn_tau / (set->turn_tau + dt);
+        c->q_turn = set->turn_sigma * set->turn_sigma / dt;
         if (c->tilt) {
             /* ζω0 = 1/τ, ω0² = 2/τ²; at rest τ grows as the state's own inclination
              * time constant does, by gyr_noise/gyr_noise_rest */
@@ -596,16 +601,15 @@ static int detect_rest(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3
     return s->rest_t >= set->rest_time;
 }
 
-/* The turn-rate part of the attitude's process noise, (gyr_noise_turn·|ω − b|)²·dt =
- * gyr_noise_turn²·|Δθ|²/dt (ahrs.h): the gyro's scale and misalignment errors turn an
- * attitude error out of the rotation itself. */
-static att_real turn_noise(const att_ahrs *s, const att_real dth[3], att_real dt)
+/* The reported covariance's turn term (ahrs.h, turn_sigma): v ← v·τ/(τ + dt) +
+ * (turn_sigma·|ω − b|)²·dt, the last written turn_sigma²/dt·|Δθ|². Not in P: the
+ * gains are not changed by it. */
+static void turn_variance(att_ahrs *s, const att_ahrs_step *k, const att_real dth[3])
 {
-    att_real k = s->set.gyr_noise_turn;
-    if (!s->step.turn) {
-        return 0;
+    if (k->turn) {
+        s->turn_var =
+            k->k_turn * s->turn_var + k->q_turn * (dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]);
     }
-    return k * k * (dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]) / dt;
 }
 
 /* Propagation: the bias-corrected increment through the integrator, then
@@ -624,7 +628,8 @@ static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3],
         return -1;
     }
     q2C(s->integ.q, C);
-    propagate_cov(s->P, C, dt, (rest ? k->q_att_rest : k->q_att) + turn_noise(s, dth, dt), k->q_bias);
+    propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
+    turn_variance(s, k, dth);
     if (over) {
         att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
         s->P[0][0] += o;
@@ -873,7 +878,7 @@ static int heading_flag(att_ahrs *s, att_real p_head)
     if (s->P[2][2] < p_head) {
         s->heading_seen = 1;
     }
-    return (s->heading_seen && s->P[2][2] <= m * m) ? 0 : ATT_AHRS_F_NO_HEADING;
+    return (s->heading_seen && s->P[2][2] + s->turn_var <= m * m) ? 0 : ATT_AHRS_F_NO_HEADING;
 }
 
 /* Output: the reported attitude, predicted over sensor_delay (when set) with
@@ -1023,7 +1028,7 @@ att_status att_ahrs_covariance(const att_ahrs *s, att_real att_cov[9], att_real 
     for (i = 0; i < 3; i++) {
         for (j = 0; j < 3; j++) {
             if (att_cov != NULL) {
-                att_cov[3 * i + j] = s->P[i][j];
+                att_cov[3 * i + j] = s->P[i][j] + (i == j ? s->turn_var : 0);
             }
             if (bias_cov != NULL) {
                 bias_cov[3 * i + j] = s->P[3 + i][3 + j];

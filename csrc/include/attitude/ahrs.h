@@ -169,11 +169,15 @@ typedef struct {
                                  field rejected) the 1σ grows by the gyro's noise and bias
                                  (its variance by at least gyr_noise²·t), so this bounds
                                  the time a rejection may last. 0.0873 (5°) */
-    att_real gyr_noise_turn;      /* [√s] ≥ 0: the attitude's process noise density grows with
-                                 the turn rate, σ_g² + (gyr_noise_turn·|ω − b|)² (rad²/s): the
-                                 gyro's scale and misalignment errors, which make the attitude
-                                 error of a fast turn, so that the covariance stays honest
-                                 there (docs/ahrs.md, "Uncertainty"). 0 = off */
+    att_real turn_sigma;          /* [√s] ≥ 0: the reported attitude covariance adds v·I, a
+                                 variance that grows with the turn rate and fades with
+                                 turn_tau, v ← v·τ/(τ + dt) + (turn_sigma·|ω − b|)²·dt: the
+                                 error a fast turn makes through the gyro's scale and
+                                 misalignment errors, which the aiding then removes. Reported
+                                 only (att_ahrs_covariance, the heading flag): the gains use P
+                                 alone, so the attitude does not change. 0.003 (BROAD's
+                                 3σ coverage, docs/ahrs.md, "Uncertainty"); 0 = off */
+    att_real turn_tau;            /* [s] > 0: see turn_sigma, 5.0 */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
@@ -200,7 +204,9 @@ typedef struct {
     int delays;             /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
                             sample: a float compare is a library call on soft-float targets) */
     int tilt;               /* 1 when tilt_tau > 0 (the same reason) */
-    int turn;               /* 1 when gyr_noise_turn > 0 (the same reason) */
+    int turn;               /* 1 when turn_sigma > 0 (the same reason) */
+    att_real k_turn;        /* turn_tau/(turn_tau + dt) */
+    att_real q_turn;        /* turn_sigma²/dt */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
@@ -234,6 +240,7 @@ typedef struct {
     int tilt_mean;         /* 1 while tilt_f is still the running mean of its start */
     int flags;             /* ATT_AHRS_F_* of the last update */
     int heading_seen;      /* 1 once a magnetometer update has measured the heading */
+    att_real turn_var;     /* [rad²] the reported covariance's turn term (turn_sigma) */
 } att_ahrs;
 
 /* The defaults listed above. */
@@ -301,8 +308,9 @@ att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bia
  *     sensor_msgs/Imu.orientation_covariance ("row major about x, y, z axes"; the
  *     message does not say which frame's axes: here the fixed ENU axes).
  *   bias_cov [(rad/s)²]: the gyro-bias error δb (body frame; b_true = b_est + δb).
- * The state's: the reported attitude (tilt_tau's levelling, the sensor_delay
- * prediction) adds no term. Before the first update: the initial covariance,
+ * att_cov is the filter's P (its attitude block) plus the turn term v·I of
+ * turn_sigma; the reported attitude's levelling (tilt_tau) and the sensor_delay
+ * prediction add no term. Before the first update: the initial covariance,
  * init_att_sigma² and init_bias_sigma² on the diagonals. ATT_E_NULL when s is
  * NULL. Consistency of these figures on simulated and real data: docs/ahrs.md,
  * "Uncertainty". */
