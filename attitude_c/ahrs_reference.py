@@ -35,7 +35,7 @@ _DEFAULTS: dict[str, Any] = {
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
     "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
-    "turn_sigma": 0.003, "turn_tau": 5.0,
+    "turn_sigma": 0.002, "turn_tau": 5.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}

@@ -53,7 +53,7 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->mag_delay = ATT_R(0.0);
     set->tilt_tau = ATT_R(3.0);
     set->heading_sigma_max = ATT_R(0.0873);
-    set->turn_sigma = ATT_R(0.003);
+    set->turn_sigma = ATT_R(0.002);
     set->turn_tau = ATT_R(5.0);
 }
 

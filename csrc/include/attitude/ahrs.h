@@ -175,7 +175,7 @@ typedef struct {
                                  error a fast turn makes through the gyro's scale and
                                  misalignment errors, which the aiding then removes. Reported
                                  only (att_ahrs_covariance, the heading flag): the gains use P
-                                 alone, so the attitude does not change. 0.003 (BROAD's
+                                 alone, so the attitude does not change. 0.002 (BROAD's
                                  3σ coverage, docs/ahrs.md, "Uncertainty"); 0 = off */
     att_real turn_tau;            /* [s] > 0: see turn_sigma, 5.0 */
 } att_ahrs_settings;
