@@ -20,7 +20,7 @@ Settings are keyword arguments named as the C struct's fields
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, Literal
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -175,6 +175,36 @@ class Ahrs:
         self._lib.att_ahrs_sigma(self._s, a, b)
         return np.array(list(a)), np.array(list(b))
 
+    def _covariance(self) -> tuple[FloatArray, FloatArray]:
+        a = self._ffi.new("att_real[9]")
+        b = self._ffi.new("att_real[9]")
+        self._lib.att_ahrs_covariance(self._s, a, b)
+        return np.array(list(a)).reshape(3, 3), np.array(list(b)).reshape(3, 3)
+
+    @property
+    def covariance(self) -> FloatArray:
+        """Attitude error covariance (3, 3), rad², float64: of the rotation vector δθ about the
+        fixed ENU axes with q_true = exp(δθ) ⊗ q (``att_ahrs_covariance``; [2, 2] is the heading
+        variance). ``covariance.ravel()`` is ROS's ``sensor_msgs/Imu.orientation_covariance``
+        layout (row-major). docs/ahrs.md, "Uncertainty"."""
+        return self._covariance()[0]
+
+    @property
+    def bias_covariance(self) -> FloatArray:
+        """Gyro-bias error covariance (3, 3), (rad/s)², body frame."""
+        return self._covariance()[1]
+
+    @property
+    def heading_sigma(self) -> float:
+        """1σ of the heading error (rad): the square root of ``covariance[2, 2]``."""
+        return float(np.sqrt(max(self._covariance()[0][2, 2], 0.0)))
+
+    @property
+    def heading_observable(self) -> bool:
+        """False in six-axis mode and once :attr:`heading_sigma` has grown past the setting
+        ``heading_sigma_max`` without a magnetometer update (``ATT_AHRS_F_NO_HEADING``)."""
+        return not self.flags & names.C["ATT_AHRS_F_NO_HEADING"]
+
     @property
     def flags(self) -> int:
         """``ATT_AHRS_F_*`` bits of the last sample."""
@@ -190,9 +220,23 @@ class Ahrs:
             raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
         return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
 
+    @overload
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,
+               dt: ArrayLike | None = ..., covariance: Literal[False] = ...) -> FloatArray: ...
+
+    @overload
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,
+               dt: ArrayLike | None = ..., *, covariance: Literal[True]) -> tuple[FloatArray, FloatArray]: ...
+
+    @overload
+    def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,
+               dt: ArrayLike | None = ..., *, covariance: bool) -> FloatArray | tuple[FloatArray, FloatArray]: ...
+
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
-               dt: ArrayLike | None = None) -> FloatArray:
-        """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4))."""
+               dt: ArrayLike | None = None, covariance: bool = False) -> Any:
+        """Feed one sample ((3,) each → (4,)) or a block ((N, 3) → (N, 4)). With
+        ``covariance=True`` also the attitude covariance after each sample ((3, 3) or
+        (N, 3, 3), rad², as :attr:`covariance`): returns ``(q, cov)``."""
         # The fast path (precision f64): one sample of (3,) float64 arrays, dt None or a float:
         # the rows copied into reused buffers (sizes checked here: memmove does not, and it
         # refuses strided arrays), one C call, the attitude copied out. The C call checks every
@@ -200,7 +244,7 @@ class Ahrs:
         # general path below then repeats it and names the bad argument.
         step = self._step if dt is None else dt if isinstance(dt, float) else None
         bufs = self._in1
-        if (step is not None and bufs is not None and type(gyr) is _ND and type(acc) is _ND
+        if (not covariance and step is not None and bufs is not None and type(gyr) is _ND and type(acc) is _ND
                 and gyr.shape == (3,) and acc.shape == (3,) and gyr.dtype == _F64 and acc.dtype == _F64
                 and (mag is None or type(mag) is _ND and mag.shape == (3,) and mag.dtype == _F64)):
             g, a, m = bufs
@@ -237,12 +281,18 @@ class Ahrs:
         def p(x: NDArray[Any] | None) -> Any:
             return ffi.NULL if x is None else ffi.cast("att_real *", ffi.from_buffer(x))
 
-        st = self._lib.att_ahrs_batch(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
+        if covariance:
+            cov = np.empty((n, 3, 3), dtype=dtype)
+            st = self._lib.att_ahrs_batch_cov(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), p(cov), err)
+        else:
+            st = self._lib.att_ahrs_batch(self._s, p(gc), p(ac), p(mc), n, p(d), d.size, p(out), err)
         if st != 0:
             i = int(err[0])
             if st == self._lib.ATT_E_AHRS_DT:
                 raise InvalidArgument(f"dt: sample {i}: the time step must be finite and > 0")
             raise_for_status(st, "ahrs", index=i)
+        if covariance:
+            return (out[0], cov[0]) if single else (out, cov)
         return out[0] if single else out  # float64 for f64 (no copy), float32 for f32
 
     def update_sparse(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None,
@@ -288,18 +338,34 @@ class Ahrs:
         return f"Ahrs(rate={self.rate}, precision={self.precision!r})"
 
 
+@overload
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
+         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
+         covariance: Literal[False] = ..., **settings: Any) -> FloatArray: ...
+
+
+@overload
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
+         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
+         *, covariance: Literal[True], **settings: Any) -> tuple[FloatArray, FloatArray]: ...
+
+
 def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float | None = None,
          dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
-         **settings: Any) -> FloatArray:
+         covariance: bool = False, **settings: Any) -> Any:
     """Run the filter over N samples: (N, 3) arrays → (N, 4) quaternions (body → ENU).
 
     ``rate`` (Hz) or ``dt`` (s, scalar or per sample) gives the time step;
     ``mag=None`` is six-axis operation (heading from the gyro only).
+    ``covariance=True`` returns ``(q, cov)``, cov (N, 3, 3) the attitude error
+    covariance after each sample (rad², ENU; :attr:`Ahrs.covariance`).
     """
+    if not isinstance(covariance, (bool, np.bool_)):
+        raise InvalidType(f"covariance must be True or False, got {type(covariance).__name__}")
     if rate is None and dt is None:
         raise InvalidArgument("give rate (Hz) or dt (s)")
     g = np.asarray(gyr)
     if g.ndim != 2:
         raise InvalidArgument(f"gyr must have shape (N, 3), got {g.shape}")
     f = Ahrs(rate=rate, q0=q0, precision=precision, **settings)
-    return f.update(gyr, acc, mag, dt=dt)
+    return f.update(gyr, acc, mag, dt=dt, covariance=bool(covariance))

@@ -106,9 +106,10 @@ def _lines(recs: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def _library_filter(gyr: np.ndarray, acc: list[np.ndarray | None], mag: list[np.ndarray | None],
-                    **settings: Any) -> tuple[np.ndarray, np.ndarray, list[int]]:
+                    **settings: Any) -> tuple[np.ndarray, np.ndarray, list[int], np.ndarray]:
     """The library's filter (attitude_c's compiled att_ahrs, f64), one att_ahrs_update per
-    sample with NULL for a missing accelerometer or magnetometer vector: q, bias, flags."""
+    sample with NULL for a missing accelerometer or magnetometer vector: q, bias, flags and the
+    attitude covariance (n, 9)."""
     from attitude_c import _settings
     from attitude_c._lib import ffi_lib
     from attitude_c.ahrs_filter import _SPEC
@@ -116,8 +117,8 @@ def _library_filter(gyr: np.ndarray, acc: list[np.ndarray | None], mag: list[np.
     ffi, lib = ffi_lib("f64")
     s = ffi.new("att_ahrs *")
     assert lib.att_ahrs_init(s, _settings.fill(ffi, lib, _SPEC, settings), ffi.NULL) == 0
-    q, b, fl = np.empty((len(gyr), 4)), np.empty((len(gyr), 3)), []
-    qo, bo = ffi.new("att_real[4]"), ffi.new("att_real[3]")
+    q, b, fl, cov = np.empty((len(gyr), 4)), np.empty((len(gyr), 3)), [], np.empty((len(gyr), 9))
+    qo, bo, co = ffi.new("att_real[4]"), ffi.new("att_real[3]"), ffi.new("att_real[9]")
     for k in range(len(gyr)):
         vec = [ffi.NULL if v is None else ffi.new("att_real[3]", [float(x) for x in v])
                for v in (acc[k], mag[k])]
@@ -125,7 +126,9 @@ def _library_filter(gyr: np.ndarray, acc: list[np.ndarray | None], mag: list[np.
         lib.att_ahrs_bias(s, bo)
         q[k], b[k] = list(qo), list(bo)
         fl.append(int(lib.att_ahrs_flags(s)))
-    return q, b, fl
+        lib.att_ahrs_covariance(s, co, ffi.NULL)
+        cov[k] = list(co)
+    return q, b, fl, cov
 
 
 def _flag_names(bits: int) -> list[str]:
@@ -204,7 +207,7 @@ def _assert_library(lines: list[dict[str, Any]], gyr: np.ndarray, acc: np.ndarra
             assert (key in r) == (want is not None), (k, key)
             if want is not None:
                 np.testing.assert_allclose(r[key], want, rtol=0, atol=8 * 2.0**-53 * 4096 * scale)
-    q, b, fl = _library_filter(g, a_k, m_k, **settings)
+    q, b, fl, cov = _library_filter(g, a_k, m_k, **settings)
     # the host build is the same C and the same IEEE double operations as the package's, printed with
     # 17 digits (round trip): equal. The ARMv4T build's soft-float libm (sqrt, atan2, sin, cos) may
     # differ from the host's in the last ulp; the filter is stable, so over these samples such
@@ -213,6 +216,15 @@ def _assert_library(lines: list[dict[str, Any]], gyr: np.ndarray, acc: np.ndarra
     np.testing.assert_allclose([r["q"] for r in lines], q, rtol=0, atol=tol)
     # bias printed in °/s as bias · (180/π): the same product here
     np.testing.assert_allclose([r["bias_dps"] for r in lines], b * (180.0 / math.pi), rtol=0, atol=tol)
+    # the covariance row-major as att_ahrs_covariance writes it (rad², ≤ 0.01: the same tolerance
+    # in absolute terms), the heading's 1σ its [8]'s root in degrees, observable as the flag says
+    np.testing.assert_allclose([r["cov"] for r in lines], cov, rtol=0, atol=tol)
+    np.testing.assert_allclose([r["heading_sigma_deg"] for r in lines], np.degrees(np.sqrt(cov[:, 8])),
+                               rtol=1e-15, atol=tol)
+    from attitude_c.names import C
+
+    nh = C["ATT_AHRS_F_NO_HEADING"]
+    assert [r["heading_observable"] for r in lines] == [not f & nh for f in fl]
     assert [r["flags"] for r in lines] == [_flag_names(f) for f in fl]
 
 
@@ -278,7 +290,7 @@ def test_losses_and_a_cut_group_in_an_aided_stream(rx_builds) -> None:
     g[20], g[31] = g[19], g[30]
     a_k = [None if k in (20, 31) else a[k] for k in range(n)]
     m_k = [None if k in (20, 30, 31) else m[k] for k in range(n)]
-    q, b, _ = _library_filter(g, a_k, m_k)
+    q, b, _, _ = _library_filter(g, a_k, m_k)
     np.testing.assert_array_equal([r["q"] for r in lines], q)  # host: the same double arithmetic
     assert [("acc_ms2" in r, "mag_ut" in r) for r in lines] == [(x is not None, y is not None)
                                                                   for x, y in zip(a_k, m_k)]
@@ -304,7 +316,7 @@ def test_estimator_choice(rx_builds) -> None:
     assert "estimator: integrator" in err and f"acc_records={n} mag_records=0 unused={n}" in err
     np.testing.assert_array_equal([r["q"] for r in _lines(out)], attitude_c.integrate(dtheta, method="rv3"))
     out, err = _run(rx_builds["host"], six, n, "--config", cfg, "--estimator", "ahrs")
-    q, _, _ = _library_filter(_converted(gyr, GYR_SCALE), list(_converted(acc, ACC_SCALE)), [None] * n)
+    q, _, _, _ = _library_filter(_converted(gyr, GYR_SCALE), list(_converted(acc, ACC_SCALE)), [None] * n)
     np.testing.assert_array_equal([r["q"] for r in _lines(out)], q)
     gyro_only = [block.encode_boot(TICKS, 9600, link="v2")] + [block.encode_sample(c) for c in gyr]
     out, err = _run(rx_builds["host"], gyro_only, n, "--estimator", "ahrs", "--method", "rv1")

@@ -34,7 +34,7 @@ from attitude_c.sim.gnss_log import (
     write_gnss_log,
 )
 from attitude_c.sim.gnss_model import BadFix, GnssReceiver, Quality, gnss_preset
-from attitude_c.sim.trajectory import make_trajectory
+from attitude_c.sim.catalog import make_trajectory
 
 E2 = WGS84_F * (2 - WGS84_F)
 

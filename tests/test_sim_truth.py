@@ -22,8 +22,8 @@ from attitude_c.sim.trajectory import (
     PaperTrajectory,
     StaticTrajectory,
     euler_rates_to_body,
-    make_trajectory,
 )
+from attitude_c.sim.catalog import make_trajectory
 
 
 def _dcm(q: np.ndarray) -> np.ndarray:

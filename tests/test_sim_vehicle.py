@@ -11,7 +11,8 @@ import pytest
 
 from attitude_c.reference import quat_conj, quat_multiply, quat_to_rotvec, rotvec_to_quat
 from attitude_c.sim import SimConfig
-from attitude_c.sim.trajectory import STANDARD_GRAVITY, make_trajectory
+from attitude_c.sim.catalog import make_trajectory
+from attitude_c.sim.trajectory import STANDARD_GRAVITY
 from attitude_c.sim.vehicle import VEHICLE_PRESETS, Leg, VehicleTrajectory, coordinated_rate
 
 G = STANDARD_GRAVITY

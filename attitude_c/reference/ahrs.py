@@ -34,7 +34,8 @@ _DEFAULTS: dict[str, Any] = {
     "mag_new_time": 20.0, "mag_new_gyr": 0.35, "mag_min_undisturbed": 0.5, "declination": 0.0,
     "rest_time": 1.5, "rest_tau": 0.5, "rest_gyr_th": 0.035, "rest_acc_th": 0.5,
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
-    "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0,
+    "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
+    "turn_sigma": 0.002, "turn_tau": 5.0,
 }
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
@@ -151,15 +152,31 @@ class ReferenceAhrs:
         self.tilt_start: F | None = np.zeros((0, 3))
         self.tilt_dts: list[float] = []
         self.flags = 0
+        self.heading_measured = False  # a magnetometer update has been made
+        self.turn_var = 0.0  # rad², added to the reported attitude covariance
+
+    @property
+    def covariance(self) -> F:
+        """The reported attitude covariance: P's attitude block plus the turn variance on its
+        diagonal (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q)."""
+        return self.P[:3, :3] + self.turn_var * np.eye(3)
+
+    @property
+    def bias_covariance(self) -> F:
+        return self.P[3:, 3:].copy()
 
     # -- the Kalman pieces -------------------------------------------------
-    def _predict(self, C: F, dt: float, rest: bool) -> None:
+    def _predict(self, C: F, dt: float, rest: bool, rate: F) -> None:
         """Q: the attitude's process noise density is the gyro's own at rest (no motion,
-        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise."""
+        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise.
+        Beside P, the reported turn variance: a first-order lag (time constant ``turn_tau``,
+        implicit Euler) driven by (``turn_sigma`` · |ω − b|)² · dt."""
         Fm = np.eye(6)
         Fm[:3, 3:] = -C * dt
         sg = self.s["gyr_noise_rest"] if rest else self.s["gyr_noise"]
         Q = np.diag([sg ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
+        tau = self.s["turn_tau"]
+        self.turn_var = self.turn_var * tau / (tau + dt) + (self.s["turn_sigma"] * float(np.linalg.norm(rate))) ** 2 * dt
         self.P = Fm @ self.P @ Fm.T + Q
 
     def _scalar(self, x: F, j: int, y: float, R: float, states: tuple[int, ...]) -> None:
@@ -266,7 +283,7 @@ class ReferenceAhrs:
             self.q = _qmul(self.q, _exp(phi))
             self.q = self.q / np.linalg.norm(self.q)
         C = _dcm(self.q)
-        self._predict(C, dt, rest)
+        self._predict(C, dt, rest, w - self.b)
         if flags & 1:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)
@@ -323,6 +340,7 @@ class ReferenceAhrs:
                     yh = math.atan2(mn[0], mn[1]) - s["declination"]
                     yh = (yh + math.pi) % (2 * math.pi) - math.pi
                     self._scalar(x, 2, yh, R, (2, 3, 4, 5))
+                    self.heading_measured = True
         if rest:
             flags |= 2
             assert self.rest_g is not None
@@ -337,6 +355,9 @@ class ReferenceAhrs:
         if self.tilt_start is not None and len(self.tilt_start):
             self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
+        # heading observability: measured at least once, and its 1σ within the bound since
+        if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
+            flags |= 32
         self.flags = flags
         out = self.reported()
         if s["sensor_delay"]:

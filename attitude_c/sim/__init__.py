@@ -31,6 +31,7 @@ from .accelmag import (
 from .adc import ADC_BACKENDS, AdcModel, quantize_ideal
 from .board import Board, BoardStream
 from .budget import STAGES, BudgetResult, format_budget, plot_budget, run_budget
+from .catalog import make_trajectory
 from .chain import (
     PAPER_MAXIMA,
     SENSOR_MODES,
@@ -63,7 +64,6 @@ from .trajectory import (
     Trajectory,
     TurntableTrajectory,
     euler_rates_to_body,
-    make_trajectory,
 )
 
 __all__ = [

@@ -362,6 +362,7 @@ class SimResult:
     period_t: np.ndarray | None = None  # (n,) start of each sample period (s)
     bias_t: np.ndarray | None = None  # (K,) times of the filter's gyro-bias estimates (s); None: no filter
     bias: np.ndarray | None = None  # (K, 3) the filter's gyro-bias estimate (rad/s, body)
+    cov: np.ndarray | None = None  # (M, 3, 3) the filter's attitude covariance at t (rad², ENU); None: none
 
     @property
     def err_heading(self) -> np.ndarray:
@@ -628,7 +629,8 @@ def simulate(cfg: SimConfig, progress: Progress | None = None,
     return SimResult(config=cfg, t=res.t, q_est=res.q_est, q_true=res.q_true, euler_est=res.euler_est,
                      euler_true=res.euler_true, err=res.err, err_angle=res.err_angle,
                      increments=dec.increments, sample_index=dec.sample_index, link_stats=acq.link_stats,
-                     summary=summary, aux=acq.aux, period_t=period_t, bias_t=est.bias_t, bias=est.bias)
+                     summary=summary, aux=acq.aux, period_t=period_t, bias_t=est.bias_t, bias=est.bias,
+                     cov=est.cov)
 
 
 def residual_bias(dec: Decoded, cfg: SimConfig) -> np.ndarray:

@@ -24,7 +24,8 @@ from .denoising import Denoise
 from .options import DEFAULT_DURATION_S, PAPER_PERIOD_S, parse
 from .sensors import gyro_preset
 from .sources import source
-from .trajectory import EARTH, Environment, make_trajectory
+from .catalog import make_trajectory
+from .trajectory import EARTH, Environment
 
 __all__ = ["build", "keywords"]
 

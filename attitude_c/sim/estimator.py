@@ -39,13 +39,15 @@ ESTIMATORS: tuple[EstimatorName, ...] = get_args(EstimatorName)
 class Estimate:
     """Estimated attitudes ``q`` (M, 4) at times ``t`` (M,) (s); a filter adds
     its gyro-bias estimate ``bias`` (K, 3) rad/s (body) at times ``bias_t``
-    (K,) (s) and ``info`` for the summary."""
+    (K,) (s), its attitude covariance ``cov`` (M, 3, 3) rad² (ENU, at ``t``;
+    ``Ahrs.covariance``) and ``info`` for the summary."""
 
     t: np.ndarray
     q: np.ndarray
     bias_t: np.ndarray | None = None
     bias: np.ndarray | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    cov: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -191,12 +193,17 @@ class AhrsFilter:
         update = f.update_sparse if sparse else f.update
         step = max(1, round(self.bias_every / h))
         q = np.empty((n, 4))
+        cov = None if sparse else np.empty((n, 3, 3))  # update_sparse has no covariance output
         bias = []
         rest = 0
         mag_rejected = 0
         for a in range(0, n, step):
             b = min(n, a + step)
-            q[a:b] = update(gyr[a:b], acc[a:b], None if mag is None else mag[a:b], dt=h)
+            m = None if mag is None else mag[a:b]
+            if cov is None:
+                q[a:b] = update(gyr[a:b], acc[a:b], m, dt=h)
+            else:
+                q[a:b], cov[a:b] = f.update(gyr[a:b], acc[a:b], m, dt=h, covariance=True)
             bias.append(f.bias)
             fl = f.flags
             rest += bool(fl & C["ATT_AHRS_F_REST"])
@@ -206,4 +213,4 @@ class AhrsFilter:
                 "settings": f.settings, "bias_final_rad_s": f.bias.tolist(),
                 "sigma_final": {"attitude_rad": f.sigma[0].tolist(), "bias_rad_s": f.sigma[1].tolist()},
                 "rest_fraction": rest / len(last), "mag_rejected_fraction": mag_rejected / len(last)}
-        return Estimate(t0 + (idx + 1.0) * h, q, t0 + (idx[last] + 1.0) * h, np.array(bias), info)
+        return Estimate(t0 + (idx + 1.0) * h, q, t0 + (idx[last] + 1.0) * h, np.array(bias), info, cov)

@@ -623,11 +623,11 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
 static const struct {
     int bit;
     const char *name;
-} flag_names[] = { { ATT_AHRS_F_OVERRANGE, "overrange" },
-                   { ATT_AHRS_F_REST, "rest" },
-                   { ATT_AHRS_F_ACC_REJECTED, "acc_rejected" },
-                   { ATT_AHRS_F_MAG_DISTURBED, "mag_disturbed" },
-                   { ATT_AHRS_F_MAG_RELEARNED, "mag_relearned" } };
+} flag_names[] = {
+    { ATT_AHRS_F_OVERRANGE, "overrange" },         { ATT_AHRS_F_REST, "rest" },
+    { ATT_AHRS_F_ACC_REJECTED, "acc_rejected" },   { ATT_AHRS_F_MAG_DISTURBED, "mag_disturbed" },
+    { ATT_AHRS_F_MAG_RELEARNED, "mag_relearned" }, { ATT_AHRS_F_NO_HEADING, "no_heading" }
+};
 
 /* ,"flags":["rest",...] */
 static int json_flags(char *p, size_t len, int flags)
@@ -645,12 +645,27 @@ static int json_flags(char *p, size_t len, int flags)
 /* What the filter adds to a line: its gyro-bias estimate and flags, the sample's aiding vectors. */
 typedef struct {
     att_real bias[3];          /* rad/s */
+    att_real cov[9];           /* attitude covariance, rad², ENU, row-major (att_ahrs_covariance) */
     int flags;                 /* ATT_AHRS_F_* */
     const att_real *acc, *mag; /* m/s², µT, or NULL: not in this sample */
 } rx_filter_out;
 
-/* A filter line: the head, then the rate, bias (°/s), flags, acc (m/s²) and mag (µT) in JSON;
- * the bias (°/s) and the flag bits in CSV. */
+/* ,"cov":[9 numbers, rad², row-major],"heading_sigma_deg":…,"heading_observable":true|false */
+static int json_uncertainty(char *p, size_t len, const rx_filter_out *f)
+{
+    const int digits = att_real_size() == 4 ? 9 : 17;
+    const att_real *c = f->cov;
+    double hs = c[8] > 0 ? sqrt((double)c[8]) * RX_R2D : 0.0;
+    return snprintf(p, len,
+                    ",\"cov\":[%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g,%.*g],\"heading_sigma_deg\":%.*g,"
+                    "\"heading_observable\":%s",
+                    digits, (double)c[0], digits, (double)c[1], digits, (double)c[2], digits, (double)c[3],
+                    digits, (double)c[4], digits, (double)c[5], digits, (double)c[6], digits, (double)c[7],
+                    digits, (double)c[8], digits, hs, (f->flags & ATT_AHRS_F_NO_HEADING) ? "false" : "true");
+}
+
+/* A filter line: the head, then the rate, bias (°/s), flags, the covariance with the heading's
+ * 1σ and observability, acc (m/s²) and mag (µT) in JSON; the bias (°/s) and the flag bits in CSV. */
 static void print_filter(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
                          const att_real q[4], const rx_filter_out *f)
 {
@@ -667,6 +682,7 @@ static void print_filter(rx_app *app, uint32_t n, const uint16_t code[3], const 
     w += vec3(app, line + w, sizeof line - (size_t)w, "rate_dps", v, RX_R2D);
     w += vec3(app, line + w, sizeof line - (size_t)w, "bias_dps", f->bias, RX_R2D);
     w += json_flags(line + w, sizeof line - (size_t)w, f->flags);
+    w += json_uncertainty(line + w, sizeof line - (size_t)w, f);
     w += vec3(app, line + w, sizeof line - (size_t)w, "acc_ms2", f->acc, 1.0);
     w += vec3(app, line + w, sizeof line - (size_t)w, "mag_ut", f->mag, 1.0);
     w += snprintf(line + w, sizeof line - (size_t)w, "}\n");
@@ -758,6 +774,7 @@ static void filter(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], cons
         return; /* past --count: filtered, not printed */
     app->updates++;
     att_ahrs_bias(&a->ahrs, f.bias);
+    att_ahrs_covariance(&a->ahrs, f.cov, NULL);
     f.flags = att_ahrs_flags(&a->ahrs);
     f.acc = acc;
     f.mag = mag;

@@ -86,7 +86,10 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
     X(sensor_delay) \
     X(acc_delay) \
     X(mag_delay) \
-    X(tilt_tau)
+    X(tilt_tau) \
+    X(heading_sigma_max) \
+    X(turn_sigma) \
+    X(turn_tau)
 // clang-format on
 #define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
 

@@ -53,6 +53,9 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->acc_delay = ATT_R(0.0);
     set->mag_delay = ATT_R(0.0);
     set->tilt_tau = ATT_R(3.0);
+    set->heading_sigma_max = ATT_R(0.0873);
+    set->turn_sigma = ATT_R(0.002);
+    set->turn_tau = ATT_R(5.0);
 }
 
 static int fin(att_real x)
@@ -111,6 +114,9 @@ static const setting_domain DOMAINS[] = {
     DOMAIN(acc_delay, ABS, 0.05),
     DOMAIN(mag_delay, ABS, 0.05),
     DOMAIN(tilt_tau, GE, 0),
+    DOMAIN(heading_sigma_max, GT, 0),
+    DOMAIN(turn_sigma, GE, 0),
+    DOMAIN(turn_tau, GT, 0),
 };
 
 static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
@@ -214,6 +220,8 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     set_initial_cov(s);
     s->step.dt = 0;
     s->step.tilt = 0; /* read by att_ahrs_attitude before the first update */
+    s->step.turn = 0;
+    s->turn_var = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -233,6 +241,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->tilt_mean = 1;
     s->tilt_t = 0;
     s->flags = 0;
+    s->heading_seen = 0;
     return ATT_OK;
 }
 
@@ -491,6 +500,9 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->r_rest = set->rest_noise * set->rest_noise / dt;
         c->delays = (set->acc_delay != 0 ? 1 : 0) | (set->mag_delay != 0 ? 2 : 0);
         c->tilt = set->tilt_tau > 0;
+        c->turn = set->turn_sigma > 0;
+        c->k_turn = set->turn_tau / (set->turn_tau + dt);
+        c->q_turn = set->turn_sigma * set->turn_sigma / dt;
         if (c->tilt) {
             /* ζω0 = 1/τ, ω0² = 2/τ²; at rest τ grows as the state's own inclination
              * time constant does, by gyr_noise/gyr_noise_rest */
@@ -619,6 +631,17 @@ static int detect_rest(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3
     return s->rest_t >= set->rest_time;
 }
 
+/* The reported covariance's turn term (ahrs.h, turn_sigma): v ← v·τ/(τ + dt) +
+ * (turn_sigma·|ω − b|)²·dt, the last written turn_sigma²/dt·|Δθ|². Not in P: the
+ * gains are not changed by it. */
+static void turn_variance(att_ahrs *s, const att_ahrs_step *k, const att_real dth[3])
+{
+    if (k->turn) {
+        s->turn_var =
+            k->k_turn * s->turn_var + k->q_turn * (dth[0] * dth[0] + dth[1] * dth[1] + dth[2] * dth[2]);
+    }
+}
+
 /* Propagation: the bias-corrected increment through the integrator, then
  * P ← F P Fᵀ + Q (at rest with the gyro's own noise), plus overrange_sigma² on
  * the attitude when over range. C = C_b^n of the propagated attitude. 0, or
@@ -636,6 +659,7 @@ static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3],
     }
     q2C(s->integ.q, C);
     propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
+    turn_variance(s, k, dth);
     if (over) {
         att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
         s->P[0][0] += o;
@@ -897,6 +921,18 @@ static void inject(att_ahrs *s, const att_ahrs_step *k, const att_real x[NX])
     s->bias[2] += x[5];
 }
 
+/* Heading observability (ahrs.h, ATT_AHRS_F_NO_HEADING): p_head is P[2][2] before the
+ * magnetometer's stage; only a magnetometer update lowers it (the accelerometer's and
+ * the zero-rate updates have zero gain on the heading and leave that entry as it is). */
+static int heading_flag(att_ahrs *s, att_real p_head)
+{
+    att_real m = s->set.heading_sigma_max;
+    if (s->P[2][2] < p_head) {
+        s->heading_seen = 1;
+    }
+    return (s->heading_seen && s->P[2][2] + s->turn_var <= m * m) ? 0 : ATT_AHRS_F_NO_HEADING;
+}
+
 /* Output: the reported attitude, predicted over sensor_delay (when set) with
  * the corrected rate, q ⊗ exp((ω − b)·d). */
 static att_status write_output(const att_ahrs *s, const att_real gyr[3], att_real q_out[4])
@@ -922,7 +958,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 {
     att_ahrs save;
     const att_ahrs_step *k;
-    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3];
+    att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3], p_head;
     att_status st;
     int rest, flags;
     if (s == NULL || gyr == NULL) {
@@ -950,6 +986,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, x, &flags, f_n) && k->tilt) {
         tilt_lowpass(s, k, f_n, dt, rest);
     }
+    p_head = s->P[2][2];
     if (mag != NULL) {
         mag_update(s, k, C, gyr, mag, dt, x, &flags);
     }
@@ -958,7 +995,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         zero_rate_update(s, k, x);
     }
     inject(s, k, x);
-    s->flags = flags;
+    s->flags = flags | heading_flag(s, p_head);
     if (!finite_state(s)) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
@@ -968,6 +1005,13 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
 
 att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
                           size_t n, const att_real *dt, size_t n_dt, att_real *q_out, size_t *err_index)
+{
+    return att_ahrs_batch_cov(s, gyr, acc, mag, n, dt, n_dt, q_out, NULL, err_index);
+}
+
+att_status att_ahrs_batch_cov(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
+                              size_t n, const att_real *dt, size_t n_dt, att_real *q_out, att_real *cov_out,
+                              size_t *err_index)
 {
     size_t k;
     if (s == NULL || gyr == NULL || acc == NULL || dt == NULL) {
@@ -984,6 +1028,9 @@ att_status att_ahrs_batch(att_ahrs *s, const att_real *gyr, const att_real *acc,
                 *err_index = k;
             }
             return st;
+        }
+        if (cov_out != NULL) {
+            att_ahrs_covariance(s, cov_out + 9 * k, NULL);
         }
     }
     return ATT_OK;
@@ -1020,6 +1067,25 @@ att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bia
     for (i = 0; i < 3; i++) {
         att_sigma[i] = att_sqrt(s->P[i][i] > 0 ? s->P[i][i] : 0);
         bias_sigma[i] = att_sqrt(s->P[3 + i][3 + i] > 0 ? s->P[3 + i][3 + i] : 0);
+    }
+    return ATT_OK;
+}
+
+att_status att_ahrs_covariance(const att_ahrs *s, att_real att_cov[9], att_real bias_cov[9])
+{
+    int i, j;
+    if (s == NULL) {
+        return ATT_E_NULL;
+    }
+    for (i = 0; i < 3; i++) {
+        for (j = 0; j < 3; j++) {
+            if (att_cov != NULL) {
+                att_cov[3 * i + j] = s->P[i][j] + (i == j ? s->turn_var : 0);
+            }
+            if (bias_cov != NULL) {
+                bias_cov[3 * i + j] = s->P[3 + i][3 + j];
+            }
+        }
     }
     return ATT_OK;
 }

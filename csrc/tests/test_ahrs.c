@@ -395,6 +395,79 @@ static void test_tilt_not_below_the_horizon(void)
     CHECK(qangle(q, q0) > 0.01); /* the state itself moved: the update was made */
 }
 
+/* Covariance and heading observability, closed form: level and at rest, bias states
+ * off (init_bias_sigma = bias_noise = 0) and no rest detection, the heading variance
+ * only grows by gyr_noise²·dt per sample without the magnetometer (no other stage
+ * touches it); the flag follows heading_sigma_max. */
+static void test_covariance_and_heading_flag(void)
+{
+    att_ahrs_settings set;
+    att_ahrs s, t;
+    att_real q0[4] = { 1, 0, 0, 0 }, e[3] = { 0, 0, 0 }, f[3], m[3], g[3] = { 0, 0, 0 }, dt = (att_real)0.01;
+    att_real P[9], B[9], sa[3], sb[3], cov[3 * 9], q[3 * 4], gs[9] = { 0 }, fs[9], ms[9];
+    double v0, grow, bound2;
+    int k, n;
+    body_vectors(e, f, m);
+    att_ahrs_default_settings(&set);
+    set.init_bias_sigma = 0;
+    set.bias_noise = 0;
+    set.rest_time = 0;
+    CHECK_EQ_INT(att_ahrs_init(&s, &set, q0), ATT_OK);
+    CHECK_EQ_INT(att_ahrs_covariance(NULL, P, B), ATT_E_NULL);
+    CHECK_EQ_INT(att_ahrs_covariance(&s, NULL, NULL), ATT_OK);
+    CHECK_EQ_INT(att_ahrs_covariance(&s, P, B), ATT_OK); /* the initial covariance */
+    CHECK_CLOSE(P[0], set.init_att_sigma * set.init_att_sigma, 0);
+    CHECK_CLOSE(P[1], 0, 0);
+    CHECK_CLOSE(B[4], 0, 0);
+    v0 = (double)P[8];
+    grow = (double)set.gyr_noise * set.gyr_noise * dt;
+    for (k = 1; k <= 100; k++) {
+        CHECK_EQ_INT(att_ahrs_update(&s, g, f, NULL, dt, NULL), ATT_OK);
+        CHECK(att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING); /* six-axis: never observable */
+    }
+    att_ahrs_covariance(&s, P, B);
+    /* 100 additions, each rounded by at most half an ulp of ~0.01 (float: 4.7e-10): < 1e-7 */
+    CHECK_CLOSE(P[8], v0 + 100 * grow, 1e-5 * v0);
+    CHECK(P[1] == P[3] && P[2] == P[6] && P[5] == P[7]); /* symmetric, as stored */
+    att_ahrs_sigma(&s, sa, sb);
+    CHECK_CLOSE(sa[2] * sa[2], P[8], 1e-6 * P[8]);
+    /* the magnetometer brings the heading's 1σ under the bound: observable */
+    for (k = 0; k < 2000 && (att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING); k++) {
+        CHECK_EQ_INT(att_ahrs_update(&s, g, f, m, dt, NULL), ATT_OK);
+    }
+    CHECK(!(att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING));
+    for (k = 0; k < 500; k++) {
+        att_ahrs_update(&s, g, f, m, dt, NULL);
+    }
+    CHECK(!(att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING));
+    /* without it the variance grows by gyr_noise²·dt a sample: the flag returns after
+     * n = ceil((bound² − P22)/(gyr_noise²·dt)) samples (± 1 for rounding) */
+    att_ahrs_covariance(&s, P, NULL);
+    bound2 = (double)set.heading_sigma_max * set.heading_sigma_max;
+    n = (int)ceil((bound2 - (double)P[8]) / grow);
+    for (k = 1; k < n - 1; k++) {
+        att_ahrs_update(&s, g, f, NULL, dt, NULL);
+        CHECK(!(att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING));
+    }
+    att_ahrs_update(&s, g, f, NULL, dt, NULL);
+    att_ahrs_update(&s, g, f, NULL, dt, NULL);
+    att_ahrs_update(&s, g, f, NULL, dt, NULL);
+    CHECK(att_ahrs_flags(&s) & ATT_AHRS_F_NO_HEADING);
+    /* the batch's covariance output: that of single updates, sample by sample */
+    for (k = 0; k < 3; k++) {
+        memcpy(fs + 3 * k, f, sizeof f);
+        memcpy(ms + 3 * k, m, sizeof m);
+    }
+    att_ahrs_init(&s, &set, q0);
+    t = s;
+    CHECK_EQ_INT(att_ahrs_batch_cov(&s, gs, fs, ms, 3, &dt, 1, q, cov, NULL), ATT_OK);
+    for (k = 0; k < 3; k++) {
+        att_ahrs_update(&t, g, f, m, dt, NULL);
+        att_ahrs_covariance(&t, P, NULL);
+        CHECK(memcmp(P, cov + 9 * k, sizeof P) == 0);
+    }
+}
+
 int main(void)
 {
     test_settings();
@@ -407,5 +480,6 @@ int main(void)
     test_tilt_reports_the_accelerometer_at_rest();
     test_tilt_step_response();
     test_tilt_not_below_the_horizon();
+    test_covariance_and_heading_flag();
     return ATT_TEST_REPORT();
 }

@@ -67,11 +67,16 @@ enum {
 
 /* Flags of the last update (att_ahrs_flags()), a bit set. */
 enum {
-    ATT_AHRS_F_OVERRANGE = 1,     /* a gyro axis at or above settings.gyro_range */
-    ATT_AHRS_F_REST = 2,          /* rest detected: zero-rate bias update made */
-    ATT_AHRS_F_ACC_REJECTED = 4,  /* accelerometer update gated out */
-    ATT_AHRS_F_MAG_DISTURBED = 8, /* magnetometer update rejected (norm/dip vs reference) */
-    ATT_AHRS_F_MAG_RELEARNED = 16 /* the magnetic reference was replaced in this update */
+    ATT_AHRS_F_OVERRANGE = 1,      /* a gyro axis at or above settings.gyro_range */
+    ATT_AHRS_F_REST = 2,           /* rest detected: zero-rate bias update made */
+    ATT_AHRS_F_ACC_REJECTED = 4,   /* accelerometer update gated out */
+    ATT_AHRS_F_MAG_DISTURBED = 8,  /* magnetometer update rejected (norm/dip vs reference) */
+    ATT_AHRS_F_MAG_RELEARNED = 16, /* the magnetic reference was replaced in this update */
+    ATT_AHRS_F_NO_HEADING = 32     /* heading not observable: no magnetometer update since
+                                  init (six-axis), or the heading's 1σ (the square root of
+                                  att_ahrs_covariance's att_cov[8]) has grown past
+                                  heading_sigma_max since the last one (docs/ahrs.md,
+                                  "Uncertainty") */
 };
 
 /* Settings. Units in brackets; defaults are att_ahrs_default_settings()'s.
@@ -168,6 +173,21 @@ typedef struct {
                                  the filtered vector vertical (while it is within 90° of up);
                                  heading, covariance and bias are the state's. See
                                  docs/ahrs.md, "Reported inclination" */
+    att_real heading_sigma_max;   /* [rad] > 0: the heading counts as observable (no
+                                 ATT_AHRS_F_NO_HEADING) while its 1σ is at most this, after
+                                 a magnetometer update; without updates (six-axis, or the
+                                 field rejected) the 1σ grows by the gyro's noise and bias
+                                 (its variance by at least gyr_noise²·t), so this bounds
+                                 the time a rejection may last. 0.0873 (5°) */
+    att_real turn_sigma;          /* [√s] ≥ 0: the reported attitude covariance adds v·I, a
+                                 variance that grows with the turn rate and fades with
+                                 turn_tau, v ← v·τ/(τ + dt) + (turn_sigma·|ω − b|)²·dt: the
+                                 error a fast turn makes through the gyro's scale and
+                                 misalignment errors, which the aiding then removes. Reported
+                                 only (att_ahrs_covariance, the heading flag): the gains use P
+                                 alone, so the attitude does not change. 0.002 (BROAD's
+                                 3σ coverage, docs/ahrs.md, "Uncertainty"); 0 = off */
+    att_real turn_tau;            /* [s] > 0: see turn_sigma, 5.0 */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
@@ -195,6 +215,9 @@ typedef struct {
     int delays;             /* bit 0: acc_delay != 0, bit 1: mag_delay != 0 (an integer test per
                             sample: a float compare is a library call on soft-float targets) */
     int tilt;               /* 1 when tilt_tau > 0 (the same reason) */
+    int turn;               /* 1 when turn_sigma > 0 (the same reason) */
+    att_real k_turn;        /* turn_tau/(turn_tau + dt) */
+    att_real q_turn;        /* turn_sigma²/dt */
 } att_ahrs_step;
 
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
@@ -229,6 +252,8 @@ typedef struct {
     int rest_init;         /* 1 once the rest low-passes hold a value */
     int tilt_mean;         /* 1 while tilt_f is still the running mean of its start */
     int flags;             /* ATT_AHRS_F_* of the last update */
+    int heading_seen;      /* 1 once a magnetometer update has measured the heading */
+    att_real turn_var;     /* [rad²] the reported covariance's turn term (turn_sigma) */
 } att_ahrs;
 
 /* The defaults listed above. */
@@ -284,6 +309,31 @@ att_status att_ahrs_bias(const att_ahrs *s, att_real b[3]);
 /* 1σ of the attitude error per navigation axis [rad] and of the bias
  * per body axis [rad/s] (square roots of P's diagonal). */
 att_status att_ahrs_sigma(const att_ahrs *s, att_real att_sigma[3], att_real bias_sigma[3]);
+
+/* The error covariance after the last update, in two 3×3 blocks, row-major (either
+ * pointer may be NULL: not written):
+ *   att_cov [rad²]: the attitude error δθ, a rotation vector in the navigation frame
+ *     (ENU: x east, y north, z up) with q_true = exp(δθ) ⊗ q_est, q body → ENU:
+ *     the rotation that carries the estimate to the truth, about the fixed (world)
+ *     axes. For small angles δθ_x, δθ_y are the errors about east and north (the
+ *     inclination) and δθ_z the heading error (about up): att_cov[8] is the heading
+ *     variance. Element [3i + j] = E[δθ_i δθ_j]: the layout of ROS's
+ *     sensor_msgs/Imu.orientation_covariance ("row major about x, y, z axes"; the
+ *     message does not say which frame's axes: here the fixed ENU axes).
+ *   bias_cov [(rad/s)²]: the gyro-bias error δb (body frame; b_true = b_est + δb).
+ * att_cov is the filter's P (its attitude block) plus the turn term v·I of
+ * turn_sigma; the reported attitude's levelling (tilt_tau) and the sensor_delay
+ * prediction add no term. Before the first update: the initial covariance,
+ * init_att_sigma² and init_bias_sigma² on the diagonals. ATT_E_NULL when s is
+ * NULL. Consistency of these figures on simulated and real data: docs/ahrs.md,
+ * "Uncertainty". */
+att_status att_ahrs_covariance(const att_ahrs *s, att_real att_cov[9], att_real bias_cov[9]);
+
+/* att_ahrs_batch that also writes, after each sample k, the attitude covariance of
+ * att_ahrs_covariance to cov_out + 9 k (n×9, row-major; may be NULL). */
+att_status att_ahrs_batch_cov(att_ahrs *s, const att_real *gyr, const att_real *acc, const att_real *mag,
+                              size_t n, const att_real *dt, size_t n_dt, att_real *q_out, att_real *cov_out,
+                              size_t *err_index);
 
 /* ATT_AHRS_F_* of the last update (0 when s is NULL). */
 int att_ahrs_flags(const att_ahrs *s);
