@@ -40,27 +40,32 @@ QUICK_LEAD, QUICK_SECONDS = 10.0, 35.0
 COLUMNS = ("chain", "direct", "unquantized")
 
 
-def _trial(tr: Any, quick: bool, cmds: dict[str, list[str]], build_dir: Path) -> dict[str, Any]:
+def _recording(tr: Any, quick: bool) -> tuple[Any, dict[str, Any]]:
+    """The trial (or its --quick excerpt) as the board's codes, and the direct filter's figures."""
     from attitude_c import broad
     from toolchain import aided_chain as ac
 
     start = max(0.0, float(np.flatnonzero(tr.movement)[0]) / tr.rate - QUICK_LEAD) if quick else 0.0
     rec = ac.recording(tr, start=start, duration=QUICK_SECONDS if quick else None)
     out: dict[str, Any] = {"name": tr.name, "start": start, "seconds": rec.n * rec.period, "clipped": rec.clipped()}
-    q_direct = ac.direct(rec)
-    out["direct"] = broad.errors(q_direct, rec.quat, rec.movement).total
-    out["unquantized"] = broad.errors(ac.direct(rec, quantized=False), rec.quat, rec.movement).total
-    for build, cmd in cmds.items():
-        print(f"   chain: {tr.name} ({build}) ...", flush=True)
-        run = ac.run_chain(rec, cmd, build_dir / f"{tr.name}_{build}")
-        q_same = ac.direct(rec, lost=run.lost) if run.lost else q_direct  # held as attitude-rx holds them
-        out[build] = {"chain": broad.errors(run.q, rec.quat, rec.movement).total,
-                      "diff": float(np.degrees(np.nanmax(broad.error_angles(run.q, q_same)[0]))),
-                      "once": run.delivered_once(rec.n), "lost": len(run.lost), "records": run.stats.get("records", 0),
-                      "frames": run.frames, "wall": run.wall_seconds, "sim": run.sim_seconds}
-        print(f"   chain: {tr.name} ({build}) done: {run.sim_seconds:.0f} s simulated in {run.wall_seconds:.0f} s",
-              flush=True)
-    return out
+    for k in ("direct", "unquantized"):
+        out[k] = broad.errors(ac.direct(rec, quantized=k == "direct"), rec.quat, rec.movement).total
+    return rec, out
+
+
+def _chain(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path) -> dict[str, Any]:
+    """One run through the chain with attitude-rx's ``build``: its figures against the direct filter."""
+    from attitude_c import broad
+    from toolchain import aided_chain as ac
+
+    print(f"   chain: {name} ({build}) ...", flush=True)
+    run = ac.run_chain(rec, cmd, build_dir / f"{name}_{build}")
+    q_same = ac.direct(rec, lost=run.lost)  # a lost sample held as attitude-rx holds it (none expected)
+    print(f"   chain: {name} ({build}) done: {run.sim_seconds:.0f} s simulated in {run.wall_seconds:.0f} s", flush=True)
+    return {"chain": broad.errors(run.q, rec.quat, rec.movement).total,
+            "diff": float(np.degrees(np.nanmax(broad.error_angles(run.q, q_same)[0]))),
+            "once": run.delivered_once(rec.n), "lost": len(run.lost), "records": run.stats.get("records", 0),
+            "frames": run.frames, "wall": run.wall_seconds, "sim": run.sim_seconds}
 
 
 def _row(r: dict[str, Any], build: str) -> str:
@@ -82,15 +87,16 @@ def _selected(trials: str) -> list[Any]:
     return picked
 
 
-def _header(quick: bool, n: int, total: int) -> str:
+def _header(quick: bool, n: int, total: int, budget: str) -> str:
     from attitude_c.sim.board_codes import board_channels
     from toolchain import firmware as tool
 
     cfg = tool.AIDED
     which = (f"{QUICK_SECONDS:.0f} s of each from {QUICK_LEAD:.0f} s before its movement phase "
              "(`--quick`; *from + s*: the excerpt's start and length)" if quick else "whole")
-    some = (f"**{n} of the {total} shipped trials** (`--trials`; `invoke bench --only chain` runs them all)"
-            if n < total else f"all {total} shipped trials")
+    cut = f" whose run started within `--budget {budget}` minutes" if budget else ""
+    some = (f"**{n} of the {total} shipped trials**: those of `--trials`{cut} (`invoke bench --only chain` runs "
+            "them all)" if n < total else f"all {total} shipped trials")
     return (f"Firmware: `toolchain.firmware.AIDED` (gyros every {cfg.period_ticks}/{tool.TICK_HZ} s, accelerometer "
             f"every {cfg.acc_every}, magnetometer every {cfg.mag_every} samples, link v2 at {cfg.baud} baud), "
             "sim image with the data-driven TLC2543 model, s51 in lockstep with attitude-rx (an acknowledgement "
@@ -119,21 +125,46 @@ def _summary(rows: list[dict[str, Any]]) -> list[str]:
             f"{max(val['unquantized']):.3f} | | | |")]
 
 
-def run(quick: bool, trials: str = "") -> str:
+def _runs(picked: list[Any], quick: bool, cmds: dict[str, list[str]], build_dir: Path,
+          budget: float) -> list[dict[str, Any]]:
+    """Every trial with the host build, then the first with the ARMv4T build; two at a time
+    (lockstep: a run's figures do not depend on the machine's load). No run starts after
+    ``budget`` minutes (0: no limit); the rows are the trials whose host run was made."""
+    import threading
+    import time
+
+    t0, lock, rows = time.monotonic(), threading.Lock(), {}
+    units = [(tr, "host") for tr in picked] + [(picked[0], "armv4t")]
+
+    def one(unit: tuple[Any, str]) -> None:
+        tr, build = unit
+        if budget and time.monotonic() - t0 > 60.0 * budget:
+            print(f"   chain: {tr.name} ({build}) not started: the {budget:g}-minute budget is spent", flush=True)
+            return
+        rec, out = _recording(tr, quick)
+        res = _chain(rec, tr.name, build, cmds[build], build_dir)
+        with lock:
+            rows.setdefault(tr.name, out)[build] = res
+
+    with ThreadPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:
+        list(pool.map(one, units))
+    return [rows[tr.name] for tr in picked if "host" in rows.get(tr.name, {})]
+
+
+def run(quick: bool, trials: str = "", budget: str = "") -> str:
     from attitude_c import broad
     from toolchain import targets
     from toolchain.tasks.cross import cross_build_target
 
     build_dir = ROOT / "build" / "bench_chain"
-    host = [str(cross_build_target("host", out=build_dir / "host")["app"])]
     arm_t = targets.load("armv4t")
-    arm = [*arm_t.run_cmd, str(cross_build_target("armv4t", out=build_dir / "armv4t")["app"])]
+    cmds = {"host": [str(cross_build_target("host", out=build_dir / "host")["app"])],
+            "armv4t": [*arm_t.run_cmd, str(cross_build_target("armv4t", out=build_dir / "armv4t")["app"])]}
     picked = _selected(trials)
-    jobs = [(tr, {"host": host, **({"armv4t": arm} if i == 0 else {})}) for i, tr in enumerate(picked)]
-    # lockstep: a run's figures do not depend on the machine's load, so trials run side by side
-    with ThreadPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:
-        rows = list(pool.map(lambda j: _trial(j[0], quick, j[1], build_dir), jobs))
-    lines = [_header(quick, len(picked), len(list(broad.iter_trials()))), "", LEGEND, "",
+    rows = _runs(picked, quick, cmds, build_dir, float(budget or 0))
+    if not rows:
+        raise RuntimeError("no trial ran within the budget")
+    lines = [_header(quick, len(rows), len(list(broad.iter_trials())), budget), "", LEGEND, "",
              ("| trial | attitude-rx | from + s | chain | direct | unquantized | max diff | once (records, frames) "
              "| sim / wall s |"), "|---|---|---:|---:|---:|---:|---:|---|---:|"]
     lines += [_row(r, b) for r in rows for b in ("host", "armv4t") if b in r]

@@ -196,8 +196,9 @@ def assemble_bench_doc() -> None:
     "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
     "data": "a data folder for the benchmarks that take one (broad: an upstream BROAD data_mat/ folder)",
     "trials": "the benchmarks that take it (chain): only the BROAD trials whose names start so (comma-separated)",
+    "budget": "the benchmarks that take it (chain): start no run after this many minutes (the table says so)",
 })
-def bench(c, only="", quick=False, data="", trials=""):
+def bench(c, only="", quick=False, data="", trials="", budget=""):
     """Run every benchmark and write the figures into docs/benchmarks.md."""
     import inspect
 
@@ -213,7 +214,7 @@ def bench(c, only="", quick=False, data="", trials=""):
             mod = importlib.import_module(f"bench.{name}")
             print(f"== bench {name}: {mod.TITLE}", flush=True)
             params = inspect.signature(mod.run).parameters
-            extra = {k: v for k, v in (("data", data), ("trials", trials)) if v and k in params}
+            extra = {k: v for k, v in (("data", data), ("trials", trials), ("budget", budget)) if v and k in params}
             body = mod.run(quick=quick, **extra)
         except Exception as exc:  # noqa: BLE001 - any failure of one module
             import traceback
