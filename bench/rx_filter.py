@@ -25,6 +25,10 @@ TABLE = 1024  #: samples per turn of the harness's field table
 #: The gyro-only sample's cost comes from a run with aiding in every GYRO_EVERY-th sample:
 #: GYRO_EVERY x its mean - the full sample's, over GYRO_EVERY - 1
 GYRO_EVERY = 2
+#: One counted run (a few hundred million logged instructions) may take this long on a loaded machine
+QEMU_TIMEOUT_S = 3600.0
+#: The builds measured: attitude-rx's (double) and the float one (ATT_REAL_F32)
+PRECISIONS = ("f64", "f32")
 
 
 def _counts(quick: bool, tmp: Path) -> dict[tuple[str, str, int], float]:
@@ -37,16 +41,11 @@ def _counts(quick: bool, tmp: Path) -> dict[tuple[str, str, int], float]:
     n1 = math.ceil(default_settings()["tilt_tau"] * RATE) + 100
     n2 = n1 + (TABLE // 8 if quick else TABLE)
     out = {}
-    for prec in _precisions(quick):
+    for prec in PRECISIONS:
         exe = t.build_program([SRC], tmp / f"rx_filter_{prec}", defines=["ATT_REAL_F32"] if prec == "f32" else [])
         for mode, every in sorted({("path", 1), ("path", GYRO_EVERY), ("path", AIDED.acc_every), ("line", 1)}):
-            out[(prec, mode, every)] = per_iteration(exe, functools.partial(_args, mode, every), n1, n2)
+            out[(prec, mode, every)] = per_iteration(exe, functools.partial(_args, mode, every), n1, n2, timeout=QEMU_TIMEOUT_S)
     return out
-
-
-def _precisions(quick: bool) -> tuple[str, ...]:
-    """The builds measured: attitude-rx's (double; --quick: that one alone) and the float build."""
-    return ("f64",) if quick else ("f64", "f32")
 
 
 def _args(mode: str, every: int, n: int) -> list[str]:
@@ -71,7 +70,7 @@ def run(quick: bool) -> str:
     with tempfile.TemporaryDirectory() as d:
         c = _counts(quick, Path(d))
     rows = []
-    for prec in _precisions(quick):
+    for prec in PRECISIONS:
         full, line = c[(prec, "path", 1)], c[(prec, "line", 1)]
         gyro_only = (g * c[(prec, "path", g)] - full) / (g - 1)
         rows.append((prec, full, gyro_only, c[(prec, "path", every)], line - full))
