@@ -7,15 +7,16 @@ samples/s and at the aided board's sampling plan (toolchain.firmware.AIDED)."""
 
 from __future__ import annotations
 
-import functools
 import math
+import os
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from bench.armv4t import CLOCK_HZ, CPI
 from toolchain import targets as T
 from toolchain.firmware import AIDED
-from toolchain.qemu_count import per_iteration
+from toolchain.qemu_count import count_instructions
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "bench" / "rx_filter_armv4t.c"
@@ -40,12 +41,19 @@ def _counts(quick: bool, tmp: Path) -> dict[tuple[str, str, int], float]:
     # difference one turn of the field table (the quick run: an eighth of a turn)
     n1 = math.ceil(default_settings()["tilt_tau"] * RATE) + 100
     n2 = n1 + (TABLE // 8 if quick else TABLE)
-    out = {}
-    for prec in PRECISIONS:
-        exe = t.build_program([SRC], tmp / f"rx_filter_{prec}", defines=["ATT_REAL_F32"] if prec == "f32" else [])
-        for mode, every in sorted({("path", 1), ("path", GYRO_EVERY), ("path", AIDED.acc_every), ("line", 1)}):
-            out[(prec, mode, every)] = per_iteration(exe, functools.partial(_args, mode, every), n1, n2, timeout=QEMU_TIMEOUT_S)
-    return out
+    exe = {p: t.build_program([SRC], tmp / f"rx_filter_{p}", defines=["ATT_REAL_F32"] if p == "f32" else [])
+           for p in PRECISIONS}
+    keys = [(p, *m) for p in PRECISIONS
+            for m in sorted({("path", 1), ("path", GYRO_EVERY), ("path", AIDED.acc_every), ("line", 1)})]
+    runs = [(k, n) for k in keys for n in (n1, n2)]
+
+    def count(run: tuple[tuple[str, str, int], int]) -> int:
+        (prec, mode, every), n = run
+        return count_instructions(exe[prec], _args(mode, every, n), timeout=QEMU_TIMEOUT_S)
+
+    with ThreadPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:  # independent runs, exact counts
+        got = dict(zip(runs, pool.map(count, runs)))
+    return {k: (got[(k, n2)] - got[(k, n1)]) / (n2 - n1) for k in keys}
 
 
 def _args(mode: str, every: int, n: int) -> list[str]:
