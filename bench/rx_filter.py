@@ -74,7 +74,7 @@ def run(quick: bool) -> str:
         raise ValueError("the harness sends accelerometer and magnetometer together: the plan's decimations differ")
     every, g = AIDED.acc_every, GYRO_EVERY
     plan_rate = 1.0 / AIDED.period_s
-    plan = f"gyros {plan_rate:.0f}/s, " + ("acc + mag in each" if every == 1 else f"acc + mag every {every}")
+    plan_txt = f"gyros {plan_rate:.0f}/s, " + ("acc + mag in each" if every == 1 else f"acc + mag every {every}")
     with tempfile.TemporaryDirectory() as d:
         c = _counts(quick, Path(d))
     rows = []
@@ -94,7 +94,7 @@ def run(quick: bool) -> str:
         "with 17 digits, newlib; the board's glibc differs) is counted apart. Time at 400 MHz assumes "
         f"{CPI} cycles per instruction (docs/bench/armv4t.md)."),
         "",
-        (f"| build | gyro + acc + mag | gyro only (filter prediction) | the plan ({plan}), mean "
+        (f"| build | gyro + acc + mag | gyro only (filter prediction) | the plan ({plan_txt}), mean "
         "| + the JSON line | µs @400 MHz (full / + line) |"),
         "|---|---|---|---|---|---|",
     ]
@@ -109,7 +109,7 @@ def run(quick: bool) -> str:
         "Share of a 400 MHz ARM920T:",
         "",
         (f"| build | {RATE:.0f} samples/s, acc + mag in each | + JSON lines | the aided board's plan: "
-        f"{plan} (toolchain.firmware.AIDED) | + JSON lines |"),
+        f"{plan_txt} (toolchain.firmware.AIDED) | + JSON lines |"),
         "|---|---|---|---|---|",
     ]
     for prec, full, _, plan, line in rows:
