@@ -15,12 +15,18 @@ instants. Beside it, the library's filter (att_ahrs, double, defaults) run direc
 same converted codes with the same decimation (NULL where the board sends no
 accelerometer or magnetometer record), and on the unquantized samples.
 
-``--quick`` runs QUICK_SECONDS of every trial from QUICK_LEAD before its movement phase
-(s51 runs slower than real time: a whole trial takes minutes of s51).
+s51 runs in lockstep with attitude-rx (toolchain.aided_chain.Relay): an acknowledgement
+reaches the firmware within a bounded simulated time however loaded the machine, so no
+sample is lost to the host's lateness. Whole trials by default; ``--quick`` runs
+QUICK_SECONDS of every trial from QUICK_LEAD before its movement phase. s51 runs slower than
+real time (about 3 x on the shared 2-core machine): ``--trials`` picks trials by name
+prefix (``invoke bench --only chain --trials 01,07``), and the table says which ran.
 """
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -31,80 +37,138 @@ TITLE = "The aided chain on BROAD: firmware (s51) → link v2 → pty → attitu
 #: --quick: each trial from QUICK_LEAD s before its first movement sample (rest: the filter
 #: settles), for QUICK_SECONDS
 QUICK_LEAD, QUICK_SECONDS = 10.0, 35.0
+COLUMNS = ("chain", "direct", "unquantized")
 
 
-def _trial(tr: Any, quick: bool, cmds: dict[str, list[str]], build_dir: Path) -> dict[str, Any]:
+def _recording(tr: Any, quick: bool) -> tuple[Any, dict[str, Any]]:
+    """The trial (or its --quick excerpt) as the board's codes, and the direct filter's figures."""
     from attitude_c import broad
     from toolchain import aided_chain as ac
 
     start = max(0.0, float(np.flatnonzero(tr.movement)[0]) / tr.rate - QUICK_LEAD) if quick else 0.0
     rec = ac.recording(tr, start=start, duration=QUICK_SECONDS if quick else None)
     out: dict[str, Any] = {"name": tr.name, "start": start, "seconds": rec.n * rec.period, "clipped": rec.clipped()}
-    q_direct = ac.direct(rec)
-    out["direct"] = broad.errors(q_direct, rec.quat, rec.movement).total
-    out["unquantized"] = broad.errors(ac.direct(rec, quantized=False), rec.quat, rec.movement).total
-    for build, cmd in cmds.items():
-        run = ac.run_chain(rec, cmd, build_dir)
-        q_same = ac.direct(rec, lost=run.lost) if run.lost else q_direct  # held as attitude-rx holds them
-        out[build] = {"total": broad.errors(run.q, rec.quat, rec.movement).total,
-                      "diff": float(np.degrees(np.nanmax(broad.error_angles(run.q, q_same)[0]))),
-                      "once": run.delivered_once(rec.n), "lost": len(run.lost), "records": run.stats.get("records", 0),
-                      "wall": run.wall_seconds, "sim": run.sim_seconds}
-    return out
+    for k in ("direct", "unquantized"):
+        out[k] = broad.errors(ac.direct(rec, quantized=k == "direct"), rec.quat, rec.movement).total
+    return rec, out
+
+
+def _chain(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path) -> dict[str, Any]:
+    """One run through the chain with attitude-rx's ``build``: its figures against the direct filter."""
+    from attitude_c import broad
+    from toolchain import aided_chain as ac
+
+    print(f"   chain: {name} ({build}) ...", flush=True)
+    run = ac.run_chain(rec, cmd, build_dir / f"{name}_{build}")
+    q_same = ac.direct(rec, lost=run.lost)  # a lost sample held as attitude-rx holds it (none expected)
+    print(f"   chain: {name} ({build}) done: {run.sim_seconds:.0f} s simulated in {run.wall_seconds:.0f} s", flush=True)
+    return {"chain": broad.errors(run.q, rec.quat, rec.movement).total,
+            "diff": float(np.degrees(np.nanmax(broad.error_angles(run.q, q_same)[0]))),
+            "once": run.delivered_once(rec.n), "lost": len(run.lost), "records": run.stats.get("records", 0),
+            "frames": run.frames, "wall": run.wall_seconds, "sim": run.sim_seconds}
 
 
 def _row(r: dict[str, Any], build: str) -> str:
     c = r[build]
-    return (f"| {r['name']} | {build} | {r['start']:.1f} + {r['seconds']:.1f} | {c['total']:.3f} | {r['direct']:.3f} | "
-            f"{r['unquantized']:.3f} | {c['diff']:.1e} | {'yes' if c['once'] else '**' + str(c['lost']) + ' lost**'} ({c['records']}) | "
-            f"{c['wall']:.0f} |")
+    once = "yes" if c["once"] else f"**no: {c['lost']} lost**"
+    return (f"| {r['name']} | {build} | {r['start']:.1f} + {r['seconds']:.1f} | {c['chain']:.3f} | {r['direct']:.3f} | "
+            f"{r['unquantized']:.3f} | {c['diff']:.1e} | {once} ({c['records']}, {c['frames']}) | "
+            f"{c['sim']:.0f} / {c['wall']:.0f} |")
 
 
-def run(quick: bool) -> str:
+def _selected(trials: str) -> list[Any]:
     from attitude_c import broad
+
+    every = list(broad.iter_trials())
+    want = [t.strip() for t in trials.split(",") if t.strip()]
+    picked = [tr for tr in every if not want or any(tr.name.startswith(w) for w in want)]
+    if not picked:
+        raise ValueError(f"trials: no BROAD trial name starts with any of {want}")
+    return picked
+
+
+def _header(quick: bool, n: int, total: int, budget: str) -> str:
     from attitude_c.sim.board_codes import board_channels
     from toolchain import firmware as tool
+
+    cfg = tool.AIDED
+    which = (f"{QUICK_SECONDS:.0f} s of each from {QUICK_LEAD:.0f} s before its movement phase "
+             "(`--quick`; *from + s*: the excerpt's start and length)" if quick else "whole")
+    cut = f" whose run started within `--budget {budget}` minutes" if budget else ""
+    some = (f"**{n} of the {total} shipped trials**: those of `--trials`{cut} (`invoke bench --only chain` runs "
+            "them all)" if n < total else f"all {total} shipped trials")
+    return (f"Firmware: `toolchain.firmware.AIDED` (gyros every {cfg.period_ticks}/{tool.TICK_HZ} s, accelerometer "
+            f"every {cfg.acc_every}, magnetometer every {cfg.mag_every} samples, link v2 at {cfg.baud} baud), "
+            "sim image with the data-driven TLC2543 model, s51 in lockstep with attitude-rx (an acknowledgement "
+            f"reaches the firmware at most {tool.LOCKSTEP_BOUND_S * 1e3:.1f} ms of simulated time after its frame). "
+            "Codes (round to nearest about 2048): "
+            + "; ".join(f"{c.name} {c.lsb:.4g} {c.unit} per code, clipped at ±{c.clip:.4g} {c.unit}"
+                        for c in board_channels().values())
+            + f". Trials: {some}, {which}.")
+
+
+LEGEND = ("BROAD total error (RMS over the movement phase, deg) of: the chain (attitude-rx's lines); the library "
+          "filter run directly on the same codes (direct); on the unquantized samples at the same instants "
+          "(unquantized). *max diff*: largest angle between the chain's and the direct filter's attitude over "
+          "all samples (deg; ~1e-6 is arccos's resolution near 0, i.e. equal). *once*: every sample printed "
+          "once in order, no loss report, no duplicate (records attitude-rx received, BOOT and CHANNELS "
+          "included; link v2 frames, each answered before s51 ran on). *sim / wall*: seconds of simulated "
+          "time and of wall time the s51 run took.")
+
+
+def _summary(rows: list[dict[str, Any]]) -> list[str]:
+    val = {k: [r["host"]["chain"] if k == "chain" else r[k] for r in rows] for k in COLUMNS}
+    once = "all" if all(r[b]["once"] for r in rows for b in ("host", "armv4t") if b in r) else "**not all**"
+    return [(f"| **mean ({len(rows)} trials)** | host | | **{np.mean(val['chain']):.3f}** | {np.mean(val['direct']):.3f} | "
+            f"{np.mean(val['unquantized']):.3f} | {max(r['host']['diff'] for r in rows):.1e} | {once} | |"),
+            (f"| **worst trial** | host | | **{max(val['chain']):.3f}** | {max(val['direct']):.3f} | "
+            f"{max(val['unquantized']):.3f} | | | |")]
+
+
+def _runs(picked: list[Any], quick: bool, cmds: dict[str, list[str]], build_dir: Path,
+          budget: float) -> list[dict[str, Any]]:
+    """Every trial with the host build, then the first with the ARMv4T build; two at a time
+    (lockstep: a run's figures do not depend on the machine's load). No run starts after
+    ``budget`` minutes (0: no limit); the rows are the trials whose host run was made."""
+    import threading
+    import time
+
+    t0, lock, rows = time.monotonic(), threading.Lock(), {}
+    units = [(tr, "host") for tr in picked] + [(picked[0], "armv4t")]
+
+    def one(unit: tuple[Any, str]) -> None:
+        tr, build = unit
+        if budget and time.monotonic() - t0 > 60.0 * budget:
+            print(f"   chain: {tr.name} ({build}) not started: the {budget:g}-minute budget is spent", flush=True)
+            return
+        rec, out = _recording(tr, quick)
+        res = _chain(rec, tr.name, build, cmds[build], build_dir)
+        with lock:
+            rows.setdefault(tr.name, out)[build] = res
+
+    with ThreadPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:
+        list(pool.map(one, units))
+    return [rows[tr.name] for tr in picked if "host" in rows.get(tr.name, {})]
+
+
+def run(quick: bool, trials: str = "", budget: str = "") -> str:
+    from attitude_c import broad
     from toolchain import targets
     from toolchain.tasks.cross import cross_build_target
 
     build_dir = ROOT / "build" / "bench_chain"
-    host = [str(cross_build_target("host", out=build_dir / "host")["app"])]
     arm_t = targets.load("armv4t")
-    arm = [*arm_t.run_cmd, str(cross_build_target("armv4t", out=build_dir / "armv4t")["app"])]
-    rows = []
-    for i, tr in enumerate(broad.iter_trials()):
-        print(f"   chain: {tr.name} ...", flush=True)
-        rows.append(_trial(tr, quick, {"host": host, **({"armv4t": arm} if i == 0 else {})}, build_dir))
-    ch = board_channels()
-    cfg = tool.AIDED
-    lines = [
-        (f"Firmware: `toolchain.firmware.AIDED` (gyros every {cfg.period_ticks}/{tool.TICK_HZ} s, accelerometer "
-        f"every {cfg.acc_every}, magnetometer every {cfg.mag_every} samples, link v2 at {cfg.baud} baud), "
-        "sim image with the data-driven TLC2543 model. Codes (round to nearest about 2048): "
-        + "; ".join(f"{c.name} {c.lsb:.4g} {c.unit} per code, clipped at ±{c.clip:.4g} {c.unit}" for c in ch.values())
-        + ". Trials: " + (f"{QUICK_SECONDS:.0f} s of each from {QUICK_LEAD:.0f} s before its movement phase "
-                          "(`--quick`; *from + s*: the excerpt's start and length)" if quick else "whole") + "."),
-        "",
-        ("BROAD total error (RMS over the movement phase, deg) of: the chain (attitude-rx's lines); the library "
-        "filter run directly on the same codes (direct); on the unquantized samples at the same instants "
-        "(unquantized). *max diff*: largest angle between the chain's and the direct filter's attitude over "
-        "all samples (deg; ~1e-6 is arccos's resolution near 0, i.e. equal; where samples were lost, against "
-        "the direct filter holding them as attitude-rx does: the last rate, no aiding). *once*: every sample "
-        "printed once in order, no loss report, no duplicate (records attitude-rx received, BOOT and CHANNELS "
-        "included); *lost*: samples the firmware reported lost (OVERRUN: its ring of records full while the "
-        "host's acknowledgements, in wall time, lag s51's simulated time on a loaded machine). *wall*: "
-        "seconds the s51 run took."),
-        "",
-        "| trial | attitude-rx | from + s | chain | direct | unquantized | max diff | once (records) | wall |",
-        "|---|---|---:|---:|---:|---:|---:|---|---:|",
-    ]
+    cmds = {"host": [str(cross_build_target("host", out=build_dir / "host")["app"])],
+            "armv4t": [*arm_t.run_cmd, str(cross_build_target("armv4t", out=build_dir / "armv4t")["app"])]}
+    picked = _selected(trials)
+    rows = _runs(picked, quick, cmds, build_dir, float(budget or 0))
+    if not rows:
+        raise RuntimeError("no trial ran within the budget")
+    lines = [_header(quick, len(rows), len(list(broad.iter_trials())), budget), "", LEGEND, "",
+             ("| trial | attitude-rx | from + s | chain | direct | unquantized | max diff | once (records, frames) "
+             "| sim / wall s |"), "|---|---|---:|---:|---:|---:|---:|---|---:|"]
     lines += [_row(r, b) for r in rows for b in ("host", "armv4t") if b in r]
-    mean = {k: float(np.mean([r[k] if k != "chain" else r["host"]["total"] for r in rows]))
-            for k in ("chain", "direct", "unquantized")}
-    lines += [(f"| **mean ({len(rows)} trials)** | host | | **{mean['chain']:.3f}** | {mean['direct']:.3f} | "
-               f"{mean['unquantized']:.3f} | {max(r['host']['diff'] for r in rows):.1e} | "
-               f"{'all' if all(r['host']['once'] for r in rows) else '**not all**'} | |"),
-              "", f"Worst trial, chain: {max(r['host']['total'] for r in rows):.3f}°. Codes clipped (values at a "
-              f"channel's limit, all trials): " + ", ".join(
-                  f"{k} {sum(r['clipped'][k] for r in rows)}" for k in ("gyro", "acc", "mag")) + "."]
+    lines += _summary(rows)
+    lines += ["", "Codes clipped (values at a channel's limit, these trials): " + ", ".join(
+        f"{k} {sum(r['clipped'][k] for r in rows)}" for k in ("gyro", "acc", "mag")) + "."]
     return "\n".join(lines)

@@ -102,6 +102,9 @@ S51_NICE = 10
 LOCKSTEP_INSNS = 10_000
 #: The hard bound above, in simulated seconds.
 LOCKSTEP_BOUND_S = 4 * LOCKSTEP_INSNS / MACHINE_HZ
+#: Steps of ``run_lockstep(..., ahead=True)`` (the aided chain): half as long, since an
+#: answer can be one step later there; the same bound, LOCKSTEP_BOUND_S.
+LOCKSTEP_AHEAD_INSNS = LOCKSTEP_INSNS // 2
 
 SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c", CSRC / "src" / "link_sender.c",
            CSRC / "src" / "block.c"]
@@ -701,12 +704,20 @@ class _Console:
         self.proc, self.deadline, self.fail = proc, deadline, fail
         self.out = bytearray()  #: everything the console printed
 
-    def ask(self, command: str, until: re.Pattern[bytes]) -> re.Match[bytes]:
-        """Send ``command``; wait (up to the deadline) until its output matches ``until``."""
-        assert self.proc.stdin is not None and self.proc.stdout is not None
-        start = len(self.out)
+    def send(self, command: str) -> None:
+        assert self.proc.stdin is not None
         self.proc.stdin.write(command.encode() + b"\n")
         self.proc.stdin.flush()
+
+    def ask(self, command: str, until: re.Pattern[bytes]) -> re.Match[bytes]:
+        """Send ``command``; wait (up to the deadline) until its output matches ``until``."""
+        start = len(self.out)
+        self.send(command)
+        return self.expect(until, start, command)
+
+    def expect(self, until: re.Pattern[bytes], start: int, command: str) -> re.Match[bytes]:
+        """Wait (up to the deadline) until the output from ``start`` on matches ``until``."""
+        assert self.proc.stdout is not None
         while (m := until.search(self.out, start)) is None:
             left = self.deadline - time.monotonic()
             if left <= 0 or self.proc.poll() is not None:
@@ -817,13 +828,22 @@ class Session:
         return ["s51", "-t", "C52" if self.image.config.aided else "C51", "-R", "1",
                 "-I", sif, "-S", f"in={self._fw_in},out={self._fw_out}", *tail]
 
-    def run_lockstep(self, pump: Callable[[], None], describe: Callable[[], str] | None = None) -> SimOutput:
+    def run_lockstep(self, pump: Callable[[], None], describe: Callable[[], str] | None = None, *,
+                     ahead: bool = False) -> SimOutput:
         """Run s51 in steps of :data:`LOCKSTEP_INSNS` instructions from its console, calling
         ``pump()`` (the host end: read everything, answer) between two steps, until the
         firmware stops itself. Simulated time stands still while the host works or is
         descheduled, so a byte the firmware sends is answered within the next step: at
         most :data:`LOCKSTEP_BOUND_S` simulated seconds later, whatever the machine's load.
-        Errors as :meth:`run`."""
+
+        ``ahead``: one more step is always queued at s51's console, so s51 runs step k+1
+        while ``pump()`` handles step k's bytes, and the command of step k+2 goes out only
+        when that pump has returned. An answer then reaches the firmware within two steps of
+        :data:`LOCKSTEP_AHEAD_INSNS` (the same bound, :data:`LOCKSTEP_BOUND_S`), at an
+        instant of step k+1 that depends on the host's speed (no longer repeatable byte
+        for byte), and s51 never idles between steps: its console, stopped with no command
+        waiting, sleeps up to 100 ms before it looks again, which is most of a plain
+        lockstep run's wall time. Errors as :meth:`run`."""
         sif_out = self._tmp / "sif.out"
         t_start = time.monotonic()
 
@@ -838,11 +858,18 @@ class Session:
                                      cwd=self._tmp)
         con = _Console(self._s51, t_start + self.timeout, fail)
         con.ask("expr uart0_check_often=1", re.compile(rb"^1$", re.MULTILINE))
+        cmd, seen = f"step {LOCKSTEP_AHEAD_INSNS if ahead else LOCKSTEP_INSNS}", len(con.out)
+        if ahead:
+            con.send(cmd)
         while not (sif_out.exists() and re.search(r"^EXIT \d+$", sif_out.read_text(errors="replace"), re.MULTILINE)):
-            step = int(con.ask(f"step {LOCKSTEP_INSNS}", _STEPPED).group(1)) / XTAL_HZ
+            con.send(cmd)
+            m = con.expect(_STEPPED, seen, cmd)
+            seen, step = m.end(), int(m.group(1)) / XTAL_HZ
             self.sim_seconds += step
             self.max_step_s = max(self.max_step_s, step)
             pump()
+        if ahead:
+            con.expect(_STEPPED, seen, cmd)  # the step queued ahead
         con.ask("state", _STATE_SP)  # printed after the clock line
         _kill_group(self._s51)
         return _sim_output(sif_out.read_text(errors="replace"), bytes(con.out), time.monotonic() - t_start)

@@ -223,8 +223,10 @@ def assemble_bench_doc() -> None:
     "only": "run only this benchmark module (bench/NAME.py); 'assemble' just rebuilds the table",
     "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
     "data": "a data folder for the benchmarks that take one (broad: an upstream BROAD data_mat/ folder)",
+    "trials": "the benchmarks that take it (chain): only the BROAD trials whose names start so (comma-separated)",
+    "budget": "the benchmarks that take it (chain): start no run after this many minutes (the table says so)",
 })
-def bench(c, only="", quick=False, data=""):
+def bench(c, only="", quick=False, data="", trials="", budget=""):
     """Run every benchmark and write the figures into docs/benchmarks.md."""
     import inspect
 
@@ -239,10 +241,9 @@ def bench(c, only="", quick=False, data=""):
         try:
             mod = importlib.import_module(f"bench.{name}")
             print(f"== bench {name}: {mod.TITLE}", flush=True)
-            if data and "data" in inspect.signature(mod.run).parameters:
-                body = mod.run(quick=quick, data=data)
-            else:
-                body = mod.run(quick=quick)
+            params = inspect.signature(mod.run).parameters
+            extra = {k: v for k, v in (("data", data), ("trials", trials), ("budget", budget)) if v and k in params}
+            body = mod.run(quick=quick, **extra)
         except Exception as exc:  # noqa: BLE001 - any failure of one module
             import traceback
 
@@ -251,7 +252,7 @@ def bench(c, only="", quick=False, data=""):
             failed.append(name)
             continue
         cmd = ("invoke bench" + (f" --only {name}" if only else "") + (" --quick" if quick else "")
-               + (f" --data {data}" if data and "data" in inspect.signature(mod.run).parameters else ""))
+               + "".join(f" --{k} {v}" for k, v in extra.items()))
         write_bench_section(name, mod.TITLE, body, cmd)
         print(body)
     assemble_bench_doc()
