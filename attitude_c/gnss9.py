@@ -224,7 +224,7 @@ def _times(n: int, rate: float | None, t: ArrayLike | None) -> tuple[FloatArray,
         if rate is None:
             raise InvalidArgument("give rate (Hz) or t (s)")
         step = 1.0 / real(rate, "rate", "Hz", lo=0.0, lo_open=True)
-        return np.arange(n) * step, np.array([step])
+        return np.arange(n, dtype=np.float64) * step, np.array([step])
     ta = real_array(t, "t").astype(np.float64).ravel()
     if ta.shape != (n,) or n < 2:
         raise InvalidArgument(f"t must have one time stamp per IMU sample ({n}, at least 2), got {ta.shape}")

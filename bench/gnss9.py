@@ -36,15 +36,15 @@ def _us(instr: float) -> float:
 def run(quick: bool) -> str:
     precisions = ("f32",) if quick else ("f32", "f64")
     out = [
-        "Instructions on the emulated ARMv4T core (`qemu-arm -cpu ti925t`, exact counts, "
+        ("Instructions on the emulated ARMv4T core (`qemu-arm -cpu ti925t`, exact counts, "
         "`toolchain/qemu_count.py`; difference of two runs of `bench/gnss9_armv4t.c`, 100 IMU samples apart; "
         "soft-float newlib libm, `-O2`; default settings, kf_period 5). Per IMU sample: the strapdown step and "
         f"a fifth of a Kalman prediction (9×9), as a mean. Per update: {EVERY} × (the per-sample mean with an "
         "update every 5th sample − without), the update and the feedback. Time at 400 MHz assumes "
-        f"{CPI} cycles per instruction (docs/bench/armv4t.md).",
+        f"{CPI} cycles per instruction (docs/bench/armv4t.md)."),
         "",
-        "| build | per IMU sample (mean) | per GNSS velocity update | per magnetic heading update "
-        "| µs @400 MHz (sample / GNSS / heading) |",
+        ("| build | per IMU sample (mean) | per GNSS velocity update | per magnetic heading update "
+        "| µs @400 MHz (sample / GNSS / heading) |"),
         "|---|---|---|---|---|",
     ]
     with tempfile.TemporaryDirectory() as d:

@@ -15,7 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
-from conftest import angle_deg
 
 import attitude_c
 from attitude_c import reference as ref
@@ -53,7 +52,7 @@ def drive(seconds: float, speed: float, turn_rate: float = 0.0, psi0: float = 0.
     """Closed-form level motion: heading ψ0 + r t, speed V along body y; sample k
     at t = (k + 1) h (the motion starts at t = 0, the truth before sample 0)."""
     rng = np.random.default_rng(seed)
-    n = int(round(seconds * RATE))
+    n = round(seconds * RATE)
     t = (np.arange(n) + 1) * H
     psi = psi0 + turn_rate * t
     q = _yaw_quat(psi)
