@@ -262,3 +262,18 @@ def test_errors_and_settings():
 def test_defaults_documented():
     from attitude_c.gnss9_reference import _DEFAULTS
     assert default_settings() == _DEFAULTS
+
+
+@pytest.mark.qemu
+def test_cost_harness_runs_on_armv4t(tmp_path) -> None:
+    """The smoke version of `invoke bench --only gnss9`: its harness (bench/gnss9_armv4t.c) runs
+    the filter on the bare ARMv4T core, every call succeeding (exit 0), double and float, each mode."""
+    from conftest import ROOT, require_target
+
+    t = require_target("armv4t-bare")
+    for prec in ("f64", "f32"):
+        exe = t.build_program([ROOT / "bench" / "gnss9_armv4t.c"], tmp_path / f"gnss9_{prec}",
+                              defines=["ATT_REAL_F32"] if prec == "f32" else [])
+        for mode in ("imu", "gnss", "heading"):
+            assert t.run([exe, mode, "40"], timeout=120, check=False).returncode == 0, (prec, mode)
+    assert t.run([exe, "imu"], timeout=60, check=False).returncode == 2  # MODE N
