@@ -154,7 +154,8 @@ att_status att_g9_init(att_g9 *s, const att_g9_settings *set, const att_real q0[
 
 /* One IMU sample: gyr [rad/s], acc [m/s², specific force, +g up at rest],
  * dt [s] > 0 since the previous sample. Runs the strapdown step and, every
- * kf_period samples, the Kalman prediction. Errors (state unchanged):
+ * kf_period samples, the Kalman prediction. After an init without q0 the
+ * first sample only sets roll and pitch (yaw 0) from acc. Errors (state unchanged):
  * ATT_E_NULL, ATT_E_G9_DT, ATT_E_NONFINITE, ATT_E_G9_ALIGN (first sample
  * with zero acc and no q0), ATT_E_G9_DIVERGED, the integrator's
  * ATT_E_INTEG_RANGE. */
