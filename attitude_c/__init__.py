@@ -79,6 +79,11 @@ from .thesis_ekf import ahrs_thesis
 
 __all__ += ["ahrs_thesis"]
 
+# The MEMS AHRS paper's nine-state filter with GNSS-velocity aiding (docs/gnss-paper-filter.md).
+from .gnss9 import Gnss9, ahrs_gnss9
+
+__all__ += ["Gnss9", "ahrs_gnss9"]
+
 # Noise identification (docs/noise.md): the Allan deviation of a rest recording, its noise terms
 # and the filter settings they give (needs allantools: pip install 'attitude-c[noise]').
 from .noise import allan

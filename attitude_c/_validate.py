@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InvalidArgument, InvalidType, NonFiniteError, RangeError
 
-__all__ = ["C_INT_RANGES", "integer", "real", "real_array"]
+__all__ = ["C_INT_RANGES", "integer", "real", "real_array", "time_steps"]
 
 #: The range of each C integer type a settings field or argument may have (LP64, as the
 #: library is built on every host it supports).
@@ -107,3 +107,16 @@ def real_array(x: ArrayLike, name: str) -> NDArray[Any]:
     if a.dtype.kind not in "iuf":
         raise InvalidType(f"{name} must hold real numbers (integer or float dtype), got dtype {a.dtype}")
     return a
+
+
+def time_steps(dt: ArrayLike | None, n: int, rate: float | None, dtype: Any) -> NDArray[Any]:
+    """A streaming filter's steps for n samples: ``dt`` (a scalar or n values, s), or
+    1/``rate`` when ``dt`` is None; contiguous in ``dtype`` (the C build's att_real)."""
+    if dt is None:
+        if rate is None:
+            raise InvalidArgument("dt is required when the filter has no rate")
+        return np.array([1.0 / rate], dtype=dtype)
+    d = real_array(dt, "dt").astype(np.float64).ravel()
+    if d.size not in (1, n):
+        raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
+    return np.ascontiguousarray(d, dtype=dtype)

@@ -27,7 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
-from ._validate import real, real_array
+from ._validate import real, real_array, time_steps
 from .errors import InvalidArgument, InvalidType, NonFiniteError
 from .names import raise_for_status
 
@@ -211,14 +211,7 @@ class Ahrs:
         return int(self._lib.att_ahrs_flags(self._s))
 
     def _dt(self, dt: ArrayLike | None, n: int) -> NDArray[Any]:
-        if dt is None:
-            if self.rate is None:
-                raise InvalidArgument("dt is required when the filter has no rate")
-            return np.array([1.0 / self.rate], dtype=_DTYPES[self.precision])
-        d = real_array(dt, "dt").astype(np.float64).ravel()
-        if d.size not in (1, n):
-            raise InvalidArgument(f"dt must be a scalar or have one value per sample ({n}), got {d.size}")
-        return np.ascontiguousarray(d, dtype=_DTYPES[self.precision])
+        return time_steps(dt, n, self.rate, _DTYPES[self.precision])
 
     @overload
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ...,

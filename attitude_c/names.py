@@ -154,6 +154,12 @@ _CLASSES: dict[str, type[Exception]] = {
     "ATT_E_TEKF_SETTINGS": InvalidArgument,
     "ATT_E_TEKF_DIVERGED": RangeError,
     "ATT_E_TEKF_ALIGN": AttitudeError,
+    # ahrs_gnss9.h
+    "ATT_E_G9_DT": InvalidArgument,
+    "ATT_E_G9_SETTINGS": InvalidArgument,
+    "ATT_E_G9_DIVERGED": RangeError,
+    "ATT_E_G9_ALIGN": AttitudeError,
+    "ATT_E_G9_AGE": InvalidArgument,
     # block.h
     "ATT_BLOCK_E_CODE": BlockFormatError,
     "ATT_BLOCK_E_KIND": BlockFormatError,

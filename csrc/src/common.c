@@ -65,6 +65,12 @@ static const struct {
     { ATT_E_TEKF_SETTINGS, "thesis EKF setting outside its domain" },
     { ATT_E_TEKF_DIVERGED, "thesis EKF state not finite" },
     { ATT_E_TEKF_ALIGN, "no initial attitude: the sample cannot align the thesis EKF" },
+    /* ahrs_gnss9.h */
+    { ATT_E_G9_DT, "GNSS nine-state filter: time step not finite or not positive" },
+    { ATT_E_G9_SETTINGS, "GNSS nine-state filter setting outside its domain" },
+    { ATT_E_G9_DIVERGED, "GNSS nine-state filter state not finite" },
+    { ATT_E_G9_ALIGN, "no initial attitude: the sample cannot align the GNSS nine-state filter" },
+    { ATT_E_G9_AGE, "GNSS nine-state filter: GNSS age not finite, negative or above max_gnss_age" },
     /* denoise.h */
     { ATT_E_WDEN_WAVELET, "denoiser: unknown wavelet" },
     { ATT_E_WDEN_MODE, "denoiser: unknown thresholding rule" },

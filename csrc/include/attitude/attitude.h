@@ -20,5 +20,6 @@
 #include "attitude/aiding.h"
 #include "attitude/ahrs.h"
 #include "attitude/ahrs_thesis.h"
+#include "attitude/ahrs_gnss9.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
