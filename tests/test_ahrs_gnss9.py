@@ -1,6 +1,6 @@
 """attitude_c.gnss9: the MEMS AHRS paper's nine-state filter against its NumPy model and the truth.
 
-Differential: the C filter (double) against attitude_c.gnss9_reference (the
+Differential: the C filter (double) against attitude_c.reference.gnss9 (the
 error model in matrix form) on a turning vehicle with drift, noise, GNSS
 and heading updates; the float build against the double build.
 Truth: a level vehicle built here in closed form — a straight line at
@@ -20,7 +20,7 @@ import attitude_c
 from attitude_c import reference as ref
 from attitude_c.errors import InvalidArgument, NonFiniteError
 from attitude_c.gnss9 import Gnss9, ahrs_gnss9, default_settings, gnss_schedule
-from attitude_c.gnss9_reference import gnss9_reference
+from attitude_c.reference.gnss9 import gnss9_reference
 
 G = 9.80665  # the filter's default gravity
 RATE = 100.0
@@ -260,7 +260,7 @@ def test_errors_and_settings():
 
 
 def test_defaults_documented():
-    from attitude_c.gnss9_reference import _DEFAULTS
+    from attitude_c.reference.gnss9 import _DEFAULTS
     assert default_settings() == _DEFAULTS
 
 

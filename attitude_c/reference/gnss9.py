@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from . import reference as ref
+from .. import reference as ref
 
 __all__ = ["gnss9_reference"]
 
