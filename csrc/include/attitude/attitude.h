@@ -20,5 +20,6 @@
 #include "attitude/aiding.h"
 #include "attitude/ahrs.h"
 #include "attitude/ahrs_thesis.h"
+#include "attitude/gnss.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */
