@@ -219,7 +219,7 @@ static void set_fix_type(att_gnss_fix *t, att_gnss_fix_type ft)
     t->present |= ATT_GNSS_HAS_FIX_TYPE;
 }
 
-/* ddmmyy -> year (20yy), month, day. */
+/* ddmmyy -> year, month, day: yy 80..99 -> 19yy (GPS time starts in 1980), 00..79 -> 20yy. */
 static int get_date(field f, att_gnss_fix *t)
 {
     dec d;
@@ -235,7 +235,7 @@ static int get_date(field f, att_gnss_fix *t)
     }
     t->day = (uint8_t)dd;
     t->month = (uint8_t)mm;
-    t->year = (uint16_t)(2000u + d.ip % 100u);
+    t->year = (uint16_t)(d.ip % 100u + (d.ip % 100u >= 80u ? 1900u : 2000u));
     t->present |= ATT_GNSS_HAS_DATE;
     return F_OK;
 }

@@ -145,7 +145,7 @@ typedef struct {
     att_real v_acc;      /* m, receiver's vertical accuracy estimate (NAV-PVT vAcc) */
     att_real s_acc;      /* m/s, receiver's speed accuracy estimate (NAV-PVT sAcc) */
     uint32_t present;    /* ATT_GNSS_HAS_* bits: which fields hold a value */
-    uint16_t year;       /* UTC date: year (4 digits; RMC's 2-digit year + 2000) */
+    uint16_t year;       /* UTC date: year (4 digits; RMC's yy: 80..99 -> 19yy, else 20yy) */
     uint8_t month;       /* 1..12 */
     uint8_t day;         /* 1..31 */
     uint8_t fix_type;    /* att_gnss_fix_type */
