@@ -78,7 +78,7 @@ def test_sender_fits_8051_ram_budget(tmp_path: Path):
     assert m and int(m.group(1), 16) <= 0x60, mem
 
 
-@pytest.mark.parametrize("target", ["link", "block", "link2"])
+@pytest.mark.parametrize("target", ["link", "block", "link2", "gnss"])
 def test_fuzz_smoke_run(tmp_path: Path, target: str):
     require_tools("clang", "llvm-profdata", "llvm-cov", apt="clang libclang-rt-14-dev llvm")
     from toolchain.tasks.link import COVERS, build_fuzzer, line_coverage, run_fuzzer
