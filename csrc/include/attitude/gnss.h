@@ -78,6 +78,11 @@ typedef enum {
     ATT_GNSS_E_STATE = -221 /* internal state corrupted (struct overwritten?) */
 } att_gnss_result;
 
+/* The parser is not built for the 8051 (its state alone exceeds the AT89S51's
+ * 256 bytes of RAM, and SDCC's 16-bit int cannot hold the presence bits):
+ * there, only the status codes above are visible (csrc/src/common.c's table). */
+#if !defined(__SDCC)
+
 /* Fix type (att_gnss_fix.fix_type): NAV-PVT's fixType values. NMEA: GSA's
  * mode 1 / 2 / 3 -> NONE / 2D / 3D; GGA's quality 0 -> NONE, 6 -> DR. */
 typedef enum {
@@ -212,6 +217,8 @@ int att_gnss_feed_buf(att_gnss_parser *p, const uint8_t *data, size_t n, att_gns
  * last sentence of an epoch seen): ATT_GNSS_FIX and *out, or
  * ATT_GNSS_NONE when none is open; a message in progress is kept. */
 att_gnss_result att_gnss_flush(att_gnss_parser *p, att_gnss_fix *out);
+
+#endif /* !__SDCC */
 
 ATT_API_END
 
