@@ -134,7 +134,7 @@ def test_invoke_build_isolates_only_when_needed() -> None:
 #: (pyproject.toml [project] dependencies), and what only one function imports
 #: on demand with a message naming what to install (scipy: attitude_c.broad's .mat reader).
 _DEPENDENCIES = {"cffi", "numpy", "serial", "matplotlib", "tqdm"}
-_ON_DEMAND = {"scipy", "aiohttp", "dask", "distributed", "pandas", "tomli"}  # optional: imported where needed, with a message saying what to install
+_ON_DEMAND = {"scipy", "aiohttp", "dask", "distributed", "pandas", "tomli", "pynmea2", "pyubx2"}  # optional: imported where needed, with a message saying what to install
 
 
 def test_the_package_imports_nothing_outside_itself() -> None:
