@@ -47,7 +47,7 @@ _REALS = {"TOD": ("tod",), "TOW": ("tow",), "LATLON": ("lat", "lon"), "HEIGHT": 
           "HEIGHT_MSL": ("height_msl",), "VEL_NE": ("vel_n", "vel_e"), "VEL_D": ("vel_d",),
           "SPEED": ("speed",), "TRACK": ("track",), "HDOP": ("hdop",), "PDOP": ("pdop",), "VDOP": ("vdop",),
           "ACC": ("h_acc", "v_acc", "s_acc")}
-_CHUNK = 64  # fixes per att_gnss_feed_buf call
+_CHUNK = 256  # fixes per att_gnss_feed_buf call
 
 
 @dataclass(frozen=True)
@@ -110,12 +110,12 @@ class Parser:
         if not isinstance(data, (bytes, bytearray, memoryview)):
             raise InvalidType(f"data must be bytes, got {type(data).__name__}")
         buf = bytes(data)
+        src = self._ffi.cast("const uint8_t *", self._ffi.from_buffer(buf))  # buf outlives the loop
         used, nfix = self._ffi.new("size_t *"), self._ffi.new("size_t *")
         out: list[GnssFix] = []
         pos = 0
         while pos < len(buf):
-            src = self._ffi.from_buffer(buf[pos:])
-            st = self._lib.att_gnss_feed_buf(self._p, src, len(buf) - pos, self._out, _CHUNK, used, nfix)
+            st = self._lib.att_gnss_feed_buf(self._p, src + pos, len(buf) - pos, self._out, _CHUNK, used, nfix)
             raise_for_status(st, "gnss.Parser.feed")
             out.extend(_fix(self._out[i]) for i in range(nfix[0]))
             pos += used[0]
