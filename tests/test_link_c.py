@@ -1,7 +1,8 @@
 """The link's C sources beyond the host test program (csrc/tests/test_link.c,
 run by test_c_programs.py): the sender compiles for the AT89S51 with SDCC
 within its RAM budget, and a libFuzzer smoke run of each fuzz target (the
-link machines against a model of the protocol; the block format) under
+link machines against a model of the protocol; the block format; the GNSS
+parser, csrc/fuzz/fuzz_gnss.c) under
 ASan + UBSan finds nothing, and its coverage build works."""
 
 from __future__ import annotations
