@@ -139,6 +139,9 @@ _CLASSES: dict[str, type[Exception]] = {
     "ATT_LINK2_E_CONFIG": InvalidArgument,
     "ATT_LINK2_E_FULL": LinkBusy,
     "ATT_LINK2_E_STATE": LinkError,
+    # gnss.h
+    "ATT_GNSS_E_NULL": InvalidArgument,
+    "ATT_GNSS_E_STATE": AttitudeError,
     # fixed.h
     "ATT_FX_E_RANGE": RangeError,
     "ATT_FX_E_METHOD": InvalidArgument,

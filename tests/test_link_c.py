@@ -1,7 +1,8 @@
 """The link's C sources beyond the host test program (csrc/tests/test_link.c,
 run by test_c_programs.py): the sender compiles for the AT89S51 with SDCC
 within its RAM budget, and a libFuzzer smoke run of each fuzz target (the
-link machines against a model of the protocol; the block format) under
+link machines against a model of the protocol; the block format; the GNSS
+parser, csrc/fuzz/fuzz_gnss.c) under
 ASan + UBSan finds nothing, and its coverage build works."""
 
 from __future__ import annotations
@@ -78,7 +79,7 @@ def test_sender_fits_8051_ram_budget(tmp_path: Path):
     assert m and int(m.group(1), 16) <= 0x60, mem
 
 
-@pytest.mark.parametrize("target", ["link", "block", "link2"])
+@pytest.mark.parametrize("target", ["link", "block", "link2", "gnss"])
 def test_fuzz_smoke_run(tmp_path: Path, target: str):
     require_tools("clang", "llvm-profdata", "llvm-cov", apt="clang libclang-rt-14-dev llvm")
     from toolchain.tasks.link import COVERS, build_fuzzer, line_coverage, run_fuzzer

@@ -89,6 +89,9 @@ static const struct {
     { ATT_LINK2_E_CONFIG, "link v2 configuration out of range" },
     { ATT_LINK2_E_FULL, "link v2 sender ring full" },
     { ATT_LINK2_E_STATE, "link v2 state corrupted" },
+    /* gnss.h */
+    { ATT_GNSS_E_NULL, "GNSS parser: NULL pointer" },
+    { ATT_GNSS_E_STATE, "GNSS parser state corrupted" },
 };
 
 const char *att_status_str(int status)

@@ -80,6 +80,8 @@ static const struct {
     CODE(ATT_LINK2_E_CONFIG),
     CODE(ATT_LINK2_E_FULL),
     CODE(ATT_LINK2_E_STATE),
+    CODE(ATT_GNSS_E_NULL),
+    CODE(ATT_GNSS_E_STATE),
 };
 
 #define N_CODES (sizeof codes / sizeof codes[0])

@@ -1,5 +1,6 @@
 """Link tasks: `invoke fuzz` runs the libFuzzer targets of the link machines
-(legacy and v2) and the block format (csrc/fuzz/fuzz_link.c, fuzz_link2.c, fuzz_block.c) under ASan +
+(legacy and v2), the block format and the GNSS parser (csrc/fuzz/fuzz_link.c, fuzz_link2.c, fuzz_block.c,
+fuzz_gnss.c) under ASan +
 UBSan; `--coverage` then measures the line coverage their corpora give each
 source (clang source-based coverage)."""
 
@@ -16,15 +17,17 @@ from invoke import task
 ROOT = Path(__file__).resolve().parents[2]
 FUZZ_DIR = ROOT / "csrc" / "fuzz"
 #: target name -> its source; both link every source below
-TARGETS = {"link": FUZZ_DIR / "fuzz_link.c", "block": FUZZ_DIR / "fuzz_block.c", "link2": FUZZ_DIR / "fuzz_link2.c"}
+TARGETS = {"link": FUZZ_DIR / "fuzz_link.c", "block": FUZZ_DIR / "fuzz_block.c", "link2": FUZZ_DIR / "fuzz_link2.c",
+           "gnss": FUZZ_DIR / "fuzz_gnss.c"}
 SRC = ROOT / "csrc" / "src"
 LIB = [SRC / n for n in ("link_sender.c", "link_sender_aux.c", "link_receiver.c", "block.c", "block_decode.c",
                          "block_sums.c", "block_channels.c", "common.c", "link2_sender.c", "link2_sender_aux.c",
-                         "link2_receiver.c")]
+                         "link2_receiver.c", "gnss_parse.c", "gnss_nmea.c", "gnss_ubx.c")]
 #: the sources each target is meant to cover (common.c only has att_status_str: not theirs)
 COVERS = {"link": ("link_sender.c", "link_sender_aux.c", "link_receiver.c"),
           "block": ("block.c", "block_decode.c", "block_sums.c", "block_channels.c"),
-          "link2": ("link2_sender.c", "link2_sender_aux.c", "link2_receiver.c")}
+          "link2": ("link2_sender.c", "link2_sender_aux.c", "link2_receiver.c"),
+          "gnss": ("gnss_parse.c", "gnss_nmea.c", "gnss_ubx.c")}
 APT_HINT = "apt-get install clang libclang-rt-14-dev llvm"
 
 
@@ -78,15 +81,15 @@ def line_coverage(target: str, corpus: Path, work: Path) -> dict[str, tuple[int,
 
 
 @task(help={"seconds": "how long to fuzz each target (default 60)",
-            "target": "link, block, link2 or all (default all)",
+            "target": "link, block, link2, gnss or all (default all)",
             "corpus": "corpus directory, one subdirectory per target (default fuzz-corpus)",
             "coverage": "then report the line coverage the corpus gives each source"})
 def fuzz(c, seconds=60, target="all", corpus="", coverage=False):
-    """Fuzz the link machines and the block format (libFuzzer + ASan + UBSan)."""
+    """Fuzz the link machines, the block format and the GNSS parser (libFuzzer + ASan + UBSan)."""
     build = ROOT / "build" / "fuzz"
     names = list(TARGETS) if target == "all" else [target]
     if any(n not in TARGETS for n in names):
-        raise SystemExit(f"fuzz: unknown target {target!r} (link, block, link2, all)")
+        raise SystemExit(f"fuzz: unknown target {target!r} ({', '.join(TARGETS)}, all)")
     base = Path(corpus) if corpus else ROOT / "fuzz-corpus"
     for name in names:
         exe = build_fuzzer(build, name)

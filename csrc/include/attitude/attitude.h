@@ -21,5 +21,6 @@
 #include "attitude/ahrs.h"
 #include "attitude/ahrs_thesis.h"
 #include "attitude/ahrs_gnss9.h"
+#include "attitude/gnss.h"
 
 #endif /* ATTITUDE_ATTITUDE_H */

@@ -49,8 +49,8 @@ typedef double att_real;
  * TLC2543 -40..-59, link -60..-79, fixed point -80..-99, block format
  * -100..-119, aiding solvers (alignment, TRIAD, Gauss-Newton, magnetometer
  * calibration) -120..-139, attitude filter -140..-159, wavelet denoiser
- * -160..-179, AD7927 -180..-199, link v2 -200..-219, the GNSS nine-state
- * filter -240..-249. Each module's header
+ * -160..-179, AD7927 -180..-199, link v2 -200..-219, GNSS parser
+ * -220..-239, the GNSS nine-state filter -240..-249. Each module's header
  * defines its own codes inside its range.
  *
  * `att_status` is an int, not the enum type: with short enums (the
