@@ -70,9 +70,10 @@ def _rchar(pid: int) -> int:
         return next(int(ln.split()[1]) for ln in f if ln.startswith("rchar:"))
 
 
-def _until_read(pid: int, n: int) -> None:
-    """Wait until link-rx has read ``n`` more bytes than it had when this was called."""
-    want, deadline = _rchar(pid) + n, time.monotonic() + STEP_S
+def _until_read(pid: int, want: int) -> None:
+    """Wait until link-rx has read ``want`` bytes in all (the count taken before the write:
+    taken after it, a read that came first would be missed and the wait never end)."""
+    deadline = time.monotonic() + STEP_S
     while _rchar(pid) < want:
         assert time.monotonic() < deadline, "link-rx did not read its port"
         select.select([], [], [], 0.001)
@@ -131,8 +132,9 @@ def test_link_rx_stops_on_sigterm_with_stdout_full(protocol: str, decode: bool) 
     argv = ["--protocol", protocol, *gap, *(["--decode"] if decode else [])]
     with _link_rx(*argv) as (proc, master):
         data = (_send_v2 if protocol == "v2" else _send_legacy)(master)
+        before = _rchar(proc.pid)
         os.write(master, data)
-        _until_read(proc.pid, len(data))  # the record is in link-rx's hands: it must print it
+        _until_read(proc.pid, before + len(data))  # the record is in link-rx's hands: it must print it
         proc.send_signal(signal.SIGTERM)
         try:
             err = proc.communicate(timeout=EXIT_S)[1]

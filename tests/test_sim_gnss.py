@@ -16,6 +16,7 @@ import pytest
 import pyubx2
 
 from attitude_c.sim import SimConfig
+from attitude_c.sim.catalog import make_trajectory
 from attitude_c.sim.geodetic import (
     WGS84_A,
     WGS84_F,
@@ -34,7 +35,6 @@ from attitude_c.sim.gnss_log import (
     write_gnss_log,
 )
 from attitude_c.sim.gnss_model import BadFix, GnssReceiver, Quality, gnss_preset
-from attitude_c.sim.catalog import make_trajectory
 
 E2 = WGS84_F * (2 - WGS84_F)
 

@@ -15,6 +15,7 @@ from attitude_c.errors import InvalidArgument, NonFiniteError
 from attitude_c.reference import euler_to_quat, quat_conj, quat_to_euler, rotvec_to_quat
 from attitude_c.reference import quat_angle as quat_angle_between
 from attitude_c.reference import quat_multiply as quat_mul
+from attitude_c.sim.catalog import make_trajectory
 from attitude_c.sim.trajectory import (
     ConingTrajectory,
     ConstantRateTrajectory,
@@ -23,7 +24,6 @@ from attitude_c.sim.trajectory import (
     StaticTrajectory,
     euler_rates_to_body,
 )
-from attitude_c.sim.catalog import make_trajectory
 
 
 def _dcm(q: np.ndarray) -> np.ndarray:

@@ -17,6 +17,7 @@ import pytest
 from attitude_c.errors import InvalidArgument
 from attitude_c.reference import quat_angle
 from attitude_c.reference import quat_multiply as quat_mul
+from attitude_c.sim.catalog import make_trajectory
 from attitude_c.sim.trajectory import (
     EARTH,
     ConingTrajectory,
@@ -25,7 +26,6 @@ from attitude_c.sim.trajectory import (
     PaperTrajectory,
     StaticTrajectory,
     TurntableTrajectory,
-    make_trajectory,
 )
 
 G = 9.80665
