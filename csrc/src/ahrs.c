@@ -12,6 +12,7 @@
 #include "attitude/aiding.h"
 
 #include "att_math.h"
+#include "settings_domain.h"
 
 #define NX 6
 
@@ -63,25 +64,12 @@ static int fin(att_real x)
     return isfinite(x);
 }
 
-/* The domain of each real setting (ahrs.h), in the struct's order: finite and, by rule, */
-enum {
-    GT, /* above the bound */
-    GE, /* at least the bound */
-    ABS /* within ±bound */
-};
-
-typedef struct {
-    const char *name;
-    size_t offset;
-    int rule;
-    att_real bound;
-} setting_domain;
-
+/* The domain of each real setting (ahrs.h), in the struct's order (settings_domain.h). */
 /* clang-format off */
-#define DOMAIN(field, rule, bound) { #field, offsetof(att_ahrs_settings, field), rule, ATT_R(bound) }
+#define DOMAIN(field, rule, bound) ATT__DOMAIN(att_ahrs_settings, field, ATT__##rule, bound)
 /* clang-format on */
 
-static const setting_domain DOMAINS[] = {
+static const att__domain DOMAINS[] = {
     DOMAIN(gravity, GT, 0),
     DOMAIN(gyr_noise, GT, 0),
     DOMAIN(gyr_noise_rest, GT, 0),
@@ -119,36 +107,24 @@ static const setting_domain DOMAINS[] = {
     DOMAIN(turn_tau, GT, 0),
 };
 
-static int in_domain(const att_ahrs_settings *set, const setting_domain *d)
-{
-    att_real v = *(const att_real *)(const void *)((const unsigned char *)set + d->offset);
-    if (!fin(v)) {
-        return 0;
-    }
-    return d->rule == GT ? v > d->bound : d->rule == GE ? v >= d->bound : att_fabs(v) <= d->bound;
-}
-
 att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
 {
     const char *bad = NULL;
-    size_t i;
+    const att__domain *d;
     if (field != NULL) {
         *field = NULL;
     }
     if (set == NULL) {
         return ATT_E_NULL;
     }
+    d = att__out_of_domain(set, DOMAINS, sizeof DOMAINS / sizeof DOMAINS[0]);
     if (set->method < 0 || set->method >= ATT_METHOD_COUNT || set->method == ATT_METHOD_RK4) {
         bad = "method";
-    }
-    for (i = 0; i < sizeof DOMAINS / sizeof DOMAINS[0] && bad == NULL; i++) {
-        if (!in_domain(set, &DOMAINS[i])) {
-            bad = DOMAINS[i].name;
-        }
-        if (bad == NULL && DOMAINS[i].offset == offsetof(att_ahrs_settings, mag_ref_window)
-            && set->mag_ref_window > set->mag_ref_tau) { /* the weight is capped at mag_ref_tau */
-            bad = DOMAINS[i].name;
-        }
+    } else if (set->mag_ref_window > set->mag_ref_tau /* the weight is capped at mag_ref_tau */
+               && (d == NULL || d->offset > offsetof(att_ahrs_settings, mag_ref_window))) {
+        bad = "mag_ref_window"; /* in the struct's order, before any later field out of its domain */
+    } else if (d != NULL) {
+        bad = d->name;
     }
     if (bad == NULL) {
         return ATT_OK;

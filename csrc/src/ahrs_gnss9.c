@@ -10,6 +10,7 @@
 #include <stddef.h>
 
 #include "att_math.h"
+#include "settings_domain.h"
 #include "attitude/aiding.h"
 #include "attitude/quat.h"
 
@@ -42,18 +43,13 @@ void att_g9_default_settings(att_g9_settings *set)
     set->kf_period = 5;
 }
 
-/* The domain of each real setting (ahrs_gnss9.h), in the struct's order. */
-typedef struct {
-    const char *name;
-    size_t offset;
-    int positive; /* 1: > 0, 0: ≥ 0 */
-} setting_domain;
-
+/* The domain of each real setting (ahrs_gnss9.h), in the struct's order (settings_domain.h):
+ * positive 1: > 0, 0: ≥ 0. */
 /* clang-format off */
-#define DOMAIN(field, positive) { #field, offsetof(att_g9_settings, field), positive }
+#define DOMAIN(field, positive) ATT__DOMAIN(att_g9_settings, field, (positive) ? ATT__GT : ATT__GE, 0)
 /* clang-format on */
 
-static const setting_domain DOMAINS[] = {
+static const att__domain DOMAINS[] = {
     DOMAIN(gravity, 1),         DOMAIN(gyr_noise, 1),
     DOMAIN(drift_noise, 0),     DOMAIN(acc_noise, 1),
     DOMAIN(mag_tau, 1),         DOMAIN(mag_sigma, 1),
@@ -63,26 +59,19 @@ static const setting_domain DOMAINS[] = {
     DOMAIN(max_gnss_age, 0),
 };
 
-static int in_domain(const att_g9_settings *set, const setting_domain *d)
-{
-    att_real v = *(const att_real *)(const void *)((const unsigned char *)set + d->offset);
-    return isfinite(v) && (d->positive ? v > 0 : v >= 0);
-}
-
 att_status att_g9_check_settings_field(const att_g9_settings *set, const char **field)
 {
     const char *bad = NULL;
-    size_t i;
+    const att__domain *d;
     if (field != NULL) {
         *field = NULL;
     }
     if (set == NULL) {
         return ATT_E_NULL;
     }
-    for (i = 0; i < sizeof DOMAINS / sizeof DOMAINS[0] && bad == NULL; i++) {
-        if (!in_domain(set, &DOMAINS[i])) {
-            bad = DOMAINS[i].name;
-        }
+    d = att__out_of_domain(set, DOMAINS, sizeof DOMAINS / sizeof DOMAINS[0]);
+    if (d != NULL) {
+        bad = d->name;
     }
     if (bad == NULL && (set->kf_period < 1 || set->kf_period > 1000)) {
         bad = "kf_period";
