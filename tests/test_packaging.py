@@ -139,9 +139,13 @@ def _extras_imports() -> set[str]:
     bench, which serve the tests and benchmarks), by import name: each is imported where it is
     needed, with a message saying what to install."""
     import re
-    import tomllib
 
     from conftest import ROOT
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover - the sweep extra installs tomli there
+        import tomli as tomllib
 
     extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["optional-dependencies"]
     return {re.split(r"[<>=;\[ ]", req, maxsplit=1)[0].lower() for name, reqs in extras.items()
