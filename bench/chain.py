@@ -25,6 +25,7 @@ prefix (``invoke bench --only chain --trials 01,07``), and the table says which 
 
 from __future__ import annotations
 
+import hashlib
 import os
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -37,12 +38,17 @@ TITLE = "The aided chain on BROAD: firmware (s51) → link v2 → pty → attitu
 #: --quick: each trial from QUICK_LEAD s before its first movement sample (rest: the filter
 #: settles), for QUICK_SECONDS
 QUICK_LEAD, QUICK_SECONDS = 10.0, 35.0
-COLUMNS = ("chain", "direct", "unquantized")
+COLUMNS = ("chain", "direct", "unquantized", "vqf")
+#: finished runs, kept between invocations (a long benchmark resumes where it stopped)
+RUNS = ROOT / "build" / "bench_chain" / "runs"
 
 
 def _recording(tr: Any, quick: bool) -> tuple[Any, dict[str, Any]]:
-    """The trial (or its --quick excerpt) as the board's codes, and the direct filter's figures."""
+    """The trial (or its --quick excerpt) as the board's codes, and the direct filters' figures."""
+    from vqf import VQF
+
     from attitude_c import broad
+    from attitude_c.sim.board_codes import values
     from toolchain import aided_chain as ac
 
     start = max(0.0, float(np.flatnonzero(tr.movement)[0]) / tr.rate - QUICK_LEAD) if quick else 0.0
@@ -50,7 +56,49 @@ def _recording(tr: Any, quick: bool) -> tuple[Any, dict[str, Any]]:
     out: dict[str, Any] = {"name": tr.name, "start": start, "seconds": rec.n * rec.period, "clipped": rec.clipped()}
     for k in ("direct", "unquantized"):
         out[k] = broad.errors(ac.direct(rec, quantized=k == "direct"), rec.quat, rec.movement).total
+    si = [np.ascontiguousarray(values(rec.codes[k], rec.channels[k])) for k in ("gyro", "acc", "mag")]
+    out["vqf"] = broad.errors(np.asarray(VQF(rec.period).updateBatch(*si)["quat9D"]), rec.quat, rec.movement).total
     return rec, out
+
+
+def _run_file(rec: Any, name: str, build: str, image: Any) -> Path:
+    """Where a run is kept: named by what decides the firmware's bytes on the link (its image and
+    the codes it serves) and the build; attitude-rx's side is checked again at every table (max diff)."""
+    h = hashlib.sha256(image.ihx.read_bytes())
+    for k in ("gyro", "acc", "mag"):
+        h.update(np.ascontiguousarray(rec.codes[k], dtype=np.int64).tobytes())
+    return RUNS / f"{name}-{build}-{h.hexdigest()[:16]}.npz"
+
+
+def _commit() -> str:
+    import subprocess
+
+    r = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=False)
+    return r.stdout.strip() or "unknown"
+
+
+def _chain_run(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path) -> dict[str, Any]:
+    """The chain's run of ``rec``: kept from an earlier run of the same firmware image on the same
+    codes (``build/bench_chain/runs``, written then renamed), else run now and kept."""
+    from toolchain import aided_chain as ac
+
+    img = ac.chain_image(rec, build_dir / f"{name}_{build}")
+    path = _run_file(rec, name, build, img)
+    if path.exists():
+        with np.load(path) as z:
+            print(f"   chain: {name} ({build}): kept from the run at {z['commit']}", flush=True)
+            return {k: z[k].item() if z[k].ndim == 0 else z[k] for k in z.files}
+    print(f"   chain: {name} ({build}) ...", flush=True)
+    run = ac.run_chain(rec, cmd, build_dir / f"{name}_{build}", image=img)
+    print(f"   chain: {name} ({build}) done: {run.sim_seconds:.0f} s simulated in {run.wall_seconds:.0f} s", flush=True)
+    got: dict[str, Any] = {"q": run.q, "lost": np.asarray(run.lost, np.int64), "once": run.delivered_once(rec.n),
+           "records": run.stats.get("records", 0), "frames": run.frames, "wall": run.wall_seconds,
+           "sim": run.sim_seconds, "commit": _commit()}
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(".part.npz")
+    np.savez(tmp, **got)
+    os.replace(tmp, path)
+    return got
 
 
 def _chain(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path) -> dict[str, Any]:
@@ -58,22 +106,22 @@ def _chain(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path) -> 
     from attitude_c import broad
     from toolchain import aided_chain as ac
 
-    print(f"   chain: {name} ({build}) ...", flush=True)
-    run = ac.run_chain(rec, cmd, build_dir / f"{name}_{build}")
-    q_same = ac.direct(rec, lost=run.lost)  # a lost sample held as attitude-rx holds it (none expected)
-    print(f"   chain: {name} ({build}) done: {run.sim_seconds:.0f} s simulated in {run.wall_seconds:.0f} s", flush=True)
-    return {"chain": broad.errors(run.q, rec.quat, rec.movement).total,
-            "diff": float(np.degrees(np.nanmax(broad.error_angles(run.q, q_same)[0]))),
-            "once": run.delivered_once(rec.n), "lost": len(run.lost), "records": run.stats.get("records", 0),
-            "frames": run.frames, "wall": run.wall_seconds, "sim": run.sim_seconds}
+    run = _chain_run(rec, name, build, cmd, build_dir)
+    lost = [int(i) for i in run["lost"]]
+    q_same = ac.direct(rec, lost=lost)  # a lost sample held as attitude-rx holds it (none expected)
+    return {"chain": broad.errors(run["q"], rec.quat, rec.movement).total,
+            "diff": float(np.degrees(np.nanmax(broad.error_angles(run["q"], q_same)[0]))),
+            "once": bool(run["once"]), "lost": len(lost), "records": int(run["records"]),
+            "frames": int(run["frames"]), "wall": float(run["wall"]), "sim": float(run["sim"]),
+            "commit": str(run["commit"])}
 
 
 def _row(r: dict[str, Any], build: str) -> str:
     c = r[build]
     once = "yes" if c["once"] else f"**no: {c['lost']} lost**"
     return (f"| {r['name']} | {build} | {r['start']:.1f} + {r['seconds']:.1f} | {c['chain']:.3f} | {r['direct']:.3f} | "
-            f"{r['unquantized']:.3f} | {c['diff']:.1e} | {once} ({c['records']}, {c['frames']}) | "
-            f"{c['sim']:.0f} / {c['wall']:.0f} |")
+            f"{r['unquantized']:.3f} | {r['vqf']:.3f} | {c['diff']:.1e} | {once} ({c['records']}, {c['frames']}) | "
+            f"{c['sim']:.0f} / {c['wall']:.0f} | {c['commit']} |")
 
 
 def _selected(trials: str) -> list[Any]:
@@ -109,32 +157,36 @@ def _header(quick: bool, n: int, total: int, budget: str) -> str:
 
 LEGEND = ("BROAD total error (RMS over the movement phase, deg) of: the chain (attitude-rx's lines); the library "
           "filter run directly on the same codes (direct); on the unquantized samples at the same instants "
-          "(unquantized). *max diff*: largest angle between the chain's and the direct filter's attitude over "
+          "(unquantized); VQF (`VQF(period)`, defaults, 9-D, `updateBatch`) on the same codes converted as "
+          "attitude-rx converts them (VQF). *max diff*: largest angle between the chain's and the direct filter's attitude over "
           "all samples (deg; ~1e-6 is arccos's resolution near 0, i.e. equal). *once*: every sample printed "
           "once in order, no loss report, no duplicate (records attitude-rx received, BOOT and CHANNELS "
           "included; link v2 frames, each answered before s51 ran on). *sim / wall*: seconds of simulated "
-          "time and of wall time the s51 run took.")
+          "time and of wall time the s51 run took. *run at*: the commit the s51 run was made at (a run is kept in "
+          "build/bench_chain/runs, named by the firmware image's and the codes' hash, and reused by a later "
+          "invocation; *max diff* is computed again at every table against the library of the table's commit).")
 
 
 def _summary(rows: list[dict[str, Any]]) -> list[str]:
     val = {k: [r["host"]["chain"] if k == "chain" else r[k] for r in rows] for k in COLUMNS}
     once = "all" if all(r[b]["once"] for r in rows for b in ("host", "armv4t") if b in r) else "**not all**"
-    return [(f"| **mean ({len(rows)} trials)** | host | | **{np.mean(val['chain']):.3f}** | {np.mean(val['direct']):.3f} | "
-            f"{np.mean(val['unquantized']):.3f} | {max(r['host']['diff'] for r in rows):.1e} | {once} | |"),
-            (f"| **worst trial** | host | | **{max(val['chain']):.3f}** | {max(val['direct']):.3f} | "
-            f"{max(val['unquantized']):.3f} | | | |")]
+    mean = " | ".join(f"{np.mean(val[k]):.3f}" for k in COLUMNS[1:])
+    worst = " | ".join(f"{max(val[k]):.3f}" for k in COLUMNS[1:])
+    return [(f"| **mean ({len(rows)} trials)** | host | | **{np.mean(val['chain']):.3f}** | {mean} | "
+             f"{max(r['host']['diff'] for r in rows):.1e} | {once} | | |"),
+            f"| **worst trial** | host | | **{max(val['chain']):.3f}** | {worst} | | | | |"]
 
 
 def _runs(picked: list[Any], quick: bool, cmds: dict[str, list[str]], build_dir: Path,
           budget: float) -> list[dict[str, Any]]:
-    """Every trial with the host build, then the first with the ARMv4T build; two at a time
+    """The first trial with the ARMv4T build, then every trial with the host build; two at a time
     (lockstep: a run's figures do not depend on the machine's load). No run starts after
     ``budget`` minutes (0: no limit); the rows are the trials whose host run was made."""
     import threading
     import time
 
     t0, lock, rows = time.monotonic(), threading.Lock(), {}
-    units = [(tr, "host") for tr in picked] + [(picked[0], "armv4t")]
+    units = [(picked[0], "armv4t")] + [(tr, "host") for tr in picked]  # the ARMv4T run first: a budget never drops it
 
     def one(unit: tuple[Any, str]) -> None:
         tr, build = unit
@@ -165,8 +217,8 @@ def run(quick: bool, trials: str = "", budget: str = "") -> str:
     if not rows:
         raise RuntimeError("no trial ran within the budget")
     lines = [_header(quick, len(rows), len(list(broad.iter_trials())), budget), "", LEGEND, "",
-             ("| trial | attitude-rx | from + s | chain | direct | unquantized | max diff | once (records, frames) "
-             "| sim / wall s |"), "|---|---|---:|---:|---:|---:|---:|---|---:|"]
+             ("| trial | attitude-rx | from + s | chain | direct | unquantized | VQF | max diff | once (records, frames) "
+             "| sim / wall s | run at |"), "|---|---|---:|---:|---:|---:|---:|---:|---|---:|---|"]
     lines += [_row(r, b) for r in rows for b in ("host", "armv4t") if b in r]
     lines += _summary(rows)
     lines += ["", "Codes clipped (values at a channel's limit, these trials): " + ", ".join(

@@ -163,14 +163,20 @@ def _valid(enc: bytes, *, ack: bool) -> bool:
             and v2.crc32c(f[:-4]) == int.from_bytes(f[-4:], "big"))
 
 
+def chain_image(rec: BoardRecording, build_dir: Path, config: tool.Config = tool.AIDED) -> tool.Image:
+    """The data-driven sim image that serves ``rec`` (stops after its records are acknowledged)."""
+    return tool.build(build_dir, config, kind="sim", sim_samples=tool.data_records(config, rec.n), data=True,
+                      name="fw_chain")
+
+
 def run_chain(rec: BoardRecording, rx_cmd: Sequence[str], build_dir: Path, *,
               config: tool.Config = tool.AIDED, timeout: float | None = None,
-              late: tuple[float, float] | None = None) -> ChainRun:
+              late: tuple[float, float] | None = None, image: tool.Image | None = None) -> ChainRun:
     """The recording through firmware (s51, in lockstep with the receiver: :class:`Relay`),
-    link v2, pty and attitude-rx (``rx_cmd``). ``late``: see :class:`Relay`."""
+    link v2, pty and attitude-rx (``rx_cmd``). ``late``: see :class:`Relay`. ``image``: the
+    firmware image :func:`chain_image` built (default: built here)."""
     n = rec.n
-    img = tool.build(build_dir, config, kind="sim", sim_samples=tool.data_records(config, n), data=True,
-                     name="fw_chain")
+    img = image or chain_image(rec, build_dir, config)
     timeout = timeout if timeout is not None else 40.0 * n * config.period_s + 120.0
     with tempfile.TemporaryDirectory(prefix="chain_") as tmp:
         data, conf = Path(tmp) / "codes.bin", Path(tmp) / "rx.conf"
