@@ -617,19 +617,19 @@
       const bmin = new Float64Array(cols).fill(NaN), bmax = new Float64Array(cols).fill(NaN);
       const bval = new Float64Array(cols).fill(NaN), bt = new Float64Array(cols).fill(NaN);
       const brk = new Uint8Array(cols);
-      let prevT = null;
+      let prevT = null, hole = false;
       for (let i = first; i < last; i++) {
         const p = pts[i];
         const v = p[tr.c];
-        if (v == null) { prevT = null; continue; }
+        if (v == null) { prevT = null; hole = true; continue; } // no value (no valid GNSS fix): the line breaks
         const x = Math.min(cols - 1, Math.max(0, Math.floor((p[0] - t0) / span * pw)));
         const a = tr.lo != null && p[tr.lo] != null ? p[tr.lo] : v, b = tr.hi != null && p[tr.hi] != null ? p[tr.hi] : v;
         if (tr.wrap && Math.abs(v - bval[x]) > tr.wrap) { bmin[x] = NaN; bmax[x] = NaN; } // wrapped in this column: its envelope restarts
         if (!(bmin[x] <= a)) bmin[x] = a;
         if (!(bmax[x] >= b)) bmax[x] = b;
         bval[x] = v; bt[x] = p[0];
-        if (prevT !== null && p[0] - prevT > gap) brk[x] = 1;
-        prevT = p[0];
+        if (hole || (prevT !== null && p[0] - prevT > gap)) brk[x] = 1;
+        prevT = p[0]; hole = false;
       }
       ctx.strokeStyle = tr.color;
       if (tr.lo != null) { // the envelope
