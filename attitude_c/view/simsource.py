@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import InvalidArgument
 from ..sim.gnss_model import FIX_DTYPE
 from ..sim.options import add_arguments, from_namespace
-from .sources import Item, Source, _filter_counters, pace
+from .sources import Item, Source, _filter_counters, gnss_fix_names, pace
 from .stream import Hub, row
 
 __all__ = ["SimulatorSource", "gnss_object", "parse_simulate_options"]
@@ -126,20 +126,15 @@ class SimulatorSource(Source):
                 f += 1
 
 
-#: The simulated receiver's fix types (:data:`attitude_c.sim.gnss_model.FIX_DTYPE`: UBX NAV-PVT's
-#: 0 no fix, 2 2-D, 3 3-D) as attitude-rx's JSON Lines name them.
-_FIX_NAMES = {0: "none", 1: "dr", 2: "2d", 3: "3d", 4: "gnss_dr", 5: "time"}
-
-
 def gnss_object(fix: Any, t: float) -> dict[str, Any]:
     """One simulated fix (a :data:`FIX_DTYPE` row) as attitude-rx's ``"gnss"`` object on a line at
     time ``t`` (``age_s``: t minus the fix's time of measurement; ``source`` "sim")."""
     def real(x: Any) -> float | None:
         return float(x) if math.isfinite(x) else None
 
-    ftype = int(fix["fix_type"])
+    ftype = int(fix["fix_type"])  # FIX_DTYPE's codes are NAV-PVT's, as att_gnss_fix_type
     up = real(-fix["vd"]) if ftype == 3 else None  # a 2-D fix reports vd = 0: not a measurement
-    return {"fix": _FIX_NAMES.get(ftype, "none"), "valid": ftype in (2, 3), "speed": real(fix["speed"]),
+    return {"fix": gnss_fix_names()[ftype], "valid": ftype in (2, 3), "speed": real(fix["speed"]),
             "track_deg": real(fix["track"]), "vel_enu": [real(fix["ve"]), real(fix["vn"]), up],
             "sats": int(fix["nsat"]), "pdop": real(fix["pdop"]), "age_s": max(0.0, t - float(fix["t_measured"])),
             "source": "sim"}

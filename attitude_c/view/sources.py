@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import functools
 import io
 import json
 import math
@@ -34,8 +35,8 @@ from ..errors import AttitudeError, InvalidArgument
 from .estimators import AUTO, Estimator, choose, make_estimator
 from .stream import GNSS_EVENT, Hub, row
 
-__all__ = ["GNSS_FIXES", "BlockPipeline", "LineReader", "ReplaySource", "SerialSource", "Source", "StdinSource",
-           "gnss_fix", "load_recording", "pace"]
+__all__ = ["BlockPipeline", "LineReader", "ReplaySource", "SerialSource", "Source", "StdinSource",
+           "gnss_fix", "gnss_fix_names", "load_recording", "pace"]
 
 _RAD = math.pi / 180.0
 
@@ -158,8 +159,16 @@ def _flag_names(bits: int) -> list[str]:
             if k.startswith(pre) and bits & v]
 
 
-#: The fix types of attitude-rx's ``"gnss"`` objects (docs/view.md; issue 30's JSON Lines contract).
-GNSS_FIXES = ("none", "dr", "2d", "3d", "gnss_dr", "time")
+@functools.cache
+def gnss_fix_names() -> dict[int, str]:
+    """The fix types (``att_gnss_fix_type``, attitude/gnss.h: UBX NAV-PVT's fixType) by code, as
+    attitude-rx's ``"gnss"`` objects name them: the lower-case suffix of ``ATT_GNSS_FIX_*``."""
+    from ..names import C
+
+    pre = "ATT_GNSS_FIX_"
+    return {v: k[len(pre):].lower() for k, v in sorted(C.items(), key=lambda kv: kv[1]) if k.startswith(pre)}
+
+
 #: The longest ``source`` name a ``"gnss"`` object may carry (characters).
 GNSS_SOURCE_MAX = 32
 
@@ -174,17 +183,18 @@ def _real(x: Any, name: str, lo: float = -math.inf, hi: float = math.inf) -> flo
 
 
 def gnss_fix(d: Any) -> dict[str, Any]:
-    """attitude-rx's ``"gnss"`` object, checked: ``fix`` (one of :data:`GNSS_FIXES`) and ``valid``
+    """attitude-rx's ``"gnss"`` object, checked: ``fix`` (a name of :func:`gnss_fix_names`) and ``valid``
     (true/false) required; ``speed`` (m/s, >= 0), ``track_deg`` ([0, 360]), ``vel_enu`` (3 numbers
     or nulls: m/s), ``sats`` (an integer >= 0), ``pdop`` (>= 0), ``age_s`` (>= 0) and ``source`` (a
-    short name) null or absent when unknown; other keys are ignored. Raises ValueError naming the
-    field."""
+    short name) null or absent when unknown; other keys are ignored. Raises ValueError (TypeError
+    for an object that is not one, or a ``valid`` that is not a bool) naming the field."""
     if not isinstance(d, dict):
-        raise ValueError("gnss must be a JSON object")
-    if d.get("fix") not in GNSS_FIXES:
-        raise ValueError(f"gnss fix {d.get('fix')!r}: must be one of {', '.join(GNSS_FIXES)}")
+        raise TypeError("gnss must be a JSON object")
+    fixes = gnss_fix_names().values()
+    if d.get("fix") not in fixes:
+        raise ValueError(f"gnss fix {d.get('fix')!r}: must be one of {', '.join(fixes)}")
     if not isinstance(d.get("valid"), bool):
-        raise ValueError(f"gnss valid {d.get('valid')!r}: must be true or false")
+        raise TypeError(f"gnss valid {d.get('valid')!r}: must be true or false")
     vel = d.get("vel_enu")
     if vel is not None and not (isinstance(vel, list) and len(vel) == 3):
         raise ValueError(f"gnss vel_enu {vel!r}: must be null or a list of 3 numbers (null where unknown)")
