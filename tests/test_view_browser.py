@@ -433,3 +433,40 @@ def test_filter_bias_and_flags_from_attitude_rx(browser) -> None:
     finally:
         page.close()
         v.kill()
+
+
+def test_gnss_panel_shows_speed_track_and_fix(browser) -> None:
+    """attitude-rx's lines with "gnss" objects (issue 30) on stdin: the GNSS panel, hidden before the
+    first fix, shows the newest fix's ground speed, track, fix type, satellites, PDOP and the filter's
+    GNSS flag, and the ground-speed chart has points."""
+    v = _view("--port", "0", "--stdin", "--display-rate", "20", stdin=subprocess.PIPE)
+    page = browser.new_page()
+    try:
+        page.goto(v.url)
+        page.wait_for_selector("body[data-state=waiting]", timeout=20_000)
+        assert page.is_hidden("#gnss-panel")
+        for k in range(40):  # a fix every tenth line, speed 20.0 + k/10 m/s; the last fix rejected
+            line = {"t": 0.02 * (k + 1), "n": k, "q": [1, 0, 0, 0], "held": 0, "bias_dps": [0, 0, 0],
+                    "flags": ["gnss_aided"] if k < 39 else ["gnss_aided", "gnss_rejected"]}
+            if k % 10 == 9:
+                line["gnss"] = {"fix": "3d", "valid": True, "speed": 20.0 + k / 10, "track_deg": 45.25,
+                                "vel_enu": [14.9, 14.9, None], "sats": 9, "pdop": 1.85, "age_s": 0.1,
+                                "source": "gpsd"}
+            v.proc.stdin.write((json.dumps(line) + "\n").encode())
+        v.proc.stdin.flush()
+        _wait_text(page, "gnss-count", "4")
+        _wait_text(page, "gnss-aiding", "aided · fix rejected")
+        assert page.is_visible("#gnss-panel")
+        assert page.text_content("#gnss-speed") == "23.90 m/s (86.0 km/h)"
+        assert page.text_content("#gnss-track") == "45.3°"  # 45.25 to one decimal (toFixed rounds up here)
+        assert page.text_content("#gnss-fix") == "3D, valid"
+        assert page.text_content("#gnss-sats") == "9"
+        assert page.text_content("#gnss-pdop") == "1.9"
+        assert page.text_content("#gnss-age") == "0.10 s"  # the last fix came on the last line
+        assert page.text_content("#gnss-source") == "gpsd"
+        page.wait_for_function("() => Number(document.getElementById('chart-gnss-speed').dataset.points) > 0",
+                               timeout=5_000)
+        _shot(page, "view-gnss-panel")
+    finally:
+        page.close()
+        v.kill()

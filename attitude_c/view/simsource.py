@@ -10,6 +10,8 @@ whole run is simulated first (in the source's thread; the page shows the
 progress), then played at ``speed`` times real time: one display sample per
 attitude update, with the simulator's truth beside the estimate and the
 body rate of the update's last gyro sample (its increment over the period).
+A run with a GNSS receiver (``--gnss PRESET``) carries its fixes as attitude-rx
+does: the newest fix delivered, on the first sample after its delivery.
 """
 
 from __future__ import annotations
@@ -23,11 +25,12 @@ from typing import Any
 import numpy as np
 
 from ..errors import InvalidArgument
+from ..sim.gnss_model import FIX_DTYPE
 from ..sim.options import add_arguments, from_namespace
-from .sources import Item, Source, _filter_counters, pace
+from .sources import Item, Source, _filter_counters, gnss_fix_names, pace
 from .stream import Hub, row
 
-__all__ = ["SimulatorSource", "parse_simulate_options"]
+__all__ = ["SimulatorSource", "gnss_object", "parse_simulate_options"]
 
 #: attitude simulate's options that write files or run a budget: not what a display does.
 _NOT_HERE = ("--budget", "--methods", "--budget-ber", "--out", "--no-plots", "--json")
@@ -106,7 +109,9 @@ class SimulatorSource(Source):
         j = np.clip(np.searchsorted(res.sample_index, ns), 0, max(len(res.sample_index) - 1, 0))
         rates = res.increments[j] / h if len(res.increments) else np.full((len(ns), 3), np.nan)
         bias_t = res.bias_t if res.bias_t is not None else np.zeros(0)
-        b = 0
+        fixes = self.cfg.gnss.fixes(self.cfg.trajectory, self.cfg.duration, self.cfg.seed) \
+            if self.cfg.gnss is not None else np.zeros(0, dtype=FIX_DTYPE)
+        b = f = 0
         for k in range(len(res.t)):
             t = float(res.t[k])
             while b < len(bias_t) and bias_t[b] <= t:  # the filter's gyro-bias estimate, as attitude-rx's
@@ -114,6 +119,25 @@ class SimulatorSource(Source):
                 b += 1
             yield (t, "sample", row(t, res.q_est[k], n=int(ns[k]), rate=rates[k], q_true=res.q_true[k],
                                     euler=res.euler_est[k]))
+            if f < len(fixes) and fixes["t_delivered"][f] <= t:  # as attitude-rx: the newest fix delivered,
+                while f + 1 < len(fixes) and fixes["t_delivered"][f + 1] <= t:  # on the first line after it
+                    f += 1
+                yield (t, "gnss", gnss_object(fixes[f], t))
+                f += 1
+
+
+def gnss_object(fix: Any, t: float) -> dict[str, Any]:
+    """One simulated fix (a :data:`FIX_DTYPE` row) as attitude-rx's ``"gnss"`` object on a line at
+    time ``t`` (``age_s``: t minus the fix's time of measurement; ``source`` "sim")."""
+    def real(x: Any) -> float | None:
+        return float(x) if math.isfinite(x) else None
+
+    ftype = int(fix["fix_type"])  # FIX_DTYPE's codes are NAV-PVT's, as att_gnss_fix_type
+    up = real(-fix["vd"]) if ftype == 3 else None  # a 2-D fix reports vd = 0: not a measurement
+    return {"fix": gnss_fix_names()[ftype], "valid": ftype in (2, 3), "speed": real(fix["speed"]),
+            "track_deg": real(fix["track"]), "vel_enu": [real(fix["ve"]), real(fix["vn"]), up],
+            "sats": int(fix["nsat"]), "pdop": real(fix["pdop"]), "age_s": max(0.0, t - float(fix["t_measured"])),
+            "source": "sim"}
 
 
 def _link_counters(stats: dict[str, Any]) -> dict[str, Any]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import functools
 import io
 import json
 import math
@@ -32,10 +33,10 @@ from numpy.typing import NDArray
 from .. import _text
 from ..errors import AttitudeError, InvalidArgument
 from .estimators import AUTO, Estimator, choose, make_estimator
-from .stream import Hub, row
+from .stream import GNSS_EVENT, Hub, row
 
 __all__ = ["BlockPipeline", "LineReader", "ReplaySource", "SerialSource", "Source", "StdinSource",
-           "load_recording", "pace"]
+           "gnss_fix", "gnss_fix_names", "load_recording", "pace"]
 
 _RAD = math.pi / 180.0
 
@@ -112,12 +113,13 @@ Sample = tuple  # a row of attitude_c.view.COLUMNS
 class Parsed:
     """One line, understood: a sample row, an event, counters, or nothing."""
 
-    kind: Literal["sample", "event", "counters", "skip"]
+    kind: Literal["sample", "event", "counters", "gnss", "skip"]
     t: float = float("nan")
     sample: Sample | None = None
     event: str = ""
     detail: dict[str, Any] | None = None
     counters: dict[str, Any] | None = None
+    gnss: dict[str, Any] | None = None  #: a GNSS fix (:func:`gnss_fix`) the line carries
 
 
 _SKIP = Parsed("skip")
@@ -155,6 +157,59 @@ def _flag_names(bits: int) -> list[str]:
     pre = "ATT_AHRS_F_"
     return [k[len(pre):].lower() for k, v in sorted(C.items(), key=lambda kv: kv[1])
             if k.startswith(pre) and bits & v]
+
+
+@functools.cache
+def gnss_fix_names() -> dict[int, str]:
+    """The fix types (``att_gnss_fix_type``, attitude/gnss.h: UBX NAV-PVT's fixType) by code, as
+    attitude-rx's ``"gnss"`` objects name them: the lower-case suffix of ``ATT_GNSS_FIX_*``."""
+    from ..names import C
+
+    pre = "ATT_GNSS_FIX_"
+    return {v: k[len(pre):].lower() for k, v in sorted(C.items(), key=lambda kv: kv[1]) if k.startswith(pre)}
+
+
+#: The longest ``source`` name a ``"gnss"`` object may carry (characters).
+GNSS_SOURCE_MAX = 32
+
+
+def _real(x: Any, name: str, lo: float = -math.inf, hi: float = math.inf) -> float | None:
+    """A JSON number in [lo, hi], or None for null (a bool is not a number)."""
+    if x is None:
+        return None
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not (math.isfinite(x) and lo <= x <= hi):
+        raise ValueError(f"gnss {name} {x!r}: must be null or a finite number in [{lo:g}, {hi:g}]")
+    return float(x)
+
+
+def gnss_fix(d: Any) -> dict[str, Any]:
+    """attitude-rx's ``"gnss"`` object, checked: ``fix`` (a name of :func:`gnss_fix_names`) and ``valid``
+    (true/false) required; ``speed`` (m/s, >= 0), ``track_deg`` ([0, 360]), ``vel_enu`` (3 numbers
+    or nulls: m/s), ``sats`` (an integer >= 0), ``pdop`` (>= 0), ``age_s`` (>= 0) and ``source`` (a
+    short name) null or absent when unknown; other keys are ignored. Raises ValueError (TypeError
+    for an object that is not one, or a ``valid`` that is not a bool) naming the field."""
+    if not isinstance(d, dict):
+        raise TypeError("gnss must be a JSON object")
+    fixes = gnss_fix_names().values()
+    if d.get("fix") not in fixes:
+        raise ValueError(f"gnss fix {d.get('fix')!r}: must be one of {', '.join(fixes)}")
+    if not isinstance(d.get("valid"), bool):
+        raise TypeError(f"gnss valid {d.get('valid')!r}: must be true or false")
+    vel = d.get("vel_enu")
+    if vel is not None and not (isinstance(vel, list) and len(vel) == 3):
+        raise ValueError(f"gnss vel_enu {vel!r}: must be null or a list of 3 numbers (null where unknown)")
+    sats = d.get("sats")
+    if sats is not None and (isinstance(sats, bool) or not isinstance(sats, int) or not 0 <= sats <= 255):
+        raise ValueError(f"gnss sats {sats!r}: must be null or an integer in [0, 255]")
+    src = d.get("source")
+    if src is not None and not (isinstance(src, str) and 0 < len(src) <= GNSS_SOURCE_MAX):
+        raise ValueError(f"gnss source {_text.clip(repr(src), 40)}: must be null or a name of at most "
+                         f"{GNSS_SOURCE_MAX} characters")
+    return {"fix": d["fix"], "valid": d["valid"], "speed": _real(d.get("speed"), "speed", 0.0),
+            "track_deg": _real(d.get("track_deg"), "track_deg", 0.0, 360.0),
+            "vel_enu": None if vel is None else [_real(v, "vel_enu") for v in vel], "sats": sats,
+            "pdop": _real(d.get("pdop"), "pdop", 0.0), "age_s": _real(d.get("age_s"), "age_s", 0.0, MAX_TIME_S),
+            "source": src}
 
 
 def _vec(d: dict[str, Any], key: str, k: int, scale: float = 1.0) -> list[float] | None:
@@ -218,7 +273,7 @@ class LineReader:
             n = d.get("n")
             smp = row(t, q, n=None if n is None else float(n), rate=_vec(d, "rate_dps", 3, _RAD),
                       q_true=_vec(d, "true_q", 4), euler=eul, heading=None if h is None else float(h) * _RAD)
-            p = Parsed("sample", t, sample=smp)
+            p = Parsed("sample", t, sample=smp, gnss=gnss_fix(d["gnss"]) if d.get("gnss") is not None else None)
             counters = {"held": d["held"]} if "held" in d else {}
             counters.update(_filter_counters(_vec(d, "bias_dps", 3), d.get("flags")))
             p.counters = counters or None
@@ -254,6 +309,8 @@ class LineReader:
         if ev is not None and cols[ev] < len(fields) and fields[cols[ev]].strip():
             det = fields[cols[r["detail"]]].strip() if r.get("detail") and cols[r["detail"]] < len(fields) else ""
             detail = json.loads(det) if det else {}
+            if fields[cols[ev]].strip() == GNSS_EVENT:  # a fix the view recorded (attitude_c.view.stream)
+                return Parsed("gnss", t, gnss=gnss_fix(detail))
             return Parsed("event", t, event=fields[cols[ev]].strip(), detail=detail)
         q = [num(c) for c in r["q"]] if r.get("q") else None
         eul = None
@@ -309,6 +366,10 @@ def _apply(p: Parsed, hub: Hub, src: Source) -> None:
         hub.samples([p.sample])
         if p.counters:
             src.set_counts(p.counters)
+        if p.gnss is not None:
+            hub.gnss(p.t, p.gnss)
+    elif p.kind == "gnss" and p.gnss is not None:
+        hub.gnss(p.t, p.gnss)
     elif p.kind == "event":
         hub.event(p.t, p.event, p.detail)
     elif p.kind == "counters" and p.counters:
@@ -425,7 +486,7 @@ class StdinSource(Source):
 # ---------------------------------------------------------------------------------------
 
 #: An item of a replay: (source time, what, payload) -- a sample row, an
-#: event (kind, detail) or counters.
+#: event (kind, detail), a GNSS fix (:func:`gnss_fix`'s dict) or counters.
 Item = tuple[float, str, Any]
 
 
@@ -470,6 +531,8 @@ def pace(hub: Hub, items: Iterable[Item], speed: float, stop: threading.Event,
             batch = []
         if what == "event":
             hub.event(t, payload[0], payload[1])
+        elif what == "gnss":
+            hub.gnss(t, payload)
         elif what == "counters" and on_counters is not None:
             on_counters(payload)
     if batch:
@@ -521,6 +584,8 @@ def _line_items(path: Path, on_bad: Callable[[int, str], None]) -> Iterator[Item
                 yield t, "event", (x.event, x.detail)
             elif x.kind == "counters" and x.counters:
                 yield t, "counters", x.counters
+            if x.gnss is not None:  # a sample's fix, after it; or a recorded fix
+                yield t, "gnss", x.gnss
             last_t = t
 
 

@@ -48,7 +48,7 @@ from numpy.typing import ArrayLike, NDArray
 from .. import core
 from ..errors import InvalidArgument
 
-__all__ = ["CHART_COLUMNS", "COLUMNS", "CSV_HEADER", "Client", "Hub", "Recorder", "SourceState", "row"]
+__all__ = ["CHART_COLUMNS", "COLUMNS", "CSV_HEADER", "GNSS_EVENT", "Client", "Hub", "Recorder", "SourceState", "row"]
 
 #: One sample as sources hand it over: time (s, the source's clock), sample
 #: number (NaN if the source has none), attitude quaternion (scalar first,
@@ -70,12 +70,19 @@ CSV_HEADER: tuple[str, ...] = (
 
 #: A chart point (one per display frame with data): display time, then for
 #: yaw, pitch, roll (deg) and rate x, y, z (deg/s) the newest value and the
-#: min and max over the frame's samples, then the truth's yaw, pitch, roll and
-#: the heading and true heading (deg).
+#: min and max over the frame's samples, then the truth's yaw, pitch, roll,
+#: the heading and true heading (deg), and the ground speed of the newest GNSS
+#: fix (m/s; null without a valid fix with a speed).
 CHART_COLUMNS: tuple[str, ...] = (
     "t", "yaw", "yaw_min", "yaw_max", "pitch", "pitch_min", "pitch_max", "roll", "roll_min", "roll_max",
     "rate_x", "rate_x_min", "rate_x_max", "rate_y", "rate_y_min", "rate_y_max",
-    "rate_z", "rate_z_min", "rate_z_max", "true_yaw", "true_pitch", "true_roll", "heading", "true_heading")
+    "rate_z", "rate_z_min", "rate_z_max", "true_yaw", "true_pitch", "true_roll", "heading", "true_heading",
+    "gnss_speed")
+
+#: The recording's event kind of a GNSS fix (its ``detail``: the fix as
+#: :func:`attitude_c.view.sources.gnss_fix` checked it); not a report: not listed
+#: among the events nor counted.
+GNSS_EVENT = "gnss"
 
 #: What a source says of itself: getting ready, delivering, finished (a
 #: replay or a simulation that ran to its end), or gone (EOF, port failure).
@@ -135,6 +142,10 @@ def _good_quat(q: NDArray[np.float64]) -> NDArray[np.bool_]:
 
 def _wrap_deg(x: NDArray[np.float64]) -> NDArray[np.float64]:
     return (x + 180.0) % 360.0 - 180.0
+
+
+def _is_real(x: Any) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
 def _num(x: float, nd: int = 3) -> float | None:
@@ -454,6 +465,8 @@ class Hub:
         self._last_status: str = ""
         self._last_status_wall = -math.inf
         self._last_counters: str = ""
+        self._gnss: dict[str, Any] | None = None  # the newest GNSS fix, with its time and the count so far
+        self.gnss_fixes = 0
 
     # ---- source side (any thread) -------------------------------------------------
 
@@ -469,6 +482,11 @@ class Hub:
         can carry it (:func:`json_safe`: NaN and infinities as null, at most
         :data:`DETAIL_MAX` bytes)."""
         self._intake.append(("e", _Event(float(t), str(kind)[:64], json_safe(dict(detail or {})))))
+
+    def gnss(self, t: float, fix: dict[str, Any]) -> None:
+        """Queue a GNSS fix at source time ``t`` (the dict of
+        :func:`attitude_c.view.sources.gnss_fix`). Never blocks."""
+        self._intake.append(("g", _Event(float(t), GNSS_EVENT, json_safe(dict(fix)))))
 
     def status(self, state: SourceState, text: str = "") -> None:
         """The source's own condition (see :data:`SourceState`)."""
@@ -533,6 +551,7 @@ class Hub:
         batches: list[_Processed] = []
         new_events: list[dict[str, Any]] = []
         pending: list[NDArray[np.float64]] = []
+        gnss_new = False
 
         def flush_samples() -> None:
             if pending:
@@ -553,6 +572,12 @@ class Hub:
                 new_events.append(ev)
                 if x.kind != _NOTE:
                     self.event_counts[x.kind] = self.event_counts.get(x.kind, 0) + 1
+            elif kind == "g":
+                flush_samples()
+                items.append(x)  # recorded, in order; shown in the GNSS panel, not among the events
+                self.gnss_fixes += 1
+                self._gnss = {"t": _num(x.t, 6), **x.detail, "count": self.gnss_fixes}
+                gnss_new = True
             else:
                 self._source_state, self._source_text = x
         flush_samples()
@@ -582,7 +607,7 @@ class Hub:
         counters = self.counters()
         ctext = json.dumps(counters, sort_keys=True)
         status_key = f"{state}|{text}"
-        if point is None and not new_events and status_key == self._last_status \
+        if point is None and not new_events and not gnss_new and status_key == self._last_status \
                 and ctext == self._last_counters and now - self._last_status_wall < 0.5:
             return None  # nothing new: a status frame at most twice a second
         self._last_status, self._last_counters, self._last_status_wall = status_key, ctext, now
@@ -597,6 +622,8 @@ class Hub:
             frame["count"] = k
         if new_events:
             frame["events"] = new_events
+        if gnss_new:
+            frame["gnss"] = self._gnss
         msg = json.dumps(frame, separators=(",", ":"), allow_nan=False)
         for c in list(self.clients):
             before = c.dropped
@@ -623,6 +650,8 @@ class Hub:
                     _num(float(v[fin].max())) if fin.any() else None]
         out += [_num(x * _DEG) for x in te[-1]]
         out += [_num(a[-1, _HEAD] * _DEG), _num(th[-1] * _DEG)]
+        g = self._gnss
+        out.append(g["speed"] if g is not None and g.get("valid") is True and _is_real(g.get("speed")) else None)
         return out
 
     @staticmethod
@@ -682,7 +711,7 @@ class Hub:
         state, text = self.state()
         msg = {"type": "hello", "session": self.session, "seq": self.seq, "source": self.description,
                "display_rate": self.display_rate, "history_s": self.history_s, "columns": list(CHART_COLUMNS),
-               "events": list(self.events), "last": self._last, "history_points": len(self.history),
+               "events": list(self.events), "last": self._last, "gnss": self._gnss, "history_points": len(self.history),
                "state": state, "text": text, "counters": self.counters(), "hub": self._hub_counters()}
         return json.dumps(msg, separators=(",", ":"), allow_nan=False)
 

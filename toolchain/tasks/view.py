@@ -410,16 +410,23 @@ def view_firmware(c, samples=3000, port=8765, period_ticks=72):
     "out": "PNG to write (default docs/img/view.png)",
     "seconds": "seconds of playback before the picture (default 12)",
 })
-def view_screenshot(c, out="", seconds=12.0):
-    """The screenshot of docs/view.md: the simulator at 200 samples/s with bit errors on the link."""
+def view_screenshot(c, out="", seconds=12.0, gnss=False):
+    """The screenshot of docs/view.md: the simulator at 200 samples/s with bit errors on the link; with
+    --gnss, the GNSS panel (docs/img/view-gnss.png) after a simulated car drive with a NEO-M8N receiver
+    and a 4 s outage in the roundabout, played at 2x to its end."""
     if (why := browser_missing()) is not None:
         print(f"view-screenshot: {why}", file=sys.stderr)
         raise SystemExit(1)
     from playwright.sync_api import sync_playwright
 
-    path = Path(out) if out else ROOT / "docs" / "img" / "view.png"
-    v = ViewProcess("--port", "0", "--simulate", "--duration", "60", "--period", "0.005", "--method", "rv3-reuse",
-                    "--ber", "1e-3", "--calibration", "5")
+    path = Path(out) if out else ROOT / "docs" / "img" / ("view-gnss.png" if gnss else "view.png")
+    if gnss:
+        v = ViewProcess("--port", "0", "--speed", "2", "--simulate", "--trajectory", "car", "--duration", "40",
+                        "--period", "0.01", "--method", "rv3-reuse", "--calibration", "5", "--gnss", "neo-m8n",
+                        "--gnss-outage", "20,24")
+    else:
+        v = ViewProcess("--port", "0", "--simulate", "--duration", "60", "--period", "0.005", "--method",
+                        "rv3-reuse", "--ber", "1e-3", "--calibration", "5")
     try:
         with sync_playwright() as pw:
             browser = launch_chromium(pw)
@@ -427,9 +434,14 @@ def view_screenshot(c, out="", seconds=12.0):
                 page = browser.new_page(viewport={"width": 1280, "height": 860})
                 page.goto(v.url)
                 page.wait_for_selector("body[data-state=live]", timeout=300_000)
-                page.select_option("#window", "10")
-                page.wait_for_timeout(float(seconds) * 1000)
-                page.screenshot(path=str(path), full_page=True)
+                page.select_option("#window", "60" if gnss else "10")
+                if gnss:
+                    page.wait_for_selector("body[data-state=ended]", timeout=300_000)
+                    page.wait_for_timeout(1000)  # the status frames after the end have been drawn
+                    page.locator("#gnss-panel").screenshot(path=str(path))
+                else:
+                    page.wait_for_timeout(float(seconds) * 1000)
+                    page.screenshot(path=str(path), full_page=True)
             finally:
                 browser.close()
         v.stop()

@@ -19,7 +19,7 @@
 
   const S = {
     conn: "connecting", state: "waiting", text: "", source: "", session: null,
-    col: {}, points: [], last: null, counters: {}, hub: {}, events: [],
+    col: {}, points: [], last: null, gnss: null, counters: {}, hub: {}, events: [],
     historyS: 600, displayRate: 25, seq: 0, missedFrames: 0,
     paused: false, frozen: null, windowS: 30, rate: {},
     dirty: true, retryMs: 500, ws: null,
@@ -86,6 +86,7 @@
     (m.columns || []).forEach((name, i) => { S.col[name] = i; });
     S.points = (m.history || []).slice();
     S.last = m.last || null;
+    S.gnss = m.gnss || null;
     S.events = (m.events || []).slice(-200);
     S.counters = m.counters || {};
     S.hub = m.hub || {};
@@ -122,6 +123,7 @@
     S.rate = m.rate || {};
     if (m.counters) S.counters = m.counters;
     if (m.hub) S.hub = m.hub;
+    if (m.gnss) S.gnss = m.gnss;
     if (m.point) {
       S.points.push(m.point);
       S.last = m.last;
@@ -261,7 +263,7 @@
   // ---- controls ---------------------------------------------------------------------
   function freeze() {
     const pts = S.points;
-    S.frozen = { last: S.last, tEnd: pts.length ? pts[pts.length - 1][0] : 0 };
+    S.frozen = { last: S.last, gnss: S.gnss, tEnd: pts.length ? pts[pts.length - 1][0] : 0 };
   }
 
   function setPaused(p) {
@@ -294,7 +296,7 @@
   document.addEventListener("keydown", (e) => {
     if (e.code === "Space" && e.target === document.body) { e.preventDefault(); setPaused(!S.paused); }
   });
-  for (const id of ["chart-angles", "chart-rates"]) {
+  for (const id of ["chart-angles", "chart-rates", "chart-gnss-speed"]) {
     $(id).addEventListener("wheel", (e) => {
       e.preventDefault();
       setWindow(S.windowS * (e.deltaY > 0 ? 1.25 : 0.8));
@@ -615,19 +617,19 @@
       const bmin = new Float64Array(cols).fill(NaN), bmax = new Float64Array(cols).fill(NaN);
       const bval = new Float64Array(cols).fill(NaN), bt = new Float64Array(cols).fill(NaN);
       const brk = new Uint8Array(cols);
-      let prevT = null;
+      let prevT = null, hole = false;
       for (let i = first; i < last; i++) {
         const p = pts[i];
         const v = p[tr.c];
-        if (v == null) { prevT = null; continue; }
+        if (v == null) { prevT = null; hole = true; continue; } // no value (no valid GNSS fix): the line breaks
         const x = Math.min(cols - 1, Math.max(0, Math.floor((p[0] - t0) / span * pw)));
         const a = tr.lo != null && p[tr.lo] != null ? p[tr.lo] : v, b = tr.hi != null && p[tr.hi] != null ? p[tr.hi] : v;
         if (tr.wrap && Math.abs(v - bval[x]) > tr.wrap) { bmin[x] = NaN; bmax[x] = NaN; } // wrapped in this column: its envelope restarts
         if (!(bmin[x] <= a)) bmin[x] = a;
         if (!(bmax[x] >= b)) bmax[x] = b;
         bval[x] = v; bt[x] = p[0];
-        if (prevT !== null && p[0] - prevT > gap) brk[x] = 1;
-        prevT = p[0];
+        if (hole || (prevT !== null && p[0] - prevT > gap)) brk[x] = 1;
+        prevT = p[0]; hole = false;
       }
       ctx.strokeStyle = tr.color;
       if (tr.lo != null) { // the envelope
@@ -675,6 +677,53 @@
     setText("est-n", last && last.n != null ? "sample " + last.n : "");
   }
 
+  // ---- GNSS: the newest fix attitude-rx reported, and the filter's GNSS flags ------------
+  const FIX_WORDS = { none: "no fix", dr: "dead reckoning", "2d": "2D", "3d": "3D", gnss_dr: "3D + dead reckoning",
+                      time: "time only" };
+
+  function num(v, d, unit) { return v == null || !isFinite(v) ? "—" : fixed(v, d) + unit; }
+
+  function setQuality(id, q) { const el = $(id); if (el.dataset.quality !== q) el.dataset.quality = q; }
+
+  // the fix's age now: its age on its line plus the source time since that line
+  function gnssAge(g, last) {
+    if (g.age_s == null) return null;
+    const since = last && last.t != null && g.t != null ? last.t - g.t : 0;
+    return g.age_s + Math.max(0, since);
+  }
+
+  // the filter's GNSS flags, from attitude-rx's flags of the newest sample (--estimator ahrs)
+  function gnssAiding() {
+    const f = S.counters.filter_flags;
+    if (typeof f !== "string") return ["—", ""];
+    const names = f.split(" ");
+    const aided = names.includes("gnss_aided"), rejected = names.includes("gnss_rejected");
+    if (aided && rejected) return ["aided · fix rejected", "bad"];
+    if (aided) return ["aided", "ok"];
+    if (rejected) return ["fix rejected", "bad"];
+    return ["not aided", ""];
+  }
+
+  function renderGnss(g, last) {
+    const panel = $("gnss-panel");
+    if (panel.hidden !== !g) { panel.hidden = !g; S.dirty = true; } // shown once a fix came
+    if (!g) return;
+    setText("gnss-speed", g.speed == null ? "—" : fixed(g.speed, 2) + " m/s (" + fixed(g.speed * 3.6, 1) + " km/h)");
+    setText("gnss-track", num(g.track_deg, 1, "°"));
+    setText("gnss-fix", (FIX_WORDS[g.fix] || g.fix) + (g.valid ? ", valid" : ", not valid"));
+    setQuality("gnss-fix", g.valid ? "ok" : "bad");
+    setText("gnss-sats", g.sats == null ? "—" : String(g.sats));
+    setText("gnss-pdop", num(g.pdop, 1, ""));
+    setText("gnss-age", num(gnssAge(g, last), 2, " s"));
+    const v = g.vel_enu;
+    setText("gnss-vel", v ? v.map((x) => num(x, 2, "")).join(", ") + " m/s" : "—");
+    const [aiding, q] = gnssAiding();
+    setText("gnss-aiding", aiding);
+    setQuality("gnss-aiding", q);
+    setText("gnss-count", g.count == null ? "—" : String(g.count));
+    setText("gnss-source", g.source || "—");
+  }
+
   function draw() {
     const t0 = performance.now();
     const last = S.paused && S.frozen ? S.frozen.last : S.last;
@@ -688,6 +737,8 @@
     drawHSI(last, flag);
     drawAxes3D(last, flag);
     renderReadouts(last);
+    const gnss = S.paused && S.frozen ? S.frozen.gnss : S.gnss;
+    renderGnss(gnss, last);
     const pts = S.points;
     const tEnd = S.paused && S.frozen ? S.frozen.tEnd : (pts.length ? pts[pts.length - 1][0] : S.windowS);
     const c = S.col;
@@ -709,6 +760,10 @@
         { c: c.rate_y, lo: c.rate_y_min, hi: c.rate_y_max, color: COLORS.pitch },
         { c: c.rate_z, lo: c.rate_z_min, hi: c.rate_z_max, color: COLORS.roll },
       ], tEnd, S.windowS);
+      if (gnss && c.gnss_speed !== undefined) {
+        const sp = drawChart($("chart-gnss-speed"), [{ c: c.gnss_speed, color: COLORS.pitch }], tEnd, S.windowS);
+        $("chart-gnss-speed").dataset.points = String(sp.shown);
+      }
       $("chart-angles").dataset.points = String(drawn.shown);
       $("chart-angles").dataset.wraps = String(drawn.wraps); // lines broken at ±180° in the last draw
       $("chart-angles").dataset.tEnd = String(tEnd);
