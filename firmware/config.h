@@ -102,6 +102,13 @@
 #ifndef FW_GYRO_OVERSAMPLE
 #define FW_GYRO_OVERSAMPLE 1
 #endif
+/* FW_GYRO_MEAN = 1 (with FW_GYRO_OVERSAMPLE > 1): send each gyro word as the rounded mean
+ * of its N codes, (sum + N/2) / N, and the accelerometer's and magnetometer's codes as they
+ * are: a plain 12-bit stream, no OVERSAMPLE report, which link v2 packs into its DATA frames
+ * (sums above 4095 travel one record per RAW frame). 0 (default): the sums. */
+#ifndef FW_GYRO_MEAN
+#define FW_GYRO_MEAN 0
+#endif
 #if FW_GYRO_OVERSAMPLE != 1 && FW_GYRO_OVERSAMPLE != 2 && FW_GYRO_OVERSAMPLE != 4 && FW_GYRO_OVERSAMPLE != 8
 #error "FW_GYRO_OVERSAMPLE must be 1, 2, 4 or 8"
 #endif

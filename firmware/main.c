@@ -475,22 +475,32 @@ static void gyro_sub_scan(void)
 }
 
 /* The group's codes (its group_n records) as sums of N conversions: the gyros' sub-scans
- * added, the accelerometer's and magnetometer's single codes times N. */
+ * added, the accelerometer's and magnetometer's single codes times N; with FW_GYRO_MEAN the
+ * gyros' rounded mean codes instead, the others as they are (a plain stream). */
 static void group_sums(void)
 {
     uint8_t i;
     for (i = 0; i < 3u; i++) {
+#if FW_GYRO_MEAN
+        /* N a power of two: the division is a shift */
+        group[i] = (uint16_t)((uint16_t)(group[i] + gsum[i] + FW_GYRO_OVERSAMPLE / 2) / FW_GYRO_OVERSAMPLE);
+#else
         group[i] += gsum[i];
+#endif
     }
+#if !FW_GYRO_MEAN
     for (i = 3; i < (uint8_t)(3u * group_n); i++) {
         group[i] *= (uint16_t)FW_GYRO_OVERSAMPLE; /* a power of two: a shift */
     }
+#endif
 }
+#endif /* FW_GYRO_OVERSAMPLE > 1 */
+#if FW_GYRO_OVERSAMPLE > 1 && !FW_GYRO_MEAN
 #define ENCODE(w) \
     att_block_encode_sums((uint8_t __data *)(w), (const uint16_t __data *)(w), FW_GYRO_OVERSAMPLE)
 #else
 #define ENCODE(w) att_block_encode_sample((uint8_t __data *)(w), (const uint16_t __data *)(w))
-#endif /* FW_GYRO_OVERSAMPLE > 1 */
+#endif
 
 /* Scan the group of sample seq and queue its records in order (gyro,
  * accelerometer, magnetometer), or one ADC_ERROR report in their place
@@ -578,7 +588,7 @@ void main(void)
         (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT)); /* the protocol in the period word */
     q_commit();
 #if FW_AIDED
-#if FW_GYRO_OVERSAMPLE > 1
+#if FW_GYRO_OVERSAMPLE > 1 && !FW_GYRO_MEAN
     (void)q_push(); /* OVERSAMPLE right after BOOT: the sample words are sums of N */
     (void)att_block_encode_oversample(wp, (uint8_t)FW_GYRO_OVERSAMPLE);
     q_commit();

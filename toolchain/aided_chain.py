@@ -67,7 +67,7 @@ def recording(trial: Any, config: tool.Config = tool.AIDED, start: float = 0.0,
     """The trial at the firmware's sampling instants (its period), as the board's codes
     (the gyros converted ``config.gyro_oversample`` times per sample, summed)."""
     return resample(trial, config.period_s, board_channels(), start=start, duration=duration,
-                    oversample=config.gyro_oversample)
+                    oversample=config.gyro_oversample, mean=config.gyro_mean)
 
 
 def _stats(err: str) -> dict[str, int]:
@@ -176,9 +176,10 @@ def run_chain(rec: BoardRecording, rx_cmd: Sequence[str], build_dir: Path, *,
     timeout = timeout if timeout is not None else 40.0 * n * config.period_s + 120.0
     with tempfile.TemporaryDirectory(prefix="chain_") as tmp:
         data, conf = Path(tmp) / "codes.bin", Path(tmp) / "rx.conf"
-        if rec.oversample != config.gyro_oversample or rec.gyro_conversions is None:
-            raise ValueError(f"the recording's gyros are converted {rec.oversample} times per sample, the firmware's "
-                             f"{config.gyro_oversample}: make it with recording(trial, config)")
+        if (rec.oversample, rec.mean) != (config.gyro_oversample, config.gyro_mean) or rec.gyro_conversions is None:
+            raise ValueError(f"the recording's gyros are converted {rec.oversample} times per sample (mean: "
+                             f"{rec.mean}), the firmware's {config.gyro_oversample} ({config.gyro_mean}): make it "
+                             "with recording(trial, config)")
         tool.data_file(data, config, _pad(rec.gyro_conversions),
                        *(_pad(rec.codes[k]) for k in ("acc", "mag")))
         conf.write_text(rx_config(rec.channels))
@@ -248,7 +249,7 @@ def direct(rec: BoardRecording, config: tool.Config = tool.AIDED, *, quantized: 
     from attitude_c.ahrs_filter import _SPEC
 
     src = {k: values(rec.codes[k], rec.channels[k]) if quantized else rec.si[k] for k in ("acc", "mag")}
-    src["gyro"] = values(rec.codes["gyro"], rec.channels["gyro"], rec.oversample) if quantized else rec.si["gyro"]
+    src["gyro"] = values(rec.codes["gyro"], rec.channels["gyro"], rec.stream_n) if quantized else rec.si["gyro"]
     ffi, lib = ffi_lib("f64")
     s = ffi.new("att_ahrs *")
     if lib.att_ahrs_init(s, _settings.fill(ffi, lib, _SPEC, settings or {}), ffi.NULL) != 0:

@@ -157,6 +157,7 @@ class Config:
     mag_every: int = 1                #: aided: magnetometer record every mag_every samples (0: none)
     mag_sr: bool = False              #: aided: magnetometer set/reset on P3.4 (FW_MAG_SR; docs/firmware.md)
     gyro_oversample: int = 1          #: aided: gyro conversions summed per sample (FW_GYRO_OVERSAMPLE: 1, 2, 4, 8)
+    gyro_mean: bool = False           #: aided, oversampled: send the rounded mean code, not the sum (FW_GYRO_MEAN)
 
     def __post_init__(self) -> None:
         if self.board not in BOARDS:
@@ -195,6 +196,8 @@ class Config:
         if self.gyro_oversample > 1 and not (self.aided and self.period_ticks % self.gyro_oversample == 0):
             raise ValueError(f"gyro_oversample {self.gyro_oversample} needs the aided board (board='aided9') and "
                              f"period_ticks a multiple of it, got board={self.board!r}, period_ticks={self.period_ticks}")
+        if self.gyro_mean and self.gyro_oversample == 1:
+            raise ValueError("gyro_mean needs gyro_oversample > 1")
         if (self.v2_batch or self.v2_hold) and not self.aided:
             raise ValueError("v2_batch and v2_hold are the aided board's (board='aided9')")
         if not 1 <= self.max_attempts <= 255:
@@ -236,7 +239,13 @@ class Config:
                   ["FW_AIDED=1", f"FW_ACC_EVERY={self.acc_every}", f"FW_MAG_EVERY={self.mag_every}",
                    "ATT_LINK2_CRC_TABLE=1", "ATT_LINK2_ONE_RING_IDATA=1", f"ATT_LINK2_ONE_BATCH={self.v2_batch}",
                    f"ATT_LINK2_ONE_HOLD={self.v2_hold}", f"FW_MAG_SR={int(self.mag_sr)}",
-                   *([f"FW_GYRO_OVERSAMPLE={self.gyro_oversample}"] if self.gyro_oversample > 1 else [])])]
+                   *([f"FW_GYRO_OVERSAMPLE={self.gyro_oversample}", f"FW_GYRO_MEAN={int(self.gyro_mean)}"]
+                     if self.gyro_oversample > 1 else [])])]
+
+    @property
+    def stream_n(self) -> int:
+        """Conversions per sample word the stream announces (OVERSAMPLE n; 1: plain codes)."""
+        return 1 if self.gyro_mean else self.gyro_oversample
 
 
 #: The aided board's default build (docs/firmware.md "The aided board"): link v2 at
@@ -415,7 +424,7 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     defines = ["ATT_REAL_F32", *config.defines(), *extra_defines]
     extra: list[str] = []
     sources = list(SOURCES_AIDED if config.aided else SOURCES if config.link == "legacy" else SOURCES_V2)
-    if config.gyro_oversample > 1:
+    if config.stream_n > 1:
         sources += SOURCES_SUMS
     fault_defs = {"dout_stuck_high": "FW_SIM_DOUT_STUCK=1", "dout_stuck_low": "FW_SIM_DOUT_STUCK=0",
                   "eoc_stuck": "FW_SIM_EOC_STUCK=1"}

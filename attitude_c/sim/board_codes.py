@@ -139,6 +139,12 @@ class BoardRecording:
     channels: dict[str, CodeChannel]
     oversample: int = 1  #: gyro conversions summed per sample
     gyro_conversions: NDArray[np.int64] | None = None  #: (n, oversample, 3) each conversion's codes, in time order
+    mean: bool = False  #: ``codes["gyro"]`` is the rounded mean code of the conversions (a plain stream), not the sum
+
+    @property
+    def stream_n(self) -> int:
+        """Conversions per gyro word a receiver divides by: ``oversample``, or 1 for means."""
+        return 1 if self.mean else self.oversample
 
     @property
     def n(self) -> int:
@@ -167,7 +173,7 @@ def _nlerp(q: NDArray[np.float64], rate: float, t: NDArray[np.float64]) -> NDArr
 
 
 def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start: float = 0.0,
-             duration: float | None = None, oversample: int = 1) -> BoardRecording:
+             duration: float | None = None, oversample: int = 1, mean: bool = False) -> BoardRecording:
     """A :class:`attitude_c.broad.Trial` (or anything with ``rate``, ``gyr``, ``acc``,
     ``mag``, ``quat``, ``movement``) at the board's instants from ``start`` (s) for
     ``duration`` (s; None: to the end): gyro, accelerometer and field linearly
@@ -176,7 +182,8 @@ def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start:
     ``oversample`` = N > 1: the gyros converted N times per sample, ``period / N`` apart
     with the last at the sample's instant t (the midpoints of the N sub-intervals of
     (t − period + period/2N, t + period/2N], as the aided firmware's sub-scans: docs/firmware.md),
-    the codes summed; instants before the recording's start take its first value."""
+    the codes summed (``mean``: their rounded mean, ``(sum + N/2) // N``, as the firmware's
+    FW_GYRO_MEAN sends it); instants before the recording's start take its first value."""
     if not (isinstance(oversample, int) and 1 <= oversample <= 16):
         raise InvalidArgument(f"oversample must be 1..16, got {oversample!r}")
     rate = float(trial.rate)
@@ -193,8 +200,9 @@ def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start:
     sub = (t[:, None] - (m - 1 - np.arange(m))[None, :] * (period / m)).reshape(-1)  # (n·m,) in time order
     g = _interp(np.asarray(trial.gyr, np.float64), rate, sub)  # np.interp: the first value before the start
     conv = codes(g, channels["gyro"]).reshape(n, m, 3)
-    si, cs = {"gyro": g.reshape(n, m, 3).mean(axis=1), **si}, {"gyro": conv.sum(axis=1), **cs}
+    words = (conv.sum(axis=1) + m // 2) // m if mean else conv.sum(axis=1)
+    si, cs = {"gyro": g.reshape(n, m, 3).mean(axis=1), **si}, {"gyro": words, **cs}
     near = np.minimum(np.rint(t * rate).astype(np.int64), n_src - 1)
     return BoardRecording(period=period, t=t, si=si, codes=cs, quat=_nlerp(np.asarray(trial.quat, np.float64), rate, t),
                           movement=np.asarray(trial.movement, bool)[near], channels=channels, oversample=m,
-                          gyro_conversions=conv)
+                          gyro_conversions=conv, mean=mean)
