@@ -91,6 +91,30 @@
 #ifndef FW_MAG_SR
 #define FW_MAG_SR 0
 #endif
+/* FW_GYRO_OVERSAMPLE = N (1, 2, 4 or 8; default 1): the gyros are converted N times per
+ * sample period, FW_PERIOD_TICKS / N ticks apart, the last one at the sample's instant t
+ * with the accelerometer and magnetometer (the midpoints of the N sub-intervals of the
+ * period (t - P + P/2N, t + P/2N]), and
+ * their sum is sent: an OVERSAMPLE n = N report after BOOT (attitude/block.h), the gyro
+ * words sums of N codes, the accelerometer's and magnetometer's (one conversion each)
+ * their code times N, so a receiver's division by n gives them back exactly (docs/firmware.md
+ * "Gyro oversampling"). 1: one scan per sample, no OVERSAMPLE report (the image as before). */
+#ifndef FW_GYRO_OVERSAMPLE
+#define FW_GYRO_OVERSAMPLE 1
+#endif
+/* FW_GYRO_MEAN = 1 (with FW_GYRO_OVERSAMPLE > 1): send each gyro word as the rounded mean
+ * of its N codes, (sum + N/2) / N, and the accelerometer's and magnetometer's codes as they
+ * are: a plain 12-bit stream, no OVERSAMPLE report, which link v2 packs into its DATA frames
+ * (sums above 4095 travel one record per RAW frame). 0 (default): the sums. */
+#ifndef FW_GYRO_MEAN
+#define FW_GYRO_MEAN 0
+#endif
+#if FW_GYRO_OVERSAMPLE != 1 && FW_GYRO_OVERSAMPLE != 2 && FW_GYRO_OVERSAMPLE != 4 && FW_GYRO_OVERSAMPLE != 8
+#error "FW_GYRO_OVERSAMPLE must be 1, 2, 4 or 8"
+#endif
+#if FW_PERIOD_TICKS % FW_GYRO_OVERSAMPLE != 0
+#error "FW_PERIOD_TICKS must be a multiple of FW_GYRO_OVERSAMPLE (sub-intervals of whole ticks)"
+#endif
 #ifndef FW_RXQ
 /* received bytes the FIFO holds (a power of two <= 128): an ACK frame is
  * 10 bytes with its delimiters, and one frame is answered at a time */

@@ -440,6 +440,68 @@ static int mag_flip(void)
 #endif
 #endif /* FW_MAG_SR */
 
+#if FW_GYRO_OVERSAMPLE > 1
+/* Gyro oversampling (config.h FW_GYRO_OVERSAMPLE = N): the sampling clock ticks N times
+ * per sample period; sub-scans 0..N-2 convert the gyros alone and sum them here, the last
+ * one is the group's scan (aided_sample), which adds these sums to its gyro codes. */
+#define FW_SUB_TICKS (FW_PERIOD_TICKS / FW_GYRO_OVERSAMPLE)
+static uint16_t __idata gsum[3]; /* the gyros' codes of sub-scans 0..fw_sub-1, summed */
+uint8_t fw_sub;                  /* the sub-scan due next: 0..N-1 (not static: the
+                                    simulation's device model reads it, as fw_ticks) */
+static int8_t sub_st;            /* ATT_OK, or a failed sub-scan's status (the sample's ADC_ERROR) */
+
+/* Sub-scan fw_sub (< N - 1) of sample seq: the gyros into gsum (the first) or added to it
+ * (through group, free between groups). */
+static void gyro_sub_scan(void)
+{
+    uint8_t i;
+    int st;
+    LINK_RX();
+    FW_HOOK_SCAN_BEGIN();
+    st = tlc2543_scan(&adc, all, 3, (uint16_t __data *)(fw_sub ? group : gsum), TLC2543_POWER_DOWN);
+    FW_HOOK_SCAN_END();
+    LINK_RX();
+    if (fw_sub == 0u) {
+        sub_st = ATT_OK;
+    } else {
+        for (i = 0; i < 3u; i++) {
+            gsum[i] += group[i];
+        }
+    }
+    if (st != ATT_OK) {
+        sub_st = (int8_t)st;
+    }
+    fw_sub++;
+}
+
+/* The group's codes (its group_n records) as sums of N conversions: the gyros' sub-scans
+ * added, the accelerometer's and magnetometer's single codes times N; with FW_GYRO_MEAN the
+ * gyros' rounded mean codes instead, the others as they are (a plain stream). */
+static void group_sums(void)
+{
+    uint8_t i;
+    for (i = 0; i < 3u; i++) {
+#if FW_GYRO_MEAN
+        /* N a power of two: the division is a shift */
+        group[i] = (uint16_t)((uint16_t)(group[i] + gsum[i] + FW_GYRO_OVERSAMPLE / 2) / FW_GYRO_OVERSAMPLE);
+#else
+        group[i] += gsum[i];
+#endif
+    }
+#if !FW_GYRO_MEAN
+    for (i = 3; i < (uint8_t)(3u * group_n); i++) {
+        group[i] *= (uint16_t)FW_GYRO_OVERSAMPLE; /* a power of two: a shift */
+    }
+#endif
+}
+#endif /* FW_GYRO_OVERSAMPLE > 1 */
+#if FW_GYRO_OVERSAMPLE > 1 && !FW_GYRO_MEAN
+#define ENCODE(w) \
+    att_block_encode_sums((uint8_t __data *)(w), (const uint16_t __data *)(w), FW_GYRO_OVERSAMPLE)
+#else
+#define ENCODE(w) att_block_encode_sample((uint8_t __data *)(w), (const uint16_t __data *)(w))
+#endif
+
 /* Scan the group of sample seq and queue its records in order (gyro,
  * accelerometer, magnetometer), or one ADC_ERROR report in their place
  * when the scan (or the encoding of a code) failed: the group goes into
@@ -479,9 +541,14 @@ static void aided_sample(void)
 #endif
     FW_HOOK_SCAN_END();
     LINK_RX();
+#if FW_GYRO_OVERSAMPLE > 1
+    group_sums();
+    if (st == ATT_OK) {
+        st = sub_st;
+    }
+#endif
     for (i = 0; i < group_n && st == ATT_OK; i++) {
-        st = att_block_encode_sample((uint8_t __data *)(group + 3u * i),
-                                     (const uint16_t __data *)(group + 3u * i));
+        st = ENCODE(group + 3u * i);
     }
     if (st != ATT_OK) {
         (void)att_block_encode_adc_error((uint8_t __data *)group, seq, (int8_t)st);
@@ -521,6 +588,11 @@ void main(void)
         (uint8_t)(FW_BAUD / (long)ATT_BLOCK_BAUD_UNIT)); /* the protocol in the period word */
     q_commit();
 #if FW_AIDED
+#if FW_GYRO_OVERSAMPLE > 1 && !FW_GYRO_MEAN
+    (void)q_push(); /* OVERSAMPLE right after BOOT: the sample words are sums of N */
+    (void)att_block_encode_oversample(wp, (uint8_t)FW_GYRO_OVERSAMPLE);
+    q_commit();
+#endif
     (void)q_push(); /* CHANNELS right after BOOT: the board and its stream */
     (void)att_block_encode_channels(wp, (uint8_t)ATT_BLOCK_BOARD_AIDED9, (uint8_t)FW_CHANNELS,
                                     (uint8_t)FW_ACC_EVERY, (uint8_t)FW_MAG_EVERY);
@@ -588,10 +660,19 @@ void main(void)
         }
         if ((int16_t)(fw_ticks - next_sample) >= 0) {
             if (sampling) {
+#if FW_AIDED && FW_GYRO_OVERSAMPLE > 1
+                next_sample += (uint16_t)FW_SUB_TICKS;
+                if (fw_sub != (uint8_t)(FW_GYRO_OVERSAMPLE - 1)) {
+                    gyro_sub_scan();
+                    continue; /* the same sample: seq stays */
+                }
+                aided_sample(); /* the last sub-scan (fw_sub = N - 1): the group */
+                fw_sub = 0;
+#elif FW_AIDED
                 next_sample += (uint16_t)FW_PERIOD_TICKS;
-#if FW_AIDED
                 aided_sample();
 #else
+                next_sample += (uint16_t)FW_PERIOD_TICKS;
                 if (sample_slot()) {
                     LINK_RX(); /* v2: the byte that came during the poll, before the scan's 0.9 ms */
                     FW_HOOK_SCAN_BEGIN();

@@ -7,6 +7,7 @@ The conversion itself against closed forms (no process)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -58,27 +59,71 @@ def test_data_file_holds_the_scan_order(tmp_path: Path) -> None:
     np.testing.assert_array_equal(words, want)
 
 
-@pytest.fixture(scope="module")
-def excerpt() -> bc.BoardRecording:
+#: the default plan with the gyros oversampled (two conversions summed per sample)
+#: (sums: link v2 carries them one record per RAW frame, so at a plan of 75 records/s, aiding every
+#: 4th sample; docs/firmware.md "Gyro oversampling")
+OVS2 = dataclasses.replace(tool.AIDED, gyro_oversample=2, acc_every=4, mag_every=4)
+#: the gyros' two conversions sent as their rounded mean (a plain stream, packed by link v2), aiding
+#: every 2nd sample (at the default plan's aiding in every sample this excerpt loses two samples at
+#: 0.1 s, at startup, then none: docs/firmware.md "Gyro oversampling", not yet explained)
+MEAN2 = dataclasses.replace(tool.AIDED, gyro_oversample=2, gyro_mean=True, acc_every=2, mag_every=2)
+
+
+def _excerpt(config: tool.Config) -> bc.BoardRecording:
     folder = broad.default_dir()
     if folder is None:
         pytest.skip("BROAD data not found beside the checkout (../shared/data/broad)")
-    return aided_chain.recording(broad.load_trial(folder / f"{TRIAL}.mat"), start=START, duration=SECONDS)
+    return aided_chain.recording(broad.load_trial(folder / f"{TRIAL}.mat"), config, start=START, duration=SECONDS)
+
+
+@pytest.fixture(scope="module")
+def excerpt() -> bc.BoardRecording:
+    return _excerpt(tool.AIDED)
+
+
+def test_oversampled_recording_sums_the_conversions_at_the_sub_interval_midpoints() -> None:
+    """Gyro oversampling: N conversions per sample, period/N apart, the last at the sample's
+    instant (as the firmware's sub-scans); the words are their sums, and values() divides by N."""
+    ch = bc.board_channels()
+
+    class Ramp:  # a rate that rises 0.1 rad/s per second on every axis: the sub-instants readable
+        rate = 100.0
+        gyr = np.linspace(0.0, 1.0, 1001)[:, None] * np.ones(3)
+        acc = mag = np.zeros((1001, 3))
+        quat = np.tile([1.0, 0, 0, 0], (1001, 1))
+        movement = np.ones(1001, bool)
+
+    period = 0.04
+    one, four = (bc.resample(Ramp(), period, ch, start=1.0, oversample=m) for m in (1, 4))
+    sub = one.t[:, None] - (3 - np.arange(4)) * period / 4  # the sub-scans' instants
+    np.testing.assert_array_equal(four.gyro_conversions, bc.codes((sub / 10).reshape(-1, 1) * np.ones(3), ch["gyro"])
+                                  .reshape(-1, 4, 3))
+    np.testing.assert_array_equal(four.codes["gyro"], four.gyro_conversions.sum(axis=1))
+    np.testing.assert_array_equal(four.gyro_conversions[:, -1], one.codes["gyro"])  # the last at the instant
+    # a sum of 4 codes / 4: the mean code, converted as attitude-rx converts (word / n − zero) · scale
+    np.testing.assert_array_equal(bc.values(four.codes["gyro"], ch["gyro"], 4),
+                                  (four.codes["gyro"] / 4 - bc.ZERO) * ch["gyro"].lsb)
+    mean = bc.resample(Ramp(), period, ch, start=1.0, oversample=4, mean=True)
+    np.testing.assert_array_equal(mean.codes["gyro"], (four.codes["gyro"] + 2) // 4)  # rounded, half up
+    assert (mean.stream_n, four.stream_n) == (1, 4)
+    with pytest.raises(ValueError, match="oversample"):
+        bc.resample(Ramp(), period, ch, oversample=0)
 
 
 def _chain(excerpt: bc.BoardRecording, tmp_path: Path, build: str,
-           late: tuple[float, float] | None = None) -> aided_chain.ChainRun:
+           late: tuple[float, float] | None = None, config: tool.Config = tool.AIDED) -> aided_chain.ChainRun:
     from toolchain.tasks.cross import cross_build_target
 
     require_target("mcs52")
     require_tools("socat", apt="socat")  # toolchain.firmware.Session checks for it
     t = require_target(build)
     cmd = [*t.run_cmd, str(cross_build_target(build, out=tmp_path / build)["app"])]
-    return aided_chain.run_chain(excerpt, cmd, tmp_path / "fw", late=late)
+    return aided_chain.run_chain(excerpt, cmd, tmp_path / "fw", late=late, config=config)
 
 
-def _same_as_direct(run: aided_chain.ChainRun, excerpt: bc.BoardRecording, build: str) -> None:
-    q = aided_chain.direct(excerpt, lost=run.lost)
+def _same_as_direct(run: aided_chain.ChainRun, excerpt: bc.BoardRecording, build: str,
+                    config: tool.Config = tool.AIDED) -> None:
+    q = aided_chain.direct(excerpt, config, lost=run.lost)
     # attitude-rx is built in double (ATT_REAL_F64) like the package's filter: the host build runs
     # the same C with the same IEEE operations and prints 17 digits (round trip), so the
     # quaternions are equal. ARMv4T: soft-float libm (sqrt, atan2, sin, cos) may differ from the
@@ -106,6 +151,24 @@ def test_broad_excerpt_through_the_chain_equals_the_library_filter(excerpt: bc.B
     assert run.stats["acks"] == run.stats["frames"] == run.frames, run.stats
     assert 0 < 2 * run.max_step_s <= tool.LOCKSTEP_BOUND_S
     _same_as_direct(run, excerpt, build)
+
+
+@pytest.mark.system
+@pytest.mark.parametrize("config", [OVS2, MEAN2], ids=["sums", "mean"])
+def test_oversampled_gyros_through_the_chain_equal_the_library_filter(tmp_path: Path, config: tool.Config) -> None:
+    """The same with gyro oversampling (N = 2): the TLC2543 model serves two gyro conversions per
+    sample; the firmware sends their sums after an OVERSAMPLE report, attitude-rx divides by 2 (and
+    the accelerometer's and magnetometer's words, their code times 2, back to the code) — or, with
+    ``gyro_mean``, their rounded mean as a plain code: its quaternions are the
+    direct filter's on the same words converted as attitude-rx converts them."""
+    rec = _excerpt(config)
+    run = _chain(rec, tmp_path, "host", config=config)
+    assert run.delivered_once(rec.n), (run.reports, run.stats)
+    head = ["BOOT", "CHANNELS"] if config.gyro_mean else ["BOOT", "OVERSAMPLE", "CHANNELS"]
+    assert [r["report"] for r in run.reports] == head
+    assert config.gyro_mean or run.reports[1]["n"] == 2
+    assert run.stats["records"] >= tool.data_records(config, rec.n) + len(head)
+    _same_as_direct(run, rec, "host", config)
 
 
 #: The host made late on purpose: its answers held back this long (simulated s) from this instant,

@@ -25,6 +25,7 @@ import dataclasses
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from conftest import require_target, require_tools
 
@@ -67,6 +68,12 @@ def test_aided_image_fits_the_at89s52(out: Path) -> None:
         tool.Config(link="v2", v2_batch=2)
     with pytest.raises(ValueError, match="mag_sr"):
         tool.Config(link="v2", mag_sr=True)
+    for bad, msg in [(dict(gyro_oversample=3), "gyro_oversample must be one of"),
+                     (dict(gyro_oversample=4, period_ticks=74), "multiple"), (dict(gyro_mean=True), "gyro_mean")]:
+        with pytest.raises(ValueError, match=msg):
+            dataclasses.replace(tool.AIDED, **bad)
+    with pytest.raises(ValueError, match="aided board"):
+        tool.Config(gyro_oversample=2)
     with pytest.raises(ValueError, match="baud"):  # 115200 is Timer 2's, not Timer 1's
         tool.Config(baud=115200)
     assert 115200 in tool.BAUD_RATES_T2 and 57600 in tool.BAUD_RATES_T2
@@ -166,3 +173,44 @@ def test_selftest_failure_is_reported_after_boot_and_channels(out: Path) -> None
     recs = [block.decode(r) for r in res.records]
     assert [r.kind for r in recs[:3]] == ["boot", "channels", "selftest"]
     assert (recs[2].status, recs[2].bad_code, recs[2].attempt) == (-41, 0xFFF, 1)  # MID read 0xFFF
+
+
+@pytest.mark.parametrize("n_ovs,mean", [(2, False), (4, False), (2, True)])
+def test_oversampled_gyro_sums_equal_the_models_codes_summed(out: Path, tmp_path: Path, n_ovs: int,
+                                                             mean: bool) -> None:
+    """Gyro oversampling (``gyro_oversample`` N, FW_GYRO_OVERSAMPLE): the TLC2543 model serves
+    codes from a file, one per conversion (N gyro triples per sample, then the accelerometer's
+    and magnetometer's when due: toolchain.firmware.data_file); the stream is BOOT, OVERSAMPLE N,
+    CHANNELS, then groups whose gyro words are exactly the sums of their sample's N triples and
+    whose accelerometer and magnetometer words are exactly N times their one code (a receiver's
+    division by N gives the code back), every group at its sample's number (losses skip groups
+    in the file: the tracker's numbers still match). ``gyro_mean``: no OVERSAMPLE report, the
+    gyro words the rounded means (sum + N/2) // N, the others the codes themselves."""
+    _need()
+    cfg = dataclasses.replace(CFG, gyro_oversample=n_ovs, gyro_mean=mean)
+    n, pad = 40, 32  # pad: the firmware scans ahead of its acknowledgements (toolchain.aided_chain)
+    rng = np.random.default_rng(n_ovs)
+    gyro = rng.integers(0, 4096, (n + pad, n_ovs, 3))
+    acc, mag = rng.integers(0, 4096, (2, n + pad, 3))
+    tool.data_file(tmp_path / "codes.bin", cfg, gyro, acc, mag)
+    img = tool.build(out, cfg, kind="sim", sim_samples=tool.data_records(cfg, n), data=True,
+                     name=f"aided_ovs{n_ovs}{'_mean' if mean else ''}")
+    res = tool.run_v2(img, "c", timeout=180, data=tmp_path / "codes.bin")
+    stream = block.number_stream(res.records)  # strict: a slip or a cut group raises
+    head = ["boot", "channels"] if mean else ["boot", "oversample", "channels"]
+    assert [r.kind for r, _ in stream[:len(head)]] == head
+    assert mean or stream[1][0].oversample == n_ovs
+    k = cfg.stream_n  # the receiver's divisor
+    want = {"gyr": (gyro.sum(axis=1) + n_ovs // 2) // n_ovs if mean else gyro.sum(axis=1), "acc": k * acc,
+            "mag": k * mag}
+    seen = lost = 0
+    for rec, span in stream[len(head):]:
+        if rec.kind != "sample":
+            assert rec.kind == "overrun", rec  # the only report a healthy run may send
+            lost += rec.count
+        elif span.first < n + pad:  # past the file's end the model reads code 0
+            assert list(rec.codes) == list(want[span.part][span.first]), (span, rec.codes)
+            seen += 1
+    print(f"\nN = {n_ovs}, mean {mean}: {seen} records checked, {lost} samples lost (OVERRUN); max SP 0x{res.max_sp:02X}")
+    assert seen >= tool.data_records(cfg, n) // 2  # most: a host late in wall time loses some
+    assert res.max_sp <= cfg.iram_size - 1 - STACK_MARGIN, f"SP reached 0x{res.max_sp:02X}"

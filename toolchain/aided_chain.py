@@ -64,8 +64,10 @@ class ChainRun:
 
 def recording(trial: Any, config: tool.Config = tool.AIDED, start: float = 0.0,
               duration: float | None = None) -> BoardRecording:
-    """The trial at the firmware's sampling instants (its period), as the board's codes."""
-    return resample(trial, config.period_s, board_channels(), start=start, duration=duration)
+    """The trial at the firmware's sampling instants (its period), as the board's codes
+    (the gyros converted ``config.gyro_oversample`` times per sample, summed)."""
+    return resample(trial, config.period_s, board_channels(), start=start, duration=duration,
+                    oversample=config.gyro_oversample, mean=config.gyro_mean)
 
 
 def _stats(err: str) -> dict[str, int]:
@@ -180,7 +182,12 @@ def run_chain(rec: BoardRecording, rx_cmd: Sequence[str], build_dir: Path, *,
     timeout = timeout if timeout is not None else 40.0 * n * config.period_s + 120.0
     with tempfile.TemporaryDirectory(prefix="chain_") as tmp:
         data, conf = Path(tmp) / "codes.bin", Path(tmp) / "rx.conf"
-        tool.data_file(data, config, *(_pad(rec.codes[k]) for k in ("gyro", "acc", "mag")))
+        if (rec.oversample, rec.mean) != (config.gyro_oversample, config.gyro_mean) or rec.gyro_conversions is None:
+            raise ValueError(f"the recording's gyros are converted {rec.oversample} times per sample (mean: "
+                             f"{rec.mean}), the firmware's {config.gyro_oversample} ({config.gyro_mean}): make it "
+                             "with recording(trial, config)")
+        tool.data_file(data, config, _pad(rec.gyro_conversions),
+                       *(_pad(rec.codes[k]) for k in ("acc", "mag")))
         conf.write_text(rx_config(rec.channels))
         with tool.Session(img, timeout=timeout, data=data, lockstep=True) as sess:
             relay = Relay(sess, late)
@@ -239,13 +246,16 @@ def direct(rec: BoardRecording, config: tool.Config = tool.AIDED, *, quantized: 
            settings: dict[str, Any] | None = None, lost: Sequence[int] = ()) -> np.ndarray:
     """The library's filter (attitude_c's att_ahrs in double), one update per sample with the
     accelerometer and magnetometer only where the board sends them (NULL elsewhere), on the
-    codes converted as attitude-rx converts them (``quantized``) or on the SI values. The
-    ``lost`` samples are held as attitude-rx holds them: the last good rate, no aiding."""
+    codes converted as attitude-rx converts them (``quantized``: an oversampled recording's
+    gyro sums divided by its n, as the OVERSAMPLE report makes attitude-rx divide) or on the
+    SI values. The ``lost`` samples are held as attitude-rx holds them: the last good rate,
+    no aiding."""
     from attitude_c import _settings
     from attitude_c._lib import ffi_lib
     from attitude_c.ahrs_filter import _SPEC
 
-    src = {k: values(rec.codes[k], rec.channels[k]) if quantized else rec.si[k] for k in ("gyro", "acc", "mag")}
+    src = {k: values(rec.codes[k], rec.channels[k]) if quantized else rec.si[k] for k in ("acc", "mag")}
+    src["gyro"] = values(rec.codes["gyro"], rec.channels["gyro"], rec.stream_n) if quantized else rec.si["gyro"]
     ffi, lib = ffi_lib("f64")
     s = ffi.new("att_ahrs *")
     if lib.att_ahrs_init(s, _settings.fill(ffi, lib, _SPEC, settings or {}), ffi.NULL) != 0:

@@ -112,6 +112,11 @@ SOURCES = [FW_DIR / "main.c", FW_DIR / "link_state.c", CSRC / "src" / "tlc2543.c
 SOURCES_V2 = [CSRC / "src" / "link2_sender.c" if s.name == "link_sender.c" else s for s in SOURCES]
 #: The aided board (link v2 only): the CHANNELS report's encoder too.
 SOURCES_AIDED = [*SOURCES_V2, CSRC / "src" / "block_channels.c"]
+#: ... with gyro oversampling: the OVERSAMPLE report's and the sums' encoders.
+SOURCES_SUMS = [CSRC / "src" / "block_sums.c"]
+#: Gyro conversions per sample the aided board can sum (FW_GYRO_OVERSAMPLE: a power of two,
+#: so the accelerometer's and magnetometer's codes times n are a shift; 8 x 4095 fits a word).
+GYRO_OVERSAMPLE = (1, 2, 4, 8)
 #: Link protocols of the firmware (Config.link).
 LINKS = ("legacy", "v2")
 SIM_HAL_HEADER = FW_DIR / "sim" / "tlc_hal_sim.h"
@@ -151,6 +156,8 @@ class Config:
     acc_every: int = 1                #: aided: accelerometer record every acc_every samples (0: none)
     mag_every: int = 1                #: aided: magnetometer record every mag_every samples (0: none)
     mag_sr: bool = False              #: aided: magnetometer set/reset on P3.4 (FW_MAG_SR; docs/firmware.md)
+    gyro_oversample: int = 1          #: aided: gyro conversions summed per sample (FW_GYRO_OVERSAMPLE: 1, 2, 4, 8)
+    gyro_mean: bool = False           #: aided, oversampled: send the rounded mean code, not the sum (FW_GYRO_MEAN)
 
     def __post_init__(self) -> None:
         if self.board not in BOARDS:
@@ -184,6 +191,13 @@ class Config:
             raise ValueError(f"v2_hold must be 0..32767 ticks, got {self.v2_hold}")
         if self.mag_sr and not (self.aided and self.mag_every):
             raise ValueError("mag_sr needs the aided board with its magnetometer (board='aided9', mag_every > 0)")
+        if self.gyro_oversample not in GYRO_OVERSAMPLE:
+            raise ValueError(f"gyro_oversample must be one of {GYRO_OVERSAMPLE}, got {self.gyro_oversample}")
+        if self.gyro_oversample > 1 and not (self.aided and self.period_ticks % self.gyro_oversample == 0):
+            raise ValueError(f"gyro_oversample {self.gyro_oversample} needs the aided board (board='aided9') and "
+                             f"period_ticks a multiple of it, got board={self.board!r}, period_ticks={self.period_ticks}")
+        if self.gyro_mean and self.gyro_oversample == 1:
+            raise ValueError("gyro_mean needs gyro_oversample > 1")
         if (self.v2_batch or self.v2_hold) and not self.aided:
             raise ValueError("v2_batch and v2_hold are the aided board's (board='aided9')")
         if not 1 <= self.max_attempts <= 255:
@@ -224,7 +238,14 @@ class Config:
                 *([] if not self.aided else
                   ["FW_AIDED=1", f"FW_ACC_EVERY={self.acc_every}", f"FW_MAG_EVERY={self.mag_every}",
                    "ATT_LINK2_CRC_TABLE=1", "ATT_LINK2_ONE_RING_IDATA=1", f"ATT_LINK2_ONE_BATCH={self.v2_batch}",
-                   f"ATT_LINK2_ONE_HOLD={self.v2_hold}", f"FW_MAG_SR={int(self.mag_sr)}"])]
+                   f"ATT_LINK2_ONE_HOLD={self.v2_hold}", f"FW_MAG_SR={int(self.mag_sr)}",
+                   *([f"FW_GYRO_OVERSAMPLE={self.gyro_oversample}", f"FW_GYRO_MEAN={int(self.gyro_mean)}"]
+                     if self.gyro_oversample > 1 else [])])]
+
+    @property
+    def stream_n(self) -> int:
+        """Conversions per sample word the stream announces (OVERSAMPLE n; 1: plain codes)."""
+        return 1 if self.gyro_mean else self.gyro_oversample
 
 
 #: The aided board's default build (docs/firmware.md "The aided board"): link v2 at
@@ -403,6 +424,8 @@ def build(out_dir: Path | str = BUILD, config: Config = Config(), *, kind: str =
     defines = ["ATT_REAL_F32", *config.defines(), *extra_defines]
     extra: list[str] = []
     sources = list(SOURCES_AIDED if config.aided else SOURCES if config.link == "legacy" else SOURCES_V2)
+    if config.stream_n > 1:
+        sources += SOURCES_SUMS
     fault_defs = {"dout_stuck_high": "FW_SIM_DOUT_STUCK=1", "dout_stuck_low": "FW_SIM_DOUT_STUCK=0",
                   "eoc_stuck": "FW_SIM_EOC_STUCK=1"}
     faults = list(faults)
@@ -474,24 +497,32 @@ def data_records(config: Config, n: int) -> int:
 
 def data_file(path: Path | str, config: Config, gyro: np.ndarray, acc: np.ndarray, mag: np.ndarray) -> int:
     """Write the input of a ``data=True`` image (firmware/sim/tlc_model.c FW_SIM_DATA): per
-    sample n the three gyro codes, then the accelerometer's if n % acc_every == 0, then the
-    magnetometer's if n % mag_every == 0 (the scan's order), each code two bytes big-endian.
-    Arrays (N, 3) of 12-bit codes; returns the sample records written."""
+    sample n the three gyro codes (of each of its ``gyro_oversample`` sub-scans, in time
+    order), then the accelerometer's if n % acc_every == 0, then the magnetometer's if
+    n % mag_every == 0 (the scan's order), each code two bytes big-endian. Arrays (N, 3) of
+    12-bit codes, the gyros' (N, gyro_oversample, 3) when that is > 1; returns the sample
+    records the firmware sends for them."""
     arrays = [np.asarray(a, dtype=np.int64) for a in (gyro, acc, mag)]
-    if any(a.shape != arrays[0].shape or a.ndim != 2 or a.shape[1] != 3 for a in arrays):
-        raise ValueError(f"gyro, acc, mag must be code arrays of one shape (N, 3), got {[a.shape for a in arrays]}")
-    if any(a.size and (a.min() < 0 or a.max() > 4095) for a in arrays):
-        raise ValueError("gyro, acc, mag must be 12-bit codes (0..4095)")
+    ovs = config.gyro_oversample
     g, a, m = arrays
-    recs = []
+    if ovs > 1 and (g.ndim != 3 or g.shape[1:] != (ovs, 3)):
+        raise ValueError(f"gyro must be codes of shape (N, {ovs}, 3) (gyro_oversample {ovs}), got {g.shape}")
+    g = g.reshape(g.shape[0], 3 * ovs) if g.ndim == 3 else g
+    if (g.ndim != 2 or g.shape[1] != 3 * ovs
+            or any(x.ndim != 2 or x.shape != (g.shape[0], 3) for x in (a, m))):
+        raise ValueError(f"gyro, acc, mag must be code arrays of one shape (N, 3), got {[x.shape for x in arrays]}")
+    if any(x.size and (x.min() < 0 or x.max() > 4095) for x in arrays):
+        raise ValueError("gyro, acc, mag must be 12-bit codes (0..4095)")
+    recs, n_rec = [], 0
     for k in range(g.shape[0]):
-        recs.append(g[k])
-        if config.acc_every and k % config.acc_every == 0:
-            recs.append(a[k])
-        if config.mag_every and k % config.mag_every == 0:
-            recs.append(m[k])
+        recs += list(g[k].reshape(-1, 3))
+        n_rec += 1
+        for x, every in ((a, config.acc_every), (m, config.mag_every)):
+            if every and k % every == 0:
+                recs.append(x[k])
+                n_rec += 1
     Path(path).write_bytes(np.asarray(recs, dtype=">u2").tobytes())
-    return len(recs)
+    return n_rec
 
 
 # -- the block stream -------------------------------------------------------
@@ -1011,9 +1042,10 @@ class V2Result(SimOutput):
 
 
 def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float = 60.0,
-           room: int = 64, late: bool = False) -> V2Result:
+           room: int = 64, late: bool = False, data: Path | None = None) -> V2Result:
     """Run a link v2 sim/bench image in s51 with libattitude's v2 receiver B on the pty:
-    the C machine (``impl="c"``, through CFFI) or the Python one written from the spec.
+    the C machine (``impl="c"``, through CFFI) or the Python one written from the spec
+    (``data``: a ``data=True`` image's input file, :func:`data_file`).
     The host keeps up with any rate: its room never shrinks. ``late``: once records flow,
     the host holds its answers back until the firmware has sent a frame again (its
     retransmission timeout ran out), as a host descheduled on a loaded machine does;
@@ -1028,7 +1060,7 @@ def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float =
     rx: Any = CReceiver2(room=room) if impl == "c" else Receiver2(room=room)
     got: list[bytes] = []
     reply = bytearray()
-    with Session(image, timeout) as sess:
+    with Session(image, timeout, data) as sess:
         port = serial.Serial(str(sess.port), image.config.baud, timeout=0.005)
 
         def pump() -> None:

@@ -105,10 +105,13 @@ def codes(x: ArrayLike, ch: CodeChannel) -> NDArray[np.int64]:
     return np.clip(c, ch.lo, ch.hi).astype(np.int64)
 
 
-def values(c: ArrayLike, ch: CodeChannel) -> NDArray[np.float64]:
-    """Codes → SI values as attitude-rx converts them with :func:`rx_config`'s keys:
-    ``(code − zero) · scale`` in double."""
-    return (np.asarray(c, dtype=np.float64) - float(ZERO)) * ch.lsb
+def values(c: ArrayLike, ch: CodeChannel, n: int = 1) -> NDArray[np.float64]:
+    """Codes (sums of ``n`` codes: an oversampled stream's words) → SI values as attitude-rx
+    converts them with :func:`rx_config`'s keys: ``(word / n − zero) · scale`` in double."""
+    if not (isinstance(n, int) and 1 <= n <= 16):
+        raise InvalidArgument(f"n must be 1..16 conversions per word, got {n!r}")
+    w = np.asarray(c, dtype=np.float64)
+    return ((w / n if n > 1 else w) - float(ZERO)) * ch.lsb
 
 
 def rx_config(channels: dict[str, CodeChannel]) -> str:
@@ -122,15 +125,26 @@ def rx_config(channels: dict[str, CodeChannel]) -> str:
 @dataclass(frozen=True)
 class BoardRecording:
     """A recording at the board's sampling instants ``t = t0 + n · period``: the SI
-    values (interpolated), their codes, and the reference attitude there."""
+    values (interpolated), their codes, and the reference attitude there. With gyro
+    oversampling (``oversample`` > 1) the gyros are converted ``oversample`` times per
+    sample (:attr:`gyro_conversions`), and ``codes["gyro"]`` holds their sums, the words
+    the board sends (``si["gyro"]`` the mean of the converted rates)."""
 
     period: float  #: s
     t: NDArray[np.float64]  #: (n,) s, in the recording's time
     si: dict[str, NDArray[np.float64]]  #: ``gyro``/``acc``/``mag`` → (n, 3) SI values
-    codes: dict[str, NDArray[np.int64]]  #: the same → (n, 3) codes
+    codes: dict[str, NDArray[np.int64]]  #: the same → (n, 3) codes (gyro: sums of ``oversample``)
     quat: NDArray[np.float64]  #: (n, 4) reference w, x, y, z (NaN where lost)
     movement: NDArray[np.bool_]  #: (n,) the samples the metric counts
     channels: dict[str, CodeChannel]
+    oversample: int = 1  #: gyro conversions summed per sample
+    gyro_conversions: NDArray[np.int64] | None = None  #: (n, oversample, 3) each conversion's codes, in time order
+    mean: bool = False  #: ``codes["gyro"]`` is the rounded mean code of the conversions (a plain stream), not the sum
+
+    @property
+    def stream_n(self) -> int:
+        """Conversions per gyro word a receiver divides by: ``oversample``, or 1 for means."""
+        return 1 if self.mean else self.oversample
 
     @property
     def n(self) -> int:
@@ -159,12 +173,19 @@ def _nlerp(q: NDArray[np.float64], rate: float, t: NDArray[np.float64]) -> NDArr
 
 
 def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start: float = 0.0,
-             duration: float | None = None) -> BoardRecording:
+             duration: float | None = None, oversample: int = 1, mean: bool = False) -> BoardRecording:
     """A :class:`attitude_c.broad.Trial` (or anything with ``rate``, ``gyr``, ``acc``,
     ``mag``, ``quat``, ``movement``) at the board's instants from ``start`` (s) for
     ``duration`` (s; None: to the end): gyro, accelerometer and field linearly
     interpolated (point samples, as the board's converter takes them), the reference by
-    normalized linear interpolation, ``movement`` of the nearest sample; then coded."""
+    normalized linear interpolation, ``movement`` of the nearest sample; then coded.
+    ``oversample`` = N > 1: the gyros converted N times per sample, ``period / N`` apart
+    with the last at the sample's instant t (the midpoints of the N sub-intervals of
+    (t − period + period/2N, t + period/2N], as the aided firmware's sub-scans: docs/firmware.md),
+    the codes summed (``mean``: their rounded mean, ``(sum + N/2) // N``, as the firmware's
+    FW_GYRO_MEAN sends it); instants before the recording's start take its first value."""
+    if not (isinstance(oversample, int) and 1 <= oversample <= 16):
+        raise InvalidArgument(f"oversample must be 1..16, got {oversample!r}")
     rate = float(trial.rate)
     n_src = int(trial.gyr.shape[0])
     end = (n_src - 1) / rate if duration is None else min((n_src - 1) / rate, start + duration)
@@ -173,8 +194,15 @@ def resample(trial: Any, period: float, channels: dict[str, CodeChannel], start:
                               f"start={start!r}, end={end!r}")
     t = (start + np.arange(math.floor((end - start) / period) + 1) * period).astype(np.float64)
     si = {k: _interp(np.asarray(a, np.float64), rate, t)
-          for k, a in (("gyro", trial.gyr), ("acc", trial.acc), ("mag", trial.mag))}
+          for k, a in (("acc", trial.acc), ("mag", trial.mag))}
+    cs = {k: codes(v, channels[k]) for k, v in si.items()}
+    n, m = t.shape[0], oversample
+    sub = (t[:, None] - (m - 1 - np.arange(m))[None, :] * (period / m)).reshape(-1)  # (n·m,) in time order
+    g = _interp(np.asarray(trial.gyr, np.float64), rate, sub)  # np.interp: the first value before the start
+    conv = codes(g, channels["gyro"]).reshape(n, m, 3)
+    words = (conv.sum(axis=1) + m // 2) // m if mean else conv.sum(axis=1)
+    si, cs = {"gyro": g.reshape(n, m, 3).mean(axis=1), **si}, {"gyro": words, **cs}
     near = np.minimum(np.rint(t * rate).astype(np.int64), n_src - 1)
-    return BoardRecording(period=period, t=t, si=si, codes={k: codes(v, channels[k]) for k, v in si.items()},
-                          quat=_nlerp(np.asarray(trial.quat, np.float64), rate, t),
-                          movement=np.asarray(trial.movement, bool)[near], channels=channels)
+    return BoardRecording(period=period, t=t, si=si, codes=cs, quat=_nlerp(np.asarray(trial.quat, np.float64), rate, t),
+                          movement=np.asarray(trial.movement, bool)[near], channels=channels, oversample=m,
+                          gyro_conversions=conv, mean=mean)

@@ -1,8 +1,9 @@
 /*
  * libattitude — block format encoders of oversampled streams (see
  * attitude/block.h): the OVERSAMPLE report and sample records of sums.
- * Host-side boards use them (the simulator's modeled board); kept out of
- * block.c so that the AT89S51 firmware, which sends plain codes, links
+ * Host-side boards use them (the simulator's modeled board), and so does the
+ * aided AT89S52 firmware built with gyro oversampling (FW_GYRO_OVERSAMPLE); kept
+ * out of block.c so that the AT89S51 firmware, which sends plain codes, links
  * exactly what it did.
  */
 #include "attitude/block.h"
@@ -26,7 +27,7 @@ int att_block_encode_oversample(uint8_t ATT_LINK_MEM *blk, uint8_t n)
 
 int att_block_encode_sums(uint8_t ATT_LINK_MEM *blk, const uint16_t ATT_LINK_MEM *sums, uint8_t n)
 {
-    uint32_t limit;
+    uint16_t limit;
     uint8_t i;
     if (blk == NULL || sums == NULL) {
         return ATT_E_NULL;
@@ -34,12 +35,15 @@ int att_block_encode_sums(uint8_t ATT_LINK_MEM *blk, const uint16_t ATT_LINK_MEM
     if (n < 1u || n > (uint8_t)ATT_BLOCK_OVERSAMPLE_MAX) {
         return ATT_BLOCK_E_FIELD;
     }
-    limit = (uint32_t)n * (uint32_t)ATT_BLOCK_CODE_MAX;
-    if (limit > (uint32_t)ATT_BLOCK_SUM_MAX) {
-        limit = (uint32_t)ATT_BLOCK_SUM_MAX;
+    /* n x 4095 as n x 4096 - n in 16 bits (16 x 4095 = 65520 fits): no multiplication, so
+     * on the 8051 (the aided board's gyro oversampling) this stays a leaf function whose
+     * locals SDCC overlays */
+    limit = (uint16_t)((uint16_t)((uint16_t)n << 12) - (uint16_t)n);
+    if (limit > (uint16_t)ATT_BLOCK_SUM_MAX) {
+        limit = (uint16_t)ATT_BLOCK_SUM_MAX;
     }
     for (i = 0; i < 3u; i++) {
-        if ((uint32_t)sums[i] > limit) {
+        if (sums[i] > limit) {
             return ATT_BLOCK_E_CODE;
         }
     }

@@ -38,6 +38,18 @@
  * scan of the sample at time k gets the file's group k: the groups of
  * samples the firmware never scanned (lost to an OVERRUN) are read and
  * dropped first, so a loss does not shift the recording.
+ *
+ * Gyro oversampling (FW_GYRO_OVERSAMPLE = N > 1, the aided board): the
+ * scan is sub-scan s (0..N-1) of its sample, the firmware's fw_sub (main.c;
+ * the sub-scans are only 1/N of a period apart, and the main loop can be late
+ * by more than half of that, so the model takes s from the firmware and k
+ * from the time of the sample's first sub-scan, fw_ticks - s x period / N);
+ * the inputs' phase index is k N + s, so the accelerometer and
+ * magnetometer, converted in the last sub-scan, are read at k N + N - 1.
+ * With FW_SIM_DATA the file's group k holds N gyro triples (one per
+ * sub-scan, in time order), then the accelerometer's and magnetometer's
+ * codes; a group the firmware started and did not finish (a sample it lost
+ * at its last sub-scan) is read to its end before the next one.
  */
 #include "attitude/tlc2543.h"
 #include "config.h"
@@ -103,6 +115,19 @@ __sfr16 __at(0xCAC9) m_bound;             /* fw_ticks at which m_k next incremen
 __sfr16 __at(0xCCCB) m_conversions;       /* gyro input evaluations so far */
 #endif
 __sfr __at(0xAF) m_fault_done; /* FW_SIM_EOC_STUCK_AT: the one failed scan happened */
+#if FW_AIDED && FW_GYRO_OVERSAMPLE > 1
+#define OVS FW_GYRO_OVERSAMPLE
+extern uint8_t fw_sub;   /* the firmware's sub-scan (main.c) */
+__sfr __at(0xF7) m_left; /* FW_SIM_DATA: codes of the group being read still in the file */
+#define M_T          ((uint8_t)(m_k * (uint8_t)OVS + fw_sub)) /* the inputs' phase index */
+#define M_SUB_TICKS  ((uint16_t)fw_sub * (uint16_t)(FW_PERIOD_TICKS / OVS))
+#define M_NEW_SAMPLE (fw_sub == 0u) /* the step of a sample's first sub-scan */
+#else
+#define OVS          1
+#define M_T          m_k
+#define M_SUB_TICKS  0u
+#define M_NEW_SAMPLE 1
+#endif
 
 void fw_sim_model_init(void)
 {
@@ -125,6 +150,9 @@ void fw_sim_model_init(void)
 #if defined(FW_SIM_DATA)
     m_next = 0;
 #endif
+#if OVS > 1
+    m_left = 0;
+#endif
 #if defined(FW_SIM_DOUT_STUCK)
     fwm_stuck_dout = FW_SIM_DOUT_STUCK;
 #endif
@@ -138,13 +166,16 @@ void fw_sim_model_init(void)
 static uint16_t next_code(void)
 {
     uint16_t hi = fw_sim_getc();
+#if OVS > 1
+    m_left--;
+#endif
     return (uint16_t)(((hi << 8) | fw_sim_getc()) << 4);
 }
 
-/* Read and drop group m_next (a sample the firmware did not scan). */
-static void skip_group(void)
+/* The codes of group m_next in the file. */
+static uint8_t group_codes(void)
 {
-    uint8_t n = 3u;
+    uint8_t n = 3u * OVS;
 #if FW_ACC_EVERY == 1
     n += 3u;
 #elif FW_ACC_EVERY != 0
@@ -159,6 +190,13 @@ static void skip_group(void)
         n += 3u;
     }
 #endif
+    return n;
+}
+
+/* Read and drop group m_next (a sample the firmware did not scan). */
+static void skip_group(void)
+{
+    uint8_t n = group_codes();
     while (n-- != 0u) {
         (void)next_code();
     }
@@ -180,7 +218,7 @@ static void skip_group(void)
 #endif
 static uint16_t INPUT_FN(uint8_t c)
 {
-    uint8_t p = (uint8_t)(gyro_phase[c] + (uint8_t)(m_k * gyro_step[c]));
+    uint8_t p = (uint8_t)(gyro_phase[c] + (uint8_t)(M_T * gyro_step[c]));
     uint8_t i = (uint8_t)(p & 63u);
     uint8_t q = (uint8_t)(p >> 6);
     uint16_t v;
@@ -271,7 +309,7 @@ unsigned char fwm_end_cycle(void)
 
 void fw_sim_model_step(void)
 {
-    uint16_t t = fw_ticks;
+    uint16_t t = (uint16_t)(fw_ticks - M_SUB_TICKS); /* oversampling: the sample's first sub-scan */
     if (!m_started) {
         m_started = 1;
         m_bound = (uint16_t)(t + (uint16_t)(FW_PERIOD_TICKS - FW_PERIOD_TICKS / 2));
@@ -283,10 +321,20 @@ void fw_sim_model_step(void)
         m_bound += (uint16_t)FW_PERIOD_TICKS;
     }
 #if defined(FW_SIM_DATA)
-    while (m_next != m_k) {
-        skip_group();
+    if (M_NEW_SAMPLE) {
+#if OVS > 1
+        while (m_left != 0u) { /* the rest of a group the firmware did not finish */
+            (void)next_code();
+        }
+#endif
+        while (m_next != m_k) {
+            skip_group();
+        }
+#if OVS > 1
+        m_left = group_codes();
+#endif
+        m_next++; /* this group: its gyros now, its other codes as they are converted */
     }
-    m_next++; /* this group: its gyros now, its other codes as they are converted */
     fwm_vx = next_code();
     fwm_vy = next_code();
     fwm_vz = next_code();

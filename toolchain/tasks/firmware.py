@@ -29,9 +29,12 @@ def _tool() -> ModuleType:
     "mag_every": "aided9: magnetometer record every N samples (likewise)",
     "mag_sr": "aided9: magnetometer set/reset on P3.4, the combined code sent (about 5.5 points of CPU more; "
               "docs/firmware.md)",
+    "gyro_oversample": "aided9: gyro conversions summed per sample, 1 (default), 2, 4 or 8 (docs/firmware.md "
+                       "\"Gyro oversampling\")",
+    "gyro_mean": "aided9, oversampled: send the gyros' rounded mean code instead of the sum (a plain stream)",
 })
 def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", board="gyro3", acc_every=-1,
-          mag_every=-1, mag_sr=False):
+          mag_every=-1, mag_sr=False, gyro_oversample=1, gyro_mean=False):
     """Build the AT89S51 image with SDCC (4 KB flash, 128 B RAM), or the aided AT89S52 one
     (8 KB, 256 B), and print flash, RAM and free stack."""
     import dataclasses
@@ -46,10 +49,12 @@ def build(c, baud=0, period_ticks=72, max_attempts=5, out="", link="legacy", boa
                                       max_attempts=int(max_attempts),
                                       acc_every=tool.AIDED.acc_every if int(acc_every) < 0 else int(acc_every),
                                       mag_every=tool.AIDED.mag_every if int(mag_every) < 0 else int(mag_every),
-                                      mag_sr=bool(mag_sr))
+                                      mag_sr=bool(mag_sr), gyro_oversample=int(gyro_oversample),
+                                      gyro_mean=bool(gyro_mean))
         else:
             cfg = tool.Config(baud=int(baud) or 9600, period_ticks=int(period_ticks), max_attempts=int(max_attempts),
-                              link=link, board=board)
+                              link=link, board=board, gyro_oversample=int(gyro_oversample),
+                              gyro_mean=bool(gyro_mean))
     except ValueError as exc:
         print(f"invoke firmware.build: {exc}", file=sys.stderr)
         raise SystemExit(2) from None

@@ -245,7 +245,8 @@ int att_block_encode_adc_error(uint8_t ATT_LINK_MEM *blk, uint16_t first, int8_t
 int att_block_encode_channels(uint8_t ATT_LINK_MEM *blk, uint8_t board, uint8_t channels, uint8_t acc_every,
                               uint8_t mag_every);
 
-/* Oversampled streams (block_sums.c, not for the 8051 firmware). */
+/* Oversampled streams (block_sums.c: host-side boards, and the aided firmware with gyro
+ * oversampling; not the AT89S51 image). */
 
 /* OVERSAMPLE: the sample records that follow carry sums of n conversions,
  * n = 1..ATT_BLOCK_OVERSAMPLE_MAX (else ATT_BLOCK_E_FIELD). */
