@@ -296,8 +296,10 @@ class ReferenceAhrs:
         x = np.zeros(6)
         gs = self.gnss
         aided = gs.used and gs.time + dt - gs.used_t <= s["gnss_timeout"]
-        if gs.aided and not aided:  # back to the accelerometer: the reported inclination starts again
-            self.tilt, self.tilt_start, self.tilt_dts = None, np.zeros((0, 3)), []
+        if gs.aided and not aided and s["tilt_tau"] > 0:
+            # back to the accelerometer: the reported inclination's low-pass continues from the
+            # state's own (the vertical, at rest), as if converged
+            self.tilt, self.tilt_start = np.array([[0.0, 0.0, s["gravity"]], [0.0, 0.0, 0.0]]), None
         # accelerometer
         wc = w - self.b  # the rate the propagation used (the bias before this sample's update)
         fnav = C @ _undelay(f, wc, s["acc_delay"])
@@ -440,12 +442,15 @@ class ReferenceAhrs:
         heading = not self.flags & 32
         self._gnss_R = var + var_a
         rows = self._gnss_rows(dS, dv, dT, gs.time - (t + t_a) / 2, has_up and up_a, heading)
-        jump = s["gnss_max_acc"] > 0 and math.hypot(dv[0], dv[1]) > s["gnss_max_acc"] * dT
-        gated = s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + self._gnss_R)
-                                           for h, y in rows)
-        if jump or gated:
-            gs.rejected = True
+        if s["gnss_max_acc"] > 0 and math.hypot(dv[0], dv[1]) > s["gnss_max_acc"] * dT:
+            gs.rejected = True  # a jump
             return
+        if s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + self._gnss_R) for h, y in rows):
+            if gs.used and gs.time - gs.used_t <= s["gnss_timeout"]:  # aided: the gate refuses
+                gs.rejected = True
+                return
+            # (re)starting the aiding: the inclination's variance grows instead
+            self.P = self.P + np.diag([1.0, 1.0, 0, 0, 0, 0]) * s["init_att_sigma"] ** 2
         x = np.zeros(6)
         states = (0, 1, 2, 3, 4, 5) if heading else (0, 1, 3, 4, 5)
         for h, y in rows:
