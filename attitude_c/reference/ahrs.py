@@ -363,14 +363,7 @@ class ReferenceAhrs:
             for i in range(3):
                 self._scalar(x, 3 + i, float(self.rest_g[i] - self.b[i]), s["rest_noise"] ** 2 / dt,
                              (3, 4, 5))
-        # injection
-        self.q = _qmul(_exp(x[:3]), self.q)
-        self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
-        if self.tilt is not None:
-            self.tilt = self.tilt + np.cross(x[:3], self.tilt)
-        if self.tilt_start is not None and len(self.tilt_start):
-            self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
-        self.b = self.b + x[3:]
+        self._inject(x)
         # heading observability: measured at least once, and its 1σ within the bound since
         if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
             flags |= 32
@@ -460,16 +453,20 @@ class ReferenceAhrs:
         states = (0, 1, 2, 3, 4, 5) if heading else (0, 1, 3, 4, 5)
         for h, y in rows:
             self._row(x, h, y, R, states)
+        self._inject(x)
+        gs.set_anchor(t, sv_t, v, var, has_up, x[:3], s["gravity"])
+        gs.used, gs.used_t = True, t
+
+    def _inject(self, x: F) -> None:
+        """q ← exp(δθ) ⊗ q, b ← b + δb; the navigation-frame vectors carried through (I + [δθ×])."""
+        assert self.q is not None and self.acc_lp is not None
         self.q = _qmul(_exp(x[:3]), self.q)
-        assert self.acc_lp is not None
         self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
         if self.tilt is not None:
             self.tilt = self.tilt + np.cross(x[:3], self.tilt)
         if self.tilt_start is not None and len(self.tilt_start):
             self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
-        gs.set_anchor(t, sv_t, v, var, has_up, x[:3], s["gravity"])
-        gs.used, gs.used_t = True, t
 
     def _row(self, x: F, h: F, y: float, R: float, states: tuple[int, ...]) -> None:
         """A scalar measurement y = h x + noise (R) with a general row h; gain masked to states;
