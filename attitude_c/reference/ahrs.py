@@ -154,12 +154,20 @@ class ReferenceAhrs:
         self.flags = 0
         self.heading_measured = False  # a magnetometer update has been made
         self.turn_var = 0.0  # rad², added to the reported attitude covariance
+        self.mag_spread = 0.0  # the accepted fields' mean (|m|/norm − 1)², norm the reference's
 
     @property
     def covariance(self) -> F:
         """The reported attitude covariance: P's attitude block plus the turn variance on its
-        diagonal (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q)."""
-        return self.P[:3, :3] + self.turn_var * np.eye(3)
+        diagonal (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q), plus the field's term
+        on the heading: a disturbance of the field that turns it about the vertical leaves its
+        norm and dip as they are, so that unseen component is given the variance of the seen
+        relative norm deviation, s², and turns the horizontal field, of size |m| cos(dip), by
+        s / cos(dip) rad."""
+        c = self.P[:3, :3] + self.turn_var * np.eye(3)
+        if self.mag_ref is not None:
+            c[2, 2] += self.mag_spread / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
+        return c
 
     @property
     def bias_covariance(self) -> F:
@@ -214,6 +222,7 @@ class ReferenceAhrs:
         w = self._weight(dt)
         if self.mag_ref is None:  # the first sample starts both
             self.mag_ref, self.mag_ref_w = cur.copy(), w
+            self.mag_spread = 0.0
             self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
             self.mag_undist = s["mag_min_undisturbed"]
         elif self._agrees(self.mag_cand, cur):
@@ -224,6 +233,9 @@ class ReferenceAhrs:
             self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
         if self._agrees(self.mag_ref, cur):
             self.mag_ref, self.mag_ref_w = self._learn(self.mag_ref, self.mag_ref_w, cur, w)
+            # the spread: the same weighted mean, of the squared deviation from the new reference
+            d2 = (cur[0] / self.mag_ref[0] - 1.0) ** 2
+            self.mag_spread += (w / self.mag_ref_w) * (d2 - self.mag_spread)
             self.mag_undist += dt
             if self.mag_undist >= s["mag_min_undisturbed"]:
                 self.mag_rej = 0.0
@@ -233,10 +245,12 @@ class ReferenceAhrs:
         if self.mag_ref_w < s["mag_ref_window"]:  # not established yet: it starts again here
             self.mag_ref, self.mag_ref_w = cur.copy(), w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            self.mag_spread = 0.0
             return True, R, 0
         if self.mag_cand_t >= s["mag_new_time"]:  # a new homogeneous field
             self.mag_ref, self.mag_ref_w = self.mag_cand.copy(), self.mag_cand_w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            self.mag_spread = 0.0
             return True, R, 16
         self.mag_undist = 0.0
         self.mag_rej += dt
@@ -356,7 +370,8 @@ class ReferenceAhrs:
             self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
         # heading observability: measured at least once, and its 1σ within the bound since
-        if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
+        # (P and the turn term: the field's term does not grow while the heading goes unmeasured)
+        if not (self.heading_measured and self.P[2, 2] + self.turn_var <= s["heading_sigma_max"] ** 2):
             flags |= 32
         self.flags = flags
         out = self.reported()

@@ -254,6 +254,9 @@ typedef struct {
     int flags;             /* ATT_AHRS_F_* of the last update */
     int heading_seen;      /* 1 once a magnetometer update has measured the heading */
     att_real turn_var;     /* [rad²] the reported covariance's turn term (turn_sigma) */
+    att_real mag_ref_var;  /* [1] weighted mean of the accepted samples' (|m|/norm − 1)²,
+                              norm the reference's: the field's spread, which gives the
+                              reported heading variance its field term (docs/ahrs.md) */
 } att_ahrs;
 
 /* The defaults listed above. */
