@@ -141,18 +141,18 @@ def test_nees_and_coverage_of_consistent_samples():
     assert c.heading == pytest.approx(c.expected_heading, abs=0.001)  # binomial σ 1.2e-4, ×8
 
 
-def _pulsing_field(n: int, rate: float, a: float):
-    """At rest, level, the field's norm alternating (1 ± a)·|M_N| sample by sample (its
+def _pulsing_field(n: int, rate: float, a: float, hold: int):
+    """At rest, level, the field's norm alternating (1 ± a)·|M_N| every ``hold`` samples (its
     direction fixed): every sample agrees with the reference for a < mag_norm_tol."""
     gyr, acc, mag, truth = motion(n, rate, (0.0, 0.0, 0.0))
-    mag = mag * (1 + a * (-1.0) ** np.arange(n))[:, None]
+    mag = mag * (1 + a * (-1.0) ** (np.arange(n) // hold))[:, None]
     return gyr, acc, mag, truth
 
 
 def test_field_spread_heading_term_matches_reference():
     """The heading's field term sample by sample, C against the model (docs/ahrs.md,
     "Uncertainty"), and the attitude it leaves as it was (reported only)."""
-    gyr, acc, mag, truth = _pulsing_field(1500, 100.0, 0.03)
+    gyr, acc, mag, truth = _pulsing_field(1500, 100.0, 0.03, 50)
     f = Ahrs(rate=100.0, q0=truth[0])
     q, cov = f.update(gyr, acc, mag, covariance=True)
     cr, flags_r, _ = _reference_run(gyr, acc, mag, 100.0, q0=truth[0])
@@ -167,16 +167,22 @@ def test_field_spread_heading_term_matches_reference():
 
 
 def test_field_spread_heading_term_closed_form():
-    """A norm alternating by ±a about its mean: the spread tends to a², so the heading's field
-    term to a²/cos²(dip) (dip that of M_N), while P's heading variance is the same as in the
-    homogeneous field."""
-    a, rate, n = 0.04, 50.0, 15000  # 300 s: ten times mag_ref_tau (30 s)
-    gyr, acc, mag, truth = _pulsing_field(n, rate, a)
+    """A norm alternating by ±a about its mean every h samples: the spread tends to a², its
+    white part (half the mean squared step) to (2a)²/2 · 1/h, so the heading's field term to
+    a²(1 − 2/h)/cos²(dip) (dip that of M_N); a norm alternating every sample (h = 1: white
+    as far as the term can tell) gives no term."""
+    a, rate, n, h = 0.04, 50.0, 15000, 100  # 300 s: ten times mag_ref_tau (30 s)
+    dip = math.atan2(-M_N[2], math.hypot(M_N[0], M_N[1]))
+    gyr, acc, mag, truth = _pulsing_field(n, rate, a, h)
     f = Ahrs(rate=rate, q0=truth[0])
     f.update(gyr, acc, mag)
     p_head = f.sigma[0][2] ** 2  # P's heading variance (att_ahrs_sigma: P alone)
-    dip = math.atan2(-M_N[2], math.hypot(M_N[0], M_N[1]))
-    # the reference oscillates by a·dt/mag_ref_tau about the mean (the deviation's relative
-    # error is that, 7e-4); the weighted mean forgets its first samples (taken while the
-    # reference was still near them) as exp(−(300 − 30)/30) = 1.2e-4: 2e-3 relative covers both
-    assert f.covariance[2, 2] - p_head == pytest.approx(a * a / math.cos(dip) ** 2, rel=2e-3)
+    # the steps' weight in the 30 s mean depends on the phase: with 15 steps per 1500 samples, the
+    # last one's share moves it by ±3 % of its 2/h (6e-4 relative); the reference ripples by
+    # a·h/(4·1500) about the mean (its square 3e-4 relative of a²); the weighted mean forgets its
+    # first samples as exp(−(300 − 30)/30) = 1.2e-4: 2e-3 relative covers them
+    assert f.covariance[2, 2] - p_head == pytest.approx(a * a * (1 - 2 / h) / math.cos(dip) ** 2, rel=2e-3)
+    gyr, acc, mag, truth = _pulsing_field(n, rate, a, 1)
+    f = Ahrs(rate=rate, q0=truth[0])
+    f.update(gyr, acc, mag)
+    assert f.covariance[2, 2] == pytest.approx(f.sigma[0][2] ** 2, rel=1e-14)  # √ then ²: a few ulp

@@ -155,6 +155,8 @@ class ReferenceAhrs:
         self.heading_measured = False  # a magnetometer update has been made
         self.turn_var = 0.0  # rad², added to the reported attitude covariance
         self.mag_spread = 0.0  # the accepted fields' mean (|m|/norm − 1)², norm the reference's
+        self.mag_dspread = 0.0  # ... and of half the squared step between accepted samples' |m|/norm
+        self.mag_prev: float | None = None  # the last accepted sample's |m|
 
     @property
     def covariance(self) -> F:
@@ -163,10 +165,12 @@ class ReferenceAhrs:
         on the heading: a disturbance of the field that turns it about the vertical leaves its
         norm and dip as they are, so that unseen component is given the variance of the seen
         relative norm deviation, s², and turns the horizontal field, of size |m| cos(dip), by
-        s / cos(dip) rad."""
+        s / cos(dip) rad. The white part of s² (the magnetometer's noise, already in the heading's
+        R) is left out: for white noise half the mean squared step between samples is its variance
+        (the Allan variance at one sample), for a slow disturbance that is small."""
         c = self.P[:3, :3] + self.turn_var * np.eye(3)
         if self.mag_ref is not None:
-            c[2, 2] += self.mag_spread / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
+            c[2, 2] += max(self.mag_spread - self.mag_dspread, 0.0) / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
         return c
 
     @property
@@ -222,7 +226,7 @@ class ReferenceAhrs:
         w = self._weight(dt)
         if self.mag_ref is None:  # the first sample starts both
             self.mag_ref, self.mag_ref_w = cur.copy(), w
-            self.mag_spread = 0.0
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
             self.mag_undist = s["mag_min_undisturbed"]
         elif self._agrees(self.mag_cand, cur):
@@ -236,6 +240,10 @@ class ReferenceAhrs:
             # the spread: the same weighted mean, of the squared deviation from the new reference
             d2 = (cur[0] / self.mag_ref[0] - 1.0) ** 2
             self.mag_spread += (w / self.mag_ref_w) * (d2 - self.mag_spread)
+            if self.mag_prev is not None:
+                e2 = ((cur[0] - self.mag_prev) / self.mag_ref[0]) ** 2 / 2
+                self.mag_dspread += (w / self.mag_ref_w) * (e2 - self.mag_dspread)
+            self.mag_prev = float(cur[0])
             self.mag_undist += dt
             if self.mag_undist >= s["mag_min_undisturbed"]:
                 self.mag_rej = 0.0
@@ -245,12 +253,12 @@ class ReferenceAhrs:
         if self.mag_ref_w < s["mag_ref_window"]:  # not established yet: it starts again here
             self.mag_ref, self.mag_ref_w = cur.copy(), w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
-            self.mag_spread = 0.0
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             return True, R, 0
         if self.mag_cand_t >= s["mag_new_time"]:  # a new homogeneous field
             self.mag_ref, self.mag_ref_w = self.mag_cand.copy(), self.mag_cand_w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
-            self.mag_spread = 0.0
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             return True, R, 16
         self.mag_undist = 0.0
         self.mag_rej += dt

@@ -199,6 +199,8 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->step.turn = 0;
     s->turn_var = 0;
     s->mag_ref_var = 0;
+    s->mag_ref_dvar = 0;
+    s->mag_prev = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -776,22 +778,38 @@ static void field_set(att_real est[2], att_real *W, att_real w, att_real nm, att
 }
 
 /* The field's spread about the reference (after field_learn has taken the
- * sample in): the weighted mean of (|m|/norm − 1)², with the reference's weights. */
+ * sample in): the weighted mean of (|m|/norm − 1)², with the reference's weights,
+ * and of half the squared step from the last accepted sample (the white part:
+ * the magnetometer's noise, which the heading's R already carries). */
 static void field_spread(att_ahrs *s, att_real w, att_real nm)
 {
-    att_real d = nm / s->mag_ref[0] - ATT_R(1.0);
-    s->mag_ref_var += w / s->mag_ref_w * (d * d - s->mag_ref_var);
+    att_real k = w / s->mag_ref_w, d = nm / s->mag_ref[0] - ATT_R(1.0), e;
+    s->mag_ref_var += k * (d * d - s->mag_ref_var);
+    if (s->mag_prev > 0) {
+        e = (nm - s->mag_prev) / s->mag_ref[0];
+        s->mag_ref_dvar += k * (ATT_R(0.5) * e * e - s->mag_ref_dvar);
+    }
+    s->mag_prev = nm;
+}
+
+/* The spread starts again with the reference. */
+static void field_spread_reset(att_ahrs *s)
+{
+    s->mag_ref_var = 0;
+    s->mag_ref_dvar = 0;
+    s->mag_prev = 0;
 }
 
 /* The reported heading variance's field term: the norm checks cannot see a
  * disturbance that turns the field about the vertical, so that component is
  * given the variance of the one they see (the norm's spread, relative), which
- * turns the heading by itself over cos(dip) (docs/ahrs.md, "Uncertainty"). */
+ * turns the heading by itself over cos(dip); its white part is left out
+ * (docs/ahrs.md, "Uncertainty"). */
 static att_real field_heading_var(const att_ahrs *s)
 {
-    att_real c = att_cos(s->mag_ref[1]);
+    att_real c = att_cos(s->mag_ref[1]), v = s->mag_ref_var - s->mag_ref_dvar;
     c *= c;
-    return s->mag_ref_valid ? s->mag_ref_var / (c > ATT_R(1e-6) ? c : ATT_R(1e-6)) : 0;
+    return (s->mag_ref_valid && v > 0) ? v / (c > ATT_R(1e-6) ? c : ATT_R(1e-6)) : 0;
 }
 
 /* Magnetic reference, start and candidate: the first sample starts both; the
@@ -806,7 +824,7 @@ static void mag_candidate(att_ahrs *s, const att_real gyr[3], att_real nm, att_r
         field_set(s->mag_ref, &s->mag_ref_w, w, nm, dip);
         field_set(s->mag_cand, &s->mag_cand_w, w, nm, dip);
         s->mag_ref_valid = 1;
-        s->mag_ref_var = 0;
+        field_spread_reset(s);
         s->mag_undist_t = set->mag_min_undisturbed;
         s->mag_cand_t = 0;
         return;
@@ -852,7 +870,7 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
             field_set(s->mag_ref, &s->mag_ref_w, s->mag_cand_w, s->mag_cand[0], s->mag_cand[1]);
             *flags |= ATT_AHRS_F_MAG_RELEARNED;
         }
-        s->mag_ref_var = 0;
+        field_spread_reset(s);
         s->mag_rej_time = 0;
         s->mag_undist_t = set->mag_min_undisturbed;
         return 1;
