@@ -169,7 +169,7 @@ def test_field_spread_heading_term_matches_reference():
 def test_field_spread_heading_term_closed_form():
     """A norm alternating by ±a about its mean every h samples: the spread tends to a², its
     white part (half the mean squared step) to (2a)²/2 · 1/h, so the heading's field term to
-    a²(1 − 2/h)/cos²(dip) (dip that of M_N); a norm alternating every sample (h = 1: white
+    (a² − 2a²/h·(1 + 2√(dt/W)))/cos²(dip) (dip that of M_N); a norm alternating every sample (h = 1: white
     as far as the term can tell) gives no term."""
     a, rate, n, h = 0.04, 50.0, 15000, 100  # 300 s: ten times mag_ref_tau (30 s)
     dip = math.atan2(-M_N[2], math.hypot(M_N[0], M_N[1]))
@@ -181,7 +181,8 @@ def test_field_spread_heading_term_closed_form():
     # last one's share moves it by ±3 % of its 2/h (6e-4 relative); the reference ripples by
     # a·h/(4·1500) about the mean (its square 3e-4 relative of a²); the weighted mean forgets its
     # first samples as exp(−(300 − 30)/30) = 1.2e-4: 2e-3 relative covers them
-    assert f.covariance[2, 2] - p_head == pytest.approx(a * a * (1 - 2 / h) / math.cos(dip) ** 2, rel=2e-3)
+    white = 2 * a * a / h * (1 + 2 * math.sqrt(1 / rate / 30.0))  # less its 2σ, W = 30 s
+    assert f.covariance[2, 2] - p_head == pytest.approx((a * a - white) / math.cos(dip) ** 2, rel=2e-3)
     gyr, acc, mag, truth = _pulsing_field(n, rate, a, 1)
     f = Ahrs(rate=rate, q0=truth[0])
     f.update(gyr, acc, mag)

@@ -157,6 +157,7 @@ class ReferenceAhrs:
         self.mag_spread = 0.0  # the accepted fields' mean (|m|/norm − 1)², norm the reference's
         self.mag_dspread = 0.0  # ... and of half the squared step between accepted samples' |m|/norm
         self.mag_prev: float | None = None  # the last accepted sample's |m|
+        self.last_dt = 0.0  # s, the last update's step
 
     @property
     def covariance(self) -> F:
@@ -170,7 +171,10 @@ class ReferenceAhrs:
         (the Allan variance at one sample), for a slow disturbance that is small."""
         c = self.P[:3, :3] + self.turn_var * np.eye(3)
         if self.mag_ref is not None:
-            c[2, 2] += max(self.mag_spread - self.mag_dspread, 0.0) / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
+            # less twice the 1σ of (spread − white part) for white noise over N = W/dt samples,
+            # white part/√N: a spread that is noise alone gives no term
+            white = self.mag_dspread * (1.0 + 2.0 * math.sqrt(self.last_dt / self.mag_ref_w))
+            c[2, 2] += max(self.mag_spread - white, 0.0) / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
         return c
 
     @property
@@ -237,15 +241,16 @@ class ReferenceAhrs:
             self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
         if self._agrees(self.mag_ref, cur):
             self.mag_ref, self.mag_ref_w = self._learn(self.mag_ref, self.mag_ref_w, cur, w)
-            # the spread: the same weighted mean, of the squared deviation from the new reference
-            d2 = (cur[0] / self.mag_ref[0] - 1.0) ** 2
-            self.mag_spread += (w / self.mag_ref_w) * (d2 - self.mag_spread)
-            if self.mag_prev is not None:
-                e2 = ((cur[0] - self.mag_prev) / self.mag_ref[0]) ** 2 / 2
-                self.mag_dspread += (w / self.mag_ref_w) * (e2 - self.mag_dspread)
-            self.mag_prev = float(cur[0])
             self.mag_undist += dt
             if self.mag_undist >= s["mag_min_undisturbed"]:
+                # the spread of the samples the heading uses: the same weighted mean, of the
+                # squared deviation from the new reference and of half the squared step
+                d2 = (cur[0] / self.mag_ref[0] - 1.0) ** 2
+                self.mag_spread += (w / self.mag_ref_w) * (d2 - self.mag_spread)
+                if self.mag_prev is not None:
+                    e2 = ((cur[0] - self.mag_prev) / self.mag_ref[0]) ** 2 / 2
+                    self.mag_dspread += (w / self.mag_ref_w) * (e2 - self.mag_dspread)
+                self.mag_prev = float(cur[0])
                 self.mag_rej = 0.0
                 return True, R, 0
             self.mag_rej += dt
@@ -269,6 +274,7 @@ class ReferenceAhrs:
     # -- one sample --------------------------------------------------------
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: float) -> F:
         s = self.s
+        self.last_dt = dt
         w = np.asarray(gyr, float)
         f = np.asarray(acc, float)
         m = None if mag is None else np.asarray(mag, float)

@@ -803,11 +803,17 @@ static void field_spread_reset(att_ahrs *s)
 /* The reported heading variance's field term: the norm checks cannot see a
  * disturbance that turns the field about the vertical, so that component is
  * given the variance of the one they see (the norm's spread, relative), which
- * turns the heading by itself over cos(dip); its white part is left out
- * (docs/ahrs.md, "Uncertainty"). */
+ * turns the heading by itself over cos(dip); its white part is left out, and
+ * what the white part's estimate may be off by (docs/ahrs.md, "Uncertainty"). */
 static att_real field_heading_var(const att_ahrs *s)
 {
-    att_real c = att_cos(s->mag_ref[1]), v = s->mag_ref_var - s->mag_ref_dvar;
+    att_real c = att_cos(s->mag_ref[1]), v;
+    if (!(s->mag_ref_w > 0)) {
+        return 0;
+    }
+    /* less twice its own 1σ for white noise, dvar·√(dt/W): a spread that is noise alone
+     * stays 0 */
+    v = s->mag_ref_var - s->mag_ref_dvar * (ATT_R(1.0) + ATT_R(2.0) * att_sqrt(s->step.dt / s->mag_ref_w));
     c *= c;
     return (s->mag_ref_valid && v > 0) ? v / (c > ATT_R(1e-6) ? c : ATT_R(1e-6)) : 0;
 }
@@ -853,9 +859,9 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
     *r = k->r_mag;
     if (field_agrees(set, s->mag_ref, nm, dip)) {
         field_learn(s->mag_ref, &s->mag_ref_w, w, set->mag_ref_tau, nm, dip);
-        field_spread(s, w, nm);
         s->mag_undist_t += dt;
         if (s->mag_undist_t >= set->mag_min_undisturbed) {
+            field_spread(s, w, nm); /* the samples the heading uses */
             s->mag_rej_time = 0;
             return 1;
         }
