@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InvalidArgument, InvalidType
 
-__all__ = ["MAPPING", "PLATEAU", "AllanResult", "Terms", "allan", "config_text", "filter_settings", "plot"]
+__all__ = ["MAPPING", "MAPPING_CALIBRATED", "PLATEAU", "AllanResult", "Terms", "allan", "config_text", "filter_settings", "plot"]
 
 FloatArray = NDArray[np.float64]
 Kind = Literal["gyro", "accel"]
@@ -231,6 +231,26 @@ MAPPING: tuple[tuple[str, str, str], ...] = (
      ("the inclination's noise density is the accelerometer's white noise over g, plus linear "
       "acceleration in motion, which rest does not show: the default stays as the floor")),
 )
+#: The same for parts whose only error in motion is their noise (``calibrated=True``: scale and
+#: misalignment calibrated out, no vibration, no linear acceleration: the simulator's calibrated
+#: parts, a turntable run): no floors, and what the floors carried is derived from the noise.
+MAPPING_CALIBRATED: tuple[tuple[str, str, str], ...] = (
+    ("gyr_noise_rest, gyr_noise, rest_noise", "N of the gyro",
+     "no model error in motion: the process noise is the gyro's own white noise, at rest and in motion"),
+    ("bias_noise", "max(√(K² + 3·(0.664·B)²/τ_min), default) of the gyro",
+     ("as in MAPPING: calibration removes scale and misalignment, not the turn-on transients and "
+      "temperature changes the default floor stands for")),
+    ("acc_noise", "σ_A(τ)·√τ / gravity at τ = acc_noise / gyr_noise (accelerometer's fitted model)",
+     ("the white density with the accelerometer's own Allan deviation over the inclination's Kalman "
+      "time constant: the bias instability and walk the filter has no state for count as the noise "
+      "they are over the time the inclination averages")),
+    ("tilt_tau", "0",
+     ("the reported inclination is the state's: the covariance is the state's, and the second "
+      "low-pass exists for real motion's linear accelerations")),
+    ("turn_sigma", "0", "no scale or misalignment error: no fast-turn term"),
+    ("mag_noise", "σ_A(τ)·√τ / |m_h| at τ = mag_noise / gyr_noise (magnetometer's fitted model)",
+     "the heading's noise is the field's noise across the horizontal field |m_h|, over the heading's time constant"),
+)
 #: Uncertainties of the terms are the least-squares 1σ times this: neighbouring octaves share
 #: their data, so their errors are correlated and the fit's own σ is too small. In the sweeps of
 #: docs/noise.md (``invoke allan-sweep``) the spread of the fitted terms was 1.1–1.7× the
@@ -239,9 +259,17 @@ UNCERTAINTY_SCALE = 2.0
 
 
 def filter_settings(gyro: Terms | AllanResult, accel: Terms | AllanResult | None = None,
-                    gravity: float | None = None) -> dict[str, float]:
+                    gravity: float | None = None, *, calibrated: bool = False,
+                    mag: Terms | AllanResult | None = None, mag_h: float | None = None) -> dict[str, float]:
     """The attitude filter's settings from the noise terms of its gyro (rad/s)
-    and accelerometer (m/s²): :data:`MAPPING`, for the worst axis of each."""
+    and accelerometer (m/s²): :data:`MAPPING`, for the worst axis of each; with
+    ``calibrated`` (parts whose only error in motion is their noise)
+    :data:`MAPPING_CALIBRATED`, which needs ``accel``, and with ``mag`` (its terms,
+    any unit) and ``mag_h`` (the horizontal field at rest, that unit) also ``mag_noise``."""
+    if not isinstance(calibrated, bool):
+        raise InvalidType(f"calibrated must be a bool, got {type(calibrated).__name__}")
+    if calibrated:
+        return _calibrated_settings(gyro, accel, gravity, mag, mag_h)
     from .ahrs_filter import default_settings
 
     d = default_settings()
@@ -256,6 +284,44 @@ def filter_settings(gyro: Terms | AllanResult, accel: Terms | AllanResult | None
         out["acc_noise"] = max(_worst(accel, "accel").n / grav, d["acc_noise"])
     if g.n <= 0:
         raise InvalidArgument("gyro: no white noise found (N = 0): is this a rate recording at rest?")
+    return out
+
+
+def _own_time_density(t: Terms, sg: float, scale: float) -> float:
+    """The fixed point a = σ_A(τ)·√τ / scale, τ = a / sg: the white density whose average over the
+    Kalman time constant it sets has the part's own Allan deviation there (σ_A²τ grows with τ, so
+    the iteration from N rises monotonically to it)."""
+    a = t.n / scale
+    for _ in range(200):
+        tau = a / sg
+        nxt = float(t.adev(tau)) * math.sqrt(tau) / scale
+        if abs(nxt - a) <= 1e-12 * a:
+            break
+        a = nxt
+    return a
+
+
+def _calibrated_settings(gyro: Terms | AllanResult, accel: Terms | AllanResult | None, gravity: float | None,
+                         mag: Terms | AllanResult | None, mag_h: float | None) -> dict[str, float]:
+    from .ahrs_filter import default_settings
+
+    if accel is None:
+        raise InvalidArgument("calibrated: the accelerometer's terms are needed (accel)")
+    g = _worst(gyro, "gyro")
+    if g.n <= 0:
+        raise InvalidArgument("gyro: no white noise found (N = 0): is this a rate recording at rest?")
+    grav = float(default_settings()["gravity"] if gravity is None else gravity)
+    if not (math.isfinite(grav) and grav > 0):
+        raise InvalidArgument(f"gravity must be a finite number > 0 (m/s²), got {gravity!r}")
+    k_eff = math.sqrt(g.k ** 2 + 3 * (PLATEAU * g.b) ** 2 / g.tau_min) if g.b > 0 else g.k
+    acc = _own_time_density(_worst(accel, "accel"), g.n, grav)
+    out = {"gyr_noise_rest": g.n, "gyr_noise": g.n, "rest_noise": g.n,
+           "bias_noise": max(k_eff, default_settings()["bias_noise"]), "acc_noise": acc, "tilt_tau": 0.0,
+           "turn_sigma": 0.0}
+    if mag is not None:
+        if mag_h is None or not (math.isfinite(mag_h) and mag_h > 0):
+            raise InvalidArgument(f"mag_h must be the horizontal field (> 0, the magnetometer's unit), got {mag_h!r}")
+        out["mag_noise"] = _own_time_density(_worst(mag, "mag"), g.n, float(mag_h))
     return out
 
 

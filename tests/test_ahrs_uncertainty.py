@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import motion
+from conftest import M_N, motion
 
 from attitude_c import names
 from attitude_c import reference as ref
@@ -139,3 +139,51 @@ def test_nees_and_coverage_of_consistent_samples():
     c = coverage(err, cov)
     assert c.ellipsoid == pytest.approx(c.expected_ellipsoid, abs=0.002)  # binomial σ 3.8e-4, ×5
     assert c.heading == pytest.approx(c.expected_heading, abs=0.001)  # binomial σ 1.2e-4, ×8
+
+
+def _pulsing_field(n: int, rate: float, a: float, hold: int):
+    """At rest, level, the field's norm alternating (1 ± a)·|M_N| every ``hold`` samples (its
+    direction fixed): every sample agrees with the reference for a < mag_norm_tol."""
+    gyr, acc, mag, truth = motion(n, rate, (0.0, 0.0, 0.0))
+    mag = mag * (1 + a * (-1.0) ** (np.arange(n) // hold))[:, None]
+    return gyr, acc, mag, truth
+
+
+def test_field_spread_heading_term_matches_reference():
+    """The heading's field term sample by sample, C against the model (docs/ahrs.md,
+    "Uncertainty"), and the attitude it leaves as it was (reported only)."""
+    gyr, acc, mag, truth = _pulsing_field(1500, 100.0, 0.03, 50)
+    f = Ahrs(rate=100.0, q0=truth[0])
+    q, cov = f.update(gyr, acc, mag, covariance=True)
+    cr, flags_r, _ = _reference_run(gyr, acc, mag, 100.0, q0=truth[0])
+    # the same recursions in double; the field term ~1e-2 rad², kept to ~1e4 ulp as above
+    assert np.abs(cov - cr).max() < 1e-14
+    assert f.flags == flags_r[-1]
+    q_homog, c_homog = ahrs(gyr, acc, motion(1500, 100.0, (0.0, 0.0, 0.0))[2], rate=100.0, q0=truth[0],
+                            covariance=True)
+    # the norm is not used by the updates (only its agreement, and all agree): the same attitude
+    np.testing.assert_array_equal(q, q_homog)
+    assert cov[-1][2, 2] > c_homog[-1][2, 2]
+
+
+def test_field_spread_heading_term_closed_form():
+    """A norm alternating by ±a about its mean every h samples: the spread tends to a², its
+    white part (half the mean squared step) to (2a)²/2 · 1/h, so the heading's field term to
+    (a² − 2a²/h·(1 + 2√(dt/W)))/cos²(dip) (dip that of M_N); a norm alternating every sample (h = 1: white
+    as far as the term can tell) gives no term."""
+    a, rate, n, h = 0.04, 50.0, 15000, 100  # 300 s: ten times mag_ref_tau (30 s)
+    dip = math.atan2(-M_N[2], math.hypot(M_N[0], M_N[1]))
+    gyr, acc, mag, truth = _pulsing_field(n, rate, a, h)
+    f = Ahrs(rate=rate, q0=truth[0])
+    f.update(gyr, acc, mag)
+    p_head = f.sigma[0][2] ** 2  # P's heading variance (att_ahrs_sigma: P alone)
+    # the steps' weight in the 30 s mean depends on the phase: with 15 steps per 1500 samples, the
+    # last one's share moves it by ±3 % of its 2/h (6e-4 relative); the reference ripples by
+    # a·h/(4·1500) about the mean (its square 3e-4 relative of a²); the weighted mean forgets its
+    # first samples as exp(−(300 − 30)/30) = 1.2e-4: 2e-3 relative covers them
+    white = 2 * a * a / h * (1 + 2 * math.sqrt(1 / rate / 30.0))  # less its 2σ, W = 30 s
+    assert f.covariance[2, 2] - p_head == pytest.approx((a * a - white) / math.cos(dip) ** 2, rel=2e-3)
+    gyr, acc, mag, truth = _pulsing_field(n, rate, a, 1)
+    f = Ahrs(rate=rate, q0=truth[0])
+    f.update(gyr, acc, mag)
+    assert f.covariance[2, 2] == pytest.approx(f.sigma[0][2] ** 2, rel=1e-14)  # √ then ²: a few ulp

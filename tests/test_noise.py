@@ -113,6 +113,32 @@ def test_filter_settings_mapping() -> None:
         filter_settings(quiet, quiet, gravity=-1.0)
 
 
+def test_filter_settings_calibrated() -> None:
+    """docs/noise.md, MAPPING_CALIBRATED: no floors; acc_noise (and mag_noise) the fixed point
+    a = σ_A(τ)·√τ / scale at τ = a / gyr_noise, checked against that equation (and, for white
+    noise alone, a = N / scale exactly); the inclination reported from the state."""
+    from attitude_c.ahrs_filter import default_settings
+
+    gyro = Terms(4e-5, 0, 0.0, 0, 0.0, 0, 100.0, 1e-5)
+    acc = Terms(8e-3, 0, 1.5e-3, 0, 1e-4, 0, 30.0, 1e-3)
+    mag = Terms(0.02, 0, 0.0, 0, 0.0, 0, 10.0, 1e-3)  # µT·√s, white only
+    s = filter_settings(gyro, acc, calibrated=True, mag=mag, mag_h=34.0)
+    assert s["gyr_noise"] == s["gyr_noise_rest"] == s["rest_noise"] == 4e-5
+    assert s["bias_noise"] == default_settings()["bias_noise"] and s["tilt_tau"] == 0 and s["turn_sigma"] == 0
+    g, a = default_settings()["gravity"], s["acc_noise"]
+    tau = a / 4e-5
+    model = (8e-3 ** 2 + (PLATEAU * 1.5e-3) ** 2 * tau + 1e-4 ** 2 * tau ** 2 / 3) / g ** 2
+    assert a ** 2 == pytest.approx(model, rel=1e-9)  # the iteration stops at 1e-12 relative steps
+    assert a > 8e-3 / g  # the bias instability adds to the white density
+    assert s["mag_noise"] == pytest.approx(0.02 / 34.0, rel=1e-12)  # white only: σ_A(τ)√τ = N
+    with pytest.raises(InvalidArgument, match="accel"):
+        filter_settings(gyro, calibrated=True)
+    with pytest.raises(InvalidArgument, match="mag_h"):
+        filter_settings(gyro, acc, calibrated=True, mag=mag)
+    with pytest.raises(InvalidType, match="calibrated"):
+        filter_settings(gyro, acc, calibrated=1)  # type: ignore[arg-type]
+
+
 def _rest_csv(path: Path, n: int = 4000, turn: float = 0.0) -> Path:
     rng = np.random.default_rng(5)
     t = np.arange(n) * 0.01

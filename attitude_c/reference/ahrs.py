@@ -161,12 +161,28 @@ class ReferenceAhrs:
         self.heading_measured = False  # a magnetometer update has been made
         self.turn_var = 0.0  # rad², added to the reported attitude covariance
         self.gnss = _GnssState()
+        self.mag_spread = 0.0  # the accepted fields' mean (|m|/norm − 1)², norm the reference's
+        self.mag_dspread = 0.0  # ... and of half the squared step between accepted samples' |m|/norm
+        self.mag_prev: float | None = None  # the last accepted sample's |m|
+        self.last_dt = 0.0  # s, the last update's step
 
     @property
     def covariance(self) -> F:
         """The reported attitude covariance: P's attitude block plus the turn variance on its
-        diagonal (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q)."""
-        return self.P[:3, :3] + self.turn_var * np.eye(3)
+        diagonal (rad², the ENU rotation vector δθ, q_true = exp(δθ) ⊗ q), plus the field's term
+        on the heading: a disturbance of the field that turns it about the vertical leaves its
+        norm and dip as they are, so that unseen component is given the variance of the seen
+        relative norm deviation, s², and turns the horizontal field, of size |m| cos(dip), by
+        s / cos(dip) rad. The white part of s² (the magnetometer's noise, already in the heading's
+        R) is left out: for white noise half the mean squared step between samples is its variance
+        (the Allan variance at one sample), for a slow disturbance that is small."""
+        c = self.P[:3, :3] + self.turn_var * np.eye(3)
+        if self.mag_ref is not None:
+            # less twice the 1σ of (spread − white part) for white noise over N = W/dt samples,
+            # white part/√N: a spread that is noise alone gives no term
+            white = self.mag_dspread * (1.0 + 2.0 * math.sqrt(self.last_dt / self.mag_ref_w))
+            c[2, 2] += max(self.mag_spread - white, 0.0) / max(math.cos(float(self.mag_ref[1])) ** 2, 1e-6)
+        return c
 
     @property
     def bias_covariance(self) -> F:
@@ -222,6 +238,7 @@ class ReferenceAhrs:
         w = self._weight(dt)
         if self.mag_ref is None:  # the first sample starts both
             self.mag_ref, self.mag_ref_w = cur.copy(), w
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             self.mag_cand, self.mag_cand_w, self.mag_cand_t = cur.copy(), w, 0.0
             self.mag_undist = s["mag_min_undisturbed"]
         elif self._agrees(self.mag_cand, cur):
@@ -234,6 +251,14 @@ class ReferenceAhrs:
             self.mag_ref, self.mag_ref_w = self._learn(self.mag_ref, self.mag_ref_w, cur, w)
             self.mag_undist += dt
             if self.mag_undist >= s["mag_min_undisturbed"]:
+                # the spread of the samples the heading uses: the same weighted mean, of the
+                # squared deviation from the new reference and of half the squared step
+                d2 = (cur[0] / self.mag_ref[0] - 1.0) ** 2
+                self.mag_spread += (w / self.mag_ref_w) * (d2 - self.mag_spread)
+                if self.mag_prev is not None:
+                    e2 = ((cur[0] - self.mag_prev) / self.mag_ref[0]) ** 2 / 2
+                    self.mag_dspread += (w / self.mag_ref_w) * (e2 - self.mag_dspread)
+                self.mag_prev = float(cur[0])
                 self.mag_rej = 0.0
                 return True, R, 0
             self.mag_rej += dt
@@ -241,10 +266,12 @@ class ReferenceAhrs:
         if self.mag_ref_w < s["mag_ref_window"]:  # not established yet: it starts again here
             self.mag_ref, self.mag_ref_w = cur.copy(), w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             return True, R, 0
         if self.mag_cand_t >= s["mag_new_time"]:  # a new homogeneous field
             self.mag_ref, self.mag_ref_w = self.mag_cand.copy(), self.mag_cand_w
             self.mag_rej, self.mag_undist = 0.0, s["mag_min_undisturbed"]
+            self.mag_spread, self.mag_dspread, self.mag_prev = 0.0, 0.0, None
             return True, R, 16
         self.mag_undist = 0.0
         self.mag_rej += dt
@@ -255,6 +282,7 @@ class ReferenceAhrs:
     # -- one sample --------------------------------------------------------
     def update(self, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: float) -> F:
         s = self.s
+        self.last_dt = dt
         w = np.asarray(gyr, float)
         f = np.asarray(acc, float)
         m = None if mag is None else np.asarray(mag, float)
@@ -365,7 +393,8 @@ class ReferenceAhrs:
                              (3, 4, 5))
         self._inject(x)
         # heading observability: measured at least once, and its 1σ within the bound since
-        if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
+        # (P and the turn term: the field's term does not grow while the heading goes unmeasured)
+        if not (self.heading_measured and self.P[2, 2] + self.turn_var <= s["heading_sigma_max"] ** 2):
             flags |= 32
         self.flags = flags | (64 if aided else 0) | (128 if gs.rejected else 0)
         gs.record(fnav, dt, g, aided, s["gnss_max_latency"] / (GNSS_HIST - 2))

@@ -216,6 +216,9 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->step.tilt = 0; /* read by att_ahrs_attitude before the first update */
     s->step.turn = 0;
     s->turn_var = 0;
+    s->mag_ref_var = 0;
+    s->mag_ref_dvar = 0;
+    s->mag_prev = 0;
     s->acc_norm_lp = 0;
     s->acc_rej_time = 0;
     s->mag_ref[0] = 0;
@@ -795,6 +798,47 @@ static void field_set(att_real est[2], att_real *W, att_real w, att_real nm, att
     *W = w;
 }
 
+/* The field's spread about the reference (after field_learn has taken the
+ * sample in): the weighted mean of (|m|/norm − 1)², with the reference's weights,
+ * and of half the squared step from the last accepted sample (the white part:
+ * the magnetometer's noise, which the heading's R already carries). */
+static void field_spread(att_ahrs *s, att_real w, att_real nm)
+{
+    att_real k = w / s->mag_ref_w, d = nm / s->mag_ref[0] - ATT_R(1.0), e;
+    s->mag_ref_var += k * (d * d - s->mag_ref_var);
+    if (s->mag_prev > 0) {
+        e = (nm - s->mag_prev) / s->mag_ref[0];
+        s->mag_ref_dvar += k * (ATT_R(0.5) * e * e - s->mag_ref_dvar);
+    }
+    s->mag_prev = nm;
+}
+
+/* The spread starts again with the reference. */
+static void field_spread_reset(att_ahrs *s)
+{
+    s->mag_ref_var = 0;
+    s->mag_ref_dvar = 0;
+    s->mag_prev = 0;
+}
+
+/* The reported heading variance's field term: the norm checks cannot see a
+ * disturbance that turns the field about the vertical, so that component is
+ * given the variance of the one they see (the norm's spread, relative), which
+ * turns the heading by itself over cos(dip); its white part is left out, and
+ * what the white part's estimate may be off by (docs/ahrs.md, "Uncertainty"). */
+static att_real field_heading_var(const att_ahrs *s)
+{
+    att_real c = att_cos(s->mag_ref[1]), v;
+    if (!(s->mag_ref_w > 0)) {
+        return 0;
+    }
+    /* less twice its own 1σ for white noise, dvar·√(dt/W): a spread that is noise alone
+     * stays 0 */
+    v = s->mag_ref_var - s->mag_ref_dvar * (ATT_R(1.0) + ATT_R(2.0) * att_sqrt(s->step.dt / s->mag_ref_w));
+    c *= c;
+    return (s->mag_ref_valid && v > 0) ? v / (c > ATT_R(1e-6) ? c : ATT_R(1e-6)) : 0;
+}
+
 /* Magnetic reference, start and candidate: the first sample starts both; the
  * candidate learns a field consistent with itself (else restarts from the
  * sample), its time running only while turning (a field fixed to the body
@@ -807,6 +851,7 @@ static void mag_candidate(att_ahrs *s, const att_real gyr[3], att_real nm, att_r
         field_set(s->mag_ref, &s->mag_ref_w, w, nm, dip);
         field_set(s->mag_cand, &s->mag_cand_w, w, nm, dip);
         s->mag_ref_valid = 1;
+        field_spread_reset(s);
         s->mag_undist_t = set->mag_min_undisturbed;
         s->mag_cand_t = 0;
         return;
@@ -837,6 +882,7 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
         field_learn(s->mag_ref, &s->mag_ref_w, w, set->mag_ref_tau, nm, dip);
         s->mag_undist_t += dt;
         if (s->mag_undist_t >= set->mag_min_undisturbed) {
+            field_spread(s, w, nm); /* the samples the heading uses */
             s->mag_rej_time = 0;
             return 1;
         }
@@ -851,6 +897,7 @@ static int mag_accept(att_ahrs *s, const att_ahrs_step *k, att_real nm, att_real
             field_set(s->mag_ref, &s->mag_ref_w, s->mag_cand_w, s->mag_cand[0], s->mag_cand[1]);
             *flags |= ATT_AHRS_F_MAG_RELEARNED;
         }
+        field_spread_reset(s);
         s->mag_rej_time = 0;
         s->mag_undist_t = set->mag_min_undisturbed;
         return 1;
@@ -1487,6 +1534,9 @@ att_status att_ahrs_covariance(const att_ahrs *s, att_real att_cov[9], att_real 
                 bias_cov[3 * i + j] = s->P[3 + i][3 + j];
             }
         }
+    }
+    if (att_cov != NULL) {
+        att_cov[8] += field_heading_var(s);
     }
     return ATT_OK;
 }

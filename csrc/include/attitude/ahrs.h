@@ -321,6 +321,13 @@ typedef struct {
     int flags;             /* ATT_AHRS_F_* of the last update */
     int heading_seen;      /* 1 once a magnetometer update has measured the heading */
     att_real turn_var;     /* [rad²] the reported covariance's turn term (turn_sigma) */
+    att_real mag_ref_var;  /* [1] weighted mean of the accepted samples' (|m|/norm − 1)²,
+                              norm the reference's: the field's spread, which gives the
+                              reported heading variance its field term (docs/ahrs.md) */
+    att_real mag_ref_dvar; /* [1] the same mean of half the squared difference of successive
+                              accepted samples' |m|/norm: the white part of that spread */
+    att_real mag_prev;     /* the last accepted sample's |m| (input units); 0: none since
+                              the reference's start */
 } att_ahrs;
 
 /* The defaults listed above. */
