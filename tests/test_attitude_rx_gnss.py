@@ -164,7 +164,7 @@ def _run_rx(cmd: list[str], gnss_args: list[str], records: Iterator[bytes], coun
             head = _stderr_until(proc, marker)
             out = Stdout(proc)
             ended = threading.Event()
-            threading.Thread(target=lambda: (proc.wait(), ended.set()), daemon=True).start()
+            threading.Thread(target=lambda: (proc.wait(), ended.set()), daemon=True).start()  # type: ignore[func-returns-value]
             with serial.Serial(board_port, 115200, timeout=0.01, write_timeout=10) as port:
                 run_sender2(port, records, impl="python", timeout=120, stop=ended)
             _, err = proc.communicate(timeout=60)
@@ -185,8 +185,8 @@ def _board(n: int) -> list[bytes]:
 def _check_lines(lines: list[dict[str, Any]], fixes: np.ndarray, fmt: str, source: str) -> list[int]:
     """The gnss objects: each a fix of the log, in the log's order; the filter aided after the first."""
     att = [x for x in lines if "q" in x]
-    got = [(i, _check_gnss(x["gnss"], fixes, fmt, source)) for i, x in enumerate(att) if "gnss" in x]
-    got = [(i, k) for i, k in got if k is not None]
+    matched = [(i, _check_gnss(x["gnss"], fixes, fmt, source)) for i, x in enumerate(att) if "gnss" in x]
+    got = [(i, k) for i, k in matched if k is not None]
     assert got, "no GNSS fix reached the attitude lines"
     ks = [k for _, k in got]
     assert ks == sorted(set(ks)), ks  # each fix once, in time order

@@ -89,7 +89,14 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
     X(tilt_tau) \
     X(heading_sigma_max) \
     X(turn_sigma) \
-    X(turn_tau)
+    X(turn_tau) \
+    X(gnss_vel_sigma) \
+    X(gnss_timeout) \
+    X(gnss_max_latency) \
+    X(gnss_max_pdop) \
+    X(gnss_max_sigma) \
+    X(gnss_max_acc) \
+    X(gnss_gate)
 // clang-format on
 #define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
 
