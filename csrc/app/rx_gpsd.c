@@ -178,22 +178,6 @@ int rx_gpsd_open(rx_gnss *g, char *msg, size_t len)
     return RX_EXIT_UNAVAILABLE;
 }
 
-/* gpsd may report one epoch in several TPVs (after each NMEA sentence until it has learnt
- * the receiver's cycle): a fix is queued once per time of validity, the first report that
- * has its horizontal velocity when an earlier one of that time had none. */
-static int new_fix(const struct gps_data_t *d, const att_gnss_fix *f)
-{
-    const int vel = (f->present & ATT_GNSS_HAS_VEL_NE) != 0;
-    const int same = d->fix.time.tv_sec == g_last.time.tv_sec && d->fix.time.tv_nsec == g_last.time.tv_nsec;
-    if (d->fix.time.tv_sec == 0)
-        return 1; /* no time to tell epochs apart */
-    if (same && (g_last.had_vel || !vel))
-        return 0;
-    g_last.time = d->fix.time;
-    g_last.had_vel = vel;
-    return 1;
-}
-
 int rx_gpsd_read(rx_gnss *g)
 {
     (void)g;

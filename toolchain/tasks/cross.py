@@ -27,7 +27,6 @@ import os
 import shutil
 import subprocess
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from invoke import task
@@ -101,33 +100,14 @@ def shared_link_cmd(t: T.Target, objs: Sequence[Path], real: Path) -> list[str]:
             "-o", str(real), *shared_ldflags(t), *t.shared_ldflags, *t.shared_link_libs()]
 
 
-@dataclass(frozen=True)
-class AppOptional:
-    """One optional dependency of attitude-rx (toolchain/app_optional.toml)."""
-
-    name: str
-    define: str
-    header: str
-    symbol: str
-    libs: tuple[str, ...]
-    apt: str
-
-
-def app_optional() -> list[AppOptional]:
-    """attitude-rx's optional dependencies, from toolchain/app_optional.toml."""
-    d = T.tomllib.loads((T.TOOLCHAIN_DIR / "app_optional.toml").read_text())
-    return [AppOptional(name=k, define=v["define"], header=v["header"], symbol=v["symbol"],
-                        libs=tuple(v["libs"]), apt=v["apt"]) for k, v in d.items()]
-
-
-def app_optional_found(t: T.Target, workdir: Path, verbose: bool = False) -> list[AppOptional]:
+def app_optional_found(t: T.Target, workdir: Path, verbose: bool = False) -> list[T.AppOptional]:
     """The optional dependencies whose probe (a program including the header and calling the
     symbol) compiles and links for target ``t`` with the app's link flags: built in."""
     workdir.mkdir(parents=True, exist_ok=True)
     found = []
-    for o in app_optional():
+    for o in T.app_optional():
         src = workdir / f"{o.name}.c"
-        src.write_text(f"#include <{o.header}>\nint main(void)\n{{\n    return (int)(long)&{o.symbol};\n}}\n")
+        src.write_text(o.probe_source())
         cmd = [t.cc, *t.target_cflags, str(src), "-o", str(workdir / o.name), *t.ldflags, *t.app_libs,
                *o.libs, *t.libs]
         ok = subprocess.run(cmd, capture_output=True, check=False).returncode == 0
@@ -231,6 +211,6 @@ def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
         else:
             print(f"  {kind:8s} {rel}")
     if "app" in products:
-        for o in app_optional():
+        for o in T.app_optional():
             print(f"  attitude-rx {o.name} support: " + ("built in" if f"app_{o.name}" in products else
                   f"not built (no <{o.header}> / {' '.join(o.libs)} for {target}: apt-get install {o.apt})"))
