@@ -721,7 +721,7 @@ def test_rx_command_line_getopt(rx_builds, tmp_path: Path) -> None:
 
 def test_rx_builds_say_whether_gpsd_is_built_in(rx_builds) -> None:
     """Host and ARMv4T (qemu-arm) builds: --help lists --gnss, --version says whether gpsd support
-    (libgps, probed at build time: toolchain/app_optional.toml) is built in, and --gnss gpsd
+    (libgps, probed at build time: toolchain/app/optional.toml) is built in, and --gnss gpsd
     agrees: without it one line and exit 69; with it, a gpsd that refuses the connection is
     one line and exit 69 as well (docs/gnss.md)."""
     import socket
