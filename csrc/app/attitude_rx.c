@@ -769,6 +769,8 @@ static void gnss_take(rx_app *app, rx_att *a, int to_filter)
 {
     rx_gnss_item it;
     double horizon = app->t + app->period;
+    if (app->cfg.gnss.kind == RX_GNSS_OFF)
+        return; /* no --gnss: the sample path as without GNSS */
     while (a->clock.known && rx_gnss_peek(&app->gnss, &it)) {
         double t = rx_gnss_clock_time(&a->clock, it.wall, app->cfg.gnss_latency);
         if (t > horizon)

@@ -801,9 +801,8 @@ void rx_usage(const char *prog, void *stream)
         "(loss reports, bad codes) are filled by holding the last rate and counted\n"
         "(docs/attitude-rx.md).\n"
         "Exit codes: 0 ok, 64 usage, 66 no such port, 69 gpsd unreachable or not built in,\n"
-        "74 port not usable or stdout failed,\n"
-        "75 stopped while stdout stayed blocked (acknowledged samples unprinted), 77 permission\n"
-        "denied, 78 bad configuration.\n",
+        "74 port not usable or stdout failed, 75 stopped while stdout stayed blocked\n"
+        "(acknowledged samples unprinted), 77 permission denied, 78 bad configuration.\n",
         prog);
     usage_ahrs((FILE *)stream);
 }
