@@ -279,7 +279,8 @@ int rx_port_write(rx_stop *s, int fd, const uint8_t *p, size_t n);
 int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
 /* The exit code of a port that rx_serial_open could not open (errno err): 66, 77 or 74. */
 int rx_open_error_code(int err);
-/* 1 if baud is one the termios layer knows. */
+/* 1 if baud is one the termios layer knows: these. */
+#define RX_BAUDS_TEXT "1200 2400 4800 9600 19200 38400 57600 115200 230400"
 int rx_serial_baud_ok(long baud);
 /* Close the port once what was written has gone out: the last answer
  * (the 0x00 of a block the app delivered, a link v2 ACK) reaches the

@@ -414,10 +414,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         strcpy(c->port, value);
     } else if (strcmp(name, "baud") == 0) {
         if (parse_ulong(value, &u) != 0 || !rx_serial_baud_ok((long)u))
-            return fail(
-                msg, len, RX_EXIT_CONFIG,
-                "baud: '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 230400)",
-                value);
+            return fail(msg, len, RX_EXIT_CONFIG, "baud: '%s' is not a supported rate (" RX_BAUDS_TEXT ")",
+                        value);
         c->baud = (long)u;
     } else if (strcmp(name, "period") == 0) {
         if (parse_double(value, &d) != 0 || !(d > 0.0) || d > 10.0)

@@ -24,9 +24,21 @@ double rx_mono_now(void)
     return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
 }
 
+/* The whole of s as a decimal integer in lo..hi: 0, or -1. */
+static int parse_range(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (*s == '\0' || *end != '\0' || v < lo || v > hi)
+        return -1;
+    *out = v;
+    return 0;
+}
+
 /* "HOST[:PORT]" after "gpsd:" (an IPv6 address in brackets: "[::1]:2947"). */
 static int parse_gpsd(const char *s, rx_gnss_spec *o, char *msg, size_t len)
 {
+    const char *arg = s; /* as given, for the message */
     const char *colon = s[0] == '[' ? strchr(s, ']') : s;
     size_t hn;
     colon = colon ? strchr(colon, ':') : NULL;
@@ -37,15 +49,14 @@ static int parse_gpsd(const char *s, rx_gnss_spec *o, char *msg, size_t len)
     }
     if (hn == 0 || hn >= sizeof o->host
         || (colon && (colon[1] == '\0' || strlen(colon + 1) >= sizeof o->service))) {
-        snprintf(msg, len, "gnss: 'gpsd:%s' must be gpsd, gpsd:HOST or gpsd:HOST:PORT", s);
+        snprintf(msg, len, "gnss: 'gpsd:%s' must be gpsd, gpsd:HOST or gpsd:HOST:PORT", arg);
         return RX_EXIT_CONFIG;
     }
     memcpy(o->host, s, hn);
     o->host[hn] = '\0';
     if (colon) {
-        char *end;
-        long p = strtol(colon + 1, &end, 10);
-        if (*end != '\0' || p < 1 || p > 65535) {
+        long p;
+        if (parse_range(colon + 1, 1, 65535, &p) != 0) {
             snprintf(msg, len, "gnss: gpsd port '%s' must be 1..65535", colon + 1);
             return RX_EXIT_CONFIG;
         }
@@ -66,13 +77,9 @@ static int parse_serial(const char *s, rx_gnss_spec *o, char *msg, size_t len)
     memcpy(o->path, s, pn);
     o->path[pn] = '\0';
     if (colon) {
-        char *end;
-        long b = strtol(colon + 1, &end, 10);
-        if (colon[1] == '\0' || *end != '\0' || !rx_serial_baud_ok(b)) {
-            snprintf(msg, len,
-                     "gnss: baud '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 "
-                     "230400)",
-                     colon + 1);
+        long b;
+        if (parse_range(colon + 1, 1, 10000000L, &b) != 0 || !rx_serial_baud_ok(b)) {
+            snprintf(msg, len, "gnss: baud '%s' is not a supported rate (" RX_BAUDS_TEXT ")", colon + 1);
             return RX_EXIT_CONFIG;
         }
         o->baud = b;
