@@ -28,7 +28,8 @@
 #
 # Products (in $(BUILDDIR), default build/make, or build/make-NAME with
 # TARGET=NAME): libattitude.a (libattitude.lib with SDCC),
-# libattitude.so(.0, .VERSION), attitude-rx, attitude.pc.
+# libattitude.so(.0, .VERSION), attitude-rx, attitude.pc. APP_OPTIONAL: attitude-rx's optional
+# dependencies built in (default: those found, e.g. gpsd with libgps).
 # A stamp of the compiler and every flag makes objects rebuild when either
 # changes (another TARGET, CFLAGS or compiler in the same BUILDDIR).
 
@@ -38,8 +39,8 @@ VERSION      := $(call att_version_part,MAJOR).$(call att_version_part,MINOR).$(
 SOVERSION    := $(call att_version_part,SO)
 
 TARGET ?=
-ifneq ($(TARGET),)
 include toolchain/targets.mk
+ifneq ($(TARGET),)
 ifeq ($(filter $(TARGET),$(ATT_TARGETS)),)
 $(error TARGET must be one of: $(ATT_TARGETS) (toolchain/*.toml), not '$(TARGET)')
 endif
@@ -101,6 +102,21 @@ PLATFORM     ?= $(if $(filter linux,$(ATT_TARGET_OS_$(TARGET))),linux,)
 else
 PLATFORM     ?= linux
 endif
+
+# attitude-rx's optional dependencies (toolchain/app/optional.toml, through targets.mk; the
+# app's only, never the library's): each is built in when a program that includes its header
+# and takes its symbol links with its libraries for this compiler and the app's link flags.
+# APP_OPTIONAL=NAMES decides instead (APP_OPTIONAL= builds attitude-rx without any).
+att_probe = $(shell printf '\043include <%s>\nint main(void)\n{\n    return (int)(long)&%s;\n}\n' \
+  '$(ATT_APP_OPTIONAL_HEADER_$(1))' '$(ATT_APP_OPTIONAL_SYMBOL_$(1))' | $(CC) $(TARGET_CFLAGS) \
+  $(CFLAGS) -x c - -o /dev/null $(TARGET_LDFLAGS) $(LDFLAGS) $(if $(filter 1,$(STATIC_APP)),-static) \
+  $(APP_LIBS) $(ATT_APP_OPTIONAL_LIBS_$(1)) $(TARGET_LIBS) >/dev/null 2>&1 && echo 1)
+ifeq ($(origin APP_OPTIONAL),undefined)
+att_building := $(if $(MAKECMDGOALS),$(filter-out version clean uninstall,$(MAKECMDGOALS)),all)
+APP_OPTIONAL := $(if $(and $(att_building),$(filter 1,$(APP))),$(foreach f,$(ATT_APP_OPTIONAL),$(if $(call att_probe,$(f)),$(f))))
+endif
+APP_OPT_DEFS := $(foreach f,$(APP_OPTIONAL),-D$(ATT_APP_OPTIONAL_DEFINE_$(f)))
+APP_OPT_LIBS := $(foreach f,$(APP_OPTIONAL),$(ATT_APP_OPTIONAL_LIBS_$(f)))
 
 # libattitude.so of a target that links its own libgcc (armv4t: the ARMv4T one
 # of arm-none-eabi-gcc, not the armel compiler's ARMv5TE runtime).
@@ -178,7 +194,7 @@ version:
 # objects rebuild exactly when the compiler or a flag changed.
 STAMP_TEXT := $(CC) $(shell $(CC) --version 2>/dev/null | head -n 1) | $(ATT_CFLAGS) $(TARGET_CFLAGS) \
   $(CPPFLAGS) $(CFLAGS) | $(TARGET_LDFLAGS) $(LDFLAGS) $(TARGET_LIBS) | $(AR) | $(STATIC_APP) \
-  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS) | $(PIC_CFLAGS)
+  | $(SHARED_LDFLAGS) $(SHARED_LIBGCC) $(SHARED_LIBS) | $(PIC_CFLAGS) | $(APP_OPT_DEFS) $(APP_OPT_LIBS)
 $(STAMP): FORCE
 	@mkdir -p $(@D)
 	@if [ "$$(cat $@ 2>/dev/null)" != '$(subst ','\'',$(STAMP_TEXT))' ]; then \
@@ -202,7 +218,7 @@ $(BUILDDIR)/obj-pic/%.o: $(PLAT_DIR)/src/%.c $(HEADERS) $(STAMP)
 
 $(BUILDDIR)/obj-app/%.o: csrc/app/%.c $(HEADERS) $(wildcard csrc/app/*.h) $(STAMP)
 	@mkdir -p $(@D)
-	$(CC) $(ATT_CFLAGS) -Icsrc/app $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+	$(CC) $(ATT_CFLAGS) -Icsrc/app $(APP_OPT_DEFS) $(TARGET_CFLAGS) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
 $(STATIC_LIB): $(LIB_OBJS)
 	@rm -f $@
@@ -220,10 +236,10 @@ $(BUILDDIR)/libattitude.so: $(SHARED_REAL)
 
 ifeq ($(STATIC_APP),1)
 $(APP_EXE): $(APP_OBJS) $(STATIC_LIB)
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) -static $(APP_OBJS) $(STATIC_LIB) -o $@ $(APP_LIBS) $(TARGET_LIBS)
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) -static $(APP_OBJS) $(STATIC_LIB) -o $@ $(APP_LIBS) $(APP_OPT_LIBS) $(TARGET_LIBS)
 else
 $(APP_EXE): $(APP_OBJS) $(BUILDDIR)/libattitude.so
-	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) $(APP_OBJS) -L$(BUILDDIR) -lattitude -o $@ $(APP_LIBS) $(TARGET_LIBS)
+	$(CC) $(TARGET_CFLAGS) $(CFLAGS) $(TARGET_LDFLAGS) $(LDFLAGS) $(APP_OBJS) -L$(BUILDDIR) -lattitude -o $@ $(APP_LIBS) $(APP_OPT_LIBS) $(TARGET_LIBS)
 endif
 
 $(PC): FORCE

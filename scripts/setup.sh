@@ -17,6 +17,7 @@ APT_PACKAGES=(
   qemu-user                                           # qemu-arm -cpu ti925t, qemu-aarch64
   sdcc sdcc-ucsim                                     # AT89S51 firmware and the s51 simulator
   socat                                               # pseudo-terminal pairs for UART tests
+  gpsd gpsd-clients libgps-dev                        # attitude-rx --gnss gpsd (libgps) and its tests (gpsfake)
   chromium                                            # attitude view's browser tests (driven by Playwright;
                                                       # its own browser download is not used)
 )

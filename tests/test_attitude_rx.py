@@ -719,6 +719,37 @@ def test_rx_command_line_getopt(rx_builds, tmp_path: Path) -> None:
     assert rc == 74 and "not a serial port" in err
 
 
+def test_rx_builds_say_whether_gpsd_is_built_in(rx_builds) -> None:
+    """Host and ARMv4T (qemu-arm) builds: --help lists --gnss, --version says whether gpsd support
+    (libgps, probed at build time: toolchain/app/optional.toml) is built in, and --gnss gpsd
+    agrees: without it one line and exit 69; with it, a gpsd that refuses the connection is
+    one line and exit 69 as well (docs/gnss.md)."""
+    import socket
+
+    def run(exe: list[str], *args: str) -> tuple[int, str, str]:
+        p = subprocess.run([*exe, *args], capture_output=True, timeout=60, check=False)
+        return p.returncode, p.stdout.decode(), p.stderr.decode()
+
+    for name, exe in rx_builds.items():
+        rc, out, _ = run(exe, "--help")
+        assert rc == 0 and "--gnss SOURCE" in out and "69 gpsd unreachable" in out, name
+        rc, out, _ = run(exe, "--version")
+        built = "gpsd support: yes (libgps)" in out
+        assert rc == 0 and (built or "gpsd support: no" in out), (name, out)
+        refused = socket.socket()  # bound, not listening: a connection to it is refused
+        refused.bind(("127.0.0.1", 0))
+        master, slave = os.openpty()
+        try:
+            rc, _, err = run(exe, "--port", os.ttyname(slave), "--gnss",
+                             f"gpsd:127.0.0.1:{refused.getsockname()[1]}")
+        finally:
+            refused.close()
+            os.close(master)
+            os.close(slave)
+        want = "is unreachable" if built else "was built without gpsd support"
+        assert rc == 69 and want in err and err.count("\n") == 1, (name, err)
+
+
 def test_rx_port_vanishes_is_reported_and_retried(rx_builds, tmp_path: Path) -> None:
     """The port goes away (EIO): reported once, reopened when it comes back, no spinning."""
     require_tools("socat", apt="socat")

@@ -8,6 +8,9 @@ Generated (and committed, so that make and CMake need no Python):
 
 * ``toolchain/targets.mk``: one block of ``ATT_TARGET_*_<name>`` variables per
   target, read by ``make TARGET=<name>``;
+* ``cmake/app-optional.cmake``: attitude-rx's optional dependencies
+  (``toolchain/app/optional.toml``), probed by ``CMakeLists.txt`` (the Makefile
+  reads them from ``targets.mk``);
 * ``cmake/<name>-toolchain.cmake`` for every gcc-kind target (CMake has no
   SDCC preset); the cross ones include ``cmake/cross-common.cmake``, what
   they share (the ``CROSS_COMPILE`` prefix, the tools under it, the find modes).
@@ -117,6 +120,26 @@ def make_fragment() -> str:
             "SHARED_LIBS": " ".join(t.shared_libs),
         }
         lines += [f"ATT_TARGET_{k}_{name} := {val}".rstrip() for k, val in v.items()]
+    opts = T.app_optional()
+    lines += ["", "# attitude-rx's optional dependencies (toolchain/app/optional.toml), probed by the Makefile.",
+              f"ATT_APP_OPTIONAL := {' '.join(o.name for o in opts)}"]
+    for o in opts:
+        lines += [f"ATT_APP_OPTIONAL_DEFINE_{o.name} := {o.define}", f"ATT_APP_OPTIONAL_HEADER_{o.name} := {o.header}",
+                  f"ATT_APP_OPTIONAL_SYMBOL_{o.name} := {o.symbol}",
+                  f"ATT_APP_OPTIONAL_LIBS_{o.name} := {' '.join(o.libs)}"]
+    return "\n".join(lines) + "\n"
+
+
+def cmake_app_optional() -> str:
+    """cmake/app-optional.cmake: attitude-rx's optional dependencies for CMakeLists.txt."""
+    opts = T.app_optional()
+    lines = [_generated_note("toolchain/app/optional.toml").rstrip("\n"),
+             "# attitude-rx's optional dependencies: CMakeLists.txt probes each (header, symbol, libraries).",
+             f"set(ATT_APP_OPTIONAL {' '.join(o.name for o in opts)})"]
+    for o in opts:
+        lines += [f"set(ATT_APP_OPTIONAL_{o.name}_DEFINE {o.define})", f"set(ATT_APP_OPTIONAL_{o.name}_HEADER {o.header})",
+                  f"set(ATT_APP_OPTIONAL_{o.name}_SYMBOL {o.symbol})",
+                  f"set(ATT_APP_OPTIONAL_{o.name}_LIBS {';'.join(o.libs)})"]
     return "\n".join(lines) + "\n"
 
 
@@ -217,7 +240,8 @@ def cmake_toolchain(t: T.Target) -> str:
 
 
 def outputs() -> dict[Path, str]:
-    files = {MAKE_FRAGMENT: make_fragment(), CROSS_COMMON: cross_common()}
+    files = {MAKE_FRAGMENT: make_fragment(), CROSS_COMMON: cross_common(),
+             CMAKE_DIR / "app-optional.cmake": cmake_app_optional()}
     for name in T.names():
         t = _load_plain(name)
         if t.kind == "gcc":

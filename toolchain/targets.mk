@@ -171,3 +171,10 @@ ATT_TARGET_SOURCES_mcs52 := csrc/src/common.c csrc/src/tlc2543.c csrc/src/link_s
 ATT_TARGET_SHARED_LDFLAGS_mcs52 :=
 ATT_TARGET_SHARED_LIBGCC_mcs52 :=
 ATT_TARGET_SHARED_LIBS_mcs52 :=
+
+# attitude-rx's optional dependencies (toolchain/app/optional.toml), probed by the Makefile.
+ATT_APP_OPTIONAL := gpsd
+ATT_APP_OPTIONAL_DEFINE_gpsd := ATT_RX_GPSD
+ATT_APP_OPTIONAL_HEADER_gpsd := gps.h
+ATT_APP_OPTIONAL_SYMBOL_gpsd := gps_open
+ATT_APP_OPTIONAL_LIBS_gpsd := -lgps

@@ -200,6 +200,31 @@ class Target:
         return proc
 
 
+@dataclass(frozen=True)
+class AppOptional:
+    """One optional dependency of attitude-rx (toolchain/app/optional.toml)."""
+
+    name: str
+    define: str
+    header: str
+    symbol: str
+    libs: tuple[str, ...]
+    apt: str
+
+
+    def probe_source(self) -> str:
+        """The probe: a program that includes the header and takes the symbol's address (the
+        Makefile and CMakeLists.txt write the same one)."""
+        return f"#include <{self.header}>\nint main(void)\n{{\n    return (int)(long)&{self.symbol};\n}}\n"
+
+
+def app_optional() -> list[AppOptional]:
+    """attitude-rx's optional dependencies, from toolchain/app/optional.toml."""
+    d = tomllib.loads((TOOLCHAIN_DIR / "app" / "optional.toml").read_text())
+    return [AppOptional(name=k, define=v["define"], header=v["header"], symbol=v["symbol"],
+                        libs=tuple(v["libs"]), apt=v["apt"]) for k, v in d.items()]
+
+
 def _run(cmd: list[str]) -> None:
     proc = subprocess.run(cmd, check=False, capture_output=True, text=True)
     if proc.returncode != 0:

@@ -95,6 +95,13 @@ typedef struct {
     int out_error;   /* stdout failed (closed pipe, ...): errno in out_errno */
     int out_errno;   /* the error */
     int out_blocked; /* stdout stayed blocked past the grace time after a stop */
+    rx_gnss gnss;    /* --gnss: the input thread and its queue */
+    unsigned long gnss_used, gnss_rejected; /* fixes the filter took / refused (ATT_AHRS_F_GNSS_REJECTED) */
+    unsigned long gnss_no_vel;              /* fixes without a horizontal velocity (not given) */
+    unsigned long gnss_late;                /* fixes the filter's clock could not place (ATT_E_ARG) */
+    att_gnss_fix gnss_fix;                  /* the newest fix taken (attitude thread), */
+    double gnss_t;                          /* its time of validity on the stream clock (s), */
+    int gnss_line;                          /* not yet on an attitude line */
 } rx_app;
 
 static const char *const report_names[ATT_BLOCK_CHANNELS + 1] = { "BOOT",    "SELFTEST",  "GAVE_UP",
@@ -224,6 +231,7 @@ static void number(att_block_seq *seq, rx_item *it, const uint8_t *raw)
 {
     memset(it, 0, sizeof *it);
     memcpy(it->raw, raw, sizeof it->raw);
+    it->wall = rx_mono_now();
     it->status =
         att_block_seq_decode(seq, it->raw, &it->blk, &it->span); /* a bad sample still takes its place */
     if (it->status == ATT_BLOCK_E_SEQ) {
@@ -604,6 +612,17 @@ static int vec3(const rx_app *app, char *p, size_t len, const char *key, const a
                     (double)v[1] * k, digits, (double)v[2] * k);
 }
 
+/* JSON: ,"gnss":{...} on the first line after a new fix (docs/gnss.md), else nothing. */
+static int gnss_object(rx_app *app, char *p, size_t len)
+{
+    int n;
+    if (!app->gnss_line || app->cfg.format != RX_FORMAT_JSONL)
+        return 0;
+    app->gnss_line = 0;
+    n = rx_gnss_json(p, len, &app->gnss_fix, app->t - app->gnss_t, rx_gnss_source(app->cfg.gnss.kind));
+    return n < 0 ? 0 : n;
+}
+
 /* An integrator line: the head, then (JSON) the body rate of the newest sample. */
 static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const att_real v[3],
                          const att_real q[4])
@@ -612,8 +631,10 @@ static void print_update(rx_app *app, uint32_t n, const uint16_t code[3], const 
     int len;
     print_header(app, RX_EST_INTEGRATOR);
     len = line_head(app, line, sizeof line, n, code, q);
-    if (app->cfg.format != RX_FORMAT_CSV)
+    if (app->cfg.format != RX_FORMAT_CSV) {
         len += vec3(app, line + len, sizeof line - (size_t)len, "rate_dps", v, RX_R2D);
+        len += gnss_object(app, line + len, sizeof line - (size_t)len);
+    }
     len +=
         snprintf(line + len, sizeof line - (size_t)len, "%s\n", app->cfg.format == RX_FORMAT_CSV ? "" : "}");
     out_line(app, line, len, 1);
@@ -626,7 +647,8 @@ static const struct {
 } flag_names[] = {
     { ATT_AHRS_F_OVERRANGE, "overrange" },         { ATT_AHRS_F_REST, "rest" },
     { ATT_AHRS_F_ACC_REJECTED, "acc_rejected" },   { ATT_AHRS_F_MAG_DISTURBED, "mag_disturbed" },
-    { ATT_AHRS_F_MAG_RELEARNED, "mag_relearned" }, { ATT_AHRS_F_NO_HEADING, "no_heading" }
+    { ATT_AHRS_F_MAG_RELEARNED, "mag_relearned" }, { ATT_AHRS_F_NO_HEADING, "no_heading" },
+    { ATT_AHRS_F_GNSS_AIDED, "gnss_aided" },       { ATT_AHRS_F_GNSS_REJECTED, "gnss_rejected" }
 };
 
 /* ,"flags":["rest",...] */
@@ -685,6 +707,7 @@ static void print_filter(rx_app *app, uint32_t n, const uint16_t code[3], const 
     w += json_uncertainty(line + w, sizeof line - (size_t)w, f);
     w += vec3(app, line + w, sizeof line - (size_t)w, "acc_ms2", f->acc, 1.0);
     w += vec3(app, line + w, sizeof line - (size_t)w, "mag_ut", f->mag, 1.0);
+    w += gnss_object(app, line + w, sizeof line - (size_t)w);
     w += snprintf(line + w, sizeof line - (size_t)w, "}\n");
     out_line(app, line, w, 1);
 }
@@ -708,15 +731,70 @@ typedef struct {
     att_sensor mag;  /* codes -> field, µT (mag-*) */
     att_ahrs ahrs;   /* the filter (initialized when a stream first needs it) */
     int ahrs_ready;
-    rx_estimator est;   /* this stream's estimator, once est_known */
-    int est_known;      /* resolved at the stream's first sample */
-    unsigned channels;  /* this stream's channel set (CHANNELS; a BOOT: gyro only) */
-    uint8_t oversample; /* conversions per sample word: 1, or the stream's OVERSAMPLE */
-    att_real rate[3];   /* body rate of the last good sample, rad/s */
-    uint16_t code[3];   /* its codes */
-    int have_rate;      /* a good sample has been integrated */
-    rx_group grp;       /* the filter's sample waiting for its group */
+    rx_estimator est;    /* this stream's estimator, once est_known */
+    int est_known;       /* resolved at the stream's first sample */
+    unsigned channels;   /* this stream's channel set (CHANNELS; a BOOT: gyro only) */
+    uint8_t oversample;  /* conversions per sample word: 1, or the stream's OVERSAMPLE */
+    att_real rate[3];    /* body rate of the last good sample, rad/s */
+    uint16_t code[3];    /* its codes */
+    int have_rate;       /* a good sample has been integrated */
+    rx_group grp;        /* the filter's sample waiting for its group */
+    rx_gnss_clock clock; /* the board stream's clock against CLOCK_MONOTONIC (GNSS alignment) */
+    unsigned gnss_given; /* fixes given to the filter since its last update */
 } rx_att;
+
+/* A fix at stream time t to the filter (its clock: att_ahrs_time, the sum of its steps). */
+static void gnss_to_filter(rx_app *app, rx_att *a, const att_gnss_fix *fix, double t)
+{
+    att_ahrs_vel v;
+    double tf = (double)att_ahrs_time(&a->ahrs) + (t - app->t);
+    int rc;
+    if (att_ahrs_vel_from_fix(fix, (att_real)tf, &v) != ATT_OK) {
+        app->gnss_no_vel++;
+        return;
+    }
+    rc = att_ahrs_update_vel(&a->ahrs, &v);
+    if (rc == ATT_OK) {
+        a->gnss_given++;
+        return;
+    }
+    if (app->gnss_late++ == 0)
+        rx_log(&app->stop, "gnss: a fix valid at t=%.3f s refused by the filter: %s (counted in late=)", t,
+               att_status_str(rc));
+}
+
+/* Every fix due by the end of the coming sample period, in time order: to the filter
+ * (`to_filter`: the filter runs this stream), the newest onto the next attitude line. */
+static void gnss_take(rx_app *app, rx_att *a, int to_filter)
+{
+    rx_gnss_item it;
+    double horizon = app->t + app->period;
+    if (app->cfg.gnss.kind == RX_GNSS_OFF)
+        return; /* no --gnss: the sample path as without GNSS */
+    while (a->clock.known && rx_gnss_peek(&app->gnss, &it)) {
+        double t = rx_gnss_clock_time(&a->clock, it.wall, app->cfg.gnss_latency);
+        if (t > horizon)
+            break; /* the board has not got there yet */
+        rx_gnss_pop(&app->gnss);
+        app->gnss_fix = it.fix;
+        app->gnss_t = t;
+        app->gnss_line = 1;
+        if (to_filter && a->ahrs_ready)
+            gnss_to_filter(app, a, &it.fix, t);
+    }
+}
+
+/* The update after fixes were given says whether it took them (ATT_AHRS_F_GNSS_REJECTED). */
+static void gnss_verdict(rx_app *app, rx_att *a, int rc)
+{
+    if (a->gnss_given == 0)
+        return;
+    if (rc == ATT_OK && (att_ahrs_flags(&a->ahrs) & ATT_AHRS_F_GNSS_REJECTED))
+        app->gnss_rejected += a->gnss_given;
+    else if (rc == ATT_OK)
+        app->gnss_used += a->gnss_given;
+    a->gnss_given = 0;
+}
 
 static int finished(const rx_app *app)
 {
@@ -729,6 +807,7 @@ static void integrate(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], c
     const rx_config *c = &app->cfg;
     att_real d[3], q[4];
     int i, rc;
+    gnss_take(app, a, 0);
     if (c->method == ATT_METHOD_RK4) {
         rc = att_integ_update_rate(&a->integ, v, (att_real)(2.0 * app->period), q);
     } else {
@@ -762,7 +841,10 @@ static void filter(rx_app *app, rx_att *a, uint32_t n, const att_real v[3], cons
 {
     att_real q[4];
     rx_filter_out f;
-    int rc = att_ahrs_update(&a->ahrs, v, acc, mag, (att_real)app->period, q);
+    int rc;
+    gnss_take(app, a, 1);
+    rc = att_ahrs_update(&a->ahrs, v, acc, mag, (att_real)app->period, q);
+    gnss_verdict(app, a, rc);
     if (rc != ATT_OK) {
         app->integ_errors++;
         rx_queue_count_failed(&app->queue); /* the receiver's --count accounting */
@@ -864,6 +946,7 @@ static void sample(rx_app *app, rx_att *a, const rx_item *it)
         a->code[i] = it->blk.code[i];
     a->have_rate = 1;
     app->integrated++;
+    rx_gnss_clock_sample(&a->clock, it->wall, app->t + app->period);
     if (estimator(app, a) != RX_EST_AHRS) {
         integrate(app, a, it->span.first, a->rate, a->code);
         return;
@@ -1159,13 +1242,40 @@ static void *attitude_thread(void *arg)
     return NULL;
 }
 
-static int open_error_code(int err)
+static void gnss_banner(rx_app *app)
 {
-    if (err == ENOENT || err == ENODEV || err == ENXIO || err == ENOTDIR)
-        return RX_EXIT_NOPORT;
-    if (err == EACCES || err == EPERM)
-        return RX_EXIT_NOPERM;
-    return RX_EXIT_IOERR;
+    const rx_gnss_spec *g = &app->cfg.gnss;
+    if (g->kind == RX_GNSS_SERIAL)
+        rx_log(&app->stop, "gnss: %s at %ld baud 8N1 (NMEA 0183 / UBX NAV-PVT), latency %g s", g->path,
+               g->baud, app->cfg.gnss_latency);
+    else if (g->kind == RX_GNSS_GPSD)
+        rx_log(&app->stop, "gnss: gpsd at %s:%s, latency %g s", g->host, g->service, app->cfg.gnss_latency);
+}
+
+/* The end-of-run "gnss:" line: what the input read, what the filter did with it, the parser's
+ * (serial) or gpsd's (reports) counters. */
+static void gnss_statistics(rx_app *app)
+{
+    rx_gnss_counts n;
+    char tail[RX_MSG_MAX];
+    if (app->cfg.gnss.kind == RX_GNSS_OFF)
+        return;
+    n = rx_gnss_counters(&app->gnss);
+    if (app->cfg.gnss.kind == RX_GNSS_GPSD)
+        snprintf(tail, sizeof tail, "reports=%lu", n.reports);
+    else
+        snprintf(tail, sizeof tail,
+                 "bytes=%lu nmea=%lu ubx=%lu bad_checksum=%lu overruns=%lu truncated=%lu bad_field=%lu "
+                 "ignored=%lu bytes_skipped=%lu",
+                 (unsigned long)n.parser.bytes, (unsigned long)n.parser.nmea_accepted,
+                 (unsigned long)n.parser.ubx_accepted, (unsigned long)n.parser.bad_checksum,
+                 (unsigned long)n.parser.overruns, (unsigned long)n.parser.truncated,
+                 (unsigned long)n.parser.bad_field, (unsigned long)n.parser.ignored,
+                 (unsigned long)n.parser.bytes_skipped);
+    rx_log(&app->stop,
+           "gnss: source=%s fixes=%lu used=%lu rejected=%lu no_velocity=%lu late=%lu dropped=%lu lost=%lu %s",
+           rx_gnss_source(app->cfg.gnss.kind), n.fixes, app->gnss_used, app->gnss_rejected, app->gnss_no_vel,
+           app->gnss_late, n.dropped, n.lost, tail);
 }
 
 static void print_statistics(rx_app *app)
@@ -1205,6 +1315,7 @@ static void print_statistics(rx_app *app)
     if (app->reports[ATT_BLOCK_CHANNELS])
         rx_log(&app->stop, "aiding: channels=%lu acc_records=%lu mag_records=%lu unused=%lu",
                app->reports[ATT_BLOCK_CHANNELS], app->acc_records, app->mag_records, app->aid_unused);
+    gnss_statistics(app);
     if (app->undelivered || app->lines_lost)
         rx_log(&app->stop, "%lu acknowledged sample%s not integrated and %lu attitude line%s not printed: %s",
                app->undelivered, app->undelivered == 1 ? "" : "s", app->lines_lost,
@@ -1228,8 +1339,8 @@ int main(int argc, char **argv)
         return RX_EXIT_OK;
     }
     if (rc == 0 && action == RX_VERSION_INFO) {
-        printf("attitude-rx %s (libattitude, att_real = %s)\n", RX_VERSION,
-               att_real_size() == 4 ? "float" : "double");
+        printf("attitude-rx %s (libattitude, att_real = %s, gpsd support: %s)\n", RX_VERSION,
+               att_real_size() == 4 ? "float" : "double", rx_gpsd_built ? "yes (libgps)" : "no");
         return RX_EXIT_OK;
     }
     if (rc != 0) {
@@ -1252,7 +1363,12 @@ int main(int argc, char **argv)
     if (app.fd < 0) {
         int e = errno;
         rx_log(&app.stop, "%s", msg);
-        return open_error_code(e);
+        return rx_open_error_code(e);
+    }
+    if ((rc = rx_gnss_open(&app.gnss, &app.cfg.gnss, &app.stop, app.cfg.reopen_delay, msg, sizeof msg))
+        != 0) {
+        rx_log(&app.stop, "%s", msg);
+        return rc;
     }
     g_stop = &app.stop;
     memset(&sa, 0, sizeof sa);
@@ -1266,14 +1382,16 @@ int main(int argc, char **argv)
     rx_log(&app.stop, "%s at %ld baud 8N1, block %u bytes, method %s, period %g s%s", app.cfg.port,
            app.cfg.baud, app.cfg.block_size, rx_method_name(app.cfg.method), app.cfg.period,
            app.cfg.period_set ? "" : " until a BOOT report announces it");
+    gnss_banner(&app);
     if (pthread_create(&att_thr, NULL, attitude_thread, &app) != 0
-        || pthread_create(&rx_thr, NULL, receiver_thread, &app) != 0) {
+        || pthread_create(&rx_thr, NULL, receiver_thread, &app) != 0 || rx_gnss_start(&app.gnss) != 0) {
         rx_log(&app.stop, "cannot start threads");
         return RX_EXIT_INTERNAL;
     }
     pthread_join(rx_thr, NULL);  /* ends at a stop request: at most one hold slice later */
     rx_queue_close(&app.queue);  /* the attitude thread handles what is queued (acknowledged) */
     pthread_join(att_thr, NULL); /* within the grace time if stdout blocks */
+    rx_gnss_end(&app.gnss);      /* its thread saw the stop request too */
     if (app.cfg.format == RX_FORMAT_JSONL)
         link_record(&app); /* the final counters */
     if (app.fd >= 0)

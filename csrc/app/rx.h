@@ -16,8 +16,9 @@
 /* Exit codes (the BSD sysexits values, so shell scripts can tell them apart). */
 enum {
     RX_EXIT_OK = 0,
-    RX_EXIT_USAGE = 64,  /* bad command line */
-    RX_EXIT_NOPORT = 66, /* port does not exist */
+    RX_EXIT_USAGE = 64,       /* bad command line */
+    RX_EXIT_UNAVAILABLE = 69, /* --gnss gpsd: gpsd unreachable, or gpsd support not built in */
+    RX_EXIT_NOPORT = 66,      /* port does not exist */
     RX_EXIT_INTERNAL = 70,
     RX_EXIT_IOERR = 74,    /* port cannot be configured (not a tty...), or stdout failed */
     RX_EXIT_TEMPFAIL = 75, /* stopped while stdout stayed blocked: acknowledged samples unprinted */
@@ -31,7 +32,7 @@ enum {
     RX_RECORDS_MAX = ATT_LINK_BLOCK_MAX / ATT_BLOCK_SIZE, /* records in one link block */
     RX_PATH_MAX = 256,
     RX_MSG_MAX = 256,
-    RX_LINE_MAX = 1024,      /* one output or log line */
+    RX_LINE_MAX = 2048,      /* one output or log line (a filter line with its GNSS fix: ~1200) */
     RX_HOLD_MS_DEFAULT = 20, /* --hold-ms: below the senders' 50 ms answer timeout (docs/attitude-rx.md) */
     RX_HOLD_MS_MAX = 10000,
     RX_STOP_GRACE_MS = 500 /* after a stop request, time left to print what was acknowledged */
@@ -79,6 +80,33 @@ typedef struct {
     double bias[3]; /* correction b, output units (0) */
 } rx_sensor_cfg;
 
+/* The GNSS input (--gnss): none, a serial port read with the library's parser, or gpsd. */
+typedef enum {
+    RX_GNSS_OFF = 0,
+    RX_GNSS_SERIAL = 1, /* --gnss /dev/ttyS1[:BAUD] */
+    RX_GNSS_GPSD = 2    /* --gnss gpsd[:HOST[:PORT]] */
+} rx_gnss_kind;
+
+enum {
+    RX_GNSS_BAUD_DEFAULT = 9600, /* u-blox and most NMEA receivers' factory rate */
+    RX_GNSS_HOST_MAX = 128,
+    RX_GNSS_SERVICE_MAX = 16
+};
+#define RX_GPSD_HOST_DEFAULT "localhost"
+#define RX_GPSD_PORT_DEFAULT "2947" /* gpsd's IANA port */
+
+typedef struct {
+    rx_gnss_kind kind;
+    char path[RX_PATH_MAX];            /* serial: the device */
+    long baud;                         /* serial: bits per second */
+    char host[RX_GNSS_HOST_MAX];       /* gpsd: host name or address */
+    char service[RX_GNSS_SERVICE_MAX]; /* gpsd: TCP port */
+} rx_gnss_spec;
+
+/* Parse a --gnss argument ("/dev/ttyS1", "/dev/ttyS1:115200", "gpsd",
+ * "gpsd:HOST", "gpsd:HOST:PORT"; "off"): 0, or RX_EXIT_CONFIG with a message. */
+int rx_gnss_parse(const char *arg, rx_gnss_spec *out, char *msg, size_t msglen);
+
 /* Everything the command line / config file sets. */
 typedef struct {
     char port[RX_PATH_MAX];
@@ -100,6 +128,9 @@ typedef struct {
     double reopen_delay;   /* s between attempts to reopen a port that went away */
     int header;            /* print the CSV header line */
     int link;              /* RX_LINK_AUTO (default), RX_LINK_V2, RX_LINK_LEGACY */
+    rx_gnss_spec gnss;     /* --gnss (default off) */
+    double gnss_latency;   /* s, a fix's time of validity to the arrival of its last byte at
+                              attitude-rx (gpsd: of its report); default 0, domain 0..2 */
 } rx_config;
 
 /* Link protocols (--link): the paper's handshake, link v2 (attitude/link2.h), or
@@ -168,6 +199,7 @@ typedef struct {
     int seq_status;      /* att_block_seq_feed's status (ATT_BLOCK_E_SEQ: numbering slipped) */
     int closes;          /* a sample record that completes its sample's group (the tracker's
                             next record is a gyro record): every gyro-only sample closes */
+    double wall;         /* s, CLOCK_MONOTONIC when the receiver thread took it (GNSS alignment) */
     uint8_t raw[ATT_BLOCK_SIZE];
 } rx_item;
 
@@ -245,7 +277,10 @@ int rx_port_write(rx_stop *s, int fd, const uint8_t *p, size_t n);
  * writes wait in poll()). Returns the fd, or -1 with errno set and a
  * message in msg. */
 int rx_serial_open(const char *path, long baud, char *msg, size_t msglen);
-/* 1 if baud is one the termios layer knows. */
+/* The exit code of a port that rx_serial_open could not open (errno err): 66, 77 or 74. */
+int rx_open_error_code(int err);
+/* 1 if baud is one the termios layer knows: these. */
+#define RX_BAUDS_TEXT "1200 2400 4800 9600 19200 38400 57600 115200 230400"
 int rx_serial_baud_ok(long baud);
 /* Close the port once what was written has gone out: the last answer
  * (the 0x00 of a block the app delivered, a link v2 ACK) reaches the
@@ -259,5 +294,89 @@ enum {
     RX_DRAIN_STUCK_MS = 100
 };
 void rx_serial_close(int fd);
+
+/* ---- GNSS input (rx_gnss.c; gpsd: rx_gpsd.c) ---- */
+enum {
+    RX_GNSS_QUEUE = 64,   /* fixes waiting for the attitude thread (the oldest dropped beyond) */
+    RX_GNSS_QUIET_MS = 50 /* serial: a silence this long ends the NMEA epoch being merged */
+};
+#define RX_GNSS_LATENCY_MAX 2.0 /* s, largest gnss_latency */
+
+/* One fix as the input thread read it: CLOCK_MONOTONIC time of its last byte (gpsd: its report). */
+typedef struct {
+    att_gnss_fix fix;
+    double wall; /* s */
+} rx_gnss_item;
+
+/* Counters of the input (the end-of-run "gnss:" line). */
+typedef struct {
+    unsigned long fixes;   /* fixes read (parser, or gpsd reports with a mode) */
+    unsigned long dropped; /* fixes the attitude thread never took (queue full: no board stream) */
+    unsigned long reports; /* gpsd: reports read (TPV, SKY, ...) */
+    unsigned long lost;    /* the port or the gpsd connection went away */
+    att_gnss_stats parser; /* serial: the parser's counters */
+} rx_gnss_counts;
+
+typedef struct {
+    rx_gnss_spec spec;
+    rx_stop *stop;
+    double reopen_delay; /* s between attempts to reopen a lost port or connection */
+    int fd;              /* the serial port or gpsd's socket; -1 while lost */
+    void *gpsd;          /* struct gps_data_t (rx_gpsd.c) */
+    att_gnss_parser parser;
+    pthread_t thread;
+    int started;
+    pthread_mutex_t lock; /* guards what follows */
+    rx_gnss_item q[RX_GNSS_QUEUE];
+    unsigned head, count;
+    rx_gnss_counts n;
+} rx_gnss;
+
+/* Open the input of spec (nothing for RX_GNSS_OFF): 0, or an RX_EXIT_* code with a
+ * message (port: 66 / 74 / 77 as the board's; gpsd: RX_EXIT_UNAVAILABLE). */
+int rx_gnss_open(rx_gnss *g, const rx_gnss_spec *spec, rx_stop *stop, double reopen_delay, char *msg,
+                 size_t msglen);
+/* Start the input thread (0, or -1); it ends at the stop request, after taking what was
+ * already readable. */
+int rx_gnss_start(rx_gnss *g);
+void rx_gnss_end(rx_gnss *g); /* join the thread, close */
+/* The oldest fix waiting (1), or none (0); rx_gnss_pop removes it. */
+int rx_gnss_peek(rx_gnss *g, rx_gnss_item *out);
+void rx_gnss_pop(rx_gnss *g);
+/* Queue a fix read at `wall` (the input threads). */
+void rx_gnss_push(rx_gnss *g, const att_gnss_fix *fix, double wall);
+rx_gnss_counts rx_gnss_counters(rx_gnss *g);
+double rx_mono_now(void); /* CLOCK_MONOTONIC, s */
+
+/* The board stream's clock seen from CLOCK_MONOTONIC (the attitude thread's): each
+ * sample read at wall time w ends at stream time t (the sum of the sample periods),
+ * so w - t is the sample's transport delay plus a constant; the smallest is the
+ * least delayed sample's, and wall - offset is the stream time of a wall time.
+ * The minimum leaks upward by RX_GNSS_CLOCK_LEAK s per s of stream, so a board
+ * crystal slower than the host's (up to 10 times the 100 ppm of a cheap one) is
+ * followed, never the delays of a backlog. */
+#define RX_GNSS_CLOCK_LEAK 1e-3
+typedef struct {
+    double offset; /* s, wall - stream time */
+    double t;      /* s, stream time of the last sample seen */
+    int known;     /* a sample was seen */
+} rx_gnss_clock;
+
+/* A sample read at `wall` ends at stream time t. */
+void rx_gnss_clock_sample(rx_gnss_clock *c, double wall, double t);
+/* The stream time of a fix read at `wall` that was valid `latency` s before (needs c->known). */
+double rx_gnss_clock_time(const rx_gnss_clock *c, double wall, double latency);
+/* ,"gnss":{...} of docs/gnss.md for fix f, age_s old at the line, from `source`. */
+int rx_gnss_json(char *p, size_t len, const att_gnss_fix *f, double age_s, const char *source);
+/* The source's name in JSON and logs: "serial" or "gpsd". */
+const char *rx_gnss_source(rx_gnss_kind k);
+
+/* gpsd (rx_gpsd.c): built with libgps when ATT_RX_GPSD is defined, else these say so. */
+extern const int rx_gpsd_built;
+/* Connect and start watching: 0, or RX_EXIT_UNAVAILABLE with a message. */
+int rx_gpsd_open(rx_gnss *g, char *msg, size_t msglen);
+/* Read the reports waiting on g->fd, queueing each fix (wall: now): 0, or -1 lost. */
+int rx_gpsd_read(rx_gnss *g);
+void rx_gpsd_close(rx_gnss *g);
 
 #endif /* ATTITUDE_RX_H */

@@ -89,7 +89,14 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
     X(tilt_tau) \
     X(heading_sigma_max) \
     X(turn_sigma) \
-    X(turn_tau)
+    X(turn_tau) \
+    X(gnss_vel_sigma) \
+    X(gnss_timeout) \
+    X(gnss_max_latency) \
+    X(gnss_max_pdop) \
+    X(gnss_max_sigma) \
+    X(gnss_max_acc) \
+    X(gnss_gate)
 // clang-format on
 #define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
 
@@ -171,6 +178,7 @@ void rx_config_defaults(rx_config *c)
     c->reopen_delay = 1.0;
     c->header = 1;
     c->link = RX_LINK_AUTO;
+    c->gnss.kind = RX_GNSS_OFF;
 }
 
 int rx_rate_check(long baud, unsigned block_size, double period, char *msg, size_t len)
@@ -406,10 +414,8 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         strcpy(c->port, value);
     } else if (strcmp(name, "baud") == 0) {
         if (parse_ulong(value, &u) != 0 || !rx_serial_baud_ok((long)u))
-            return fail(
-                msg, len, RX_EXIT_CONFIG,
-                "baud: '%s' is not a supported rate (1200 2400 4800 9600 19200 38400 57600 115200 230400)",
-                value);
+            return fail(msg, len, RX_EXIT_CONFIG, "baud: '%s' is not a supported rate (" RX_BAUDS_TEXT ")",
+                        value);
         c->baud = (long)u;
     } else if (strcmp(name, "period") == 0) {
         if (parse_double(value, &d) != 0 || !(d > 0.0) || d > 10.0)
@@ -487,6 +493,13 @@ int rx_config_set(rx_config *c, const char *name, const char *value, char *msg, 
         if (parse_double(value, &d) != 0 || d < 0.01 || d > 60)
             return fail(msg, len, RX_EXIT_CONFIG, "reopen-delay: '%s' must be 0.01..60 s", value);
         c->reopen_delay = d;
+    } else if (strcmp(name, "gnss") == 0) {
+        return rx_gnss_parse(value, &c->gnss, msg, len);
+    } else if (strcmp(name, "gnss_latency") == 0) {
+        if (parse_double(value, &d) != 0 || d < 0 || d > RX_GNSS_LATENCY_MAX)
+            return fail(msg, len, RX_EXIT_CONFIG, "gnss_latency: '%s' must be 0..%g s", value,
+                        RX_GNSS_LATENCY_MAX);
+        c->gnss_latency = d;
     } else if (strcmp(name, "header") == 0) {
         if (strcmp(value, "yes") == 0 || strcmp(value, "1") == 0)
             c->header = 1;
@@ -598,7 +611,9 @@ static const struct option long_options[] = { { "help", no_argument, NULL, OPT_H
                                               { "mag-matrix", required_argument, NULL, OPT_SETTING },
                                               { "mag-bias", required_argument, NULL, OPT_SETTING },
                                               { "gyro-matrix", required_argument, NULL, OPT_SETTING },
-                                              { "gyro-bias", required_argument, NULL, OPT_SETTING } };
+                                              { "gyro-bias", required_argument, NULL, OPT_SETTING },
+                                              { "gnss", required_argument, NULL, OPT_SETTING },
+                                              { "gnss_latency", required_argument, NULL, OPT_SETTING } };
 
 enum {
     N_BASE = sizeof long_options / sizeof long_options[0],
@@ -737,50 +752,55 @@ static void usage_ahrs(FILE *f)
 
 void rx_usage(const char *prog, void *stream)
 {
-    fprintf((FILE *)stream,
-            "usage: %s --port PATH [options]\n"
-            "Receive gyro samples and reports over the serial link (link v2, or the legacy AA/BB\n"
-            "handshake with checksum and 00/FF answer: whichever the board speaks; block format of\n"
-            "attitude/block.h), integrate the attitude in a second thread, print one line per attitude\n"
-            "update (and, with --format jsonl, one record per report).\n\n"
-            "  --port PATH              serial device (required)\n"
-            "  --baud N                 line rate, default 9600 (8N1 raw)\n"
-            "  --period SECONDS         gyro sample period; default: the one the BOOT report announces\n"
-            "                           (0.02 s until one arrives); given, it wins over BOOT (warning)\n"
-            "  --gyro-zero CODE[,C,C]   ADC code at zero rate, default 2048\n"
-            "  --gyro-scale K[,K,K]     rad/s per code, default 7.6699e-4 (90 deg/s per 2048 codes)\n"
-            "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
-            "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4, default rv3\n"
-            "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
-            "  --block-size N           legacy link block bytes (multiple of 6), default 6\n"
-            "  --queue N                records the inter-thread queue holds, default 256\n"
-            "  --gap-ms MS              legacy link gap timeout inside a block, default 20\n"
-            "  --link P                 auto (default: the protocol the board speaks, detected from\n"
-            "                           its first valid v2 frame or legacy block, which is not lost),\n"
-            "                           v2 (link v2) or legacy (AA/BB handshake)\n"
-            "  --hold-ms MS             a legacy block that finds the queue full waits this long for\n"
-            "                           room before it is answered 0xFF (send again), default 20\n"
-            "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
-            "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
-            "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
-            "  --estimator E            auto|ahrs|integrator: the attitude filter (att_ahrs: gyro bias,\n"
-            "                           accelerometer and magnetometer aiding) or the gyros alone; auto\n"
-            "                           (default): ahrs when the stream's CHANNELS report announces\n"
-            "                           accelerometer and magnetometer, else integrator\n"
-            "  --acc-zero, --acc-scale, --acc-axes, --acc-matrix, --acc-bias: the accelerometer's codes\n"
-            "                           -> m/s^2, as --gyro-zero, --gyro-scale, --axes, then M (v - b):\n"
-            "                           9 values row-major (default identity), b in m/s^2 (default 0)\n"
-            "  --mag-zero, --mag-scale, --mag-axes, --mag-matrix, --mag-bias: the magnetometer's, in uT\n"
-            "                           (matrix: soft iron, bias: hard iron); --gyro-matrix, --gyro-bias\n"
-            "  --config FILE            'name = value' lines with the names above; the command line wins\n"
-            "  -h, --help               this text;  --version: the version\n"
-            "A block (v2: a record) is acknowledged only once its records are queued; every acknowledged\n"
-            "sample is integrated and printed, also on --count and SIGINT/SIGTERM. Missing samples\n"
-            "(loss reports, bad codes) are filled by holding the last rate and counted\n"
-            "(docs/attitude-rx.md).\n"
-            "Exit codes: 0 ok, 64 usage, 66 no such port, 74 port not usable or stdout failed,\n"
-            "75 stopped while stdout stayed blocked (acknowledged samples unprinted), 77 permission\n"
-            "denied, 78 bad configuration.\n",
-            prog);
+    fprintf(
+        (FILE *)stream,
+        "usage: %s --port PATH [options]\n"
+        "Receive gyro samples and reports over the serial link (link v2, or the legacy AA/BB\n"
+        "handshake with checksum and 00/FF answer: whichever the board speaks; block format of\n"
+        "attitude/block.h), integrate the attitude in a second thread, print one line per attitude\n"
+        "update (and, with --format jsonl, one record per report).\n\n"
+        "  --port PATH              serial device (required)\n"
+        "  --baud N                 line rate, default 9600 (8N1 raw)\n"
+        "  --period SECONDS         gyro sample period; default: the one the BOOT report announces\n"
+        "                           (0.02 s until one arrives); given, it wins over BOOT (warning)\n"
+        "  --gyro-zero CODE[,C,C]   ADC code at zero rate, default 2048\n"
+        "  --gyro-scale K[,K,K]     rad/s per code, default 7.6699e-4 (90 deg/s per 2048 codes)\n"
+        "  --axes A,B,C             body x,y,z from channels with signs, default x,y,z (e.g. -y,x,z)\n"
+        "  --method M               rv1|rv2|rv3|rv3-coning|rv3-reuse|rv3-reuse-poly|rk4, default rv3\n"
+        "  --format F               csv|jsonl, default csv; --no-header drops the CSV header\n"
+        "  --block-size N           legacy link block bytes (multiple of 6), default 6\n"
+        "  --queue N                records the inter-thread queue holds, default 256\n"
+        "  --gap-ms MS              legacy link gap timeout inside a block, default 20\n"
+        "  --link P                 auto (default: the protocol the board speaks, detected from\n"
+        "                           its first valid v2 frame or legacy block, which is not lost),\n"
+        "                           v2 (link v2) or legacy (AA/BB handshake)\n"
+        "  --hold-ms MS             a legacy block that finds the queue full waits this long for\n"
+        "                           room before it is answered 0xFF (send again), default 20\n"
+        "  --count N                stop after N attitude lines (default: until SIGINT/SIGTERM)\n"
+        "  --reopen-delay SECONDS   wait between attempts to reopen a vanished port, default 1\n"
+        "  --consumer-delay SECONDS make the attitude thread sleep per record (diagnostics)\n"
+        "  --estimator E            auto|ahrs|integrator: the attitude filter (att_ahrs: gyro bias,\n"
+        "                           accelerometer and magnetometer aiding) or the gyros alone; auto\n"
+        "                           (default): ahrs when the stream's CHANNELS report announces\n"
+        "                           accelerometer and magnetometer, else integrator\n"
+        "  --acc-zero, --acc-scale, --acc-axes, --acc-matrix, --acc-bias: the accelerometer's codes\n"
+        "                           -> m/s^2, as --gyro-zero, --gyro-scale, --axes, then M (v - b):\n"
+        "                           9 values row-major (default identity), b in m/s^2 (default 0)\n"
+        "  --mag-zero, --mag-scale, --mag-axes, --mag-matrix, --mag-bias: the magnetometer's, in uT\n"
+        "                           (matrix: soft iron, bias: hard iron); --gyro-matrix, --gyro-bias\n"
+        "  --gnss SOURCE            a GNSS receiver's velocity for the filter (docs/gnss.md): gpsd[:HOST\n"
+        "                           [:PORT]] (default localhost:2947; gpsd support: --version says) or\n"
+        "                           a serial port PATH[:BAUD] read as NMEA 0183 / UBX NAV-PVT (9600)\n"
+        "  --gnss_latency SECONDS   a fix's time of validity to its arrival here, default 0 (0..2)\n"
+        "  --config FILE            'name = value' lines with the names above; the command line wins\n"
+        "  -h, --help               this text;  --version: the version\n"
+        "A block (v2: a record) is acknowledged only once its records are queued; every acknowledged\n"
+        "sample is integrated and printed, also on --count and SIGINT/SIGTERM. Missing samples\n"
+        "(loss reports, bad codes) are filled by holding the last rate and counted\n"
+        "(docs/attitude-rx.md).\n"
+        "Exit codes: 0 ok, 64 usage, 66 no such port, 69 gpsd unreachable or not built in,\n"
+        "74 port not usable or stdout failed, 75 stopped while stdout stayed blocked\n"
+        "(acknowledged samples unprinted), 77 permission denied, 78 bad configuration.\n",
+        prog);
     usage_ahrs((FILE *)stream);
 }

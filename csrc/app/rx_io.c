@@ -374,6 +374,15 @@ int rx_serial_baud_ok(long baud)
     return baud_code(baud, &c) == 0;
 }
 
+int rx_open_error_code(int err)
+{
+    if (err == ENOENT || err == ENODEV || err == ENXIO || err == ENOTDIR)
+        return RX_EXIT_NOPORT;
+    if (err == EACCES || err == EPERM)
+        return RX_EXIT_NOPERM;
+    return RX_EXIT_IOERR;
+}
+
 int rx_serial_open(const char *path, long baud, char *msg, size_t len)
 {
     struct termios tio;

@@ -100,6 +100,24 @@ def shared_link_cmd(t: T.Target, objs: Sequence[Path], real: Path) -> list[str]:
             "-o", str(real), *shared_ldflags(t), *t.shared_ldflags, *t.shared_link_libs()]
 
 
+def app_optional_found(t: T.Target, workdir: Path, verbose: bool = False) -> list[T.AppOptional]:
+    """The optional dependencies whose probe (a program including the header and calling the
+    symbol) compiles and links for target ``t`` with the app's link flags: built in."""
+    workdir.mkdir(parents=True, exist_ok=True)
+    found = []
+    for o in T.app_optional():
+        src = workdir / f"{o.name}.c"
+        src.write_text(o.probe_source())
+        cmd = [t.cc, *t.target_cflags, str(src), "-o", str(workdir / o.name), *t.ldflags, *t.app_libs,
+               *o.libs, *t.libs]
+        ok = subprocess.run(cmd, capture_output=True, check=False).returncode == 0
+        if verbose:
+            print(f"probe {o.name}: {' '.join(cmd)}: {'ok' if ok else 'failed'}", flush=True)
+        if ok:
+            found.append(o)
+    return found
+
+
 def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = None,
                        verbose: bool = False) -> dict[str, Path]:
     """Build target ``name`` into ``out`` (default build/NAME); returns the products."""
@@ -140,11 +158,14 @@ def cross_build_target(name: str, *, precision: str = "f64", out: Path | None = 
     if t.app:
         app_srcs = sorted(APP_DIR.glob("*.c"))
         if app_srcs:
-            app_objs = _compile_all(t, app_srcs, out / "obj-app", [], defines, verbose)
+            found = app_optional_found(t, out / "probe", verbose)
+            app_defines = [*defines, *(o.define for o in found)]
+            app_objs = _compile_all(t, app_srcs, out / "obj-app", [], app_defines, verbose)
             exe = out / "attitude-rx"
-            _run([t.cc, *t.cflags, *app_objs, lib, "-o", exe, *t.ldflags, *t.app_libs, *t.libs],
-                 verbose)
+            _run([t.cc, *t.cflags, *app_objs, lib, "-o", exe, *t.ldflags, *t.app_libs,
+                  *(f for o in found for f in o.libs), *t.libs], verbose)
             products["app"] = exe
+            products.update({f"app_{o.name}": exe for o in found})
 
     inc = out / "include" / "attitude"
     inc.mkdir(parents=True)
@@ -183,9 +204,13 @@ def cross_build(c, target="armv4t", precision="f64", out="", verbose=False):
         raise SystemExit(f"cross-build: {exc}")
     for kind, p in products.items():
         rel = os.path.relpath(p, ROOT)
+        if kind.startswith("app_"):
+            continue
         if kind == "armv4t_check":
             print("  ARMv4T check: every object and libattitude.so are ARMv4T clean")
         else:
             print(f"  {kind:8s} {rel}")
-
-
+    if "app" in products:
+        for o in T.app_optional():
+            print(f"  attitude-rx {o.name} support: " + ("built in" if f"app_{o.name}" in products else
+                  f"not built (no <{o.header}> / {' '.join(o.libs)} for {target}: apt-get install {o.apt})"))
