@@ -1,0 +1,69 @@
+"""Issue 30's simulated acceptance of GNSS-velocity aiding, one seed and shortened for the
+default suite; `invoke bench --only gnss_accept` runs the full three-seed runs with VQF and
+Fusion beside (docs/bench/gnss_accept.md). The scenarios, the simulated system, the
+filters' configuration and how each figure is measured: bench/gnss_accept.py.
+
+Shortened (bench.gnss_accept.SHORT): the turn is held 30 s instead of 60 s (the aided error
+is steady within a few seconds of the roll-in: docs/img/gnss-turn.png); the outage's turn
+50 s instead of 90 s, the 30 s outage from 20 s instead of 40 s. Braking and the roundabout
+run at full length. Every limit below is issue 30's own, never loosened."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bench.gnss_accept import DEG, LIMIT_DEG, RECOVERY_S, SHORT, Result, evaluate, recovery_time
+
+
+def _run(case: str) -> Result:
+    return evaluate(case, 0, peers=False, **SHORT.get(case, {}))
+
+
+@pytest.mark.system  # runs the simulator end to end
+@pytest.mark.parametrize("case", ["turn", "brake", "roundabout"])
+def test_aided_roll_and_pitch_within_half_a_degree(case: str) -> None:
+    """Issue 30: roll and pitch error ≤ 0.5° with GNSS aiding in the 30° / 60 m/s coordinated
+    turn, braking at 0.5 g and the roundabout; without aiding the same run leaves 0.5° (the
+    scenario tests what the aiding is for: measured 5-16° at full length, docs/bench/gnss_accept.md)."""
+    r = _run(case)
+    aided, unaided = r.figures("aided"), r.figures("unaided")
+    assert aided["tilt_max"] <= LIMIT_DEG, aided
+    assert unaided["tilt_max"] > LIMIT_DEG, unaided
+
+
+@pytest.mark.system  # runs the simulator end to end
+def test_outage_in_turn_degrades_gracefully_and_recovers() -> None:
+    """Issue 30: through a 30 s outage in the turn the filter falls back to the accelerometer
+    (the aiding flag clears once gnss_timeout has passed) and is no worse than the filter that
+    never had GNSS; within 10 s of the fix's return roll and pitch are back within 0.5° for good,
+    and the aiding flag is set again."""
+    from attitude_c import Ahrs
+
+    r = _run("outage-in-turn")
+    a, b = r.outage  # type: ignore[misc]
+    timeout = float(Ahrs().settings["gnss_timeout"])
+    assert r.aided_fraction(r.data.judged_from, a) == 1.0
+    assert r.aided_fraction(a + timeout, b) == 0.0
+    assert r.aided_fraction(b + RECOVERY_S, float(r.data.t[-1])) == 1.0
+    before = (r.data.t >= r.data.judged_from) & (r.data.t < a)
+    assert np.max(np.abs(r.err["aided"][before])) <= LIMIT_DEG * DEG
+    assert r.outage_max_deg("aided") <= r.figures("unaided")["tilt_max"]
+    assert r.recovery_s() <= RECOVERY_S
+
+
+def test_recovery_time_definition() -> None:
+    """Closed forms: from the return to the first sample after the last one out of the band."""
+    t = np.arange(0.0, 20.0, 0.5)
+    e = np.zeros((len(t), 2))
+    assert recovery_time(t, e, 5.0) == 0.0  # never out of the band
+    e[(t >= 4.0) & (t < 8.0), 1] = 0.6 * DEG  # out from 4 s to 7.5 s, back at 8 s
+    assert recovery_time(t, e, 5.0) == 3.0
+    e[t == 12.0, 0] = -0.51 * DEG  # one more sample out: counted, it did not stay back
+    assert recovery_time(t, e, 5.0) == 7.5
+    e[t == 3.0, 0] = 1.0  # before the return: not counted
+    assert recovery_time(t, e, 5.0) == 7.5
+    e[-1, 0] = 1.0  # out at the end of the run: never recovered
+    assert recovery_time(t, e, 5.0) == math.inf
