@@ -264,8 +264,8 @@ def table(results: list[Result]) -> list[str]:
 
 
 def outage_table(results: list[Result], timeout: float) -> list[str]:
-    out = ["| seed | max error in the outage: GNSS-aided / no GNSS (°) | GNSS_AIDED flag: before / in the outage "
-           "(after the timeout) / 10 s after | recovery (s) |", "|---:|---:|---|---:|"]
+    out = [("| seed | max error in the outage: GNSS-aided / no GNSS (°) | GNSS_AIDED flag: before / in the "
+            "outage (after the timeout) / 10 s after | recovery (s) |"), "|---:|---:|---|---:|"]
     for r in results:
         if r.outage is None:
             continue
@@ -342,8 +342,8 @@ def plot_outage(r: Result) -> Path:
     from attitude_c._io import write_with
 
     assert r.outage is not None
+    shade = (*r.outage, "GNSS outage")
     title = (f"30 s GNSS outage in the turn (seed {r.data.seed}, shaded: no fix); recovery "
              f"{r.recovery_s():.1f} s after the fix returns; dashed: ±{LIMIT_DEG:g}°")
-    write_with(PLOT_OUTAGE, lambda tmp: _draw(tmp, r, ("aided", "unaided"), title, (*r.outage, "GNSS outage"),
-                                              symlog=True))
+    write_with(PLOT_OUTAGE, lambda tmp: _draw(tmp, r, ("aided", "unaided"), title, shade, symlog=True))
     return PLOT_OUTAGE
