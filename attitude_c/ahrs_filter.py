@@ -11,7 +11,10 @@ unit (µT typical; only its direction, norm ratios and dip are used).
 Quaternions scalar first, body → ENU (docs/conventions.md).
 
 * :class:`Ahrs` — streaming: one sample ``(3,)`` or a block ``(N, 3)`` per call;
-* :func:`ahrs` — batch: ``(N, 3)`` arrays in, ``(N, 4)`` quaternions out.
+  :meth:`Ahrs.update_vel` gives it a GNSS velocity (ENU, m/s) time-stamped on its clock
+  :attr:`Ahrs.time`;
+* :func:`ahrs` — batch: ``(N, 3)`` arrays in, ``(N, 4)`` quaternions out; GNSS velocities
+  with their own times (``gnss_t``, ``gnss_vel``).
 
 Settings are keyword arguments named as the C struct's fields
 (:data:`SETTINGS`; ``method`` by name, e.g. ``"rv3-reuse"``).
@@ -27,7 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from . import _settings, names
 from ._lib import ffi_lib
-from ._validate import real, real_array, time_steps
+from ._validate import integer, real, real_array, time_steps
 from .errors import InvalidArgument, InvalidType, NonFiniteError
 from .names import raise_for_status
 
@@ -48,7 +51,8 @@ def _method(name: str, v: Any) -> int:
 _SPEC = _settings.SettingsSpec(
     "att_ahrs_settings", "att_ahrs_default_settings", "att_ahrs_check_settings", label="filter",
     domain="ahrs.h: noises and times > 0, '0 = off' fields ≥ 0, |sensor_delay| ≤ 1 s, "
-    "|acc_delay|, |mag_delay| ≤ 0.05 s, 0 ≤ mag_ref_window ≤ mag_ref_tau",
+    "|acc_delay|, |mag_delay| ≤ 0.05 s, 0 ≤ mag_ref_window ≤ mag_ref_tau, gnss_vel_sigma, "
+    "gnss_timeout, gnss_max_latency > 0, the other gnss_ fields ≥ 0",
     choices={"method": _settings.Choice(_method, lambda code: names.method_names()[code])},
     field_fn="att_ahrs_check_settings_field")
 
@@ -210,6 +214,47 @@ class Ahrs:
         """``ATT_AHRS_F_*`` bits of the last sample."""
         return int(self._lib.att_ahrs_flags(self._s))
 
+    @property
+    def time(self) -> float:
+        """The filter's clock (s): the sum of the time steps of every sample so far
+        (``att_ahrs_time``); GNSS velocities are time-stamped on it."""
+        return float(self._lib.att_ahrs_time(self._s))
+
+    def update_vel(self, t: float, vel_enu: ArrayLike, sigma: float = 0.0, pdop: float = 0.0,
+                   has_up: bool = False, fix_type: int = 3) -> None:
+        """Give the filter one GNSS velocity (``att_ahrs_update_vel``; docs/ahrs.md, "GNSS
+        velocity aiding"): ``t`` its time of validity on :attr:`time` (the receiver's latency
+        subtracted), ``vel_enu`` (2,) or (3,) m/s east, north (, up: used with ``has_up``),
+        ``sigma`` its 1σ per component (m/s; 0: the setting ``gnss_vel_sigma``), ``pdop`` (0:
+        unknown), ``fix_type`` as :class:`attitude_c.gnss` (2 2-D, 3 3-D, 4 GNSS + dead
+        reckoning are used). A refused sample (quality, jump, gate) is not an error: the next
+        sample's :attr:`flags` carry ``ATT_AHRS_F_GNSS_REJECTED``."""
+        tt = real(t, "t", "s")
+        v = real_array(vel_enu, "vel_enu").astype(np.float64)
+        if v.shape not in ((2,), (3,)):
+            raise InvalidArgument(f"vel_enu must have shape (2,) or (3,), got {v.shape}")
+        if not isinstance(has_up, (bool, np.bool_)):
+            raise InvalidType(f"has_up must be True or False, got {type(has_up).__name__}")
+        if has_up and v.shape != (3,):
+            raise InvalidArgument("has_up=True needs vel_enu of shape (3,) (east, north, up)")
+        if not np.isfinite(v[:3 if has_up else 2]).all():
+            raise NonFiniteError("vel_enu holds NaN or Inf")
+        rec = self._ffi.new("att_ahrs_vel *")
+        rec.t = tt
+        rec.vel = [float(v[0]), float(v[1]), float(v[2]) if has_up else 0.0]
+        rec.sigma = real(sigma, "sigma", "m/s", lo=0.0)
+        rec.pdop = real(pdop, "pdop", lo=0.0)
+        rec.has_up = int(bool(has_up))
+        rec.fix_type = integer(fix_type, "fix_type", 0, 255)
+        st = self._lib.att_ahrs_update_vel(self._s, rec)
+        if st == self._lib.ATT_E_ARG:
+            raise InvalidArgument(
+                f"t: {tt:g} s is outside the filter's window: its clock is {self.time:g} s; t must be "
+                f"at most one step later, at most gnss_max_latency = {self.settings['gnss_max_latency']:g} s "
+                "earlier, and after the previous velocity's t")
+        if st != 0:
+            raise_for_status(st, "update_vel")
+
     def _dt(self, dt: ArrayLike | None, n: int) -> NDArray[Any]:
         return time_steps(dt, n, self.rate, _DTYPES[self.precision])
 
@@ -331,27 +376,112 @@ class Ahrs:
         return f"Ahrs(rate={self.rate}, precision={self.precision!r})"
 
 
-@overload
-def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
-         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
-         covariance: Literal[False] = ..., **settings: Any) -> FloatArray: ...
+class _Gnss:
+    """The batch's GNSS velocities, checked: times of validity, when each is given to the
+    filter (delivered), ENU velocities with has_up, sigmas, fix types."""
+
+    def __init__(self, gnss_t: ArrayLike, gnss_vel: ArrayLike, gnss_sigma: ArrayLike | None,
+                 gnss_delivered: ArrayLike | None, gnss_fix: ArrayLike | None) -> None:
+        self.t = real_array(gnss_t, "gnss_t").astype(np.float64).reshape(-1)
+        m = self.t.size
+        v = real_array(gnss_vel, "gnss_vel").astype(np.float64)
+        if v.ndim != 2 or v.shape[0] != m or v.shape[1] not in (2, 3):
+            raise InvalidArgument(f"gnss_vel must have shape ({m}, 2) or ({m}, 3) (one row per gnss_t), "
+                                  f"got {v.shape}")
+        self.up = np.zeros(m, bool) if v.shape[1] == 2 else np.isfinite(v[:, 2])
+        self.vel = np.zeros((m, 3))
+        self.vel[:, :v.shape[1]] = v
+        self.vel[~self.up, 2] = 0.0
+        self.sigma = self._column(gnss_sigma, "gnss_sigma", m, 0.0)
+        self.delivered = self._column(gnss_delivered, "gnss_delivered", m, None)
+        self.fix = np.round(self._column(gnss_fix, "gnss_fix", m, 3.0)).astype(int)
+        ok = self.fix >= 2
+        if not np.isfinite(self.t).all():
+            raise NonFiniteError("gnss_t holds NaN or Inf")
+        if not np.isfinite(self.vel[ok, :2]).all():
+            raise NonFiniteError("gnss_vel: a row used (gnss_fix >= 2) holds NaN or Inf")
+        self.vel[~ok] = 0.0  # no fix: the velocity is not read (the filter refuses the fix type)
+        self.up &= ok
+        if np.any(np.diff(self.delivered) < 0):
+            raise InvalidArgument("gnss_t (or gnss_delivered) must be in time order")
+
+    def _column(self, x: ArrayLike | None, name: str, m: int, default: float | None) -> NDArray[np.float64]:
+        if x is None:
+            return self.t.copy() if default is None else np.full(m, default)
+        a = real_array(x, name).astype(np.float64).reshape(-1)
+        if a.size != m:
+            raise InvalidArgument(f"{name} must have one value per gnss_t ({m}), got {a.size}")
+        if not np.isfinite(a).all():
+            raise NonFiniteError(f"{name} holds NaN or Inf")
+        return a
+
+    def give(self, f: Ahrs, i: int) -> None:
+        f.update_vel(float(self.t[i]), self.vel[i], sigma=float(self.sigma[i]), has_up=bool(self.up[i]),
+                     fix_type=int(self.fix[i]))
+
+
+def _ahrs_gnss(f: Ahrs, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: ArrayLike | None,
+               covariance: bool, gn: _Gnss) -> Any:
+    """The batch with GNSS: the samples in blocks, each velocity given after the last sample
+    whose time (the sum of the steps so far) is at or before its delivery time."""
+    g = _vectors(gyr, "gyr")
+    assert g is not None
+    n = g.shape[0]
+    times = np.cumsum(np.broadcast_to(f._dt(dt, n).astype(np.float64), (n,)))
+    cut = np.searchsorted(times, gn.delivered, side="right")
+    a = np.asarray(acc)
+    m = None if mag is None else np.asarray(mag)
+    step = None if dt is None or np.ndim(dt) == 0 else np.asarray(dt)
+    outs, covs, k0 = [], [], 0
+    for i, k in enumerate([*cut, n]):
+        if k > k0:
+            r = f.update(g[k0:k], a[k0:k], None if m is None else m[k0:k],
+                         dt=dt if step is None else step[k0:k], covariance=covariance)
+            outs.append(r[0] if covariance else r)
+            if covariance:
+                covs.append(r[1])
+            k0 = k
+        if i < len(cut):
+            gn.give(f, i)
+    q = np.concatenate(outs) if outs else np.empty((0, 4))
+    return (q, np.concatenate(covs)) if covariance else q
 
 
 @overload
 def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
          dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
-         *, covariance: Literal[True], **settings: Any) -> tuple[FloatArray, FloatArray]: ...
+         covariance: Literal[False] = ..., gnss_t: ArrayLike | None = ..., gnss_vel: ArrayLike | None = ...,
+         gnss_sigma: ArrayLike | None = ..., gnss_delivered: ArrayLike | None = ...,
+         gnss_fix: ArrayLike | None = ..., **settings: Any) -> FloatArray: ...
+
+
+@overload
+def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = ..., rate: float | None = ...,
+         dt: ArrayLike | None = ..., q0: ArrayLike | None = ..., precision: Precision = ...,
+         *, covariance: Literal[True], gnss_t: ArrayLike | None = ..., gnss_vel: ArrayLike | None = ...,
+         gnss_sigma: ArrayLike | None = ..., gnss_delivered: ArrayLike | None = ...,
+         gnss_fix: ArrayLike | None = ..., **settings: Any) -> tuple[FloatArray, FloatArray]: ...
 
 
 def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float | None = None,
          dt: ArrayLike | None = None, q0: ArrayLike | None = None, precision: Precision = "f64",
-         covariance: bool = False, **settings: Any) -> Any:
+         covariance: bool = False, gnss_t: ArrayLike | None = None, gnss_vel: ArrayLike | None = None,
+         gnss_sigma: ArrayLike | None = None, gnss_delivered: ArrayLike | None = None,
+         gnss_fix: ArrayLike | None = None, **settings: Any) -> Any:
     """Run the filter over N samples: (N, 3) arrays → (N, 4) quaternions (body → ENU).
 
     ``rate`` (Hz) or ``dt`` (s, scalar or per sample) gives the time step;
     ``mag=None`` is six-axis operation (heading from the gyro only).
     ``covariance=True`` returns ``(q, cov)``, cov (N, 3, 3) the attitude error
     covariance after each sample (rad², ENU; :attr:`Ahrs.covariance`).
+
+    GNSS velocity aiding (docs/ahrs.md, "GNSS velocity aiding"): ``gnss_t`` (M,) the
+    velocities' times of validity (s, on the filter's clock: sample k, from 0, is at the sum
+    of the first k + 1 steps), ``gnss_vel`` (M, 2) or (M, 3) ENU m/s (a NaN up component: not
+    measured), optional ``gnss_sigma`` (M,) 1σ m/s (0: the setting), ``gnss_delivered`` (M,)
+    when each reaches the filter (default ``gnss_t``: no latency), ``gnss_fix`` (M,) fix
+    types (default 3; below 2 the row is a fix without velocity, refused). Velocity i is
+    given after the last sample whose time is ≤ ``gnss_delivered[i]``.
     """
     if not isinstance(covariance, (bool, np.bool_)):
         raise InvalidType(f"covariance must be True or False, got {type(covariance).__name__}")
@@ -361,4 +491,12 @@ def ahrs(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: flo
     if g.ndim != 2:
         raise InvalidArgument(f"gyr must have shape (N, 3), got {g.shape}")
     f = Ahrs(rate=rate, q0=q0, precision=precision, **settings)
-    return f.update(gyr, acc, mag, dt=dt, covariance=bool(covariance))
+    if gnss_t is None and gnss_vel is None:
+        for name, x in (("gnss_sigma", gnss_sigma), ("gnss_delivered", gnss_delivered), ("gnss_fix", gnss_fix)):
+            if x is not None:
+                raise InvalidArgument(f"{name} given without gnss_t and gnss_vel")
+        return f.update(gyr, acc, mag, dt=dt, covariance=bool(covariance))
+    if gnss_t is None or gnss_vel is None:
+        raise InvalidArgument("give both gnss_t and gnss_vel, or neither")
+    gn = _Gnss(gnss_t, gnss_vel, gnss_sigma, gnss_delivered, gnss_fix)
+    return _ahrs_gnss(f, gyr, acc, mag, dt, bool(covariance), gn)

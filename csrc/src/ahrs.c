@@ -57,6 +57,13 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->heading_sigma_max = ATT_R(0.0873);
     set->turn_sigma = ATT_R(0.002);
     set->turn_tau = ATT_R(5.0);
+    set->gnss_vel_sigma = ATT_R(0.2);
+    set->gnss_timeout = ATT_R(2.0);
+    set->gnss_max_latency = ATT_R(1.0);
+    set->gnss_max_pdop = ATT_R(10.0);
+    set->gnss_max_sigma = ATT_R(2.0);
+    set->gnss_max_acc = ATT_R(40.0);
+    set->gnss_gate = ATT_R(5.0);
 }
 
 static int fin(att_real x)
@@ -105,6 +112,13 @@ static const att__domain DOMAINS[] = {
     DOMAIN(heading_sigma_max, GT, 0),
     DOMAIN(turn_sigma, GE, 0),
     DOMAIN(turn_tau, GT, 0),
+    DOMAIN(gnss_vel_sigma, GT, 0),
+    DOMAIN(gnss_timeout, GT, 0),
+    DOMAIN(gnss_max_latency, GT, 0),
+    DOMAIN(gnss_max_pdop, GE, 0),
+    DOMAIN(gnss_max_sigma, GE, 0),
+    DOMAIN(gnss_max_acc, GE, 0),
+    DOMAIN(gnss_gate, GE, 0),
 };
 
 att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
@@ -218,6 +232,7 @@ att_status att_ahrs_init(att_ahrs *s, const att_ahrs_settings *set, const att_re
     s->tilt_t = 0;
     s->flags = 0;
     s->heading_seen = 0;
+    memset(&s->gnss, 0, sizeof s->gnss);
     return ATT_OK;
 }
 
@@ -421,7 +436,7 @@ static void report_q(const att_ahrs *s, att_real out[4])
 {
     const att_real *q = s->integ.q;
     att_real n, vz, r0, r1, r2;
-    n = s->step.tilt ? norm3(s->tilt_f) : 0; /* tilt_f = 0 until its first sample */
+    n = (s->step.tilt && !s->gnss.aided) ? norm3(s->tilt_f) : 0; /* tilt_f = 0 until its first sample */
     vz = (n > 0) ? s->tilt_f[2] / n : 0;
     if (vz <= 0) {
         out[0] = q[0];
@@ -678,7 +693,7 @@ static int acc_gated(att_ahrs *s, att_real ang, att_real dt)
  * the navigation frame, whose inclination measures δθx, δθy (gated). 1 when
  * the update was made. */
 static int acc_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], const att_real f[3],
-                      att_real norm_lp, att_real dt, att_real x[NX], int *flags, att_real f_n[3])
+                      att_real norm_lp, att_real dt, int aided, att_real x[NX], int *flags, att_real f_n[3])
 {
     att_real v[3], nv, hs, ang, y0 = 0, y1 = 0;
     int i;
@@ -695,7 +710,8 @@ static int acc_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9], 
     }
     s->acc_norm_lp = norm_lp;
     nv = norm3(s->acc_lp);
-    if (!(nv > 0)) {
+    if (aided || !(nv > 0)) { /* GNSS-aided: the inclination comes from the velocities */
+        s->acc_rej_time = 0;
         return 0;
     }
     for (i = 0; i < 3; i++) {
@@ -909,6 +925,383 @@ static int heading_flag(att_ahrs *s, att_real p_head)
     return (s->heading_seen && s->P[2][2] + s->turn_var <= m * m) ? 0 : ATT_AHRS_F_NO_HEADING;
 }
 
+/* ---- GNSS velocity aiding (docs/ahrs.md, "GNSS velocity aiding") ---- */
+
+/* 1 when the filter is aided at clock time now: a velocity used, at most gnss_timeout old. */
+static int gnss_aided_at(const att_ahrs *s, att_real now)
+{
+    return s->gnss.used && now - s->gnss.used_t <= s->set.gnss_timeout;
+}
+
+/* The reported inclination's low-pass starts again (its state as after init). */
+static void tilt_restart(att_ahrs *s)
+{
+    int i;
+    for (i = 0; i < 3; i++) {
+        s->tilt_f[i] = 0;
+        s->tilt_fd[i] = 0;
+    }
+    s->tilt_t = 0;
+    s->tilt_mean = 1;
+}
+
+static void copy3(att_real dst[3], const att_real src[3])
+{
+    dst[0] = src[0];
+    dst[1] = src[1];
+    dst[2] = src[2];
+}
+
+/* A history entry at the clock's time holding the current sv. */
+static void gnss_push(att_ahrs_gnss *g)
+{
+    g->hhead = (g->hhead + 1) % ATT_AHRS_GNSS_HIST;
+    g->ht[g->hhead] = g->time;
+    copy3(g->hs[g->hhead], g->sv);
+    if (g->hn < ATT_AHRS_GNSS_HIST) {
+        g->hn++;
+    }
+}
+
+/* End of a successful update: the clock, the flags' state, and once armed the integral
+ * sv and the history (an entry when the newest is gnss_max_latency/(HIST − 2) old); a
+ * sample without accelerometer breaks the integral: history and anchor start again. */
+static void gnss_record(att_ahrs *s, const att_real f_n[3], att_real dt, int aided)
+{
+    att_ahrs_gnss *g = &s->gnss;
+    g->time += dt;
+    g->rejected = 0;
+    g->aided = aided;
+    if (!g->armed) {
+        return;
+    }
+    if (f_n == NULL) {
+        g->hn = 0;
+        g->anchor = 0;
+        g->sv[0] = g->sv[1] = g->sv[2] = 0;
+        gnss_push(g);
+        return;
+    }
+    g->sv[0] += f_n[0] * dt;
+    g->sv[1] += f_n[1] * dt;
+    g->sv[2] += (f_n[2] - s->set.gravity) * dt;
+    if (g->time - g->ht[g->hhead] >= s->set.gnss_max_latency / (ATT_AHRS_GNSS_HIST - 2)) {
+        gnss_push(g);
+    }
+}
+
+/* sv at time t, interpolated linearly in the history (the current sv for t at or after
+ * the clock): 1, or 0 when t is older than the oldest entry. */
+static int gnss_sv_at(const att_ahrs_gnss *g, att_real t, att_real out[3])
+{
+    att_real t1 = g->time, t0, w;
+    const att_real *s1 = g->sv, *s0;
+    int n, i, idx = g->hhead;
+    if (t >= t1) {
+        copy3(out, s1);
+        return 1;
+    }
+    for (n = 0; n < g->hn; n++) {
+        t0 = g->ht[idx];
+        s0 = g->hs[idx];
+        if (t >= t0) {
+            w = (t1 > t0) ? (t - t0) / (t1 - t0) : 0;
+            for (i = 0; i < 3; i++) {
+                out[i] = s0[i] + w * (s1[i] - s0[i]);
+            }
+            return 1;
+        }
+        t1 = t0;
+        s1 = s0;
+        idx = (idx + ATT_AHRS_GNSS_HIST - 1) % ATT_AHRS_GNSS_HIST;
+    }
+    return 0;
+}
+
+/* x ← (x − base) + θ × (x − base + g (t_x − t_a) e_z): an integral re-based to the new
+ * anchor and turned by the correction θ (the specific force since the anchor was
+ * integrated in the frame before it). */
+static void rebase_turn(att_real x[3], const att_real base[3], const att_real th[3], att_real gz)
+{
+    att_real u0 = x[0] - base[0], u1 = x[1] - base[1], u2 = x[2] - base[2], v2 = u2 + gz;
+    x[0] = u0 + (th[1] * v2 - th[2] * u1);
+    x[1] = u1 + (th[2] * u0 - th[0] * v2);
+    x[2] = u2 + (th[0] * u1 - th[1] * u0);
+}
+
+/* The velocity v (time t, sv there sv_t, variance var) becomes the anchor; sv, the
+ * history and the anchor's integral are re-based to it and turned by th. */
+static void gnss_set_anchor(att_ahrs *s, const att_ahrs_vel *v, const att_real sv_t[3], att_real var,
+                            const att_real th[3])
+{
+    att_ahrs_gnss *g = &s->gnss;
+    att_real base[3], grav = s->set.gravity;
+    int n, idx = g->hhead;
+    copy3(base, sv_t);
+    for (n = 0; n < g->hn; n++) {
+        rebase_turn(g->hs[idx], base, th, grav * (g->ht[idx] - v->t));
+        idx = (idx + ATT_AHRS_GNSS_HIST - 1) % ATT_AHRS_GNSS_HIST;
+    }
+    rebase_turn(g->sv, base, th, grav * (g->time - v->t));
+    g->anchor_t = v->t;
+    g->anchor_s[0] = g->anchor_s[1] = g->anchor_s[2] = 0;
+    copy3(g->anchor_v, v->vel);
+    g->anchor_var = var;
+    g->anchor = v->has_up ? 2 : 1;
+}
+
+/* The first velocity: the integral and the history start at the clock's time. */
+static void gnss_arm(att_ahrs_gnss *g)
+{
+    g->armed = 1;
+    g->hn = 0;
+    g->sv[0] = g->sv[1] = g->sv[2] = 0;
+    gnss_push(g);
+}
+
+/* A sample's checks that return an error (nothing is written). */
+static att_status gnss_check(const att_ahrs *s, const att_ahrs_vel *v)
+{
+    const att_ahrs_gnss *g = &s->gnss;
+    if (!fin(v->t) || !fin(v->vel[0]) || !fin(v->vel[1]) || (v->has_up && !fin(v->vel[2])) || !fin(v->sigma)
+        || !fin(v->pdop)) {
+        return ATT_E_NONFINITE;
+    }
+    if (v->sigma < 0 || v->pdop < 0 || v->t > g->time + s->step.dt || v->t < g->time - s->set.gnss_max_latency
+        || (g->anchor && v->t <= g->anchor_t)) {
+        return ATT_E_ARG;
+    }
+    return ATT_OK;
+}
+
+/* The sample's own quality: fix type, PDOP, sigma (1 when usable). */
+static int gnss_quality(const att_ahrs_settings *set, const att_ahrs_vel *v, att_real sigma)
+{
+    if (v->fix_type != ATT_GNSS_FIX_2D && v->fix_type != ATT_GNSS_FIX_3D
+        && v->fix_type != ATT_GNSS_FIX_GNSS_DR) {
+        return 0;
+    }
+    if (set->gnss_max_pdop > 0 && v->pdop > set->gnss_max_pdop) {
+        return 0;
+    }
+    return !(set->gnss_max_sigma > 0 && sigma > set->gnss_max_sigma);
+}
+
+/* One scalar measurement of the error state: y = h·x + noise of variance r. */
+typedef struct {
+    att_real h[NX];
+    att_real y;
+    att_real r;
+} gnss_row;
+
+/* Row i of −[F×] (the attitude part of h: r = −F × ... = −[F×] δθ), its bias part
+ * h_b = τ h_θ C (δθ at the window's middle = δθ + C τ δb), measurement y. */
+static void gnss_row_set(gnss_row *row, const att_real F[3], const att_real u[3], const att_real C[9],
+                         att_real tau, att_real y, att_real r)
+{
+    int j;
+    row->h[0] = u[2] * F[1] - u[1] * F[2]; /* u·(−[F×]) for a unit u: (u × F)ᵀ */
+    row->h[1] = u[0] * F[2] - u[2] * F[0];
+    row->h[2] = u[1] * F[0] - u[0] * F[1];
+    for (j = 0; j < 3; j++) {
+        row->h[3 + j] = tau * (row->h[0] * C[j] + row->h[1] * C[3 + j] + row->h[2] * C[6 + j]);
+    }
+    row->y = y;
+    row->r = r;
+}
+
+/* The rows of one comparison: Δv − Δsv = −[ΔF×] δθ(t_m) + noise, ΔF = Δsv + g Δt e_z.
+ * Heading known: the east, north (and up) components. Heading unknown (its column
+ * dropped): while |Δv_h| is above 3σ, the horizontal magnitudes compared along Δsv_h
+ * (a heading error turns Δsv_h, its length stays); else the components. */
+static int gnss_rows(const att_real dsv[3], const att_real dv[3], att_real dT, att_real grav,
+                     const att_real C[9], att_real tau, att_real r, int up, int heading, gnss_row rows[3])
+{
+    static const att_real E[3][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } };
+    att_real F[3], u[3], nv, ns;
+    int n = 0;
+    F[0] = dsv[0];
+    F[1] = dsv[1];
+    F[2] = dsv[2] + grav * dT;
+    nv = att_sqrt(dv[0] * dv[0] + dv[1] * dv[1]);
+    ns = att_sqrt(dsv[0] * dsv[0] + dsv[1] * dsv[1]);
+    if (!heading && ns > 0 && nv * nv > 9 * r) {
+        u[0] = dsv[0] / ns;
+        u[1] = dsv[1] / ns;
+        u[2] = 0;
+        gnss_row_set(&rows[n++], F, u, C, tau, nv - ns, r);
+    } else {
+        gnss_row_set(&rows[n++], F, E[0], C, tau, dv[0] - dsv[0], r);
+        gnss_row_set(&rows[n++], F, E[1], C, tau, dv[1] - dsv[1], r);
+    }
+    if (up) {
+        gnss_row_set(&rows[n++], F, E[2], C, tau, dv[2] - dsv[2], r);
+    }
+    if (!heading) {
+        int i;
+        for (i = 0; i < n; i++) {
+            rows[i].h[2] = 0;
+        }
+    }
+    return n;
+}
+
+/* A scalar measurement y = h·x with variance R, moving the states in mask (the
+ * general-row form of scalar_update: ph = P hᵀ, S = h ph + R, K = ph/S masked,
+ * Joseph form P ← P − K phᵀ − ph Kᵀ + K Kᵀ S). */
+static void dense_update(att_real P[NX][NX], att_real x[NX], const att_real h[NX], att_real y, att_real R,
+                         unsigned mask)
+{
+    att_real ph[NX], K[NX], S = R, innov = y, v;
+    int r, c;
+    for (r = 0; r < NX; r++) {
+        ph[r] = 0;
+        for (c = 0; c < NX; c++) {
+            ph[r] += P[r][c] * h[c];
+        }
+    }
+    for (r = 0; r < NX; r++) {
+        S += h[r] * ph[r];
+        innov -= h[r] * x[r];
+    }
+    for (r = 0; r < NX; r++) {
+        K[r] = (mask & (1u << r)) ? ph[r] / S : 0;
+        x[r] += K[r] * innov;
+    }
+    for (r = 0; r < NX; r++) {
+        for (c = r; c < NX; c++) {
+            v = P[r][c] - K[r] * ph[c] - ph[r] * K[c] + K[r] * K[c] * S;
+            P[r][c] = v;
+            P[c][r] = v;
+        }
+    }
+}
+
+/* The gate: 1 when a row's innovation exceeds gnss_gate standard deviations of
+ * h P hᵀ + r (all rows against the prior P). */
+static int gnss_gated(const att_ahrs *s, const gnss_row rows[3], int n)
+{
+    att_real gate = s->set.gnss_gate, S;
+    int i, r, c;
+    if (!(gate > 0)) {
+        return 0;
+    }
+    for (i = 0; i < n; i++) {
+        S = rows[i].r;
+        for (r = 0; r < NX; r++) {
+            for (c = 0; c < NX; c++) {
+                S += rows[i].h[r] * s->P[r][c] * rows[i].h[c];
+            }
+        }
+        if (rows[i].y * rows[i].y > gate * gate * S) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* A velocity change of |Δv_h| over dT beyond gnss_max_acc·dT: a jump (1). */
+static int gnss_jump(const att_ahrs_settings *set, const att_real dv[3], att_real dT)
+{
+    att_real a = set->gnss_max_acc * dT;
+    return set->gnss_max_acc > 0 && dv[0] * dv[0] + dv[1] * dv[1] > a * a;
+}
+
+/* The comparison with the anchor: checks, the Kalman update, the new anchor. */
+static att_status gnss_compare(att_ahrs *s, const att_ahrs_vel *v, const att_real sv_t[3], att_real var)
+{
+    att_ahrs_gnss *g = &s->gnss, gsave = s->gnss;
+    att_ahrs save;
+    gnss_row rows[3];
+    att_real dsv[3], dv[3], C[9], x[NX] = { 0 }, dT = v->t - g->anchor_t;
+    int n, i, heading = !(s->flags & ATT_AHRS_F_NO_HEADING);
+    for (i = 0; i < 3; i++) {
+        dsv[i] = sv_t[i] - g->anchor_s[i];
+        dv[i] = v->vel[i] - g->anchor_v[i];
+    }
+    q2C(s->integ.q, C);
+    n = gnss_rows(dsv, dv, dT, s->set.gravity, C, g->time - (v->t + g->anchor_t) * ATT_R(0.5),
+                  var + g->anchor_var, v->has_up && g->anchor == 2, heading, rows);
+    if (gnss_jump(&s->set, dv, dT) || gnss_gated(s, rows, n)) {
+        g->rejected = 1;
+        return ATT_OK;
+    }
+    copy_mutable(&save, s);
+    for (i = 0; i < n; i++) {
+        dense_update(s->P, x, rows[i].h, rows[i].y, rows[i].r, heading ? 0x3Fu : 0x3Bu);
+    }
+    inject(s, &s->step, x);
+    if (!finite_state(s)) {
+        copy_mutable(s, &save);
+        *g = gsave;
+        return ATT_E_AHRS_DIVERGED;
+    }
+    gnss_set_anchor(s, v, sv_t, var, x);
+    g->used = 1;
+    g->used_t = v->t;
+    return ATT_OK;
+}
+
+att_status att_ahrs_update_vel(att_ahrs *s, const att_ahrs_vel *v)
+{
+    static const att_real zero[3] = { 0, 0, 0 };
+    att_ahrs_gnss *g;
+    att_real sigma, sv_t[3];
+    att_status st;
+    if (s == NULL || v == NULL) {
+        return ATT_E_NULL;
+    }
+    st = gnss_check(s, v);
+    if (st != ATT_OK || !s->aligned) {
+        return st;
+    }
+    g = &s->gnss;
+    if (!g->armed) {
+        gnss_arm(g);
+        return ATT_OK;
+    }
+    sigma = (v->sigma > 0) ? v->sigma : s->set.gnss_vel_sigma;
+    if (!gnss_quality(&s->set, v, sigma)) {
+        g->rejected = 1;
+        return ATT_OK;
+    }
+    if (!gnss_sv_at(g, v->t, sv_t)) {
+        return ATT_OK;
+    }
+    if (!g->anchor || v->t - g->anchor_t > s->set.gnss_timeout) {
+        gnss_set_anchor(s, v, sv_t, sigma * sigma, zero);
+        return ATT_OK;
+    }
+    return gnss_compare(s, v, sv_t, sigma * sigma);
+}
+
+att_real att_ahrs_time(const att_ahrs *s)
+{
+    return s == NULL ? 0 : s->gnss.time;
+}
+
+att_status att_ahrs_vel_from_fix(const att_gnss_fix *fix, att_real t, att_ahrs_vel *out)
+{
+    if (fix == NULL || out == NULL) {
+        return ATT_E_NULL;
+    }
+    if (!(fix->present & ATT_GNSS_HAS_VEL_NE)) {
+        return ATT_E_ARG;
+    }
+    out->t = t;
+    out->vel[0] = fix->vel_e;
+    out->vel[1] = fix->vel_n;
+    out->has_up = (fix->present & ATT_GNSS_HAS_VEL_D) ? 1 : 0;
+    out->vel[2] = out->has_up ? -fix->vel_d : 0;
+    out->sigma = (fix->present & ATT_GNSS_HAS_ACC) ? fix->s_acc : 0;
+    out->pdop = (fix->present & ATT_GNSS_HAS_PDOP) ? fix->pdop : 0;
+    out->fix_type = (fix->present & ATT_GNSS_HAS_FIX_TYPE) ? fix->fix_type : ATT_GNSS_FIX_2D;
+    if ((fix->present & ATT_GNSS_HAS_VALID) && !fix->valid) {
+        out->fix_type = ATT_GNSS_FIX_NONE;
+    }
+    return ATT_OK;
+}
+
 /* Output: the reported attitude, predicted over sensor_delay (when set) with
  * the corrected rate, q ⊗ exp((ω − b)·d). */
 static att_status write_output(const att_ahrs *s, const att_real gyr[3], att_real q_out[4])
@@ -936,7 +1329,7 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     const att_ahrs_step *k;
     att_real C[9], x[NX] = { 0 }, f_n[3], norm_lp, acc_c[3], mag_c[3], p_head;
     att_status st;
-    int rest, flags;
+    int rest, flags, aided;
     if (s == NULL || gyr == NULL) {
         return ATT_E_NULL;
     }
@@ -951,15 +1344,19 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     k = step_constants(s, dt);
     flags = overrange(&s->set, gyr) ? ATT_AHRS_F_OVERRANGE : 0;
     rest = detect_rest(s, k, gyr, acc, dt);
+    aided = gnss_aided_at(s, s->gnss.time + dt);
     if (propagate(s, k, gyr, dt, rest, flags & ATT_AHRS_F_OVERRANGE, C) != 0) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
+    }
+    if (s->gnss.aided && !aided) { /* back to the accelerometer: the reported inclination restarts */
+        tilt_restart(s);
     }
     if (k->delays) { /* from here on the aiding samples at the gyro's time (one integer test when both are 0) */
         acc = at_gyro_time(s, gyr, acc, k->delays & 1, s->set.acc_delay, acc_c);
         mag = at_gyro_time(s, gyr, mag, k->delays & 2, s->set.mag_delay, mag_c);
     }
-    if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, x, &flags, f_n) && k->tilt) {
+    if (acc != NULL && acc_update(s, k, C, acc, norm_lp, dt, aided, x, &flags, f_n) && k->tilt) {
         tilt_lowpass(s, k, f_n, dt, rest);
     }
     p_head = s->P[2][2];
@@ -971,11 +1368,13 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         zero_rate_update(s, k, x);
     }
     inject(s, k, x);
+    flags |= (aided ? ATT_AHRS_F_GNSS_AIDED : 0) | (s->gnss.rejected ? ATT_AHRS_F_GNSS_REJECTED : 0);
     s->flags = flags | heading_flag(s, p_head);
     if (!finite_state(s)) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
+    gnss_record(s, acc != NULL ? f_n : NULL, dt, aided);
     return write_output(s, gyr, q_out);
 }
 

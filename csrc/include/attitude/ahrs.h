@@ -52,6 +52,7 @@
 #define ATTITUDE_AHRS_H
 
 #include "attitude/common.h"
+#include "attitude/gnss.h"
 #include "attitude/integrator.h"
 
 ATT_API_BEGIN
@@ -72,11 +73,16 @@ enum {
     ATT_AHRS_F_ACC_REJECTED = 4,   /* accelerometer update gated out */
     ATT_AHRS_F_MAG_DISTURBED = 8,  /* magnetometer update rejected (norm/dip vs reference) */
     ATT_AHRS_F_MAG_RELEARNED = 16, /* the magnetic reference was replaced in this update */
-    ATT_AHRS_F_NO_HEADING = 32     /* heading not observable: no magnetometer update since
+    ATT_AHRS_F_NO_HEADING = 32,    /* heading not observable: no magnetometer update since
                                   init (six-axis), or the heading's 1σ (the square root of
                                   att_ahrs_covariance's att_cov[8]) has grown past
                                   heading_sigma_max since the last one (docs/ahrs.md,
                                   "Uncertainty") */
+    ATT_AHRS_F_GNSS_AIDED = 64,    /* a GNSS velocity used by an update (att_ahrs_update_vel) is
+                                  at most settings.gnss_timeout old: the inclination comes
+                                  from the GNSS velocities, not the accelerometer's low-pass */
+    ATT_AHRS_F_GNSS_REJECTED = 128 /* the GNSS velocities given since the previous update were
+                                  refused (fix type, DOP, sigma, a jump, the gate) */
 };
 
 /* Settings. Units in brackets; defaults are att_ahrs_default_settings()'s.
@@ -188,6 +194,26 @@ typedef struct {
                                  alone, so the attitude does not change. 0.002 (BROAD's
                                  3σ coverage, docs/ahrs.md, "Uncertainty"); 0 = off */
     att_real turn_tau;            /* [s] > 0: see turn_sigma, 5.0 */
+    /* GNSS velocity aiding (att_ahrs_update_vel; docs/ahrs.md, "GNSS velocity aiding") */
+    att_real gnss_vel_sigma;   /* [m/s] > 0: 1σ of each velocity component when the sample
+                                 gives none (att_ahrs_vel.sigma = 0), 0.2 */
+    att_real gnss_timeout;     /* [s] > 0: aided (ATT_AHRS_F_GNSS_AIDED) while the last velocity
+                                 used is at most this old on the filter's clock; also the
+                                 longest interval two velocities are compared over. Must
+                                 exceed the receiver's period plus its latency. 2.0 */
+    att_real gnss_max_latency; /* [s] > 0: how far back (behind the filter's clock) a
+                                 velocity's time of validity may be; the history's span
+                                 (ATT_AHRS_GNSS_HIST entries spaced gnss_max_latency/
+                                 (ATT_AHRS_GNSS_HIST − 2) apart), 1.0 */
+    att_real gnss_max_pdop;    /* [1] ≥ 0: a sample with a larger PDOP is refused, 10 (0 = no
+                                 check; a sample's pdop 0 = unknown passes) */
+    att_real gnss_max_sigma;   /* [m/s] ≥ 0: a sample whose sigma is larger is refused, 2.0
+                                 (0 = no check) */
+    att_real gnss_max_acc;     /* [m/s²] ≥ 0: a velocity that differs from the previous one
+                                 used by more than this times their interval (horizontal)
+                                 is a jump and refused, 40 (0 = no check) */
+    att_real gnss_gate;        /* [1] ≥ 0: innovation gate in standard deviations (each
+                                 component against H P Hᵀ + R), 5 (0 = off) */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
@@ -220,12 +246,41 @@ typedef struct {
     att_real q_turn;        /* turn_sigma²/dt */
 } att_ahrs_step;
 
+/* Entries of the GNSS history (att_ahrs_gnss). */
+enum {
+    ATT_AHRS_GNSS_HIST = 24
+};
+
+/* GNSS velocity aiding's part of the state (treat as opaque; docs/ahrs.md, "GNSS
+ * velocity aiding"). Written only by att_ahrs_update_vel and at the end of a
+ * successful att_ahrs_update, so an update need not save it. */
+typedef struct {
+    att_real time;                      /* [s] the filter's clock (att_ahrs_time) */
+    att_real sv[3];                     /* [m/s] ∫ (f_n − g e_z) dt since the last anchor,
+                                             navigation frame of the estimate */
+    att_real ht[ATT_AHRS_GNSS_HIST];    /* [s] history: times (ring, oldest first from hhead + 1) */
+    att_real hs[ATT_AHRS_GNSS_HIST][3]; /* [m/s] history: sv at those times */
+    att_real anchor_t;                  /* [s] the previous velocity's time of validity */
+    att_real anchor_s[3];               /* [m/s] sv at anchor_t */
+    att_real anchor_v[3];               /* [m/s] the previous velocity (ENU) */
+    att_real anchor_var;                /* [m²/s²] its variance per component */
+    att_real used_t;                    /* [s] time of validity of the last velocity used */
+    int hn;                             /* entries held */
+    int hhead;                          /* index of the newest entry */
+    int armed;                          /* 1 once a velocity was given: sv and the history run */
+    int anchor;                         /* 0: none, 1: horizontal, 2: with the vertical */
+    int used;                           /* 1 once a velocity was used in an update */
+    int aided;                          /* ATT_AHRS_F_GNSS_AIDED's state at the last update */
+    int rejected;                       /* a sample was refused since the last update */
+} att_ahrs_gnss;
+
 /* Caller-owned state. Treat as opaque; read it with the accessors. (Order:
  * set and step first; an update saves and restores the members from integ
  * on.) */
 typedef struct {
     att_ahrs_settings set;
     att_ahrs_step step;    /* per-step constants for the last dt */
+    att_ahrs_gnss gnss;    /* GNSS velocity aiding (not saved by an update: see its type) */
     att_integ integ;       /* attitude q (body → ENU) and the integrator's buffers */
     att_real bias[3];      /* gyro bias estimate b_est [rad/s], body frame */
     att_real P[6][6];      /* error covariance [δθ (rad); δb (rad/s)] */
@@ -337,6 +392,44 @@ att_status att_ahrs_batch_cov(att_ahrs *s, const att_real *gyr, const att_real *
 
 /* ATT_AHRS_F_* of the last update (0 when s is NULL). */
 int att_ahrs_flags(const att_ahrs *s);
+
+/* One GNSS velocity for att_ahrs_update_vel(). */
+typedef struct {
+    att_real t;       /* [s] the velocity's time of validity on the filter's clock (att_ahrs_time():
+                         the sum of the dt of every att_ahrs_update since init); the caller
+                         subtracts the receiver's latency */
+    att_real vel[3];  /* [m/s] velocity in the navigation frame ENU: east, north, up */
+    att_real sigma;   /* [m/s] ≥ 0: 1σ of each component (NAV-PVT sAcc); 0: settings.gnss_vel_sigma */
+    att_real pdop;    /* ≥ 0: position dilution of precision, 0 = unknown */
+    uint8_t has_up;   /* 1: vel[2] was measured (NAV-PVT velD); 0: ignore vel[2] (NMEA) */
+    uint8_t fix_type; /* att_gnss_fix_type (gnss.h): 2D, 3D and GNSS + dead reckoning are used */
+} att_ahrs_vel;
+
+/* Give the filter one GNSS velocity (call between att_ahrs_update calls, any rate 1-10 Hz,
+ * in time order). The specific force integrated in the navigation frame between the
+ * previous velocity's time of validity and this one's, minus the velocity change, measures
+ * the attitude error (docs/ahrs.md, "GNSS velocity aiding"); from the first velocity used
+ * until gnss_timeout after the last, it replaces the accelerometer's inclination update
+ * (ATT_AHRS_F_GNSS_AIDED). Quality checks (fix type, DOP, sigma, a velocity jump, the
+ * innovation gate) refuse a sample: ATT_OK is still returned and ATT_AHRS_F_GNSS_REJECTED
+ * is set in the flags of the next update. The first velocity only starts the history; one
+ * older than the history holds so far (within gnss_max_latency of the clock), or given
+ * before the filter is aligned, is ignored (ATT_OK, no flag). Errors (state unchanged):
+ * ATT_E_NULL, ATT_E_NONFINITE, ATT_E_ARG (t later than the filter's clock by more than one
+ * step, earlier than it by more than gnss_max_latency, not after the previous velocity's
+ * t, or sigma or pdop < 0), ATT_E_AHRS_DIVERGED. */
+att_status att_ahrs_update_vel(att_ahrs *s, const att_ahrs_vel *v);
+
+/* The filter's clock [s]: the sum of the dt of every att_ahrs_update since init (0 when s
+ * is NULL). Float builds: its resolution is 2⁻²⁴ of its value (5 ms after a day). */
+att_real att_ahrs_time(const att_ahrs *s);
+
+/* A parsed fix (gnss.h) as an att_ahrs_vel at time t: ATT_OK, or ATT_E_ARG when the fix has
+ * no horizontal velocity (ATT_GNSS_HAS_VEL_NE clear); ATT_E_NULL. vel = (vel_e, vel_n,
+ * −vel_d), has_up from ATT_GNSS_HAS_VEL_D, sigma = s_acc (ATT_GNSS_HAS_ACC, else 0), pdop
+ * (ATT_GNSS_HAS_PDOP, else 0), fix_type (ATT_GNSS_HAS_FIX_TYPE; without it 2D when the fix
+ * is flagged valid), ATT_GNSS_FIX_NONE when the receiver flags the fix invalid. */
+att_status att_ahrs_vel_from_fix(const att_gnss_fix *fix, att_real t, att_ahrs_vel *out);
 
 ATT_API_END
 
