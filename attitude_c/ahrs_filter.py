@@ -423,11 +423,12 @@ class _Gnss:
 def _ahrs_gnss(f: Ahrs, gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None, dt: ArrayLike | None,
                covariance: bool, gn: _Gnss) -> Any:
     """The batch with GNSS: the samples in blocks, each velocity given after the last sample
-    whose time (the sum of the steps so far) is at or before its delivery time."""
+    whose time ((k + 1) dt, or the sum of the steps so far) is at or before its delivery time."""
     g = _vectors(gyr, "gyr")
     assert g is not None
     n = g.shape[0]
-    times = np.cumsum(np.broadcast_to(f._dt(dt, n).astype(np.float64), (n,)))
+    d = time_steps(dt, n, f.rate, np.float64)  # the steps as given (not rounded to f32's)
+    times = (np.arange(n) + 1.0) * d[0] if d.size == 1 else np.cumsum(d)  # sample k at (k + 1) dt
     cut = np.searchsorted(times, gn.delivered, side="right")
     a = np.asarray(acc)
     m = None if mag is None else np.asarray(mag)

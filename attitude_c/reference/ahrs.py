@@ -36,7 +36,13 @@ _DEFAULTS: dict[str, Any] = {
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
     "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
     "turn_sigma": 0.002, "turn_tau": 5.0,
+    "gnss_vel_sigma": 0.2, "gnss_timeout": 2.0, "gnss_max_latency": 1.0, "gnss_max_pdop": 10.0,
+    "gnss_max_sigma": 2.0, "gnss_max_acc": 40.0, "gnss_gate": 5.0,
 }
+
+#: Entries of the GNSS history (ahrs.h, ATT_AHRS_GNSS_HIST: part of the documented behaviour,
+#: since a velocity's integral is interpolated between them).
+GNSS_HIST = 24
 
 _FRAME = {"rv1": 1, "rv2": 2, "rv3": 3, "rv3-coning": 3, "rv3-reuse": 1, "rv3-reuse-poly": 1}
 
@@ -154,6 +160,7 @@ class ReferenceAhrs:
         self.flags = 0
         self.heading_measured = False  # a magnetometer update has been made
         self.turn_var = 0.0  # rad², added to the reported attitude covariance
+        self.gnss = _GnssState()
 
     @property
     def covariance(self) -> F:
@@ -287,6 +294,12 @@ class ReferenceAhrs:
         if flags & 1:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)
+        gs = self.gnss
+        aided = gs.used and gs.time + dt - gs.used_t <= s["gnss_timeout"]
+        if gs.aided and not aided and s["tilt_tau"] > 0:
+            # back to the accelerometer: the reported inclination's low-pass continues from the
+            # state's own (the vertical, at rest), as if converged
+            self.tilt, self.tilt_start = np.array([[0.0, 0.0, s["gravity"]], [0.0, 0.0, 0.0]]), None
         # accelerometer
         wc = w - self.b  # the rate the propagation used (the bias before this sample's update)
         fnav = C @ _undelay(f, wc, s["acc_delay"])
@@ -301,7 +314,9 @@ class ReferenceAhrs:
         ang = math.atan2(float(np.linalg.norm(axis)), float(v[2]))
         y = axis / np.linalg.norm(axis) * ang if np.linalg.norm(axis) > 0 else np.zeros(3)
         use = True
-        if s["acc_gate"] > 0 and ang > s["acc_gate"]:
+        if aided:  # the inclination comes from the GNSS velocities
+            use, self.acc_rej = False, 0.0
+        elif s["acc_gate"] > 0 and ang > s["acc_gate"]:
             self.acc_rej += dt
             if self.acc_rej < s["acc_reject_max"]:
                 use = False
@@ -358,7 +373,8 @@ class ReferenceAhrs:
         # heading observability: measured at least once, and its 1σ within the bound since
         if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
             flags |= 32
-        self.flags = flags
+        self.flags = flags | (64 if aided else 0) | (128 if gs.rejected else 0)
+        gs.record(fnav, dt, g, aided, s["gnss_max_latency"] / (GNSS_HIST - 2))
         out = self.reported()
         if s["sensor_delay"]:
             return _qmul(out, _exp((w - self.b) * s["sensor_delay"]))
@@ -367,7 +383,146 @@ class ReferenceAhrs:
     def reported(self) -> F:
         """The reported attitude: the state's, levelled by the tilt_tau low-pass when on."""
         assert self.q is not None
-        return self.q.copy() if self.tilt is None else _level(self.q, self.tilt[0])
+        if self.tilt is None or self.gnss.aided:
+            return self.q.copy()
+        return _level(self.q, self.tilt[0])
+
+    # -- GNSS velocity aiding (docs/ahrs.md, "GNSS velocity aiding") ----------
+    def update_vel(self, t: float, vel: ArrayLike, sigma: float = 0.0, pdop: float = 0.0, has_up: bool = False,
+                   fix_type: int = 3) -> None:
+        """One GNSS velocity (ENU, m/s) valid at ``t`` on the filter's clock; ValueError where the
+        C function returns ATT_E_ARG."""
+        s, gs = self.s, self.gnss
+        v = np.zeros(3)
+        v[:3 if has_up else 2] = np.asarray(vel, float)[:3 if has_up else 2]
+        step = gs.last_dt
+        if sigma < 0 or pdop < 0 or t > gs.time + step or t < gs.time - s["gnss_max_latency"] or (
+                gs.anchor is not None and t <= gs.anchor[0]):
+            raise ValueError("t, sigma or pdop outside the domain")
+        if self.q is None:
+            return
+        if not gs.armed:
+            gs.arm()
+            return
+        sig = sigma if sigma > 0 else s["gnss_vel_sigma"]
+        if (fix_type not in (2, 3, 4) or (s["gnss_max_pdop"] > 0 and pdop > s["gnss_max_pdop"])
+                or (s["gnss_max_sigma"] > 0 and sig > s["gnss_max_sigma"])):
+            gs.rejected = True
+            return
+        sv_t = gs.integral_at(t)
+        if sv_t is None:
+            return
+        if gs.anchor is None or t - gs.anchor[0] > s["gnss_timeout"]:
+            gs.set_anchor(t, sv_t, v, sig ** 2, has_up, np.zeros(3), s["gravity"])
+            return
+        self._gnss_compare(t, sv_t, v, sig ** 2, has_up)
+
+    def _gnss_rows(self, dS: F, dv: F, dT: float, tau: float, up: bool, heading: bool) -> list[tuple[F, float]]:
+        """(h, y) rows of r = Δv − ΔS = −[ΔF×] δθ(t_m), δθ(t_m) = δθ + C τ δb, ΔF = ΔS + g Δt e_z."""
+        Fv = dS + np.array([0.0, 0.0, self.s["gravity"] * dT])
+        Hfull = np.hstack([-_skew(Fv), -_skew(Fv) @ _dcm(self.q) * tau])  # 3×6
+        r = dv - dS
+        nv, ns = math.hypot(dv[0], dv[1]), math.hypot(dS[0], dS[1])
+        R = self._gnss_R
+        if not heading and ns > 0 and nv * nv > 9 * R:  # compare the horizontal lengths along ΔS_h
+            u = np.array([dS[0] / ns, dS[1] / ns, 0.0])
+            rows = [(u @ Hfull, nv - ns)]
+        else:
+            rows = [(Hfull[i], float(r[i])) for i in (0, 1)]
+        if up:
+            rows.append((Hfull[2], float(r[2])))
+        if not heading:
+            rows = [(np.where(np.arange(6) == 2, 0.0, h), y) for h, y in rows]
+        return rows
+
+    def _gnss_compare(self, t: float, sv_t: F, v: F, var: float, has_up: bool) -> None:
+        s, gs = self.s, self.gnss
+        t_a, s_a, v_a, var_a, up_a = gs.anchor
+        dS, dv, dT = sv_t - s_a, v - v_a, t - t_a
+        heading = not self.flags & 32
+        self._gnss_R = var + var_a
+        rows = self._gnss_rows(dS, dv, dT, gs.time - (t + t_a) / 2, has_up and up_a, heading)
+        if s["gnss_max_acc"] > 0 and math.hypot(dv[0], dv[1]) > s["gnss_max_acc"] * dT:
+            gs.rejected = True  # a jump
+            return
+        if s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + self._gnss_R) for h, y in rows):
+            if gs.used and gs.time - gs.used_t <= s["gnss_timeout"]:  # aided: the gate refuses
+                gs.rejected = True
+                return
+            # (re)starting the aiding: the inclination's variance grows instead
+            self.P = self.P + np.diag([1.0, 1.0, 0, 0, 0, 0]) * s["init_att_sigma"] ** 2
+        x = np.zeros(6)
+        states = (0, 1, 2, 3, 4, 5) if heading else (0, 1, 3, 4, 5)
+        for h, y in rows:
+            self._row(x, h, y, self._gnss_R, states)
+        self.q = _qmul(_exp(x[:3]), self.q)
+        assert self.acc_lp is not None
+        self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
+        if self.tilt is not None:
+            self.tilt = self.tilt + np.cross(x[:3], self.tilt)
+        if self.tilt_start is not None and len(self.tilt_start):
+            self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
+        self.b = self.b + x[3:]
+        gs.set_anchor(t, sv_t, v, var, has_up, x[:3], s["gravity"])
+        gs.used, gs.used_t = True, t
+
+    def _row(self, x: F, h: F, y: float, R: float, states: tuple[int, ...]) -> None:
+        """A scalar measurement y = h x + noise (R) with a general row h; gain masked to states;
+        Joseph form."""
+        S = float(h @ self.P @ h) + R
+        keep = np.zeros(6)
+        keep[list(states)] = 1.0
+        K = self.P @ h / S * keep
+        x += K * (y - float(h @ x))
+        A = np.eye(6) - np.outer(K, h)
+        self.P = A @ self.P @ A.T + R * np.outer(K, K)
+
+
+class _GnssState:
+    """The clock, the specific-force integral since the anchor and its history, the anchor."""
+
+    def __init__(self) -> None:
+        self.time = 0.0
+        self.last_dt = 0.0
+        self.armed = self.used = self.aided = self.rejected = False
+        self.used_t = 0.0
+        self.sv = np.zeros(3)  # ∫ (f_n − g e_z) dt, relative to the anchor's
+        self.entries: list[tuple[float, F]] = []  # (time, sv), oldest first, at most GNSS_HIST
+        self.anchor: tuple[float, F, F, float, bool] | None = None  # t, sv at t, velocity, variance, has_up
+
+    def arm(self) -> None:
+        self.armed, self.sv, self.entries = True, np.zeros(3), [(self.time, np.zeros(3))]
+
+    def record(self, fnav: F, dt: float, g: float, aided: bool, spacing: float) -> None:
+        self.time += dt
+        self.last_dt = dt
+        self.rejected, self.aided = False, aided
+        if not self.armed:
+            return
+        self.sv = self.sv + (fnav - np.array([0.0, 0.0, g])) * dt
+        if self.time - self.entries[-1][0] >= spacing:
+            self.entries = (self.entries + [(self.time, self.sv.copy())])[-GNSS_HIST:]
+
+    def integral_at(self, t: float) -> F | None:
+        """sv at t: linear between the history's entries and the current value; None before them."""
+        pts = self.entries + [(self.time, self.sv)]
+        if t >= self.time:
+            return self.sv.copy()
+        for (t0, s0), (t1, s1) in zip(reversed(pts[:-1]), reversed(pts[1:])):
+            if t >= t0:
+                return s0 + ((t - t0) / (t1 - t0) if t1 > t0 else 0.0) * (s1 - s0)
+        return None
+
+    def set_anchor(self, t: float, sv_t: F, v: F, var: float, has_up: bool, th: F, g: float) -> None:
+        """The anchor moves to t; every integral is re-based to it and the specific force
+        integrated since, F_rel = sv − sv_t + g (t_x − t) e_z, turned by the correction th."""
+        def turn(tx: float, sx: F) -> F:
+            rel = sx - sv_t
+            return rel + np.cross(th, rel + np.array([0.0, 0.0, g * (tx - t)]))
+
+        self.entries = [(tx, turn(tx, sx)) for tx, sx in self.entries]
+        self.sv = turn(self.time, self.sv)
+        self.anchor = (t, np.zeros(3), v.copy(), var, has_up)
 
 
 def ahrs_reference(gyr: ArrayLike, acc: ArrayLike, mag: ArrayLike | None = None, rate: float = 100.0,

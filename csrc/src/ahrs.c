@@ -933,16 +933,19 @@ static int gnss_aided_at(const att_ahrs *s, att_real now)
     return s->gnss.used && now - s->gnss.used_t <= s->set.gnss_timeout;
 }
 
-/* The reported inclination's low-pass starts again (its state as after init). */
-static void tilt_restart(att_ahrs *s)
+/* The end of GNSS aiding: the reported inclination's low-pass restarts from the state's
+ * own (g e_z at rest: the reported attitude continues from the aided one), the
+ * accelerometer's accepted samples then pull it with tilt_tau. */
+static void tilt_from_state(att_ahrs *s)
 {
     int i;
     for (i = 0; i < 3; i++) {
         s->tilt_f[i] = 0;
         s->tilt_fd[i] = 0;
     }
-    s->tilt_t = 0;
-    s->tilt_mean = 1;
+    s->tilt_f[2] = s->set.gravity;
+    s->tilt_t = s->set.tilt_tau;
+    s->tilt_mean = 0;
 }
 
 static void copy3(att_real dst[3], const att_real src[3])
@@ -1222,11 +1225,21 @@ static att_status gnss_compare(att_ahrs *s, const att_ahrs_vel *v, const att_rea
     q2C(s->integ.q, C);
     n = gnss_rows(dsv, dv, dT, s->set.gravity, C, g->time - (v->t + g->anchor_t) * ATT_R(0.5),
                   var + g->anchor_var, v->has_up && g->anchor == 2, heading, rows);
-    if (gnss_jump(&s->set, dv, dT) || gnss_gated(s, rows, n)) {
+    if (gnss_jump(&s->set, dv, dT)) {
         g->rejected = 1;
         return ATT_OK;
     }
     copy_mutable(&save, s);
+    if (gnss_gated(s, rows, n)) {
+        if (gnss_aided_at(s, g->time)) {
+            g->rejected = 1;
+            return ATT_OK;
+        }
+        /* (re)starting the aiding (after an outage the accelerometer may have tilted the
+         * state in a turn): the inclination's variance grows by init_att_sigma² instead */
+        s->P[0][0] += s->set.init_att_sigma * s->set.init_att_sigma;
+        s->P[1][1] += s->set.init_att_sigma * s->set.init_att_sigma;
+    }
     for (i = 0; i < n; i++) {
         dense_update(s->P, x, rows[i].h, rows[i].y, rows[i].r, heading ? 0x3Fu : 0x3Bu);
     }
@@ -1349,8 +1362,8 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }
-    if (s->gnss.aided && !aided) { /* back to the accelerometer: the reported inclination restarts */
-        tilt_restart(s);
+    if (s->gnss.aided && !aided) { /* back to the accelerometer */
+        tilt_from_state(s);
     }
     if (k->delays) { /* from here on the aiding samples at the gyro's time (one integer test when both are 0) */
         acc = at_gyro_time(s, gyr, acc, k->delays & 1, s->set.acc_delay, acc_c);
