@@ -197,6 +197,13 @@ def recovery_time(t: np.ndarray, err: np.ndarray, t_return: float, limit: float 
     return float(t[out[-1] + 1] - t_return)
 
 
+def first_within(t: np.ndarray, err: np.ndarray, t_return: float, limit: float = LIMIT_DEG * DEG) -> float:
+    """Seconds from ``t_return`` to the first sample whose every |error| (n, k) is ≤ ``limit``
+    (inf if none): the return into the band, whether it stays there or not."""
+    back = np.nonzero((t >= t_return) & (np.max(np.abs(err), axis=1) <= limit))[0]
+    return float(t[back[0]] - t_return) if len(back) else math.inf
+
+
 @dataclass
 class Result:
     """One scenario and seed: each filter's roll/pitch error series and figures."""
@@ -221,6 +228,10 @@ class Result:
         if self.outage is None:
             return None
         return recovery_time(self.data.t, self.err["aided"], self.outage[1])
+
+    def first_within_s(self) -> float | None:
+        """The aided filter's first return within LIMIT_DEG after the outage (None without one)."""
+        return None if self.outage is None else first_within(self.data.t, self.err["aided"], self.outage[1])
 
     def outage_max_deg(self, name: str) -> float | None:
         """Max |roll/pitch error| (°) of ``name`` during the outage."""
@@ -278,14 +289,15 @@ def table(results: list[Result]) -> list[str]:
 
 def outage_table(results: list[Result], timeout: float) -> list[str]:
     out = [("| seed | max error in the outage: GNSS-aided / no GNSS (°) | GNSS_AIDED flag: before / in the "
-            "outage (after the timeout) / 10 s after | recovery (s) |"), "|---:|---:|---|---:|"]
+            f"outage (after the timeout) / {RECOVERY_S:g} s after | first back within {LIMIT_DEG:g}° (s) | "
+            "recovery, within it for good (s) |"), "|---:|---:|---|---:|---:|"]
     for r in results:
         if r.outage is None:
             continue
         a, b = r.outage
         frac = [r.aided_fraction(*w) for w in ((r.data.judged_from, a), (a + timeout, b), (b + RECOVERY_S, r.data.t[-1]))]
         out.append(f"| {r.data.seed} | {r.outage_max_deg('aided'):.2f} / {r.outage_max_deg('unaided'):.2f} | "
-                   + " / ".join(f"{x:.0%}" for x in frac) + f" | {r.recovery_s():.2f} |")
+                   + " / ".join(f"{x:.0%}" for x in frac) + f" | {r.first_within_s():.2f} | {r.recovery_s():.2f} |")
     return out
 
 

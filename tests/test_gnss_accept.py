@@ -26,6 +26,7 @@ from bench.gnss_accept import (
     acquire,
     evaluate,
     evaluate_data,
+    first_within,
     recovery_time,
 )
 
@@ -75,14 +76,17 @@ def test_outage_in_turn_degrades_gracefully_and_recovers(outage_run: Data) -> No
 
 
 def test_recovery_time_definition() -> None:
-    """Closed forms: from the return to the first sample after the last one out of the band."""
+    """Closed forms: recovery, from the return to the first sample after the last one out of
+    the band; the first return, to the first sample in it."""
     t = np.arange(0.0, 20.0, 0.5)
     e = np.zeros((len(t), 2))
     assert recovery_time(t, e, 5.0) == 0.0  # never out of the band
     e[(t >= 4.0) & (t < 8.0), 1] = 0.6 * DEG  # out from 4 s to 7.5 s, back at 8 s
     assert recovery_time(t, e, 5.0) == 3.0
+    assert first_within(t, e, 5.0) == 3.0
     e[t == 12.0, 0] = -0.51 * DEG  # one more sample out: counted, it did not stay back
     assert recovery_time(t, e, 5.0) == 7.5
+    assert first_within(t, e, 5.0) == 3.0  # the first return, whether it stays or not
     e[t == 3.0, 0] = 1.0  # before the return: not counted
     assert recovery_time(t, e, 5.0) == 7.5
     e[-1, 0] = 1.0  # out at the end of the run: never recovered
