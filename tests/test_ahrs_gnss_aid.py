@@ -150,7 +150,7 @@ def test_c_matches_reference(case):
     if case == "rejected":
         rx = {"bad_fixes": (BadFix(t0 + 6.0, t0 + 6.5, (8.0, -6.0, 0.0)),)}
     if case == "outage":
-        rx = {"outages": ((t0 + 5.0, t0 + 9.0),)}
+        rx = {"outages": ((t0 + 4.0, t0 + 10.0),)}
     gn = _fixes(traj, t0, secs, seed=3, preset=preset, **rx)
     q0 = traj.quat(np.array([t0]))[0]
     settings = {"declination": DECL}
@@ -170,7 +170,7 @@ def test_c_matches_reference(case):
     assert (flc & AIDED).any()
     if case == "rejected":
         assert (flc & REJECTED).any()
-    if case == "outage":  # 4 s without a fix > gnss_timeout (2 s): back to the accelerometer
+    if case == "outage":  # 6 s without a fix > gnss_timeout (3 s): back to the accelerometer
         assert not (flc & AIDED).all()
     # the batch gives the same as the streaming calls
     qb = ahrs(g, a, m, rate=rate, q0=q0, **gn, **settings)
@@ -245,20 +245,25 @@ def test_update_vel_errors_name_the_argument():
 
 def test_order_and_flags():
     f = _filter()
+    level = np.array([0.0, 0.0, 9.81])
+
+    def run(n: int) -> None:
+        for _ in range(n):
+            f.update(np.zeros(3), level)
+
     f.update_vel(1.0, [0.0, 0.0])  # arms the history
-    f.update(np.zeros(3), np.array([0.0, 0.0, 9.81]))
-    f.update_vel(1.005, [0.0, 0.0])  # the anchor
+    run(10)
+    f.update_vel(1.1, [0.0, 0.0])  # the anchor
     with pytest.raises(InvalidArgument, match="t:"):
-        f.update_vel(1.005, [0.0, 0.0])  # not after the previous one
-    f.update(np.zeros(3), np.array([0.0, 0.0, 9.81]))
-    f.update_vel(1.02, [0.0, 0.0], pdop=50.0)  # PDOP above gnss_max_pdop (10): refused
-    f.update(np.zeros(3), np.array([0.0, 0.0, 9.81]))
+        f.update_vel(1.1, [0.0, 0.0])  # not after the previous one
+    run(100)
+    f.update_vel(2.05, [0.0, 0.0], pdop=50.0)  # PDOP above gnss_max_pdop (10): refused
+    run(1)
     assert f.flags & REJECTED and not f.flags & AIDED
-    f.update_vel(1.03, [0.0, 0.0])  # compared with the anchor: used
-    f.update(np.zeros(3), np.array([0.0, 0.0, 9.81]))
+    f.update_vel(2.1, [0.0, 0.0])  # 1 s after the anchor (≥ gnss_window, 0.9 s): used
+    run(1)
     assert f.flags & AIDED and not f.flags & REJECTED
-    for _ in range(201):  # more than gnss_timeout (2 s) later: no longer aided
-        f.update(np.zeros(3), np.array([0.0, 0.0, 9.81]))
+    run(301)  # more than gnss_timeout (3 s) after its time of validity: no longer aided
     assert not f.flags & AIDED
 
 

@@ -36,8 +36,8 @@ _DEFAULTS: dict[str, Any] = {
     "rest_noise": 3e-4, "gyro_range": 0.0, "overrange_sigma": 0.05, "sensor_delay": 0.0,
     "acc_delay": 0.0, "mag_delay": 0.0, "tilt_tau": 3.0, "heading_sigma_max": 0.0873,
     "turn_sigma": 0.002, "turn_tau": 5.0,
-    "gnss_vel_sigma": 0.2, "gnss_timeout": 2.0, "gnss_max_latency": 1.0, "gnss_max_pdop": 10.0,
-    "gnss_max_sigma": 2.0, "gnss_max_acc": 40.0, "gnss_gate": 5.0,
+    "gnss_vel_sigma": 0.2, "gnss_timeout": 3.0, "gnss_max_latency": 1.0, "gnss_max_pdop": 10.0,
+    "gnss_max_sigma": 2.0, "gnss_max_acc": 40.0, "gnss_gate": 5.0, "gnss_window": 0.9, "gnss_gyr_noise": 0.002,
 }
 
 #: Entries of the GNSS history (ahrs.h, ATT_AHRS_GNSS_HIST: part of the documented behaviour,
@@ -173,14 +173,15 @@ class ReferenceAhrs:
         return self.P[3:, 3:].copy()
 
     # -- the Kalman pieces -------------------------------------------------
-    def _predict(self, C: F, dt: float, rest: bool, rate: F) -> None:
+    def _predict(self, C: F, dt: float, rest: bool, rate: F, aided: bool = False) -> None:
         """Q: the attitude's process noise density is the gyro's own at rest (no motion,
-        no model error: ``gyr_noise_rest``), ``gyr_noise`` (gyro noise + model error) otherwise.
+        no model error: ``gyr_noise_rest``), ``gnss_gyr_noise`` while GNSS-aided, ``gyr_noise``
+        (gyro noise + model error) otherwise.
         Beside P, the reported turn variance: a first-order lag (time constant ``turn_tau``,
         implicit Euler) driven by (``turn_sigma`` · |ω − b|)² · dt."""
         Fm = np.eye(6)
         Fm[:3, 3:] = -C * dt
-        sg = self.s["gyr_noise_rest"] if rest else self.s["gyr_noise"]
+        sg = self.s["gyr_noise_rest"] if rest else self.s["gnss_gyr_noise"] if aided else self.s["gyr_noise"]
         Q = np.diag([sg ** 2 * dt] * 3 + [self.s["bias_noise"] ** 2 * dt] * 3)
         tau = self.s["turn_tau"]
         self.turn_var = self.turn_var * tau / (tau + dt) + (self.s["turn_sigma"] * float(np.linalg.norm(rate))) ** 2 * dt
@@ -290,12 +291,12 @@ class ReferenceAhrs:
             self.q = _qmul(self.q, _exp(phi))
             self.q = self.q / np.linalg.norm(self.q)
         C = _dcm(self.q)
-        self._predict(C, dt, rest, w - self.b)
+        gs = self.gnss
+        aided = gs.used and gs.time + dt - gs.used_t <= s["gnss_timeout"]
+        self._predict(C, dt, rest, w - self.b, aided)
         if flags & 1:
             self.P[:3, :3] += s["overrange_sigma"] ** 2 * np.eye(3)
         x = np.zeros(6)
-        gs = self.gnss
-        aided = gs.used and gs.time + dt - gs.used_t <= s["gnss_timeout"]
         if gs.aided and not aided and s["tilt_tau"] > 0:
             # back to the accelerometer: the reported inclination's low-pass continues from the
             # state's own (the vertical, at rest), as if converged
@@ -414,6 +415,8 @@ class ReferenceAhrs:
             return
         if gs.anchor is None or t - gs.anchor[0] > s["gnss_timeout"]:
             gs.set_anchor(t, sv_t, v, sig ** 2, has_up, np.zeros(3), s["gravity"])
+            return
+        if t - gs.anchor[0] < s["gnss_window"]:  # too close to the anchor: skipped
             return
         self._gnss_compare(t, sv_t, v, sig ** 2, has_up)
 

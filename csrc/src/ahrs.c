@@ -58,12 +58,14 @@ void att_ahrs_default_settings(att_ahrs_settings *set)
     set->turn_sigma = ATT_R(0.002);
     set->turn_tau = ATT_R(5.0);
     set->gnss_vel_sigma = ATT_R(0.2);
-    set->gnss_timeout = ATT_R(2.0);
+    set->gnss_timeout = ATT_R(3.0);
     set->gnss_max_latency = ATT_R(1.0);
     set->gnss_max_pdop = ATT_R(10.0);
     set->gnss_max_sigma = ATT_R(2.0);
     set->gnss_max_acc = ATT_R(40.0);
     set->gnss_gate = ATT_R(5.0);
+    set->gnss_window = ATT_R(0.9);
+    set->gnss_gyr_noise = ATT_R(0.002);
 }
 
 static int fin(att_real x)
@@ -119,6 +121,8 @@ static const att__domain DOMAINS[] = {
     DOMAIN(gnss_max_sigma, GE, 0),
     DOMAIN(gnss_max_acc, GE, 0),
     DOMAIN(gnss_gate, GE, 0),
+    DOMAIN(gnss_window, GE, 0),
+    DOMAIN(gnss_gyr_noise, GT, 0),
 };
 
 att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
@@ -484,6 +488,7 @@ static const att_ahrs_step *step_constants(att_ahrs *s, att_real dt)
         c->k_acc = (set->acc_tau > 0) ? dt / (set->acc_tau + dt) : ATT_R(1.0);
         c->q_att = set->gyr_noise * set->gyr_noise * dt;
         c->q_att_rest = set->gyr_noise_rest * set->gyr_noise_rest * dt;
+        c->q_att_gnss = set->gnss_gyr_noise * set->gnss_gyr_noise * dt;
         c->q_bias = set->bias_noise * set->bias_noise * dt;
         c->r_acc = set->acc_noise * set->acc_noise / dt;
         c->r_mag = set->mag_noise * set->mag_noise / dt;
@@ -637,7 +642,7 @@ static void turn_variance(att_ahrs *s, const att_ahrs_step *k, const att_real dt
  * P ← F P Fᵀ + Q (at rest with the gyro's own noise), plus overrange_sigma² on
  * the attitude when over range. C = C_b^n of the propagated attitude. 0, or
  * the integrator's error. */
-static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real dt, int rest,
+static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3], att_real dt, att_real qa,
                      int over, att_real C[9])
 {
     att_real dth[3];
@@ -649,7 +654,7 @@ static int propagate(att_ahrs *s, const att_ahrs_step *k, const att_real gyr[3],
         return -1;
     }
     q2C(s->integ.q, C);
-    propagate_cov(s->P, C, dt, rest ? k->q_att_rest : k->q_att, k->q_bias);
+    propagate_cov(s->P, C, dt, qa, k->q_bias);
     turn_variance(s, k, dth);
     if (over) {
         att_real o = s->set.overrange_sigma * s->set.overrange_sigma;
@@ -1285,6 +1290,9 @@ att_status att_ahrs_update_vel(att_ahrs *s, const att_ahrs_vel *v)
         gnss_set_anchor(s, v, sv_t, sigma * sigma, zero);
         return ATT_OK;
     }
+    if (v->t - g->anchor_t < s->set.gnss_window) { /* too close to the anchor: skipped */
+        return ATT_OK;
+    }
     return gnss_compare(s, v, sv_t, sigma * sigma);
 }
 
@@ -1358,7 +1366,12 @@ att_status att_ahrs_update(att_ahrs *s, const att_real gyr[3], const att_real ac
     flags = overrange(&s->set, gyr) ? ATT_AHRS_F_OVERRANGE : 0;
     rest = detect_rest(s, k, gyr, acc, dt);
     aided = gnss_aided_at(s, s->gnss.time + dt);
-    if (propagate(s, k, gyr, dt, rest, flags & ATT_AHRS_F_OVERRANGE, C) != 0) {
+    if (propagate(s, k, gyr, dt,
+                  rest    ? k->q_att_rest
+                  : aided ? k->q_att_gnss
+                          : k->q_att,
+                  flags & ATT_AHRS_F_OVERRANGE, C)
+        != 0) {
         copy_mutable(s, &save);
         return ATT_E_AHRS_DIVERGED;
     }

@@ -200,7 +200,8 @@ typedef struct {
     att_real gnss_timeout;     /* [s] > 0: aided (ATT_AHRS_F_GNSS_AIDED) while the last velocity
                                  used is at most this old on the filter's clock; also the
                                  longest interval two velocities are compared over. Must
-                                 exceed the receiver's period plus its latency. 2.0 */
+                                 exceed gnss_window plus the receiver's period and latency.
+                                 3.0 */
     att_real gnss_max_latency; /* [s] > 0: how far back (behind the filter's clock) a
                                  velocity's time of validity may be; the history's span
                                  (ATT_AHRS_GNSS_HIST entries spaced gnss_max_latency/
@@ -213,7 +214,17 @@ typedef struct {
                                  used by more than this times their interval (horizontal)
                                  is a jump and refused, 40 (0 = no check) */
     att_real gnss_gate;        /* [1] ≥ 0: innovation gate in standard deviations (each
-                                 component against H P Hᵀ + R), 5 (0 = off) */
+                                 component against H P Hᵀ + R), 5 (0 = off); not applied
+                                 when the aiding (re)starts (not aided): the inclination's
+                                 variance grows by init_att_sigma² instead */
+    att_real gnss_window;      /* [s] ≥ 0: the shortest interval two velocities are compared
+                                 over (a velocity closer to the previous one used is skipped,
+                                 unflagged): the velocity noise's share of the measured angle
+                                 falls with the interval, 0.9 (under 1 s: a 1 Hz receiver's
+                                 fixes, with jitter, are each compared) */
+    att_real gnss_gyr_noise;   /* [rad/√s] > 0: σ_g while GNSS-aided (and not at rest): the
+                                 velocities measure the inclination without the
+                                 accelerometer's model error, 0.002 */
 } att_ahrs_settings;
 
 /* Constants of one time step, derived from the settings and dt; kept in
@@ -228,6 +239,7 @@ typedef struct {
                             weight in the reference */
     att_real q_att;         /* gyr_noise²·dt */
     att_real q_att_rest;    /* gyr_noise_rest²·dt */
+    att_real q_att_gnss;    /* gnss_gyr_noise²·dt */
     att_real q_bias;        /* bias_noise²·dt */
     att_real r_acc;         /* acc_noise²/dt */
     att_real r_mag;         /* mag_noise²/dt */
