@@ -1,6 +1,8 @@
-"""ARMv4T cost of the MEMS AHRS paper's nine-state filter (csrc/include/attitude/ahrs_gnss9.h):
-instructions per IMU sample, per GNSS velocity update and per magnetic heading update on the
-emulated ARM920T core (exact counts, toolchain/qemu_count.py), double and float."""
+"""ARMv4T cost of GNSS aiding: the MEMS AHRS paper's nine-state filter
+(csrc/include/attitude/ahrs_gnss9.h) — instructions per IMU sample, per GNSS velocity update and
+per magnetic heading update — and att_ahrs's velocity aiding (ahrs.h, att_ahrs_update_vel) — per
+IMU sample without and with aiding, per GNSS update — on the emulated ARM920T core (exact counts,
+toolchain/qemu_count.py), double and float."""
 
 from __future__ import annotations
 
@@ -14,7 +16,9 @@ from toolchain.qemu_count import per_iteration
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "bench" / "gnss9_armv4t.c"
-TITLE = "ARMv4T cost of the nine-state GNSS filter (instructions per IMU sample and per update)"
+AHRS_SRC = ROOT / "bench" / "ahrs_gnss_armv4t.c"
+TITLE = ("ARMv4T cost of GNSS aiding: the nine-state filter and att_ahrs's velocity aiding "
+         "(instructions per IMU sample and per update)")
 EVERY = 5  #: the harness's aiding period and the default kf_period (gnss9_armv4t.c)
 
 
@@ -27,6 +31,37 @@ def counts(precision: str, tmp: Path, n1: int = 100, n2: int = 200) -> dict[str,
     t = T.load("armv4t-bare")
     exe = t.build_program([SRC], tmp / f"gnss9_{precision}", defines=["ATT_REAL_F32"] if precision == "f32" else [])
     return {m: per_iteration(exe, functools.partial(_args, m), n1, n2) for m in ("imu", "gnss", "heading")}
+
+
+def ahrs_counts(precision: str, tmp: Path, n1: int = 100, n2: int = 200) -> dict[str, float]:
+    """att_ahrs: instructions per IMU sample unaided, per aided sample and per GNSS update."""
+    t = T.load("armv4t-bare")
+    exe = t.build_program([AHRS_SRC], tmp / f"ahrs_gnss_{precision}",
+                          defines=["ATT_REAL_F32"] if precision == "f32" else [])
+    m = {mode: per_iteration(exe, functools.partial(_args, mode), n1, n2) for mode in ("imu", "gnss10", "gnss20")}
+    return {"imu": m["imu"], "aided": 2 * m["gnss20"] - m["gnss10"], "update": 20 * (m["gnss10"] - m["gnss20"])}
+
+
+def _ahrs_table(precisions: tuple[str, ...], tmp: Path) -> list[str]:
+    out = [
+        "",
+        ("att_ahrs with a magnetometer (`bench/ahrs_gnss_armv4t.c`: a level turn at 0.2 rad/s, 10 m/s, "
+         "100 samples/s; default settings but `gnss_window` 0, so every velocity is an update; the "
+         "velocity valid 50 ms before the clock). With m10 and m20 the per-sample means with a "
+         "velocity after every 10th and every 20th sample: per GNSS update 20 (m10 − m20) (the "
+         "checks, the history's interpolation, two or three scalar updates with a general row, the "
+         "injection, the re-basing of the history); per aided sample 2 m20 − m10 (no accelerometer "
+         "update; the integral and the history). Without any velocity the filter does what it did "
+         "before the aiding existed (docs/ahrs.md, \"GNSS velocity aiding\")."),
+        "",
+        "| build | per IMU sample, no GNSS | per IMU sample, aided | per GNSS update | µs @400 MHz (sample / aided / update) |",
+        "|---|---|---|---|---|",
+    ]
+    for prec in precisions:
+        c = ahrs_counts(prec, tmp)
+        out.append(f"| {prec} | {c['imu']:,.0f} | {c['aided']:,.0f} | {c['update']:,.0f} "
+                   f"| {_us(c['imu']):.1f} / {_us(c['aided']):.1f} / {_us(c['update']):.1f} |")
+    return out
 
 
 def _us(instr: float) -> float:
@@ -53,4 +88,5 @@ def run(quick: bool) -> str:
             imu, gnss, hd = c["imu"], EVERY * (c["gnss"] - c["imu"]), EVERY * (c["heading"] - c["imu"])
             out.append(f"| {prec} | {imu:,.0f} | {gnss:,.0f} | {hd:,.0f} "
                        f"| {_us(imu):.1f} / {_us(gnss):.1f} / {_us(hd):.1f} |")
+        out += _ahrs_table(precisions, Path(d))
     return "\n".join(out) + "\n"

@@ -54,8 +54,8 @@ def _fixes(traj, t0: float, seconds: float, seed: int, preset: str = "neo-m8n", 
     vel = np.stack([fx["ve"], fx["vn"], -fx["vd"]], 1)
     ok = fx["fix_type"] >= 2
     vel[~ok] = 0.0
-    return dict(gnss_t=fx["t_measured"] - t0, gnss_vel=vel, gnss_delivered=fx["t_delivered"] - t0,
-                gnss_fix=fx["fix_type"].astype(int))
+    return {"gnss_t": fx["t_measured"] - t0, "gnss_vel": vel, "gnss_delivered": fx["t_delivered"] - t0,
+            "gnss_fix": fx["fix_type"].astype(int)}
 
 
 def _reference(gyr, acc, mag, rate, q0, gnss, **settings):
@@ -123,8 +123,8 @@ def test_refused_velocities_leave_the_output_bit_identical():
     g, a, m = _sim_inputs()
     n = 600
     q0 = ahrs(g[:n], a[:n], m[:n], rate=100.0)
-    bad = dict(gnss_t=np.arange(1, 12) * 0.5, gnss_vel=np.tile([0.0, 60.0, 0.0], (11, 1)),
-               gnss_fix=np.zeros(11, int))  # no fix: every sample refused
+    bad = {"gnss_t": np.arange(1, 12) * 0.5, "gnss_vel": np.tile([0.0, 60.0, 0.0], (11, 1)),
+               "gnss_fix": np.zeros(11, int)}  # no fix: every sample refused
     q1 = ahrs(g[:n], a[:n], m[:n], rate=100.0, **bad)
     assert np.array_equal(q0, q1)
 
@@ -195,7 +195,7 @@ def test_turn_tilt_with_and_without_aiding():
 
 def test_f32_follows_f64_when_aided():
     rate = 50.0
-    traj, t, g, a, m = _turn_imu(rate, 0.0, 20.0, seed=6)
+    traj, _, g, a, m = _turn_imu(rate, 0.0, 20.0, seed=6)
     q0 = traj.quat(np.array([0.0]))[0]
     gn = _fixes(traj, 0.0, 20.0, 6)
     # rest detection off: straight and level flight with a quiet gyro sits at its thresholds,

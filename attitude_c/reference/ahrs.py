@@ -363,14 +363,7 @@ class ReferenceAhrs:
             for i in range(3):
                 self._scalar(x, 3 + i, float(self.rest_g[i] - self.b[i]), s["rest_noise"] ** 2 / dt,
                              (3, 4, 5))
-        # injection
-        self.q = _qmul(_exp(x[:3]), self.q)
-        self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
-        if self.tilt is not None:
-            self.tilt = self.tilt + np.cross(x[:3], self.tilt)
-        if self.tilt_start is not None and len(self.tilt_start):
-            self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
-        self.b = self.b + x[3:]
+        self._inject(x)
         # heading observability: measured at least once, and its 1σ within the bound since
         if not (self.heading_measured and self.covariance[2, 2] <= s["heading_sigma_max"] ** 2):
             flags |= 32
@@ -420,13 +413,14 @@ class ReferenceAhrs:
             return
         self._gnss_compare(t, sv_t, v, sig ** 2, has_up)
 
-    def _gnss_rows(self, dS: F, dv: F, dT: float, tau: float, up: bool, heading: bool) -> list[tuple[F, float]]:
+    def _gnss_rows(self, dS: F, dv: F, dT: float, tau: float, up: bool, heading: bool,
+                   R: float) -> list[tuple[F, float]]:
         """(h, y) rows of r = Δv − ΔS = −[ΔF×] δθ(t_m), δθ(t_m) = δθ + C τ δb, ΔF = ΔS + g Δt e_z."""
+        assert self.q is not None
         Fv = dS + np.array([0.0, 0.0, self.s["gravity"] * dT])
-        Hfull = np.hstack([-_skew(Fv), -_skew(Fv) @ _dcm(self.q) * tau])  # 3×6
+        Hfull = np.asarray(np.hstack([-_skew(Fv), -_skew(Fv) @ _dcm(self.q) * tau]), dtype=np.float64)  # 3×6
         r = dv - dS
         nv, ns = math.hypot(dv[0], dv[1]), math.hypot(dS[0], dS[1])
-        R = self._gnss_R
         if not heading and ns > 0 and nv * nv > 9 * R:  # compare the horizontal lengths along ΔS_h
             u = np.array([dS[0] / ns, dS[1] / ns, 0.0])
             rows = [(u @ Hfull, nv - ns)]
@@ -440,15 +434,16 @@ class ReferenceAhrs:
 
     def _gnss_compare(self, t: float, sv_t: F, v: F, var: float, has_up: bool) -> None:
         s, gs = self.s, self.gnss
+        assert gs.anchor is not None and self.q is not None
         t_a, s_a, v_a, var_a, up_a = gs.anchor
         dS, dv, dT = sv_t - s_a, v - v_a, t - t_a
         heading = not self.flags & 32
-        self._gnss_R = var + var_a
-        rows = self._gnss_rows(dS, dv, dT, gs.time - (t + t_a) / 2, has_up and up_a, heading)
+        R = var + var_a
+        rows = self._gnss_rows(dS, dv, dT, gs.time - (t + t_a) / 2, has_up and up_a, heading, R)
         if s["gnss_max_acc"] > 0 and math.hypot(dv[0], dv[1]) > s["gnss_max_acc"] * dT:
             gs.rejected = True  # a jump
             return
-        if s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + self._gnss_R) for h, y in rows):
+        if s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + R) for h, y in rows):
             if gs.used and gs.time - gs.used_t <= s["gnss_timeout"]:  # aided: the gate refuses
                 gs.rejected = True
                 return
@@ -457,17 +452,21 @@ class ReferenceAhrs:
         x = np.zeros(6)
         states = (0, 1, 2, 3, 4, 5) if heading else (0, 1, 3, 4, 5)
         for h, y in rows:
-            self._row(x, h, y, self._gnss_R, states)
+            self._row(x, h, y, R, states)
+        self._inject(x)
+        gs.set_anchor(t, sv_t, v, var, has_up, x[:3], s["gravity"])
+        gs.used, gs.used_t = True, t
+
+    def _inject(self, x: F) -> None:
+        """q ← exp(δθ) ⊗ q, b ← b + δb; the navigation-frame vectors carried through (I + [δθ×])."""
+        assert self.q is not None and self.acc_lp is not None
         self.q = _qmul(_exp(x[:3]), self.q)
-        assert self.acc_lp is not None
         self.acc_lp = self.acc_lp + np.cross(x[:3], self.acc_lp)
         if self.tilt is not None:
             self.tilt = self.tilt + np.cross(x[:3], self.tilt)
         if self.tilt_start is not None and len(self.tilt_start):
             self.tilt_start = self.tilt_start + np.cross(x[:3], self.tilt_start)
         self.b = self.b + x[3:]
-        gs.set_anchor(t, sv_t, v, var, has_up, x[:3], s["gravity"])
-        gs.used, gs.used_t = True, t
 
     def _row(self, x: F, h: F, y: float, R: float, states: tuple[int, ...]) -> None:
         """A scalar measurement y = h x + noise (R) with a general row h; gain masked to states;

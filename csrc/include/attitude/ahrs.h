@@ -424,7 +424,8 @@ typedef struct {
  * until gnss_timeout after the last, it replaces the accelerometer's inclination update
  * (ATT_AHRS_F_GNSS_AIDED). Quality checks (fix type, DOP, sigma, a velocity jump, the
  * innovation gate) refuse a sample: ATT_OK is still returned and ATT_AHRS_F_GNSS_REJECTED
- * is set in the flags of the next update. The first velocity only starts the history; one
+ * is set in the flags of the next update. A velocity less than gnss_window after the previous
+ * one used is skipped (unflagged). The first velocity only starts the history; one
  * older than the history holds so far (within gnss_max_latency of the clock), or given
  * before the filter is aligned, is ignored (ATT_OK, no flag). Errors (state unchanged):
  * ATT_E_NULL, ATT_E_NONFINITE, ATT_E_ARG (t later than the filter's clock by more than one
