@@ -270,8 +270,16 @@ def _cell(f: dict[str, float], axis: str) -> str:
 
 
 def _verdict(r: Result) -> str:
-    worst = r.figures("aided")["tilt_max"]
-    ok = worst <= LIMIT_DEG and (r.recovery_s() is None or (r.recovery_s() or 0.0) <= RECOVERY_S)
+    """Issue 30's targets for the run: every error within LIMIT_DEG; with an outage, within it
+    before the outage, no worse in the outage than the filter without GNSS, and recovered
+    within RECOVERY_S of the fix's return (the return's transient is the recovery's)."""
+    if r.outage is None:
+        ok = r.figures("aided")["tilt_max"] <= LIMIT_DEG
+    else:
+        before = (r.data.t >= r.data.judged_from) & (r.data.t < r.outage[0])
+        ok = (float(np.max(np.abs(r.err["aided"][before]))) <= LIMIT_DEG * DEG
+              and (r.outage_max_deg("aided") or 0.0) <= r.figures("unaided")["tilt_max"]
+              and (r.recovery_s() or 0.0) <= RECOVERY_S)
     return "yes" if ok else "**no**"
 
 
@@ -313,8 +321,10 @@ def run(quick: bool = False) -> str:
         ("The scenarios, the simulated system and how each figure is measured: `bench/gnss_accept.py` and "
          "docs/gnss.md, \"Acceptance\". Cells: RMS / max of the roll or pitch error (°) from the end of the "
          "run's unaccelerated lead (10 s for the turns, 5 s for the car) to its end. Targets (issue 30): "
-         f"the GNSS-aided filter within {LIMIT_DEG:g}° in every run, and back within {LIMIT_DEG:g}° (for good) "
-         f"within {RECOVERY_S:g} s of the first fix after the outage. "
+         f"the GNSS-aided filter within {LIMIT_DEG:g}° in every run; in the outage run within it before the "
+         "outage, no worse in the outage than the filter without GNSS, and back within "
+         f"{LIMIT_DEG:g}° for good within {RECOVERY_S:g} s of the first fix after the outage (its max "
+         "includes that return's transient). "
          + (f"Quick run: seed {seeds[0]}, the outage run shortened ({SHORT})." if quick else
             f"Seeds {', '.join(map(str, seeds))} (sensor noise and draws, GNSS noise).")),
         "",

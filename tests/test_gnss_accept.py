@@ -70,6 +70,8 @@ def test_outage_in_turn_degrades_gracefully_and_recovers(outage_run: Data) -> No
     assert r.aided_fraction(r.data.judged_from, a) == 1.0
     assert r.aided_fraction(a + timeout, b) == 0.0
     assert r.aided_fraction(b + RECOVERY_S, float(r.data.t[-1])) == 1.0
+    before = (r.data.t >= r.data.judged_from) & (r.data.t < a)
+    assert np.max(np.abs(r.err["aided"][before])) / DEG <= LIMIT_DEG  # the aided turn's own target
     in_outage, recovery = r.outage_max_deg("aided"), r.recovery_s()
     assert in_outage is not None and in_outage <= r.figures("unaided")["tilt_max"], (in_outage, r.figures("unaided"))
     assert recovery is not None and recovery <= RECOVERY_S, recovery
