@@ -8,8 +8,11 @@ loop adds the machine cycles of every iteration that did nothing (no byte in or 
 poll result but NONE/IDLE, no scan) to an idle counter; busy = 1 - idle / total, the total
 being the firmware's Timer 0 ticks from its first iteration to the end (x 256 cycles). In
 s51 nothing drives P1, so EOC reads "done" at once: a scan is the driver's own cost (on a
-board each conversion also waits up to 10 us). The host answers in wall time while s51 runs
-slower than real time: its latency shows, stretched, as records waiting in the ring.
+board each conversion also waits up to 10 us). s51 runs in lockstep with the receiver
+(``run_v2(..., lockstep=True)``: every answer reaches the firmware within
+``toolchain.firmware.LOCKSTEP_BOUND_S`` of simulated time), so the figures are the
+firmware's own, not the machine's load (a host answering in wall time, as before, showed a
+loaded machine's lateness, stretched, as records waiting in the ring and lost).
 
 Accuracy. BROAD (D. Laidig, M. Caruso, A. Cereatti, T. Seel, Data 6(7), 2021,
 doi:10.3390/data6070072, CC BY 4.0), the trials in ../shared/data/broad: each trial taken
@@ -56,7 +59,7 @@ def cpu_load(tool: Any, build_dir: Path, plan: tuple[int, int, int], baud: int, 
     img = tool.build(build_dir, cfg, kind="bench", sim_samples=records,
                      name=f"aided_{baud}_{period}_{acc}_{mag}" + ("_sr" if sr else "") + (f"_x{ovs}" if ovs > 1 else "")
                      + ("_mean" if mean else ""))
-    res = tool.run_v2(img, "c", timeout=900)
+    res = tool.run_v2(img, "c", timeout=900, lockstep=True)
     b = res.bench
     total = ((b["ticks"] - b["tick0"]) & 0xFFFF) * 256  # ticks since the first iteration, in cycles
     seconds = total / tool.MACHINE_HZ
@@ -73,7 +76,7 @@ def profile(tool: Any, build_dir: Path, records: int) -> dict[str, float]:
     the busy figure comes from the plain bench image)."""
     img = tool.build(build_dir, tool.AIDED, kind="bench", sim_samples=records, name="aided_profile",
                      extra_defines=["FW_PROFILE"])
-    res = tool.run_v2(img, "c", timeout=900)
+    res = tool.run_v2(img, "c", timeout=900, lockstep=True)
     b, n = res.bench, res.stats["accepted"]
     return {"per_frame": n / max(1, b["nframe"]), "bytes": b["nsend"] / n, "poll": b["psend"] / b["nsend"],
             "rx_bytes": b["nrx"] / n, "sink": b["prx"] / max(1, b["nrx"]), "scan": b["scan_sum"] / n,

@@ -1042,14 +1042,17 @@ class V2Result(SimOutput):
 
 
 def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float = 60.0,
-           room: int = 64, late: bool = False, data: Path | None = None) -> V2Result:
+           room: int = 64, late: bool = False, data: Path | None = None, lockstep: bool = False) -> V2Result:
     """Run a link v2 sim/bench image in s51 with libattitude's v2 receiver B on the pty:
     the C machine (``impl="c"``, through CFFI) or the Python one written from the spec
     (``data``: a ``data=True`` image's input file, :func:`data_file`).
     The host keeps up with any rate: its room never shrinks. ``late``: once records flow,
     the host holds its answers back until the firmware has sent a frame again (its
     retransmission timeout ran out), as a host descheduled on a loaded machine does;
-    waiting for that event, not for a time, makes it certain."""
+    waiting for that event, not for a time, makes it certain. ``lockstep``: s51 in lockstep
+    with the receiver (:meth:`Session.run_lockstep`, ``ahead=True``): every answer reaches
+    the firmware within :data:`LOCKSTEP_BOUND_S` of simulated time whatever the machine's
+    load, so what the firmware delivers is its own figure, not the host's (not with ``late``)."""
     import serial  # pyserial
 
     from attitude_c.link.v2 import Receiver2, Result2
@@ -1057,30 +1060,41 @@ def run_v2(image: Image, impl: Literal["c", "python"] = "c", *, timeout: float =
 
     if image.config.link != "v2":
         raise ValueError(f"run_v2 needs a link v2 image, got link={image.config.link!r}")
+    if lockstep and late:
+        raise ValueError("run_v2: late needs the free-running host (lockstep=False)")
     rx: Any = CReceiver2(room=room) if impl == "c" else Receiver2(room=room)
     got: list[bytes] = []
     reply = bytearray()
-    with Session(image, timeout, data) as sess:
-        port = serial.Serial(str(sess.port), image.config.baud, timeout=0.005)
 
-        def pump() -> None:
-            for b in port.read(max(1, port.in_waiting)):
-                if rx.sink(b) == Result2.DELIVERED:
-                    got.extend(rx.delivered)
-                    rx.set_room(room)
-            while True:
-                res, byte = rx.poll()
-                if res != Result2.SEND or byte is None:
-                    break
-                reply.append(byte)
-            if reply and not (late and got and rx.stats.duplicates == 0):
-                port.write(bytes(reply))
-                reply.clear()
+    def take(data_in: bytes) -> bytes:
+        """The receiver fed ``data_in``: the answer bytes it has to send now."""
+        for b in data_in:
+            if rx.sink(b) == Result2.DELIVERED:
+                got.extend(rx.delivered)
+                rx.set_room(room)
+        while True:
+            res, byte = rx.poll()
+            if res != Result2.SEND or byte is None:
+                break
+            reply.append(byte)
+        if not reply or (late and got and rx.stats.duplicates == 0):
+            return b""
+        out = bytes(reply)
+        reply.clear()
+        return out
 
-        try:
-            fw = sess.run(pump=pump, describe=lambda: f"{len(got)} records, receiver {rx.stats.as_dict()}")
-        finally:
-            port.close()
+    def describe() -> str:
+        return f"{len(got)} records, receiver {rx.stats.as_dict()}"
+
+    with Session(image, timeout, data, lockstep=lockstep) as sess:
+        if lockstep:
+            fw = sess.run_lockstep(lambda: sess.write(take(sess.read())), describe=describe, ahead=True)
+        else:
+            port = serial.Serial(str(sess.port), image.config.baud, timeout=0.005)
+            try:
+                fw = sess.run(pump=lambda: port.write(take(port.read(max(1, port.in_waiting)))), describe=describe)
+            finally:
+                port.close()
     return V2Result(**vars(fw), records=got, receiver=dict(rx.stats.as_dict()))
 
 
