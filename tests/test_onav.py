@@ -140,9 +140,10 @@ def test_bench_tilt_errors_ignore_heading_and_wrap() -> None:
 def test_bench_figures_and_missing_data(tmp_path: Path) -> None:
     from bench import onav as b
 
-    rms_r, max_r, rms_p, max_p = b.figures(np.radians([[3.0, 0.0], [-4.0, 1.0]]))
-    # closed forms: sqrt((9 + 16) / 2), max |.|; sqrt(1 / 2), 1 (1e-12: double rounding)
-    assert (rms_r, max_r, rms_p, max_p) == pytest.approx((math.sqrt(12.5), 4.0, math.sqrt(0.5), 1.0), abs=1e-12)
+    f = b.figures(np.radians([[3.0, 0.0], [-4.0, 1.0], [0.0, 0.25]]))
+    # closed forms: sqrt((9 + 16) / 3), max |.|; sqrt((1 + 1/16) / 3), 1; 2 of 3 samples beyond
+    # 0.5° (1e-12: double rounding)
+    assert f == pytest.approx((math.sqrt(25 / 3), 4.0, math.sqrt(17 / 48), 1.0, 2 / 3), abs=1e-12)
     assert b.missing(str(tmp_path)) == b.HOW  # a folder without the n380 drives
     for r in b.RECORDINGS:
         (tmp_path / onav.RECORDINGS[r][1]).mkdir(parents=True)
