@@ -121,3 +121,30 @@ def test_errors_name_what_is_wrong(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     (d / "mag_data.txt.zip").write_bytes(b"not a zip")
     with pytest.raises(InvalidArgument, match="cannot read"):
         onav.load("umn-thor77", tmp_path)
+
+
+# -- bench/onav.py's pure helpers (no data needed) -----------------------------------------
+
+def test_bench_tilt_errors_ignore_heading_and_wrap() -> None:
+    """Roll and pitch errors are the z-x-y Euler differences whatever the two headings (the
+    yaw is the first rotation, about the world's up), wrapped to ±π."""
+    from attitude_c.core import euler_to_quat
+    from bench.onav import tilt_errors
+
+    ref = euler_to_quat(np.radians([[10.0, 2.0, -3.0], [200.0, -1.0, 179.0]]))
+    est = euler_to_quat(np.radians([[95.0, 2.5, -2.0], [-30.0, -1.25, -179.0]]))
+    # 1e-9 rad: double-precision conversions of angles of order 1 rad
+    np.testing.assert_allclose(np.degrees(tilt_errors(est, ref)), [[1.0, 0.5], [2.0, -0.25]], atol=1e-7)
+
+
+def test_bench_figures_and_missing_data(tmp_path: Path) -> None:
+    from bench import onav as b
+
+    f = b.figures(np.radians([[3.0, 0.0], [-4.0, 1.0], [0.0, 0.25]]))
+    # closed forms: sqrt((9 + 16) / 3), max |.|; sqrt((1 + 1/16) / 3), 1; 2 of 3 samples beyond
+    # 0.5° (1e-12: double rounding)
+    assert f == pytest.approx((math.sqrt(25 / 3), 4.0, math.sqrt(17 / 48), 1.0, 2 / 3), abs=1e-12)
+    assert b.missing(str(tmp_path)) == b.HOW  # a folder without the n380 drives
+    for r in b.RECORDINGS:
+        (tmp_path / onav.RECORDINGS[r][1]).mkdir(parents=True)
+    assert b.missing(str(tmp_path)) is None

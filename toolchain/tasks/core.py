@@ -219,10 +219,15 @@ def assemble_bench_doc() -> None:
     BENCH_DOC.write_text(bench_doc_text())
 
 
+class _NoData(Exception):
+    """``--only`` a benchmark whose data is missing (its ``missing(data)`` says why)."""
+
+
 @task(help={
     "only": "run only this benchmark module (bench/NAME.py); 'assemble' just rebuilds the table",
     "quick": "shorter runs (smoke test of the benchmark code, figures less precise)",
-    "data": "a data folder for the benchmarks that take one (broad: an upstream BROAD data_mat/ folder)",
+    "data": "a data folder for the benchmarks that take one (broad: an upstream BROAD data_mat/ folder; "
+            "onav: onavdata 0.2.5's data folder)",
     "trials": "the benchmarks that take it (chain): only the BROAD trials whose names start so (comma-separated)",
     "budget": "the benchmarks that take it (chain): start no run after this many minutes (the table says so)",
 })
@@ -241,9 +246,21 @@ def bench(c, only="", quick=False, data="", trials="", budget=""):
         try:
             mod = importlib.import_module(f"bench.{name}")
             print(f"== bench {name}: {mod.TITLE}", flush=True)
+            # a benchmark on data the project does not ship says what it needs through
+            # missing(data) -> str | None: skipped in a full run, one clear line with --only
+            why = mod.missing(data or None) if hasattr(mod, "missing") else None
+            if why and not only:
+                print(f"== bench {name}: skipped ({why})", flush=True)
+                continue
+            if why:
+                raise _NoData(why)
             params = inspect.signature(mod.run).parameters
             extra = {k: v for k, v in (("data", data), ("trials", trials), ("budget", budget)) if v and k in params}
             body = mod.run(quick=quick, **extra)
+        except _NoData as exc:  # --only a benchmark without its data: one line, no traceback
+            from invoke.exceptions import Exit
+
+            raise Exit(f"bench {name}: {exc}", code=1) from None
         except Exception as exc:  # noqa: BLE001 - any failure of one module
             import traceback
 
