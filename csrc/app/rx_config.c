@@ -96,7 +96,9 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
     X(gnss_max_pdop) \
     X(gnss_max_sigma) \
     X(gnss_max_acc) \
-    X(gnss_gate)
+    X(gnss_gate) \
+    X(gnss_window) \
+    X(gnss_gyr_noise)
 // clang-format on
 #define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
 

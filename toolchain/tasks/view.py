@@ -409,6 +409,7 @@ def view_firmware(c, samples=3000, port=8765, period_ticks=72):
 @task(help={
     "out": "PNG to write (default docs/img/view.png)",
     "seconds": "seconds of playback before the picture (default 12)",
+    "gnss": "the GNSS panel instead (docs/img/view-gnss.png): a simulated car drive with a NEO-M8N receiver",
 })
 def view_screenshot(c, out="", seconds=12.0, gnss=False):
     """The screenshot of docs/view.md: the simulator at 200 samples/s with bit errors on the link; with

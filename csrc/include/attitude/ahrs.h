@@ -449,7 +449,9 @@ att_real att_ahrs_time(const att_ahrs *s);
  * −vel_d), has_up from ATT_GNSS_HAS_VEL_D, sigma = s_acc (ATT_GNSS_HAS_ACC, else 0), pdop
  * (ATT_GNSS_HAS_PDOP, else 0), fix_type (ATT_GNSS_HAS_FIX_TYPE; without it 2D when the fix
  * is flagged valid), ATT_GNSS_FIX_NONE when the receiver flags the fix invalid. */
+#if !defined(__SDCC) /* att_gnss_fix is not built for the 8051 (gnss.h) */
 att_status att_ahrs_vel_from_fix(const att_gnss_fix *fix, att_real t, att_ahrs_vel *out);
+#endif
 
 ATT_API_END
 
