@@ -19,8 +19,8 @@ from conftest import G, angle_deg, motion
 from attitude_c import broad, names
 from attitude_c import reference as ref
 from attitude_c.ahrs_filter import Ahrs, ahrs, default_settings
-from attitude_c.reference.ahrs import ahrs_reference
 from attitude_c.errors import InvalidArgument, InvalidType, NonFiniteError
+from attitude_c.reference.ahrs import ahrs_reference
 
 
 @pytest.mark.parametrize("method", ["rv3-reuse", "rv1", "rv3"])
@@ -335,3 +335,18 @@ def test_streaming_bench_smoke():
     gyr, acc, mag, _ = motion(200, 100.0, (0.2, -0.1, 0.3), noise=0.002)
     us = streaming([SimpleNamespace(gyr=gyr, acc=acc, mag=mag, rate=100.0)], n=200, rounds=1)
     assert len(us) == 4 and all(len(v) == 1 and np.isfinite(v[0]) and v[0] >= 0 for v in us.values())
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+def test_setting_field_table_is_every_real_field_in_order(precision: str) -> None:
+    """att_ahrs_setting_field walks the struct's real fields in order with their offsets (what
+    attitude-rx reads its settings by), the count in the header, NULL past the last; truth:
+    the struct as the compiler laid it out (CFFI's view of the header)."""
+    from attitude_c._lib import ffi_lib
+
+    ffi, lib = ffi_lib(precision)
+    real = [(n, f.offset) for n, f in ffi.typeof("att_ahrs_settings").fields if f.type.cname in ("double", "float")]
+    off = ffi.new("size_t *")
+    got = [(ffi.string(lib.att_ahrs_setting_field(i, off)).decode(), off[0]) for i in range(lib.ATT_AHRS_REAL_SETTINGS)]
+    assert got == real
+    assert lib.att_ahrs_setting_field(lib.ATT_AHRS_REAL_SETTINGS, off) == ffi.NULL

@@ -50,74 +50,22 @@ int rx_sensor_init(const rx_sensor_cfg *c, att_sensor *s)
 }
 
 /* The filter's settings by field name (attitude/ahrs.h): every att_real field of
- * att_ahrs_settings; method is the shared "method" key. A field added to the header
- * is added here (tests/test_attitude_rx_aided.py compares this list with the header's). */
-/* One field a line, unformatted: clang-format 14 reflows an X-macro list differently each pass. */
-// clang-format off
-#define RX_AHRS_REAL_FIELDS(X) \
-    X(gravity) \
-    X(gyr_noise) \
-    X(gyr_noise_rest) \
-    X(bias_noise) \
-    X(init_att_sigma) \
-    X(init_bias_sigma) \
-    X(acc_tau) \
-    X(acc_noise) \
-    X(acc_gate) \
-    X(acc_reject_max) \
-    X(mag_noise) \
-    X(mag_norm_tol) \
-    X(mag_dip_tol) \
-    X(mag_ref_tau) \
-    X(mag_ref_window) \
-    X(mag_reject_max) \
-    X(mag_reject_factor) \
-    X(mag_new_time) \
-    X(mag_min_undisturbed) \
-    X(mag_new_gyr) \
-    X(declination) \
-    X(rest_time) \
-    X(rest_tau) \
-    X(rest_gyr_th) \
-    X(rest_acc_th) \
-    X(rest_noise) \
-    X(gyro_range) \
-    X(overrange_sigma) \
-    X(sensor_delay) \
-    X(acc_delay) \
-    X(mag_delay) \
-    X(tilt_tau) \
-    X(heading_sigma_max) \
-    X(turn_sigma) \
-    X(turn_tau) \
-    X(gnss_vel_sigma) \
-    X(gnss_timeout) \
-    X(gnss_max_latency) \
-    X(gnss_max_pdop) \
-    X(gnss_max_sigma) \
-    X(gnss_max_acc) \
-    X(gnss_gate) \
-    X(gnss_window) \
-    X(gnss_gyr_noise)
-// clang-format on
-#define RX_AHRS_ENTRY(f) { #f, offsetof(att_ahrs_settings, f) },
-
-static const struct {
-    const char *name;
-    size_t offset;
-} ahrs_fields[] = { RX_AHRS_REAL_FIELDS(RX_AHRS_ENTRY) };
-
+ * att_ahrs_settings, from the library's own table (att_ahrs_setting_field: a field added
+ * to the header is read here with no change); method is the shared "method" key. */
+/* The i-th real field of *set (the library's table: att_ahrs_setting_field). */
 static att_real *ahrs_field(att_ahrs_settings *set, size_t i)
 {
-    return (att_real *)(void *)((char *)set + ahrs_fields[i].offset);
+    size_t offset = 0;
+    (void)att_ahrs_setting_field(i, &offset);
+    return (att_real *)(void *)((char *)set + offset);
 }
 
 const char *rx_ahrs_setting(size_t i, const att_ahrs_settings *set, double *value)
 {
-    if (i >= sizeof ahrs_fields / sizeof ahrs_fields[0])
+    if (i >= ATT_AHRS_REAL_SETTINGS)
         return NULL;
     *value = (double)*ahrs_field((att_ahrs_settings *)(uintptr_t)set, i);
-    return ahrs_fields[i].name;
+    return att_ahrs_setting_field(i, NULL);
 }
 
 static const char *const estimator_names[] = { "auto", "ahrs", "integrator" };
@@ -386,10 +334,10 @@ static int set_ahrs(rx_config *c, const char *name, const char *value, char *msg
     att_ahrs_settings t = c->ahrs;
     double d;
     size_t i;
-    for (i = 0; i < sizeof ahrs_fields / sizeof ahrs_fields[0]; i++)
-        if (strcmp(name, ahrs_fields[i].name) == 0)
+    for (i = 0; i < ATT_AHRS_REAL_SETTINGS; i++)
+        if (strcmp(name, att_ahrs_setting_field(i, NULL)) == 0)
             break;
-    if (i == sizeof ahrs_fields / sizeof ahrs_fields[0])
+    if (i == ATT_AHRS_REAL_SETTINGS)
         return fail(msg, len, RX_EXIT_CONFIG, "unknown setting '%s'", name);
     if (parse_double(value, &d) != 0)
         return fail(msg, len, RX_EXIT_CONFIG, "%s: '%s' is not a number", name, value);
@@ -619,7 +567,7 @@ static const struct option long_options[] = { { "help", no_argument, NULL, OPT_H
 
 enum {
     N_BASE = sizeof long_options / sizeof long_options[0],
-    N_AHRS = sizeof ahrs_fields / sizeof ahrs_fields[0]
+    N_AHRS = ATT_AHRS_REAL_SETTINGS
 };
 
 /* The options getopt_long sees: the list above, then one per filter setting, then the end. */
@@ -630,7 +578,7 @@ static const struct option *all_options(void)
     for (i = 0; i < N_BASE; i++)
         all[i] = long_options[i];
     for (i = 0; i < N_AHRS; i++) {
-        all[N_BASE + i].name = ahrs_fields[i].name;
+        all[N_BASE + i].name = att_ahrs_setting_field(i, NULL);
         all[N_BASE + i].has_arg = required_argument;
         all[N_BASE + i].flag = NULL;
         all[N_BASE + i].val = OPT_SETTING;

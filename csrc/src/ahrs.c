@@ -125,6 +125,20 @@ static const att__domain DOMAINS[] = {
     DOMAIN(gnss_gyr_noise, GT, 0),
 };
 
+/* every real field has a domain, and the header's count is the table's */
+typedef char att__domains_complete[sizeof DOMAINS / sizeof DOMAINS[0] == ATT_AHRS_REAL_SETTINGS ? 1 : -1];
+
+const char *att_ahrs_setting_field(size_t i, size_t *offset)
+{
+    if (i >= ATT_AHRS_REAL_SETTINGS) {
+        return NULL;
+    }
+    if (offset != NULL) {
+        *offset = DOMAINS[i].offset;
+    }
+    return DOMAINS[i].name;
+}
+
 att_status att_ahrs_check_settings_field(const att_ahrs_settings *set, const char **field)
 {
     const char *bad = NULL;

@@ -333,6 +333,16 @@ typedef struct {
 /* The defaults listed above. */
 void att_ahrs_default_settings(att_ahrs_settings *set);
 
+/* The real (att_real) fields of att_ahrs_settings: how many, and the i-th in the struct's
+ * order, 0 <= i < ATT_AHRS_REAL_SETTINGS: its name as spelled in the struct (the library's
+ * static string) and its byte offset in the struct (*offset, may be NULL); NULL past the last.
+ * An application that reads settings by name (attitude-rx's config file and options) walks
+ * this instead of keeping its own list. */
+enum {
+    ATT_AHRS_REAL_SETTINGS = 44
+};
+const char *att_ahrs_setting_field(size_t i, size_t *offset);
+
 /* Check a settings struct against the domains above: ATT_OK or
  * ATT_E_AHRS_SETTINGS (ATT_E_NULL for NULL). */
 att_status att_ahrs_check_settings(const att_ahrs_settings *set);
