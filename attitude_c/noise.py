@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .errors import InvalidArgument, InvalidType
 
-__all__ = ["MAPPING", "MAPPING_CALIBRATED", "PLATEAU", "AllanResult", "Terms", "allan", "config_text", "filter_settings", "plot"]
+__all__ = ["MAPPING", "MAPPING_CALIBRATED", "PLATEAU", "AllanResult", "Terms", "allan", "config_text", "filter_settings", "horizontal_field", "plot"]
 
 FloatArray = NDArray[np.float64]
 Kind = Literal["gyro", "accel"]
@@ -323,6 +323,16 @@ def _calibrated_settings(gyro: Terms | AllanResult, accel: Terms | AllanResult |
             raise InvalidArgument(f"mag_h must be the horizontal field (> 0, the magnetometer's unit), got {mag_h!r}")
         out["mag_noise"] = _own_time_density(_worst(mag, "mag"), g.n, float(mag_h))
     return out
+
+
+def horizontal_field(acc: ArrayLike, mag: ArrayLike) -> float:
+    """|m_h| of a rest recording: the mean field's part across the mean specific force (which
+    points up), in the magnetometer's unit: ``mag_h`` of :func:`filter_settings`."""
+    a, m = np.asarray(acc, float).reshape(-1, 3).mean(axis=0), np.asarray(mag, float).reshape(-1, 3).mean(axis=0)
+    na = float(np.linalg.norm(a))
+    if not (math.isfinite(na) and na > 0 and np.all(np.isfinite(m))):
+        raise InvalidArgument("horizontal_field: acc and mag must be finite, acc's mean not zero")
+    return float(np.linalg.norm(np.cross(m, a / na)))
 
 
 def _worst(x: Terms | AllanResult, name: str) -> Terms:

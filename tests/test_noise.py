@@ -169,6 +169,33 @@ def test_cli_writes_results_and_config(tmp_path: Path, capsys: pytest.CaptureFix
         assert abs(t["n"] - 1e-3) < 3 * t["n_sigma"], t
 
 
+def test_cli_calibrated_with_a_magnetometer(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`attitude allan --calibrated`: MAPPING_CALIBRATED on the file's terms, mag_noise from its
+    magnetometer across the horizontal field of the mean (written to the config too); white noise
+    alone, so mag_noise is N_mag/|m_h| within the fit's 3σ."""
+    rng = np.random.default_rng(7)
+    n = 6000
+    t = np.arange(n) * 0.01
+    g = rng.standard_normal((n, 3)) * 0.01
+    a = rng.standard_normal((n, 3)) * 0.02 + [0.0, 0.0, 9.81]
+    m = rng.standard_normal((n, 3)) * 0.05 + [0.0, 20.0, -40.0]  # µT: |m_h| = 20
+    path = tmp_path / "rest9.csv"
+    np.savetxt(path, np.column_stack([t, g, a, m]), delimiter=",", header="t,gx,gy,gz,ax,ay,az,mx,my,mz",
+               comments="")
+    conf = tmp_path / "rx.conf"
+    rc = main(["allan", str(path), "--calibrated", "--out", str(tmp_path / "o"), "--no-plots",
+               "--write-config", str(conf)])
+    assert rc == 0, capsys.readouterr().err
+    summary = json.loads((tmp_path / "o" / "allan.json").read_text())
+    st = summary["settings"]
+    assert list(summary["sensors"]) == ["gyro", "accel", "mag"]
+    assert st["tilt_tau"] == 0 and st["turn_sigma"] == 0 and st["gyr_noise"] == st["gyr_noise_rest"]
+    worst = max(summary["sensors"]["mag"]["terms"], key=lambda x: x["n"])
+    # N_mag = 0.05·√0.01 = 5e-3 µT·√s; over |m_h| = 20 µT: 2.5e-4 rad·√s
+    assert abs(st["mag_noise"] - 2.5e-4) < 3 * worst["n_sigma"] / 20.0 + 1e-6, (st, worst)
+    assert "mag_noise = " in conf.read_text()
+
+
 def test_cli_warns_of_motion(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """A recording that turns (0.1 rad/s, above the filter's rest_gyr_th of 0.035) is analysed
     with a warning: its terms are the motion's."""
@@ -198,11 +225,16 @@ def test_cli_reads_the_boards_stream(tmp_path: Path) -> None:
     (["SHORT"], 2, "at least 256 samples"),
     (["REST", "--rate", "-1"], 2, "--rate"),
     (["REST", "--columns", "gx"], 2, "expected NAME=HEADER"),
+    (["STREAM", "--calibrated"], 2, "--calibrated needs the accelerometer"),
 ])
 def test_cli_user_mistakes(tmp_path: Path, capsys: pytest.CaptureFixture[str], args: list[str], code: int,
                            text: str) -> None:
     """One line on stderr and the documented exit status (docs/cli.md), never a traceback."""
-    files = {"SHORT": str(_rest_csv(tmp_path / "s.csv", 100)), "REST": str(_rest_csv(tmp_path / "r.csv"))}
+    stream = tmp_path / "rx.jsonl"
+    stream.write_text("\n".join(json.dumps({"t": k * 0.08, "n": k, "q": [1, 0, 0, 0], "rate_dps": [0.1, 0.0, 0.0]})
+                                for k in range(300)) + "\n")
+    files = {"SHORT": str(_rest_csv(tmp_path / "s.csv", 100)), "REST": str(_rest_csv(tmp_path / "r.csv")),
+             "STREAM": str(stream)}
     args = [files.get(a, a) for a in args]
     with pytest.raises(SystemExit) if code == 2 and "--rate" in args else _nothing() as exc:
         rc = main(["allan", *args, "--out", str(tmp_path / "o")])

@@ -96,16 +96,6 @@ def implied_tilt(res: SimResult) -> tuple[float, float]:
 #: least this fraction of the samples after SETTLE
 NEES_BAND_P = 0.95
 NEES_INSIDE_MIN = 0.90
-#: settings that describe the simulated (calibrated) parts rather than BROAD's real ones: white
-#: aiding (no low-pass: acc_tau = 0, the reported inclination the state's: tilt_tau = 0), noise
-#: densities near the parts' own, no fast-turn term (the calibrated gyro has no scale error). The
-#: defaults are tuned for real data and claim 10-30x the simulated errors (median NEES 0.002).
-#: Chosen on a grid (gyr_noise 2e-4/3e-4, gyr_noise_rest 1.5e-4/2e-4, acc_noise 8e-4/1e-3,
-#: mag_noise 8e-4/1.2e-3) by the worst in-band fraction of the consistency runs (seeds 0-2); issue
-#: 32's Allan-variance mapping is the way to derive them from a rest recording.
-SENSOR_SETTINGS: dict[str, float] = {"gyr_noise": 3e-4, "gyr_noise_rest": 2e-4, "bias_noise": 1e-5,
-                                     "acc_noise": 8e-4, "mag_noise": 8e-4, "acc_tau": 0.0, "tilt_tau": 0.0,
-                                     "turn_sigma": 0.0}
 
 
 def nees_inside(res: SimResult) -> float:

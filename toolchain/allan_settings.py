@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from attitude_c.noise import AllanResult, allan, filter_settings
+from attitude_c.noise import AllanResult, allan, filter_settings, horizontal_field
 from attitude_c.sim import acquire, make_trajectory
 
 from .ahrs_acceptance import (
@@ -40,12 +40,6 @@ def rest_recording(duration: float, seed: int = 0, calibrated: bool = False
     dec = acq.decoded
     assert dec is not None
     return dec.increments / cfg.period, np.asarray(dec.aux["accel"]), 1.0 / cfg.period, np.asarray(dec.aux["mag"])
-
-
-def horizontal_field(acc: np.ndarray, mag: np.ndarray) -> float:
-    """|m_h| at rest: the mean field's part across the mean specific force (up)."""
-    up = acc.mean(axis=0) / np.linalg.norm(acc.mean(axis=0))
-    return float(np.linalg.norm(np.cross(mag.mean(axis=0), up)))
 
 
 def calibrated_settings(duration: float = 600.0, seed: int = 11

@@ -17,6 +17,11 @@ tau = 1 s), the bias instability B (the flat floor is 0.664 B) and the bias
 random walk K (slope +1/2, read at tau = 3 s), each with its 1-sigma.
 From them the filter's settings (gyr_noise_rest, gyr_noise, bias_noise,
 rest_noise, acc_noise: docs/noise.md says which term sets which and why).
+With --calibrated (parts whose only error in motion is their noise: scale
+and misalignment calibrated out, as on a turntable) the settings carry no
+allowance for model error, and a magnetometer in the file (mx my mz; a
+BROAD trial's) gives mag_noise: the reported covariance is then the one to
+pass on (docs/noise.md, "Parts whose only error is their noise").
 
 Output (--out DIR): allan.json (the deviations, the terms, the settings) and
 allan.png (log-log, with the fitted lines); --write-config FILE writes the
@@ -40,7 +45,10 @@ from .options import positive
 
 PROG = "attitude allan"
 #: Units of the terms, per sensor: (white noise N, bias instability B, random walk K).
-UNITS = {"gyro": ("rad/√s", "rad/s", "rad/s/√s"), "accel": ("m/s²·√s", "m/s²", "m/s²/√s")}
+UNITS = {"gyro": ("rad/√s", "rad/s", "rad/s/√s"), "accel": ("m/s²·√s", "m/s²", "m/s²/√s"),
+         "mag": ("µT·√s", "µT", "µT/√s")}
+#: The deviation's unit, per sensor (the plot's axes).
+RATE_UNITS = {"gyro": "rad/s", "accel": "m/s²", "mag": "µT"}
 
 
 def register(sub: Any) -> None:
@@ -55,6 +63,9 @@ def register(sub: Any) -> None:
     add_csv_options(p, "t gx gy gz ax ay az")
     p.add_argument("--gravity", type=positive("--gravity"), default=None,
                    help="local gravity, m/s² (acc_noise = N/gravity; default the filter's 9.81)")
+    p.add_argument("--calibrated", action="store_true",
+                   help="parts whose only error in motion is their noise (turntable-calibrated): no model-error "
+                        "floors, mag_noise from the magnetometer (mx my mz) when the file has one")
     p.add_argument("--write-config", metavar="FILE", default=None,
                    help="write the filter settings into this attitude-rx config file (other lines kept)")
     p.add_argument("--no-plots", action="store_true", help="do not write allan.png")
@@ -92,18 +103,20 @@ def _is_stream(path: Path) -> bool:
 
 
 def _read(path: Path, args: argparse.Namespace) -> tuple[dict[str, np.ndarray], float]:
-    """The sensors' samples ({"gyro": (N, 3) rad/s, "accel": (N, 3) m/s²}) and their rate (Hz)."""
+    """The sensors' samples ({"gyro": (N, 3) rad/s, "accel": (N, 3) m/s², "mag": (N, 3) µT where
+    the file has one}) and their rate (Hz)."""
     if path.suffix.lower() == ".mat":
         from .. import broad
 
         tr = broad.load_trial(path)
-        return {"gyro": tr.gyr, "accel": tr.acc}, float(tr.rate)
+        return {"gyro": tr.gyr, "accel": tr.acc, "mag": tr.mag}, float(tr.rate)
     if _is_stream(path):
         return _read_stream(path)
     from ..recording import read_csv
 
     rec = read_csv(path, rate=args.rate, **_csv_options(args))
-    return {"gyro": rec.gyr, "accel": rec.acc}, float(rec.rate)
+    out = {"gyro": rec.gyr, "accel": rec.acc}
+    return (out if rec.mag is None else out | {"mag": rec.mag}), float(rec.rate)
 
 
 def _read_stream(path: Path) -> tuple[dict[str, np.ndarray], float]:
@@ -123,24 +136,25 @@ def _read_stream(path: Path) -> tuple[dict[str, np.ndarray], float]:
 
 
 def _main(args: argparse.Namespace) -> int:
-    from ..noise import allan, config_text, filter_settings
+    from ..noise import allan, config_text
 
     path = Path(args.file)
     if not path.is_file():
         raise FileNotFoundError(2, "no such file", str(path))
     out = check_output_dir(Path(args.out) if args.out else Path("results") / f"allan-{path.stem}")
     data, rate = _read(path, args)
+    if args.calibrated and "accel" not in data:
+        raise _Usage(f"{path}: --calibrated needs the accelerometer (ax ay az): the stream carries the gyro only")
     _warn_motion(data["gyro"])
     res = {name: allan(x, rate) for name, x in data.items()}
-    settings = filter_settings(res["gyro"], res.get("accel"), args.gravity)
+    settings = _settings(res, data, args)
     summary: dict[str, Any] = {"file": str(path), "samples": len(data["gyro"]), "rate_hz": rate, "hours": len(data["gyro"]) / rate / 3600,
                "units": {k: dict(zip("NBK", UNITS[k])) for k in res}, "settings": settings,
                "sensors": {k: r.as_dict() for k, r in res.items()}, "out": str(out), "files": ["allan.json"]}
     if not args.no_plots:
         from ..noise import plot
 
-        units = {"gyro": "rad/s", "accel": "m/s²"}
-        write_with(out / "allan.png", lambda tmp: plot({k: (r, units[k]) for k, r in res.items()}, tmp,
+        write_with(out / "allan.png", lambda tmp: plot({k: (r, RATE_UNITS[k]) for k, r in res.items()}, tmp,
                                                        f"{path.name}: Allan deviation, {summary['hours']:.2g} h at rest"))
         summary["files"].append("allan.png")
     write_text(out / "allan.json", json.dumps(summary, indent=1) + "\n")
@@ -148,6 +162,18 @@ def _main(args: argparse.Namespace) -> int:
         _write_config(Path(args.write_config), config_text(settings, path.name))
     _print(summary, res, args)
     return EXIT_OK
+
+
+def _settings(res: dict[str, Any], data: dict[str, np.ndarray], args: argparse.Namespace) -> dict[str, float]:
+    """MAPPING, or with --calibrated MAPPING_CALIBRATED (mag_noise where there is a magnetometer,
+    across the horizontal field of the recording's mean)."""
+    from ..noise import filter_settings, horizontal_field
+
+    if not args.calibrated:
+        return filter_settings(res["gyro"], res.get("accel"), args.gravity)
+    mag_h = horizontal_field(data["accel"], data["mag"]) if "mag" in data else None
+    return filter_settings(res["gyro"], res["accel"], args.gravity, calibrated=True, mag=res.get("mag"),
+                           mag_h=mag_h)
 
 
 def _warn_motion(gyr: np.ndarray) -> None:

@@ -383,7 +383,12 @@ class ReferenceAhrs:
                 if use:
                     yh = math.atan2(mn[0], mn[1]) - s["declination"]
                     yh = (yh + math.pi) % (2 * math.pi) - math.pi
-                    self._scalar(x, 2, yh, R, (2, 3, 4, 5))
+                    # the field's heading in the estimate's frame: an error δθ turns the field
+                    # by −δθ × m, whose horizontal part across the field is h·(δθz + tan(dip)·δθ·u)
+                    # with u the horizontal field's direction (magnetic north)
+                    u = np.array([mn[0], mn[1], 0.0]) / h
+                    row = np.concatenate([math.tan(float(cur[1])) * u + np.array([0.0, 0.0, 1.0]), np.zeros(3)])
+                    self._row(x, row, yh, R, (2, 3, 4, 5))
                     self.heading_measured = True
         if rest:
             flags |= 2

@@ -381,14 +381,40 @@ static void update_acc(att_real P[NX][NX], att_real x[NX], int j, att_real y, at
     scalar_update(P, x, j, y, R, MASK_ACC);
 }
 
-static void update_mag(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
-{
-    scalar_update(P, x, j, y, R, MASK_MAG);
-}
-
 static void update_bias(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R)
 {
     scalar_update(P, x, j, y, R, MASK_BIAS);
+}
+
+/* A scalar measurement y = h·x with variance R, moving the states in mask (the
+ * general-row form of scalar_update: ph = P hᵀ, S = h ph + R, K = ph/S masked,
+ * Joseph form P ← P − K phᵀ − ph Kᵀ + K Kᵀ S). */
+static void dense_update(att_real (*P)[NX], att_real x[NX], const att_real h[NX], att_real y, att_real R,
+                         unsigned mask)
+{
+    att_real ph[NX], K[NX], S = R, innov = y, v;
+    int r, c;
+    for (r = 0; r < NX; r++) {
+        ph[r] = 0;
+        for (c = 0; c < NX; c++) {
+            ph[r] += P[r][c] * h[c];
+        }
+    }
+    for (r = 0; r < NX; r++) {
+        S += h[r] * ph[r];
+        innov -= h[r] * x[r];
+    }
+    for (r = 0; r < NX; r++) {
+        K[r] = (mask & (1u << r)) ? ph[r] / S : 0;
+        x[r] += K[r] * innov;
+    }
+    for (r = 0; r < NX; r++) {
+        for (c = r; c < NX; c++) {
+            v = P[r][c] - K[r] * ph[c] - ph[r] * K[c] + K[r] * K[c] * S;
+            P[r][c] = v;
+            P[c][r] = v;
+        }
+    }
 }
 
 /* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
@@ -944,7 +970,13 @@ static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9],
     w = dt * k->v_dip / (k->v_dip + s->P[0][0] + s->P[1][1]);
     mag_candidate(s, gyr, nm, dip, w, dt);
     if (mag_accept(s, k, nm, dip, w, dt, flags, &r)) {
-        update_mag(s->P, x, 2, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r);
+        /* the heading of m_n measures δθz + tan(dip) (δθ·u), u = (m_x, m_y)/h the horizontal
+         * field's direction: an inclination error about magnetic north turns the field's
+         * horizontal part (docs/ahrs.md, "Magnetometer"); the gain still moves δθz and δb only */
+        att_real row[NX] = {0, 0, 1, 0, 0, 0};
+        row[0] = -m[2] * m[0] / (h * h);
+        row[1] = -m[2] * m[1] / (h * h);
+        dense_update(s->P, x, row, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r, MASK_MAG);
     }
 }
 
@@ -1213,37 +1245,6 @@ static int gnss_rows(const att_real dsv[3], const att_real dv[3], att_real dT, a
         }
     }
     return n;
-}
-
-/* A scalar measurement y = h·x with variance R, moving the states in mask (the
- * general-row form of scalar_update: ph = P hᵀ, S = h ph + R, K = ph/S masked,
- * Joseph form P ← P − K phᵀ − ph Kᵀ + K Kᵀ S). */
-static void dense_update(att_real P[NX][NX], att_real x[NX], const att_real h[NX], att_real y, att_real R,
-                         unsigned mask)
-{
-    att_real ph[NX], K[NX], S = R, innov = y, v;
-    int r, c;
-    for (r = 0; r < NX; r++) {
-        ph[r] = 0;
-        for (c = 0; c < NX; c++) {
-            ph[r] += P[r][c] * h[c];
-        }
-    }
-    for (r = 0; r < NX; r++) {
-        S += h[r] * ph[r];
-        innov -= h[r] * x[r];
-    }
-    for (r = 0; r < NX; r++) {
-        K[r] = (mask & (1u << r)) ? ph[r] / S : 0;
-        x[r] += K[r] * innov;
-    }
-    for (r = 0; r < NX; r++) {
-        for (c = r; c < NX; c++) {
-            v = P[r][c] - K[r] * ph[c] - ph[r] * K[c] + K[r] * K[c] * S;
-            P[r][c] = v;
-            P[c][r] = v;
-        }
-    }
 }
 
 /* The gate: 1 when a row's innovation exceeds gnss_gate standard deviations of
