@@ -97,9 +97,10 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--nees", action="store_true",
                    help="the consistency motions (seeds 0-2) with the settings for the calibrated parts "
                         "(10 min at rest, seed 11)")
+    p.add_argument("--seeds", default="0,1,2", help="--nees: the motions' seeds (comma-separated; the test's 0,1,2)")
     a = p.parse_args(argv)
     if a.nees:
-        return consistency(SHORT if a.short else FULL)
+        return consistency(SHORT if a.short else FULL, tuple(int(x) for x in a.seeds.split(",") if x))
     settings, g, acc = derived(a.hours * 3600.0)
     print_terms({"gyro (rad/s)": g, "accel (m/s²)": acc})
     print("settings: " + ", ".join(f"{k} {v:.4g}" for k, v in settings.items()))

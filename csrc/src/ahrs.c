@@ -973,7 +973,7 @@ static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9],
         /* the heading of m_n measures δθz + tan(dip) (δθ·u), u = (m_x, m_y)/h the horizontal
          * field's direction: an inclination error about magnetic north turns the field's
          * horizontal part (docs/ahrs.md, "Magnetometer"); the gain still moves δθz and δb only */
-        att_real row[NX] = {0, 0, 1, 0, 0, 0};
+        att_real row[NX] = { 0, 0, 1, 0, 0, 0 };
         row[0] = -m[2] * m[0] / (h * h);
         row[1] = -m[2] * m[1] / (h * h);
         dense_update(s->P, x, row, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r, MASK_MAG);

@@ -54,11 +54,16 @@ def sim_acceptance(c, short=False, seed=0, only="", setting="", json=""):
         c.run(" ".join(shlex.quote(x) for x in cmd), pty=sys.stdout.isatty())
 
 
-@task(help={"short": "the acceptance scenarios' shortened runs", "hours": "length of the rest recording (h)"})
-def allan_settings(c, short=False, hours=2.0):
+@task(help={"short": "the acceptance scenarios' shortened runs", "hours": "length of the rest recording (h)",
+            "nees": "instead: the consistency motions with the settings for calibrated parts (10 min at rest)",
+            "seeds": "with --nees: the motions' seeds, comma-separated (default 0,1,2: the test's)"})
+def allan_settings(c, short=False, hours=2.0, nees=False, seeds="0,1,2"):
     """Filter settings from a simulated rest recording's Allan terms, and the acceptance tests with them
-    beside the defaults (docs/noise.md); exit 1 if a target is missed with the derived settings."""
+    beside the defaults (docs/noise.md); exit 1 if a target is missed with the derived settings. With
+    --nees: the NEES in-band fractions of the consistency motions (exit 1 below 90 %)."""
     cmd = [sys.executable, "-m", "toolchain.allan_settings", "--hours", str(float(hours))]
+    if nees:
+        cmd += ["--nees", "--seeds", str(seeds)]
     if short:
         cmd.append("--short")
     with c.cd(str(ROOT)):
