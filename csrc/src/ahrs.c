@@ -1277,6 +1277,26 @@ static int gnss_jump(const att_ahrs_settings *set, const att_real dv[3], att_rea
     return set->gnss_max_acc > 0 && dv[0] * dv[0] + dv[1] * dv[1] > a * a;
 }
 
+/* (Re)starting the aiding: since the last velocity the accelerometer alone held the
+ * inclination, and in a turn or under braking it tilts the state by errors P does not hold
+ * (a centripetal acceleration read as gravity), nor their relation to the heading and the
+ * bias. The inclination starts again from what the velocities say: its variance grows by
+ * init_att_sigma² and its covariances with the other states are dropped (block diagonal:
+ * positive semi-definite as P was). */
+static void gnss_restart(att_ahrs *s)
+{
+    int i, j;
+    for (i = 0; i < 2; i++) {
+        for (j = 0; j < NX; j++) {
+            if (j != i) {
+                s->P[i][j] = 0;
+                s->P[j][i] = 0;
+            }
+        }
+        s->P[i][i] += s->set.init_att_sigma * s->set.init_att_sigma;
+    }
+}
+
 /* The comparison with the anchor: checks, the Kalman update, the new anchor. */
 static att_status gnss_compare(att_ahrs *s, const att_ahrs_vel *v, const att_real sv_t[3], att_real var)
 {
@@ -1297,15 +1317,13 @@ static att_status gnss_compare(att_ahrs *s, const att_ahrs_vel *v, const att_rea
         return ATT_OK;
     }
     copy_mutable(&save, s);
-    if (gnss_gated(s, rows, n)) {
-        if (gnss_aided_at(s, g->time)) {
+    if (gnss_aided_at(s, g->time)) {
+        if (gnss_gated(s, rows, n)) {
             g->rejected = 1;
             return ATT_OK;
         }
-        /* (re)starting the aiding (after an outage the accelerometer may have tilted the
-         * state in a turn): the inclination's variance grows by init_att_sigma² instead */
-        s->P[0][0] += s->set.init_att_sigma * s->set.init_att_sigma;
-        s->P[1][1] += s->set.init_att_sigma * s->set.init_att_sigma;
+    } else {
+        gnss_restart(s);
     }
     for (i = 0; i < n; i++) {
         dense_update(s->P, x, rows[i].h, rows[i].y, rows[i].r, heading ? 0x3Fu : 0x3Bu);
