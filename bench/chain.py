@@ -61,10 +61,12 @@ def _recording(tr: Any, quick: bool) -> tuple[Any, dict[str, Any]]:
     return rec, out
 
 
-def _run_file(rec: Any, name: str, build: str, image: Any) -> Path:
-    """Where a run is kept: named by what decides the firmware's bytes on the link (its image and
-    the codes it serves) and the build; attitude-rx's side is checked again at every table (max diff)."""
+def _run_file(rec: Any, name: str, build: str, image: Any, app: Path) -> Path:
+    """Where a run is kept: named by what decides it — the firmware's image, the codes it serves
+    and attitude-rx's executable (a library change makes a new one, so the run is made again);
+    the table also recomputes max diff against the library of the moment."""
     h = hashlib.sha256(image.ihx.read_bytes())
+    h.update(app.read_bytes())
     for k in ("gyro", "acc", "mag"):
         h.update(np.ascontiguousarray(rec.codes[k], dtype=np.int64).tobytes())
     return RUNS / f"{name}-{build}-{h.hexdigest()[:16]}.npz"
@@ -83,7 +85,7 @@ def _chain_run(rec: Any, name: str, build: str, cmd: list[str], build_dir: Path)
     from toolchain import aided_chain as ac
 
     img = ac.chain_image(rec, build_dir / f"{name}_{build}")
-    path = _run_file(rec, name, build, img)
+    path = _run_file(rec, name, build, img, Path(cmd[-1]))
     if path.exists():
         with np.load(path) as z:
             print(f"   chain: {name} ({build}): kept from the run at {z['commit']}", flush=True)
@@ -163,8 +165,8 @@ LEGEND = ("BROAD total error (RMS over the movement phase, deg) of: the chain (a
           "once in order, no loss report, no duplicate (records attitude-rx received, BOOT and CHANNELS "
           "included; link v2 frames, each answered before s51 ran on). *sim / wall*: seconds of simulated "
           "time and of wall time the s51 run took. *run at*: the commit the s51 run was made at (a run is kept in "
-          "build/bench_chain/runs, named by the firmware image's and the codes' hash, and reused by a later "
-          "invocation; *max diff* is computed again at every table against the library of the table's commit).")
+          "build/bench_chain/runs, named by the hash of the firmware image, the codes and attitude-rx's executable, "
+          "and reused by a later invocation; *max diff* is computed again at every table against the library of the table's commit).")
 
 
 def _summary(rows: list[dict[str, Any]]) -> list[str]:
