@@ -484,11 +484,15 @@ class ReferenceAhrs:
         else:
             # (re)starting the aiding: the inclination was the accelerometer's alone, tilted by
             # whatever it read as gravity; P describes neither that error nor its relation to the
-            # other states: the inclination's block starts again, wider and uncorrelated
+            # other states: the inclination is uncorrelated again, and wider where the velocities
+            # can tell both its axes (heading known: the full vectors are compared) or disagree
+            gated = s["gnss_gate"] > 0 and any(y * y > s["gnss_gate"] ** 2 * (h @ self.P @ h + R) for h, y in rows)
             keep = np.ones((6, 6), bool)
             keep[:2, :] = keep[:, :2] = False
             keep[0, 0] = keep[1, 1] = True
-            self.P = np.where(keep, self.P, 0.0) + np.diag([1.0, 1.0, 0, 0, 0, 0]) * s["init_att_sigma"] ** 2
+            self.P = np.where(keep, self.P, 0.0)
+            if heading or gated:
+                self.P = self.P + np.diag([1.0, 1.0, 0, 0, 0, 0]) * s["init_att_sigma"] ** 2
         x = np.zeros(6)
         states = (0, 1, 2, 3, 4, 5) if heading else (0, 1, 3, 4, 5)
         for h, y in rows:

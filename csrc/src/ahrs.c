@@ -1280,10 +1280,10 @@ static int gnss_jump(const att_ahrs_settings *set, const att_real dv[3], att_rea
 /* (Re)starting the aiding: since the last velocity the accelerometer alone held the
  * inclination, and in a turn or under braking it tilts the state by errors P does not hold
  * (a centripetal acceleration read as gravity), nor their relation to the heading and the
- * bias. The inclination starts again from what the velocities say: its variance grows by
- * init_att_sigma² and its covariances with the other states are dropped (block diagonal:
- * positive semi-definite as P was). */
-static void gnss_restart(att_ahrs *s)
+ * bias. The inclination's covariances with the other states are dropped (block diagonal:
+ * positive semi-definite as P was), and with grow its variance grows by init_att_sigma², so
+ * that it starts again from what the velocities say. */
+static void gnss_restart(att_ahrs *s, int grow)
 {
     int i, j;
     for (i = 0; i < 2; i++) {
@@ -1293,7 +1293,9 @@ static void gnss_restart(att_ahrs *s)
                 s->P[j][i] = 0;
             }
         }
-        s->P[i][i] += s->set.init_att_sigma * s->set.init_att_sigma;
+        if (grow) {
+            s->P[i][i] += s->set.init_att_sigma * s->set.init_att_sigma;
+        }
     }
 }
 
@@ -1322,8 +1324,8 @@ static att_status gnss_compare(att_ahrs *s, const att_ahrs_vel *v, const att_rea
             g->rejected = 1;
             return ATT_OK;
         }
-    } else {
-        gnss_restart(s);
+    } else { /* widened when the velocities see both tilt axes (heading known) or disagree */
+        gnss_restart(s, heading || gnss_gated(s, rows, n));
     }
     for (i = 0; i < n; i++) {
         dense_update(s->P, x, rows[i].h, rows[i].y, rows[i].r, heading ? 0x3Fu : 0x3Bu);

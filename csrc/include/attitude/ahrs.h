@@ -216,8 +216,9 @@ typedef struct {
     att_real gnss_gate;        /* [1] ≥ 0: innovation gate in standard deviations (each
                                  component against H P Hᵀ + R), 5 (0 = off); not applied
                                  when the aiding (re)starts (not aided): the inclination's
-                                 variance grows by init_att_sigma² and its covariances with
-                                 the other states are dropped instead */
+                                 covariances with the other states are dropped and its
+                                 variance grows by init_att_sigma² (with a heading, or when
+                                 the gate would refuse) instead */
     att_real gnss_window;      /* [s] ≥ 0: the shortest interval two velocities are compared
                                  over (a velocity closer to the previous one used is skipped,
                                  unflagged): the velocity noise's share of the measured angle
