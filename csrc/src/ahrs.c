@@ -319,12 +319,12 @@ static att_real wrap_pi(att_real a)
     return a;
 }
 
-/* A scalar measurement y of the error state x[j] (H = e_j) with variance R,
- * moving only the states in mask (bit i: state i):
- *     S = P_jj + R,   K_i = P_ij / S (i in the mask, else 0),   x ← x + K (y − x_j),
- *     P ← P − K P_jᵀ − P_j Kᵀ + K Kᵀ S   (P_j = column j; Joseph form, valid for any K).
+/* A scalar measurement y = h·x with variance R, moving only the states in mask
+ * (bit i: state i), from ph = P hᵀ, S = h ph + R and the innovation y − h·x:
+ *     K_i = ph_i / S (i in the mask, else 0),   x ← x + K (y − h·x),
+ *     P ← P − K phᵀ − ph Kᵀ + K Kᵀ S   (Joseph form, valid for any K).
  * Where one of the two states is outside the mask its gain is 0 and the entry
- * reduces exactly to P_rc − K_r P_jc (or − P_jr K_c); where both are, it is
+ * reduces exactly to P_rc − K_r ph_c (or − ph_r K_c); where both are, it is
  * unchanged. P is symmetric: the upper triangle is computed and mirrored.
  * gcc and clang unroll the loops and inline the function into each mask's
  * wrapper below, where the constant mask folds the tests away: straight-line
@@ -336,17 +336,16 @@ static att_real wrap_pi(att_real a)
 #define UNROLLED_INLINE inline
 #endif
 
-static UNROLLED_INLINE void scalar_update(att_real P[NX][NX], att_real x[NX], int j, att_real y, att_real R,
-                                          unsigned mask)
+static UNROLLED_INLINE void masked_update(att_real (*P)[NX], att_real x[NX], const att_real ph[NX],
+                                          att_real S, att_real innov, unsigned mask)
 {
-    att_real pj[NX], K[NX], S = P[j][j] + R, innov = y - x[j], v;
+    att_real K[NX], v;
     int r, c;
 #pragma GCC unroll 6
     for (r = 0; r < NX; r++) {
-        pj[r] = P[r][j];
         K[r] = 0;
         if (mask & (1u << r)) {
-            K[r] = pj[r] / S;
+            K[r] = ph[r] / S;
             x[r] += K[r] * innov;
         }
     }
@@ -356,11 +355,11 @@ static UNROLLED_INLINE void scalar_update(att_real P[NX][NX], att_real x[NX], in
         for (c = r; c < NX; c++) {
             int in_r = (mask >> r) & 1u, in_c = (mask >> c) & 1u;
             if (in_r && in_c) {
-                v = P[r][c] - K[r] * pj[c] - pj[r] * K[c] + K[r] * K[c] * S;
+                v = P[r][c] - K[r] * ph[c] - ph[r] * K[c] + K[r] * K[c] * S;
             } else if (in_r) {
-                v = P[r][c] - K[r] * pj[c];
+                v = P[r][c] - K[r] * ph[c];
             } else if (in_c) {
-                v = P[r][c] - pj[r] * K[c];
+                v = P[r][c] - ph[r] * K[c];
             } else {
                 continue;
             }
@@ -368,6 +367,36 @@ static UNROLLED_INLINE void scalar_update(att_real P[NX][NX], att_real x[NX], in
             P[c][r] = v;
         }
     }
+}
+
+/* h = e_j: ph = column j, S = P_jj + R. */
+static UNROLLED_INLINE void scalar_update(att_real (*P)[NX], att_real x[NX], int j, att_real y, att_real R,
+                                          unsigned mask)
+{
+    att_real pj[NX];
+    int r;
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+        pj[r] = P[r][j];
+    }
+    masked_update(P, x, pj, P[j][j] + R, y - x[j], mask);
+}
+
+/* h = (a₀, a₁, a₂, 0, 0, 0), a row on the attitude states only (the heading's). */
+static UNROLLED_INLINE void attitude_row_update(att_real (*P)[NX], att_real x[NX], const att_real a[3],
+                                                att_real y, att_real R, unsigned mask)
+{
+    att_real ph[NX], S = R, innov = y;
+    int r;
+#pragma GCC unroll 6
+    for (r = 0; r < NX; r++) {
+        ph[r] = P[r][0] * a[0] + P[r][1] * a[1] + P[r][2] * a[2];
+    }
+    for (r = 0; r < 3; r++) {
+        S += a[r] * ph[r];
+        innov -= a[r] * x[r];
+    }
+    masked_update(P, x, ph, S, innov, mask);
 }
 
 /* The masks: the accelerometer never moves the heading (state 2), the
@@ -386,13 +415,16 @@ static void update_bias(att_real P[NX][NX], att_real x[NX], int j, att_real y, a
     scalar_update(P, x, j, y, R, MASK_BIAS);
 }
 
-/* A scalar measurement y = h·x with variance R, moving the states in mask (the
- * general-row form of scalar_update: ph = P hᵀ, S = h ph + R, K = ph/S masked,
- * Joseph form P ← P − K phᵀ − ph Kᵀ + K Kᵀ S). */
+static void update_mag(att_real P[NX][NX], att_real x[NX], const att_real a[3], att_real y, att_real R)
+{
+    attitude_row_update(P, x, a, y, R, MASK_MAG);
+}
+
+/* A general row h (the GNSS rows'): ph = P hᵀ, S = h ph + R. */
 static void dense_update(att_real (*P)[NX], att_real x[NX], const att_real h[NX], att_real y, att_real R,
                          unsigned mask)
 {
-    att_real ph[NX], K[NX], S = R, innov = y, v;
+    att_real ph[NX], S = R, innov = y;
     int r, c;
     for (r = 0; r < NX; r++) {
         ph[r] = 0;
@@ -404,17 +436,7 @@ static void dense_update(att_real (*P)[NX], att_real x[NX], const att_real h[NX]
         S += h[r] * ph[r];
         innov -= h[r] * x[r];
     }
-    for (r = 0; r < NX; r++) {
-        K[r] = (mask & (1u << r)) ? ph[r] / S : 0;
-        x[r] += K[r] * innov;
-    }
-    for (r = 0; r < NX; r++) {
-        for (c = r; c < NX; c++) {
-            v = P[r][c] - K[r] * ph[c] - ph[r] * K[c] + K[r] * K[c] * S;
-            P[r][c] = v;
-            P[c][r] = v;
-        }
-    }
+    masked_update(P, x, ph, S, innov, mask);
 }
 
 /* P ← F P F' + Q with F = [[I, −C dt], [0, I]] (blocks A = Pθθ, B = Pθb,
@@ -973,10 +995,10 @@ static void mag_update(att_ahrs *s, const att_ahrs_step *k, const att_real C[9],
         /* the heading of m_n measures δθz + tan(dip) (δθ·u), u = (m_x, m_y)/h the horizontal
          * field's direction: an inclination error about magnetic north turns the field's
          * horizontal part (docs/ahrs.md, "Magnetometer"); the gain still moves δθz and δb only */
-        att_real row[NX] = { 0, 0, 1, 0, 0, 0 };
+        att_real row[3] = { 0, 0, 1 };
         row[0] = -m[2] * m[0] / (h * h);
         row[1] = -m[2] * m[1] / (h * h);
-        dense_update(s->P, x, row, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r, MASK_MAG);
+        update_mag(s->P, x, row, wrap_pi(att_atan2(m[0], m[1]) - s->set.declination), r);
     }
 }
 
