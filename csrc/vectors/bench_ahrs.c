@@ -38,12 +38,12 @@ typedef att_ahrs bench_filter;
 
 #define TABLE 256
 
-static att_real mag[TABLE][3];
+static att_real mag[TABLE][3], gyr[TABLE][3], acc[TABLE][3];
 
 int main(int argc, char **argv)
 {
     bench_filter s;
-    att_real q[4], acc[3] = { 0.0f, 0.0f, 9.81f }, gyr[3] = { 0.0f, 0.0f, 0.0f };
+    att_real q[4];
     att_real dt = (att_real)(1.0 / 200.0);
     unsigned long n, i;
     double w = 2.0 * 3.14159265358979 / (TABLE * (1.0 / 200.0));
@@ -51,12 +51,19 @@ int main(int argc, char **argv)
         return 2;
     }
     n = strtoul(argv[1], NULL, 10);
-    gyr[2] = (att_real)w;
     for (i = 0; i < TABLE; i++) { /* m_b = R_z(−ψ) m_n, m_n = (0, 20, −40) µT */
-        double psi = w * (double)i / 200.0;
-        mag[i][0] = (att_real)(20.0 * sin(psi));
-        mag[i][1] = (att_real)(20.0 * cos(psi));
-        mag[i][2] = (att_real)-40.0;
+        double psi = w * (double)i / 200.0, k = (double)i;
+        mag[i][0] = (att_real)(20.0 * sin(psi) + 0.3 * sin(1.7 * k));
+        mag[i][1] = (att_real)(20.0 * cos(psi) + 0.3 * sin(2.3 * k));
+        mag[i][2] = (att_real)(-40.0 + 0.3 * sin(3.1 * k));
+        /* sensor-like noise on every axis (none of the inputs exactly 0: soft-float's
+         * fast paths for zero operands would flatter the count) */
+        gyr[i][0] = (att_real)(0.002 * sin(1.3 * k));
+        gyr[i][1] = (att_real)(0.002 * sin(2.9 * k));
+        gyr[i][2] = (att_real)(w + 0.002 * sin(3.7 * k));
+        acc[i][0] = (att_real)(0.03 * sin(1.1 * k));
+        acc[i][1] = (att_real)(0.03 * sin(2.7 * k));
+        acc[i][2] = (att_real)(9.81 + 0.03 * sin(3.3 * k));
     }
 #ifdef BENCH_AHRS_DELAYS
     {
@@ -74,7 +81,7 @@ int main(int argc, char **argv)
     }
 #endif
     for (i = 0; i < n; i++) {
-        if (BENCH_UPDATE(&s, gyr, acc, mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
+        if (BENCH_UPDATE(&s, gyr[i & (TABLE - 1)], acc[i & (TABLE - 1)], mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
             return 4;
         }
     }
