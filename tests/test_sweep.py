@@ -10,6 +10,7 @@ against the same serial reference.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -18,6 +19,7 @@ import subprocess
 import sys
 import threading
 import time
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +127,73 @@ def scheduler(tmp_path_factory):
             except ProcessLookupError:
                 pass
         log.close()
+
+
+#: The run the tests below hold in flight (:func:`_holding`): one that finishes without error.
+HELD = {"case": "full", "method": "rv3", "seed": 1}
+
+
+class _Held:
+    """A run of a sweep held in flight on the loopback cluster (:func:`_holding`)."""
+
+    def __init__(self, client, tag: str) -> None:
+        from distributed import Event, Queue
+
+        self._started = Queue(f"started-{tag}", client=client)
+        self._release = Event(f"release-{tag}", client=client)
+
+    def started(self) -> int:
+        """Wait until a worker is running the held run; its worker process's pid."""
+        return int(self._started.get(timeout=120))  # a failure guard: the run is waited for, not a time
+
+    def release(self) -> None:
+        """Let the held run (and every later attempt at it) go on."""
+        self._release.set()
+
+
+@contextlib.contextmanager
+def _holding(client, **match):
+    """Inside: the run whose parameters include ``match`` waits, on whichever worker of
+    the loopback cluster runs it, until ``release()``; each attempt at it first puts its
+    worker process's pid on the ``started`` queue. A test then acts while that run is in
+    flight (kills its worker, or the client) instead of at a moment it hopes to catch.
+
+    Installed on every worker with ``Client.run`` (functions defined here so that they
+    pickle by value: the workers cannot import this module): ``sweeps._run_simulate``,
+    which ``run_chunk`` looks up at each run, is wrapped; released and removed on exit
+    (a worker its nanny restarted starts without it)."""
+    tag = uuid.uuid4().hex
+
+    def install(tag: str, match: dict) -> None:
+        import os
+
+        from distributed import Event, Queue
+
+        from attitude_c.sim import sweeps as sw
+
+        run = sw._run_simulate
+
+        def held(params):
+            if all(params.get(k) == v for k, v in match.items()):
+                Queue(f"started-{tag}").put(os.getpid())
+                Event(f"release-{tag}").wait()
+            return run(params)
+
+        held.unheld = run
+        sw._run_simulate = held
+
+    def remove() -> None:
+        from attitude_c.sim import sweeps as sw
+
+        sw._run_simulate = getattr(sw._run_simulate, "unheld", sw._run_simulate)
+
+    hold = _Held(client, tag)
+    client.run(install, tag, match)
+    try:
+        yield hold
+    finally:
+        hold.release()  # a held run left waiting would keep its worker's only thread
+        client.run(remove)
 
 
 # ---------------------------------------------------------------------------
@@ -420,8 +489,8 @@ def test_local_cluster_of_2_processes_gives_the_same_table(reference, tmp_path):
 def test_external_scheduler_gives_the_same_table(reference, scheduler, tmp_path, capsys):
     spec, ref = reference
     rc = main(["sweep", str(spec), "--scheduler", scheduler, "--out", str(tmp_path / "out"), "--no-plots"])
-    assert rc == 1  # finished, one run recorded as failed
-    assert "1 run(s) raised" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert rc == 1 and "1 run(s) raised" in err, err  # finished, one run recorded as failed; else all it said
     import pandas as pd
 
     df = pd.read_csv(tmp_path / "out" / "runs.csv", keep_default_na=False, na_values=[""])
@@ -433,25 +502,31 @@ def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tm
     from distributed import Client
 
     spec, ref = reference
-    killed: list[int] = []
+    result: dict = {}
+
+    def run() -> None:
+        try:
+            result["df"] = sweeps.sweep(spec, scheduler, out=tmp_path / "o", plots=False)
+        except BaseException as exc:  # noqa: BLE001 - raised again below, in the test's thread
+            result["exc"] = exc
+
     with Client(scheduler, timeout="30s") as watch:
-        result: dict = {}
-        t = threading.Thread(target=lambda: result.update(df=sweeps.sweep(spec, scheduler, out=tmp_path / "o",
-                                                                          plots=False)))
-        t.start()
-        deadline = time.monotonic() + 60
-        while not killed and time.monotonic() < deadline and t.is_alive():
-            busy = [w for w, ks in watch.processing().items() if ks]
-            if busy:
-                pid = watch.run(os.getpid, workers=[busy[0]])[busy[0]]
-                os.kill(pid, signal.SIGKILL)  # the worker process (its nanny restarts it)
-                killed.append(pid)
-            time.sleep(0.05)
-        t.join(120)
-        assert killed, "no worker was seen busy"
+        with _holding(watch, **HELD) as held:
+            t = threading.Thread(target=run)
+            t.start()
+            try:
+                pid = held.started()  # the run is in flight on that worker process, and stays so
+                os.kill(pid, signal.SIGKILL)  # the worker process, mid-run (its nanny restarts it)
+            finally:
+                held.release()  # the engine's retry of the lost run goes through
+                t.join()
         watch.wait_for_workers(2, timeout=60)  # the nanny brought it back
+    if "exc" in result:
+        raise result["exc"]
     df = result["df"]
-    _same(df, ref)  # the lost run was run again, elsewhere, to the same result
+    # the lost run was run again, elsewhere, to the same result: its first attempt could
+    # record nothing (killed while held), so its row is the retry's
+    _same(df, ref)
     assert df.attrs["failed"] == 1  # only the run that raises by design
 
 
@@ -462,25 +537,31 @@ def test_worker_killed_mid_run_is_retried_by_the_engine(reference, scheduler, tm
 @pytest.mark.system
 def test_interrupted_sweep_resumes_running_only_the_missing_runs(reference, scheduler, tmp_path):
     """The command is killed (SIGKILL: no clean-up at all) mid-sweep on the loopback
-    cluster, then run again serially: only the runs it has no record of run."""
+    cluster -- one run held in flight, so the sweep cannot be over, and at least one
+    recorded -- then run again serially: only the runs it has no record of run."""
+    from distributed import Client
+
     spec, ref = reference
     out = tmp_path / "out"
     journal = out / sweeps.JOURNAL
     env = {**os.environ, "MPLBACKEND": "Agg"}
-    p = subprocess.Popen([sys.executable, "-m", "attitude_c", "sweep", str(spec), "--scheduler", scheduler, "--out",
-                          str(out), "--no-plots", "--no-progress"], stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, env=env, start_new_session=True)
-    try:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and p.poll() is None:
-            if journal.exists() and journal.read_bytes().count(b"\n") >= 1:
-                break
-            time.sleep(0.02)
-        os.killpg(p.pid, signal.SIGKILL)  # the command, mid-sweep
-    finally:
-        p.wait(30)
-    done = journal.read_bytes().count(b"\n")
-    assert 1 <= done < len(ref), f"{done} runs recorded before the kill: the test needs some, not all"
+    with Client(scheduler, timeout="30s") as watch, _holding(watch, **HELD) as held:
+        p = subprocess.Popen([sys.executable, "-m", "attitude_c", "sweep", str(spec), "--scheduler", scheduler,
+                              "--out", str(out), "--no-plots", "--no-progress"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, env=env, start_new_session=True)
+        try:
+            held.started()  # the held run is in flight: the sweep cannot finish
+            deadline = time.monotonic() + 120  # a failure guard: the other runs do finish
+            while p.poll() is None and time.monotonic() < deadline and not (
+                    journal.exists() and journal.read_bytes().count(b"\n") >= 1):
+                time.sleep(0.02)
+        finally:
+            with contextlib.suppress(ProcessLookupError):  # gone already only if it failed
+                os.killpg(p.pid, signal.SIGKILL)  # the command, mid-sweep
+            p.wait()
+    done = journal.read_bytes().count(b"\n") if journal.exists() else 0
+    assert 1 <= done < len(ref), f"{done} runs recorded before the kill: the test needs some, not all; " \
+        f"{p.stderr.read().decode()}"
     with open(journal, "ab") as f:  # a line torn by the kill
         f.write(b'{"key": "abc", "params": {"dur')
     df = sweeps.sweep(spec, "serial", out=out, plots=False)
