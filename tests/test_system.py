@@ -116,8 +116,11 @@ def test_firmware_in_s51_to_attitude_rx_tracks_the_closed_form_motion(build_root
     else:
         # every record the firmware saw acknowledged reached attitude-rx, none twice; the
         # firmware stops at its BLOCKS-th acknowledgement, when ACKs for up to a ring of
-        # records (4) attitude-rx already took may still be on the way
-        assert stats["duplicates"] == 0 and stats["bad_frames"] == 0, stats
+        # records (4) attitude-rx already took may still be on the way. A frame the firmware
+        # sends again because a loaded host acknowledged it late is a duplicate attitude-rx
+        # acknowledges and drops (stats["duplicates"], 0 on an idle machine): never printed
+        # (a record taken twice would add its increment: the closed-form bound below would fail)
+        assert stats["bad_frames"] == 0, stats
         # (one ACK may cover several records: the count can pass BLOCKS)
         assert BLOCKS <= fw.stats["accepted"] <= stats["records"] <= fw.stats["accepted"] + 4, (fw.stats, stats)
     losses = {r["first"] + i: r["report"] for r in reports if "first" in r for i in range(r["count"])}

@@ -81,7 +81,8 @@ int main(int argc, char **argv)
     }
 #endif
     for (i = 0; i < n; i++) {
-        if (BENCH_UPDATE(&s, gyr[i & (TABLE - 1)], acc[i & (TABLE - 1)], mag[i & (TABLE - 1)], dt, q) != ATT_OK) {
+        if (BENCH_UPDATE(&s, gyr[i & (TABLE - 1)], acc[i & (TABLE - 1)], mag[i & (TABLE - 1)], dt, q)
+            != ATT_OK) {
             return 4;
         }
     }
