@@ -468,6 +468,32 @@ static void test_covariance_and_heading_flag(void)
     }
 }
 
+/* The heading's row: the field's heading in the estimate's frame measures δθz + tan(dip)·(δθ·u)
+ * (u magnetic north, docs/ahrs.md "Magnetometer"). One sample, the estimate tilted by ε about
+ * north with its heading right, the accelerometer trusted (gain ≈ 1): its innovation holds no
+ * heading error, so the heading is left (the row's residual is 6ε³ = 6e-6 rad for this field);
+ * without the tilt term (H = e_z) it would turn by ≈ tan(dip)·ε = 0.02 rad. The truth is the
+ * identity, so δθ = log(q_est*): δθ_y ≈ −2 q_y, δθ_z ≈ −2 q_z. */
+static void test_heading_row_tilt_about_north(void)
+{
+    att_ahrs s;
+    att_ahrs_settings set;
+    const double eps = 0.01;
+    att_real q0[4], q[4], w[3] = { 0, 0, 0 }, f[3] = { 0, 0, (att_real)G }, m[3] = { 0, 20, -40 };
+    q0[0] = (att_real)cos(eps / 2);
+    q0[1] = 0;
+    q0[2] = (att_real)-sin(eps / 2); /* q_est = exp(−ε e_north) */
+    q0[3] = 0;
+    att_ahrs_default_settings(&set);
+    set.acc_noise = (att_real)1e-6;
+    set.mag_noise = (att_real)1e-4;
+    set.tilt_tau = 0;
+    CHECK_EQ_INT(att_ahrs_init(&s, &set, q0), ATT_OK);
+    CHECK_EQ_INT(att_ahrs_update(&s, w, f, m, (att_real)0.01, q), ATT_OK);
+    CHECK(fabs(2.0 * q[2]) < 1e-6); /* the tilt found: 1 − K_acc = R/(P + R) ≈ 1e-8 */
+    CHECK(fabs(2.0 * q[3]) < 1e-5); /* the heading left: 6ε³ = 6e-6 rad */
+}
+
 int main(void)
 {
     test_settings();
@@ -481,5 +507,6 @@ int main(void)
     test_tilt_step_response();
     test_tilt_not_below_the_horizon();
     test_covariance_and_heading_flag();
+    test_heading_row_tilt_about_north();
     return ATT_TEST_REPORT();
 }
